@@ -1,0 +1,15 @@
+/* SolidWire: definitions shared by the vertex and fragment stages.
+ *
+ * Window space is Blender's/GL's: pixel (i, j) covers [i, i+1] x [j, j+1] and
+ * is sampled at its centre, which is what gl_FragCoord.xy holds. */
+
+/* A distance that stands for "this edge does not exist here" (an edge wholly
+ * behind the near plane, a diagonal that is not drawn). Its square still fits
+ * in a float, so length() never overflows to inf/NaN. */
+#define NO_EDGE 1.0e17
+
+/* Bits of the per-corner `edge_flags` attribute (see extract.py). */
+#define EDGE0_REAL 1  /* edge p0-p1 is a polygon boundary edge */
+#define EDGE1_REAL 2  /* edge p1-p2 */
+#define EDGE2_REAL 4  /* edge p2-p0 */
+#define HAS_QUAD_CORNER 8 /* p3 is the 4th corner of a quad: p2-p3, p3-p0 are real */

@@ -1,0 +1,98 @@
+/* SolidWire fragment stage: exact window-space distance to the face's edges,
+ * prefiltered intensity profile, diagonal pattern, depth fade, colour.
+ *
+ * Variant defines (set by shaders.py; a feature that is off is not compiled):
+ *   USE_FILL           opaque fill colour under the wire
+ *   USE_FADE           depth fade
+ *   DIAGONALS          0 hidden, 1 solid, 2 patterned (dotted/dashed)
+ *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
+ */
+
+/* Distance from window point p to the segment stored as (line, span). */
+float edge_distance(vec3 line, vec2 span, vec2 p)
+{
+  float across = dot(line, vec3(p, 1.0));
+  float along = dot(vec2(-line.y, line.x), p);
+  float beyond = max(min(span.x, span.y) - along, 0.0) + max(along - max(span.x, span.y), 0.0);
+  return length(vec2(across, beyond));
+}
+
+/* SPEC 1.4 profile: 1 inside the core, 2^(-2 x^2) falloff over two softness
+ * widths, cut to 0 beyond (the step there is 2^-8, one 8-bit level). */
+float line_profile(float d)
+{
+  float x = max(d - params.half_thickness, 0.0) / params.softness;
+  return (x < 2.0) ? exp2(-2.0 * x * x) : 0.0;
+}
+
+#if DIAGONALS == 2
+/* Integral of the on/off square wave (on for the first `duty` of each
+ * period) from 0 to t: the box-filtered mask is a difference of two of these,
+ * which anti-aliases the dash ends over one pixel exactly. */
+float pattern_integral(float t)
+{
+  float period = params.pattern_period;
+  float cycles = floor(t / period);
+  return cycles * params.pattern_duty * period +
+         clamp(t - cycles * period, 0.0, params.pattern_duty * period);
+}
+
+float pattern_mask(float t)
+{
+  return pattern_integral(t + 0.5) - pattern_integral(t - 0.5);
+}
+#endif
+
+void main()
+{
+  vec2 p = gl_FragCoord.xy;
+  float d0 = edge_distance(edge_line0, edge_span0, p);
+  float d1 = edge_distance(edge_line1, edge_span1, p);
+  float d2 = edge_distance(edge_line2, edge_span2, p);
+  float d3 = edge_distance(edge_line3, edge_span3, p);
+  float d4 = edge_distance(edge_line4, edge_span4, p);
+
+  bool real0 = (triangle_flags & EDGE0_REAL) != 0;
+  bool real1 = (triangle_flags & EDGE1_REAL) != 0;
+  bool real2 = (triangle_flags & EDGE2_REAL) != 0;
+
+  /* Quad edges p2-p3 and p3-p0 are NO_EDGE unless the triangle has them. */
+  float d_real = min(min(d3, d4),
+                     min(real0 ? d0 : NO_EDGE, min(real1 ? d1 : NO_EDGE, real2 ? d2 : NO_EDGE)));
+  float intensity = line_profile(d_real);
+
+#if DIAGONALS >= 1
+  float diag0 = real0 ? NO_EDGE : d0;
+  float diag1 = real1 ? NO_EDGE : d1;
+  float diag2 = real2 ? NO_EDGE : d2;
+  float d_diag = min(diag0, min(diag1, diag2));
+  float diag_intensity = line_profile(d_diag);
+#  if DIAGONALS == 2
+  /* Position along the nearest diagonal, from its end that the vertex stage
+   * chose (stable for a still camera whatever the settings). */
+  vec3 line = (diag0 <= diag1 && diag0 <= diag2) ? edge_line0 : ((diag1 <= diag2) ? edge_line1 : edge_line2);
+  vec2 span = (diag0 <= diag1 && diag0 <= diag2) ? edge_span0 : ((diag1 <= diag2) ? edge_span1 : edge_span2);
+  float along = dot(vec2(-line.y, line.x), p);
+  diag_intensity *= pattern_mask(abs(along - span.x));
+#  endif
+  intensity = max(intensity, diag_intensity);
+#endif
+
+#ifdef USE_FADE
+  float fade_range = params.fade_end - params.fade_start;
+  float fade = (fade_range > 0.0) ? clamp((params.fade_end - view_depth) / fade_range, 0.0, 1.0) :
+                                    ((view_depth <= params.fade_start) ? 1.0 : 0.0);
+  intensity *= fade;
+#endif
+
+  float wire_weight = intensity * params.wire_color.a;
+#ifdef USE_FILL
+  frag_color = vec4(mix(params.fill_color.rgb, params.wire_color.rgb, wire_weight), 1.0);
+#else
+  /* Premultiplied: what the render pass expects and what blending needs. */
+  frag_color = vec4(params.wire_color.rgb * wire_weight, wire_weight);
+#endif
+#ifdef WRITE_VIEW_DEPTH
+  frag_view_depth = view_depth;
+#endif
+}

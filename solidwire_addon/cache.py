@@ -1,0 +1,109 @@
+"""GPU cache: one upload per mesh, shared by every object and instance using it.
+
+A :class:`GPUMesh` holds what the vertex stage pulls from (a position table
+and a triangle table, both RGBA32F textures) and a triangle-list batch whose
+only attribute is the per-corner edge-flag word. Entries are keyed by the
+caller (see gather.py: the evaluated mesh's identity plus a change counter),
+never hold Blender data, and are dropped when the key is invalidated or no
+longer seen, which frees their GPU memory.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .extract import MeshArrays
+
+TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
+
+
+def _table_texture(rows4: np.ndarray):
+    """(N, 4) float32 -> RGBA32F texture, row-major with TABLE_WIDTH texels a row."""
+    import gpu
+
+    count = max(len(rows4), 1)
+    width = min(count, TABLE_WIDTH)
+    height = -(-count // width)
+    buf = gpu.types.Buffer("FLOAT", width * height * 4)
+    # Fill through numpy's view of the buffer: one memcpy instead of a
+    # per-element Python sequence copy.
+    view = np.asarray(buf)
+    view[: rows4.size] = rows4.reshape(-1)
+    view[rows4.size :] = 0.0
+    return gpu.types.GPUTexture((width, height), format="RGBA32F", data=buf)
+
+
+class GPUMesh:
+    """GPU resources of one extracted mesh."""
+
+    def __init__(self, arrays: MeshArrays):
+        import gpu
+
+        self.triangle_count = arrays.triangle_count
+        self.centre = arrays.centre
+        self.bounds_min = arrays.bounds_min - arrays.centre
+        self.bounds_max = arrays.bounds_max - arrays.centre
+
+        positions = np.zeros((arrays.vertex_count, 4), dtype=np.float32)
+        positions[:, :3] = arrays.positions
+        self.positions = _table_texture(positions)
+        self.triangles = _table_texture(arrays.triangles.astype(np.float32))
+
+        fmt = gpu.types.GPUVertFormat()
+        fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
+        vbo = gpu.types.GPUVertBuf(fmt, 3 * self.triangle_count)
+        vbo.attr_fill("edge_flags", np.repeat(arrays.edge_flags, 3))
+        self.batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+        self.gpu_bytes = (
+            self.positions.width * self.positions.height * 16
+            + self.triangles.width * self.triangles.height * 16
+            + 3 * self.triangle_count * 4
+        )
+
+
+class MeshCache:
+    """GPU meshes by key, with counters for stats()."""
+
+    def __init__(self):
+        self._entries: dict[object, GPUMesh] = {}
+        self.extracted = 0
+        self.reused = 0
+
+    def __len__(self) -> int:
+        return len(self._entries)
+
+    def get(self, key, make_arrays) -> GPUMesh | None:
+        """The cached GPU mesh for ``key``, built from ``make_arrays()`` if new.
+
+        ``make_arrays`` returns a MeshArrays or None (nothing to draw)."""
+        entry = self._entries.get(key)
+        if entry is not None:
+            self.reused += 1
+            return entry
+        arrays = make_arrays()
+        self.extracted += 1
+        if arrays is None or arrays.triangle_count == 0:
+            return None
+        entry = GPUMesh(arrays)
+        self._entries[key] = entry
+        return entry
+
+    def discard(self, key) -> None:
+        self._entries.pop(key, None)
+
+    def keep_only(self, keys) -> None:
+        """Drop every entry whose key is not in ``keys`` (frees GPU memory)."""
+        keys = set(keys)
+        for key in [k for k in self._entries if k not in keys]:
+            del self._entries[key]
+
+    def clear(self) -> None:
+        self._entries.clear()
+
+    def reset_counters(self) -> None:
+        self.extracted = 0
+        self.reused = 0
+
+    @property
+    def gpu_bytes(self) -> int:
+        return sum(e.gpu_bytes for e in self._entries.values())
