@@ -13,3 +13,5 @@
 #define EDGE1_REAL 2  /* edge p1-p2 */
 #define EDGE2_REAL 4  /* edge p2-p0 */
 #define HAS_QUAD_CORNER 8 /* p3 is the 4th corner of a quad: p2-p3, p3-p0 are real */
+#define IS_NGON 16 /* part of a polygon with more than 4 corners; see NGON_SHIFT */
+#define NGON_SHIFT 8 /* edge_flags >> NGON_SHIFT: the n-gon's corner count */

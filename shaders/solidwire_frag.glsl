@@ -59,6 +59,22 @@ void main()
   /* Quad edges p2-p3 and p3-p0 are NO_EDGE unless the triangle has them. */
   float d_real = min(min(d3, d4),
                      min(real0 ? d0 : NO_EDGE, min(real1 ? d1 : NO_EDGE, real2 ? d2 : NO_EDGE)));
+  if ((triangle_flags & IS_NGON) != 0) {
+    /* An n-gon's boundary edges may pass near this fragment although they
+     * belong to another of its triangles (thin ears, concave outlines): walk
+     * the whole outline. Only n-gon fragments pay for this loop. */
+    int corners = triangle_flags >> NGON_SHIFT;
+    vec4 first = vertex_clip(fetch_texel(ngon_corners, ngon_corner_start).x);
+    vec4 a = first;
+    for (int k = 1; k <= corners; k++) {
+      vec4 b = (k == corners) ? first : vertex_clip(fetch_texel(ngon_corners, ngon_corner_start + k).x);
+      vec3 line;
+      vec2 span;
+      edge_setup(a, b, line, span);
+      d_real = min(d_real, edge_distance(line, span, p));
+      a = b;
+    }
+  }
   float intensity = line_profile(d_real);
 
 #if DIAGONALS >= 1

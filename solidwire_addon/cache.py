@@ -48,6 +48,9 @@ class GPUMesh:
         positions[:, :3] = arrays.positions
         self.positions = _table_texture(positions)
         self.triangles = _table_texture(arrays.triangles.astype(np.float32))
+        ngon = np.zeros((max(len(arrays.ngon_corners), 1), 4), dtype=np.float32)
+        ngon[: len(arrays.ngon_corners), 0] = arrays.ngon_corners
+        self.ngon_corners = _table_texture(ngon)
 
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
@@ -58,6 +61,7 @@ class GPUMesh:
             self.positions.width * self.positions.height * 16
             + self.triangles.width * self.triangles.height * 16
             + 3 * self.triangle_count * 4
+            + self.ngon_corners.width * self.ngon_corners.height * 16
         )
 
 

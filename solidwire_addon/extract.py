@@ -19,7 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-EDGE0_REAL, EDGE1_REAL, EDGE2_REAL, HAS_QUAD_CORNER = 1, 2, 4, 8
+EDGE0_REAL, EDGE1_REAL, EDGE2_REAL, HAS_QUAD_CORNER, IS_NGON = 1, 2, 4, 8, 16
+NGON_SHIFT = 8  # edge_flags >> NGON_SHIFT is an n-gon's corner count
 
 # Vertex ids travel to the GPU as float32 texels: exact below 2**24.
 MAX_VERTICES = 1 << 24
@@ -36,12 +37,15 @@ class MeshArrays:
 
     positions: np.ndarray  # (V, 3) float32, relative to centre
     centre: np.ndarray  # (3,) float64
-    triangles: np.ndarray  # (T, 4) int32: p0, p1, p2, quad 4th corner (or p0)
+    triangles: np.ndarray  # (T, 4) int32: p0, p1, p2, quad 4th corner / n-gon corner start / p0
     edge_flags: np.ndarray  # (T,) int32, EDGE*_REAL | HAS_QUAD_CORNER
     triangle_polygons: np.ndarray  # (T,) int32 polygon index of each triangle
     bounds_min: np.ndarray  # (3,) float64, mesh space (not re-centred)
     bounds_max: np.ndarray  # (3,) float64
     dropped_triangles: int = 0  # triangles skipped for non-finite vertices
+    # Vertex ids of every n-gon's outline in loop order, one polygon after
+    # another; an n-gon triangle's column 3 says where its polygon starts.
+    ngon_corners: np.ndarray = None
 
     @property
     def triangle_count(self) -> int:
@@ -141,6 +145,20 @@ def build_arrays(
         real[:, 0] * EDGE0_REAL + real[:, 1] * EDGE1_REAL + real[:, 2] * EDGE2_REAL + is_quad * HAS_QUAD_CORNER
     ).astype(np.int32)
 
+    # N-gons: the fragment stage walks the whole outline (see solidwire_frag.glsl),
+    # so pack the outlines of the n-gons that have triangles here.
+    ngon_corners = np.zeros(0, dtype=np.int32)
+    is_ngon_tri = total[:, 0] > 4
+    if is_ngon_tri.any():
+        ngon_polys = np.unique(tri_polygons[is_ngon_tri])
+        sizes = loop_total[ngon_polys].astype(np.int64)
+        offsets = np.cumsum(sizes) - sizes
+        corner_loops = np.repeat(loop_start[ngon_polys].astype(np.int64) - offsets, sizes) + np.arange(sizes.sum())
+        ngon_corners = np.asarray(corner_vert)[corner_loops].astype(np.int32)
+        poly_offset = offsets[np.searchsorted(ngon_polys, tri_polygons[is_ngon_tri])]
+        triangles[is_ngon_tri, 3] = poly_offset
+        flags[is_ngon_tri] |= IS_NGON | (total[is_ngon_tri, 0] << NGON_SHIFT).astype(np.int32)
+
     if finite_vertex.any():
         pos64 = positions.astype(np.float64)
         bounds_min = pos64[finite_vertex].min(axis=0)
@@ -150,7 +168,7 @@ def build_arrays(
     else:
         bounds_min = bounds_max = centre = np.zeros(3)
         local = np.zeros_like(positions)
-    return MeshArrays(local, centre, triangles, flags, tri_polygons.copy(), bounds_min, bounds_max, dropped)
+    return MeshArrays(local, centre, triangles, flags, tri_polygons.copy(), bounds_min, bounds_max, dropped, ngon_corners)
 
 
 def extract_mesh(mesh) -> MeshArrays:

@@ -34,7 +34,14 @@ class Targets:
         self.color = gpu.types.GPUTexture((width, height), format="RGBA32F")
         self.view_depth = gpu.types.GPUTexture((width, height), format="R32F")
         self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
-        self.framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.color, self.view_depth))
+
+    def framebuffer(self):
+        """A framebuffer over the textures. Made per use: textures are shared
+        between GL contexts but framebuffer objects are not, and the render
+        engine's context differs from the one scripts draw in."""
+        import gpu
+
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.color, self.view_depth))
 
 
 _targets: Targets | None = None
@@ -64,8 +71,9 @@ def render(items, view: draw_mod.View, settings: draw_mod.DrawSettings, *, cull:
     ensure_gpu()
     width, height = view.width, view.height
     targets = targets_for(width, height)
-    with targets.framebuffer.bind():
-        targets.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+    framebuffer = targets.framebuffer()
+    with framebuffer.bind():
+        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, width, height)
         stats = draw_mod.draw(items, view, settings, write_view_depth=True, cull=cull)
         gpu.state.depth_test_set("NONE")

@@ -136,6 +136,9 @@ def render_to_file(scene, path: Path, *, depth16: bool = True) -> np.ndarray:
 
 def load_png(path: Path) -> np.ndarray:
     image = bpy.data.images.load(str(Path(path).resolve()), check_existing=False)
+    # The values as stored in the file (what an outside checker reads):
+    # without this Blender decodes 16-bit PNGs to linear floats.
+    image.colorspace_settings.name = "Non-Color"
     try:
         width, height = image.size
         pixels = np.empty(width * height * 4, dtype=np.float32)

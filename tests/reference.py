@@ -1,0 +1,459 @@
+"""Float64 reference of the SolidWire image model (SPEC section 1).
+
+This is the oracle every accuracy test and the benchmark compare against. It
+shares no code with the add-on: it reads the evaluated scene through Blender's
+own API, casts a float64 ray through every sample, and measures exact
+window-space distances to the near-clipped projection of each face's edges.
+
+    result = render_reference(scene)
+    result.intensity       # (H, W) line intensity I (fade included)
+    result.on_silhouette   # (H, W) samples within 0.01 px of a face change
+    result.face            # (H, W) visible face id, -1 for background
+    result.depth           # (H, W) view depth of the visible point (inf: none)
+
+Method:
+- Visibility: every triangle is clipped to the near plane only to bound the
+  pixels it may cover; for those pixels a float64 ray (from the near to the
+  far clip plane through the sample) is intersected with the triangle
+  (Moller-Trumbore). The nearest hit between clip start and end wins.
+  Zero-area and edge-on triangles never hit.
+- Silhouette flag: the visible face is also found for four samples 0.01 px
+  away; a sample whose visible face differs from any of them is "on a
+  silhouette" (SPEC 1.5).
+- Distances: each polygon edge is clipped to the near plane in clip space,
+  its front part projected, and the point-segment distance taken in window
+  pixels (pixel aspect included via the projection).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import bpy
+import numpy as np
+
+SILHOUETTE_OFFSET = 0.01  # px, SPEC 1.5
+OFFSETS = np.array([[0.0, 0.0], [SILHOUETTE_OFFSET, 0.0], [-SILHOUETTE_OFFSET, 0.0], [0.0, SILHOUETTE_OFFSET], [0.0, -SILHOUETTE_OFFSET]])
+PAIR_CHUNK = 400_000
+
+
+@dataclass
+class ReferenceResult:
+    intensity: np.ndarray
+    on_silhouette: np.ndarray
+    face: np.ndarray
+    depth: np.ndarray
+    rows: np.ndarray  # window rows (j, bottom = 0) that the arrays hold
+
+
+@dataclass
+class _Geometry:
+    """All drawn triangles of the scene in view space, float64."""
+
+    tri_view: np.ndarray  # (T, 3, 3) view-space vertices
+    tri_face: np.ndarray  # (T,) global face id
+    edges_view: np.ndarray  # (E, 2, 3) view-space edge endpoints
+    edge_face: np.ndarray  # (E,) global face id
+    edge_real: np.ndarray  # (E,) bool: polygon boundary (else diagonal)
+    edge_origin_first: np.ndarray  # (E,) bool: pattern measured from endpoint 0
+
+
+# ---------------------------------------------------------------- scene input
+
+
+def _camera(scene, depsgraph, width, height):
+    cam = scene.camera.evaluated_get(depsgraph)
+    r = scene.render
+    proj = np.array(
+        cam.calc_matrix_camera(depsgraph, x=width, y=height, scale_x=r.pixel_aspect_x, scale_y=r.pixel_aspect_y),
+        dtype=np.float64,
+    )
+    m = np.array(cam.matrix_world, dtype=np.float64)
+    # Camera scale is ignored (SPEC 1.4): normalise the rotation columns.
+    m[:3, :3] /= np.linalg.norm(m[:3, :3], axis=0)
+    return np.linalg.inv(m), proj
+
+
+def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
+    tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
+    face_offset = 0
+    for inst in depsgraph.object_instances:
+        obj = inst.object
+        if obj.type != "MESH":
+            continue
+        if not inst.is_instance and not inst.show_self:
+            continue
+        exclude = getattr(obj.original, "solidwire_exclude", False)
+        if exclude:
+            continue
+        mesh = obj.data
+        nv, nl, npoly = len(mesh.vertices), len(mesh.loops), len(mesh.polygons)
+        if npoly == 0:
+            continue
+        co = np.empty(nv * 3, np.float32)
+        mesh.vertices.foreach_get("co", co)
+        co = co.reshape(-1, 3).astype(np.float64)
+        to_view = view_matrix @ np.array(inst.matrix_world, dtype=np.float64)
+        with np.errstate(invalid="ignore", over="ignore"):
+            vco = co @ to_view[:3, :3].T + to_view[:3, 3]
+        loop_vert = np.empty(nl, np.int64)
+        mesh.loops.foreach_get("vertex_index", loop_vert)
+        start = np.empty(npoly, np.int64)
+        total = np.empty(npoly, np.int64)
+        mesh.polygons.foreach_get("loop_start", start)
+        mesh.polygons.foreach_get("loop_total", total)
+        lt = mesh.loop_triangles
+        ntri = len(lt)
+        tri_v = np.empty(ntri * 3, np.int64)
+        lt.foreach_get("vertices", tri_v)
+        tri_v = tri_v.reshape(-1, 3)
+        tri_p = np.empty(ntri, np.int64)
+        lt.foreach_get("polygon_index", tri_p)
+
+        # Real edges: consecutive loops of each polygon.
+        loop_poly = np.repeat(np.arange(npoly), total)
+        loop_idx = np.arange(nl)
+        nxt = start[loop_poly] + (loop_idx - start[loop_poly] + 1) % total[loop_poly]
+        real_a, real_b = loop_vert[loop_idx], loop_vert[nxt]
+        # Diagonals: triangle edges that are not polygon edges of that polygon.
+        key_real = set(zip(loop_poly.tolist(), np.minimum(real_a, real_b).tolist(), np.maximum(real_a, real_b).tolist()))
+        diag = set()
+        for t in range(ntri):  # small meshes only (reference)
+            p = int(tri_p[t])
+            for k in range(3):
+                a, b = int(tri_v[t, k]), int(tri_v[t, (k + 1) % 3])
+                key = (p, min(a, b), max(a, b))
+                if key not in key_real:
+                    diag.add(key)
+        diag = np.array(sorted(diag), dtype=np.int64).reshape(-1, 3)
+
+        finite = np.isfinite(vco).all(axis=1)
+        tri_ok = finite[tri_v].all(axis=1)
+        tris.append(vco[tri_v[tri_ok]])
+        tri_faces.append(face_offset + tri_p[tri_ok])
+        ra, rb = real_a, real_b
+        ok = finite[ra] & finite[rb]
+        edges.append(np.stack([vco[ra[ok]], vco[rb[ok]]], axis=1))
+        edge_faces.append(face_offset + loop_poly[ok])
+        edge_real.append(np.ones(ok.sum(), bool))
+        edge_origin.append(ra[ok] < rb[ok])
+        if len(diag):
+            da, db = diag[:, 1], diag[:, 2]
+            ok = finite[da] & finite[db]
+            edges.append(np.stack([vco[da[ok]], vco[db[ok]]], axis=1))
+            edge_faces.append(face_offset + diag[ok, 0])
+            edge_real.append(np.zeros(ok.sum(), bool))
+            edge_origin.append(np.ones(ok.sum(), bool))  # da < db by construction
+        face_offset += npoly
+
+    def cat(parts, shape, dtype):
+        return np.concatenate(parts) if parts else np.zeros(shape, dtype)
+
+    return _Geometry(
+        cat(tris, (0, 3, 3), np.float64),
+        cat(tri_faces, (0,), np.int64),
+        cat(edges, (0, 2, 3), np.float64),
+        cat(edge_faces, (0,), np.int64),
+        cat(edge_real, (0,), bool),
+        cat(edge_origin, (0,), bool),
+    )
+
+
+# ---------------------------------------------------------------- visibility
+
+
+def _to_clip(proj, pts):
+    return pts @ proj[:3, :3].T + proj[:3, 3], pts @ proj[3, :3] + proj[3, 3]
+
+
+def _window(proj, pts, width, height):
+    """View-space points (in front of the near plane) -> window coordinates."""
+    xyz, w = _to_clip(proj, pts)
+    return np.stack([(xyz[..., 0] / w + 1.0) * 0.5 * width, (xyz[..., 1] / w + 1.0) * 0.5 * height], axis=-1)
+
+
+def _triangle_pixel_bounds(proj, tri_view, width, height):
+    """Per triangle, the window bbox of its near-clipped part (or empty)."""
+    clip_xyz, clip_w = _to_clip(proj, tri_view)  # (T,3,3), (T,3)
+    front = clip_xyz[..., 2] + clip_w  # >= 0 in front of the near plane
+    cand = [tri_view[:, k] for k in range(3)]
+    valid = [front[:, k] >= 0 for k in range(3)]
+    for k in range(3):
+        a, b = k, (k + 1) % 3
+        fa, fb = front[:, a], front[:, b]
+        crosses = (fa >= 0) != (fb >= 0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.where(crosses, fa / (fa - fb), 0.0)
+        cand.append(tri_view[:, a] + t[:, None] * (tri_view[:, b] - tri_view[:, a]))
+        valid.append(crosses)
+    pts = np.stack(cand, axis=1)  # (T, 6, 3)
+    ok = np.stack(valid, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        win = _window(proj, pts, width, height)
+    win = np.where(ok[..., None] & np.isfinite(win), win, np.nan)
+    with np.errstate(invalid="ignore"), np.testing.suppress_warnings() as sup:
+        sup.filter(RuntimeWarning)
+        lo = np.nanmin(win, axis=1)
+        hi = np.nanmax(win, axis=1)
+    any_ok = ok.any(axis=1) & np.isfinite(lo).all(axis=1)
+    margin = 2 * SILHOUETTE_OFFSET + 1e-6
+    x0 = np.clip(np.floor(lo[:, 0] - 0.5 - margin), 0, width)
+    x1 = np.clip(np.ceil(hi[:, 0] - 0.5 + margin), -1, width - 1)
+    y0 = np.clip(np.floor(lo[:, 1] - 0.5 - margin), 0, height)
+    y1 = np.clip(np.ceil(hi[:, 1] - 0.5 + margin), -1, height - 1)
+    x0, x1, y0, y1 = (np.nan_to_num(v, nan=0).astype(np.int64) for v in (x0, x1, y0, y1))
+    empty = ~any_ok | (x1 < x0) | (y1 < y0)
+    x1 = np.where(empty, x0 - 1, x1)
+    return x0, x1, y0, y1
+
+
+def _rays(inv_proj, px, py, width, height):
+    """Float64 rays through window points: origin on the near plane, and the
+    vector to the far plane point (t in [0, 1] spans clip start..end)."""
+    x = px / width * 2.0 - 1.0
+    y = py / height * 2.0 - 1.0
+    near = np.stack([x, y, -np.ones_like(x), np.ones_like(x)], axis=-1) @ inv_proj.T
+    far = np.stack([x, y, np.ones_like(x), np.ones_like(x)], axis=-1) @ inv_proj.T
+    near = near[..., :3] / near[..., 3:4]
+    far = far[..., :3] / far[..., 3:4]
+    return near, far - near
+
+
+def _visibility(geo, proj, width, height, rows, backface_culling):
+    """Nearest face for the sample of each pixel of ``rows`` and its 4 offsets."""
+    inv_proj = np.linalg.inv(proj)
+    n_rows = len(rows)
+    row_of = np.full(height, -1, np.int64)
+    row_of[rows] = np.arange(n_rows)
+    n_samples = len(OFFSETS)
+    best_depth = np.full((n_samples, n_rows * width), np.inf)
+    best_face = np.full((n_samples, n_rows * width), -1, np.int64)
+
+    x0, x1, y0, y1 = _triangle_pixel_bounds(proj, geo.tri_view, width, height)
+    tri_ids = np.nonzero(x1 >= x0)[0]
+    if len(tri_ids) == 0:
+        return best_face, best_depth
+    # Only rows we evaluate: count per triangle the rows of its bbox in `rows`.
+    row_mask = np.zeros(height + 1, np.int64)
+    row_mask[rows] = 1
+    cum = np.concatenate([[0], np.cumsum(row_mask)])
+    row_counts = cum[y1[tri_ids] + 1] - cum[y0[tri_ids]]
+    widths = x1[tri_ids] - x0[tri_ids] + 1
+    areas = np.maximum(row_counts, 0) * widths
+    tri_ids, areas, widths = tri_ids[areas > 0], areas[areas > 0], widths[areas > 0]
+    bounds = np.cumsum(areas)
+    start = 0
+    while start < len(tri_ids):
+        # A chunk of triangles whose candidate pixels fit in PAIR_CHUNK.
+        base = bounds[start - 1] if start else 0
+        stop = max(start + 1, int(np.searchsorted(bounds, base + PAIR_CHUNK, side="right")))
+        ids = tri_ids[start:stop]
+        area = areas[start:stop]
+        wid = widths[start:stop]
+        pair_tri = np.repeat(ids, area)
+        local = np.arange(area.sum()) - np.repeat(np.cumsum(area) - area, area)
+        pair_w = np.repeat(wid, area)
+        px = x0[pair_tri] + local % pair_w
+        row_rank = local // pair_w  # k-th evaluated row inside the bbox
+        py = rows[np.searchsorted(rows, y0[pair_tri]) + row_rank]
+        pixel = row_of[py] * width + px
+        v0 = geo.tri_view[pair_tri, 0]
+        e1 = geo.tri_view[pair_tri, 1] - v0
+        e2 = geo.tri_view[pair_tri, 2] - v0
+        scale = np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
+        for s, (ox, oy) in enumerate(OFFSETS):
+            origin, direction = _rays(inv_proj, px + 0.5 + ox, py + 0.5 + oy, width, height)
+            pvec = np.cross(direction, e2)
+            det = np.einsum("ij,ij->i", e1, pvec)
+            ok = np.abs(det) > 1e-13 * scale * np.linalg.norm(direction, axis=1)
+            if backface_culling:
+                ok &= det > 0.0  # front side faces the ray
+            with np.errstate(divide="ignore", invalid="ignore"):
+                inv_det = np.where(ok, 1.0 / det, 0.0)
+                tvec = origin - v0
+                u = np.einsum("ij,ij->i", tvec, pvec) * inv_det
+                qvec = np.cross(tvec, e1)
+                v = np.einsum("ij,ij->i", direction, qvec) * inv_det
+                t = np.einsum("ij,ij->i", e2, qvec) * inv_det
+            hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
+            depth = -(origin[:, 2] + t * direction[:, 2])
+            h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
+            # Nearest hit per pixel (ties: lowest face id, deterministic).
+            order = np.lexsort((h_face, h_depth, h_pix))
+            h_pix, h_depth, h_face = h_pix[order], h_depth[order], h_face[order]
+            first = np.ones(len(h_pix), bool)
+            first[1:] = h_pix[1:] != h_pix[:-1]
+            h_pix, h_depth, h_face = h_pix[first], h_depth[first], h_face[first]
+            closer = h_depth < best_depth[s, h_pix]
+            best_depth[s, h_pix[closer]] = h_depth[closer]
+            best_face[s, h_pix[closer]] = h_face[closer]
+        start = stop
+    return best_face, best_depth
+
+
+# ---------------------------------------------------------------- distances
+
+
+def _clip_edges_to_window(proj, edges_view, width, height):
+    """Near-clip each edge and project its front part: (A, B, valid)."""
+    xyz, w = _to_clip(proj, edges_view)  # (E,2,3), (E,2)
+    front = xyz[..., 2] + w
+    fa, fb = front[:, 0], front[:, 1]
+    valid = (fa >= 0) | (fb >= 0)
+    a, b = edges_view[:, 0], edges_view[:, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ta = np.where(fa < 0, fa / (fa - fb), 0.0)
+        tb = np.where(fb < 0, fb / (fb - fa), 0.0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        # (edges wholly behind the near plane give NaN here; `valid` drops them)
+        a_front = a + ta[:, None] * (b - a)
+        b_front = b + tb[:, None] * (a - b)
+        wa = _window(proj, a_front, width, height)
+        wb = _window(proj, b_front, width, height)
+    valid &= np.isfinite(wa).all(axis=1) & np.isfinite(wb).all(axis=1)
+    return wa, wb, valid
+
+
+def _segment_distance(p, a, b):
+    ab = b - a
+    len2 = np.einsum("ij,ij->i", ab, ab)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.clip(np.where(len2 > 0, np.einsum("ij,ij->i", p - a, ab) / len2, 0.0), 0.0, 1.0)
+    closest = a + t[:, None] * ab
+    return np.linalg.norm(p - closest, axis=1), t * np.sqrt(len2)
+
+
+def profile(d, thickness, softness):
+    """SPEC 1.4 intensity profile P(d)."""
+    x = np.maximum(d - thickness / 2.0, 0.0) / softness
+    return np.where(x < 2.0, np.exp2(-2.0 * x * x), 0.0)
+
+
+def pattern_mask(t, period, duty):
+    """Box-filtered (1 px) on/off mask along a diagonal, on for the first
+    ``duty`` of every period measured from the diagonal's origin end."""
+
+    def integral(x):
+        cycles = np.floor(x / period)
+        return cycles * duty * period + np.clip(x - cycles * period, 0.0, duty * period)
+
+    return integral(t + 0.5) - integral(t - 0.5)
+
+
+def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False):
+    """For every pixel: min distance to the selected edges of its own face."""
+    n = len(pix_face)
+    best = np.full(n, np.inf)
+    best_along = np.zeros(n)
+    idx = np.nonzero(select & valid)[0]
+    if len(idx) == 0 or n == 0:
+        return best, best_along
+    order = idx[np.argsort(geo.edge_face[idx], kind="stable")]
+    faces_sorted = geo.edge_face[order]
+    lo = np.searchsorted(faces_sorted, pix_face, side="left")
+    hi = np.searchsorted(faces_sorted, pix_face, side="right")
+    count = hi - lo
+    pair_pix = np.repeat(np.arange(n), count)
+    pair_edge = order[np.repeat(lo, count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))]
+    if len(pair_pix) == 0:
+        return best, best_along
+    # Pattern origin: endpoint 0 when edge_origin_first, else endpoint 1.
+    first = geo.edge_origin_first[pair_edge]
+    a = np.where(first[:, None], wa[pair_edge], wb[pair_edge])
+    b = np.where(first[:, None], wb[pair_edge], wa[pair_edge])
+    d, along = _segment_distance(pix_xy[pair_pix], a, b)
+    if want_along:
+        # unclamped projection for the pattern coordinate
+        ab = b - a
+        len_ab = np.linalg.norm(ab, axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            along = np.where(len_ab > 0, np.einsum("ij,ij->i", pix_xy[pair_pix] - a, ab) / len_ab, 0.0)
+    order2 = np.lexsort((d, pair_pix))
+    pair_pix, d, along = pair_pix[order2], d[order2], along[order2]
+    keep = np.ones(len(pair_pix), bool)
+    keep[1:] = pair_pix[1:] != pair_pix[:-1]
+    best[pair_pix[keep]] = d[keep]
+    best_along[pair_pix[keep]] = along[keep]
+    return best, best_along
+
+
+# ---------------------------------------------------------------- entry point
+
+
+def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None) -> ReferenceResult:
+    """Evaluate SPEC section 1 in float64 for ``scene``'s camera.
+
+    ``size`` overrides the render size (the camera projection is computed for
+    it); ``rows`` restricts evaluation to some window rows (bottom = 0).
+    ``settings`` defaults to ``scene.solidwire``."""
+    if depsgraph is None:
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+    s = settings if settings is not None else scene.solidwire
+    if size is None:
+        pct = scene.render.resolution_percentage / 100.0
+        size = (max(int(scene.render.resolution_x * pct), 1), max(int(scene.render.resolution_y * pct), 1))
+    width, height = size
+    rows = np.arange(height) if rows is None else np.sort(np.asarray(rows, dtype=np.int64))
+
+    view_matrix, proj = _camera(scene, depsgraph, width, height)
+    geo = _gather_geometry(depsgraph, view_matrix)
+    faces, depths = _visibility(geo, proj, width, height, rows, bool(s.use_backface_culling))
+
+    face = faces[0]
+    depth = depths[0]
+    on_silhouette = (faces[1:] != face[None, :]).any(axis=0)
+
+    intensity = np.zeros(len(face))
+    covered = np.nonzero(face >= 0)[0]
+    if len(covered):
+        pix_xy = np.stack([covered % width + 0.5, rows[covered // width] + 0.5], axis=1).astype(np.float64)
+        pix_face = face[covered]
+        wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
+        thickness, softness = float(s.thickness), float(s.softness)
+        d_real, _ = _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, geo.edge_real)
+        value = profile(d_real, thickness, softness)
+        mode = s.diagonal_mode
+        if mode != "HIDDEN":
+            d_diag, along = _min_distance_per_pixel(
+                pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, want_along=(mode in ("DOTTED", "DASHED"))
+            )
+            diag_value = profile(d_diag, thickness, softness)
+            if mode in ("DOTTED", "DASHED"):
+                diag_value *= pattern_mask(np.abs(along), float(s.pattern_period), float(s.pattern_duty))
+            value = np.maximum(value, diag_value)
+        if s.use_fade:
+            z = depth[covered]
+            fs, fe = float(s.fade_start), float(s.fade_end)
+            if fe > fs:
+                value *= np.clip((fe - z) / (fe - fs), 0.0, 1.0)
+            else:
+                value *= (z <= fs).astype(np.float64)
+        intensity[covered] = value
+
+    shape = (len(rows), width)
+    return ReferenceResult(
+        intensity.reshape(shape),
+        on_silhouette.reshape(shape),
+        face.reshape(shape),
+        depth.reshape(shape),
+        rows,
+    )
+
+
+def error_report(measured: np.ndarray, ref: ReferenceResult) -> dict:
+    """SPEC 1.5 error numbers of a measured intensity image (same rows)."""
+    diff = np.abs(measured - ref.intensity)
+    off = ~ref.on_silhouette
+    d = diff[off]
+    nan = int(np.count_nonzero(~np.isfinite(measured)))
+    d = np.nan_to_num(d, nan=1.0)
+    return {
+        "mean": float(d.mean()) if d.size else 0.0,
+        "p999": float(np.percentile(d, 99.9)) if d.size else 0.0,
+        "max": float(d.max()) if d.size else 0.0,
+        "over_2_255": int(np.count_nonzero(d > 2.0 / 255.0)),
+        "pixels": int(d.size),
+        "silhouette_pixels": int(np.count_nonzero(ref.on_silhouette)),
+        "silhouette_max": float(np.nan_to_num(diff[ref.on_silhouette], nan=1.0).max()) if ref.on_silhouette.any() else 0.0,
+        "nan": nan,
+    }
