@@ -17,51 +17,16 @@
  * needs the near plane: it is clipped in clip space (z + w >= 0), which is
  * where only the part of an edge in front of the near plane has a projection. */
 
-vec4 fetch_texel(sampler2D table, int index)
+/* Edges run from their lower vertex id: the two triangles sharing a diagonal
+ * then measure its pattern from the same end (no seam along the diagonal). */
+void edge_setup_from_lower(vec4 a, vec4 b, float id_a, float id_b, out vec3 line, out vec2 span)
 {
-  int width = textureSize(table, 0).x;
-  return texelFetch(table, ivec2(index % width, index / width), 0);
-}
-
-vec4 vertex_clip(float vertex_index)
-{
-  vec3 p = fetch_texel(vertex_positions, int(vertex_index)).xyz;
-  return object_to_clip * vec4(p, 1.0);
-}
-
-/* Homogeneous window coordinates: (x_win * w, y_win * w, w). */
-vec3 window_homogeneous(vec4 clip)
-{
-  return vec3((clip.xy + clip.w) * 0.5 * params.viewport.zw + params.viewport.xy * clip.w, clip.w);
-}
-
-vec2 window_point(vec4 clip)
-{
-  vec3 h = window_homogeneous(clip);
-  return h.xy / h.z;
-}
-
-/* Edge a->b as a unit-normal window line (n.x, n.y, c) and the interval
- * `span` = (s_a, s_b) its near-clipped segment covers along dir = (-n.y, n.x).
- * s_a belongs to endpoint a, so a pattern can be measured from a chosen end. */
-void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
-{
-  vec3 l = cross(window_homogeneous(a), window_homogeneous(b));
-  float len2 = dot(l.xy, l.xy);
-  float depth_a = a.z + a.w; /* >= 0 in front of the near plane */
-  float depth_b = b.z + b.w;
-  if (len2 == 0.0 || (depth_a < 0.0 && depth_b < 0.0)) {
-    /* Projects to a point (edge along a view ray) or lies wholly behind the
-     * near plane: it has no visible projection and no distance. */
-    line = vec3(0.0, 0.0, NO_EDGE);
-    span = vec2(0.0);
-    return;
+  if (id_b < id_a) {
+    edge_setup(b, a, line, span);
   }
-  line = l * inversesqrt(len2);
-  vec4 a_front = (depth_a < 0.0) ? mix(a, b, depth_a / (depth_a - depth_b)) : a;
-  vec4 b_front = (depth_b < 0.0) ? mix(b, a, depth_b / (depth_b - depth_a)) : b;
-  vec2 dir = vec2(-line.y, line.x);
-  span = vec2(dot(dir, window_point(a_front)), dot(dir, window_point(b_front)));
+  else {
+    edge_setup(a, b, line, span);
+  }
 }
 
 void main()
@@ -74,18 +39,14 @@ void main()
   vec4 c1 = vertex_clip(ids.y);
   vec4 c2 = vertex_clip(ids.z);
 
-  edge_setup(c0, c1, edge_line0, edge_span0);
-  edge_setup(c1, c2, edge_line1, edge_span1);
-  /* Edge 2 runs from its lower vertex id so both triangles of a quad measure
-   * the diagonal pattern from the same end (no seam along the diagonal). */
-  if (ids.z < ids.x) {
-    edge_setup(c2, c0, edge_line2, edge_span2);
-  }
-  else {
-    edge_setup(c0, c2, edge_line2, edge_span2);
-  }
+  edge_setup_from_lower(c0, c1, ids.x, ids.y, edge_line0, edge_span0);
+  edge_setup_from_lower(c1, c2, ids.y, ids.z, edge_line1, edge_span1);
+  edge_setup_from_lower(c2, c0, ids.z, ids.x, edge_line2, edge_span2);
 
   triangle_flags = edge_flags;
+  /* For an n-gon triangle the 4th id is where its polygon's corners start
+   * in `ngon_corners`. */
+  ngon_corner_start = int(ids.w);
   if ((edge_flags & HAS_QUAD_CORNER) != 0) {
     vec4 c3 = vertex_clip(ids.w);
     edge_setup(c2, c3, edge_line3, edge_span3);
@@ -100,5 +61,16 @@ void main()
   vec3 local = fetch_texel(vertex_positions,
                            int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
+#ifdef DEPTH_BIAS
+  /* Viewport overlay only: Blender's own Solid shading has already written
+   * (nearly) the same depth for the same surface, but from its own float32
+   * matrices and positions, so ours differs by a few ULPs either way and a
+   * LESS_EQUAL test would stipple. Moving every vertex a constant DEPTH_BIAS
+   * towards the camera in NDC (z - b*w, i.e. z/w - b after the divide) makes
+   * our surface win that tie; NDC bias is the right unit because float32
+   * rounding of z/w is relative to |z/w| <= 1. Window x/y and the edge
+   * distances are untouched (only z changes). */
+  position.z -= DEPTH_BIAS * position.w;
+#endif
   gl_Position = position;
 }

@@ -49,7 +49,7 @@ class DrawSettings:
             values[name] = value
         return cls(**values)
 
-    def shader_variant(self, write_view_depth: bool = False) -> shaders.ShaderVariant:
+    def shader_variant(self, write_view_depth: bool = False, depth_bias: float = 0.0) -> shaders.ShaderVariant:
         diagonals = {
             "HIDDEN": shaders.DIAGONALS_HIDDEN,
             "SOLID": shaders.DIAGONALS_SOLID,
@@ -59,6 +59,7 @@ class DrawSettings:
             use_fill=bool(self.use_fill),
             use_fade=bool(self.use_fade),
             write_view_depth=write_view_depth,
+            depth_bias=depth_bias,
         )
 
 
@@ -136,7 +137,15 @@ def outside_frustum(object_to_clip: np.ndarray, bounds_min, bounds_max) -> bool:
     )
 
 
-def draw(items, view: View, settings: DrawSettings, *, write_view_depth: bool = False, cull: bool = True) -> DrawStats:
+def draw(
+    items,
+    view: View,
+    settings: DrawSettings,
+    *,
+    write_view_depth: bool = False,
+    cull: bool = True,
+    depth_bias: float = 0.0,
+) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
 
     Every fragment of a face writes depth (nothing is discarded), so a wire is
@@ -146,15 +155,16 @@ def draw(items, view: View, settings: DrawSettings, *, write_view_depth: bool = 
     stats = DrawStats()
     if not items:
         return stats
-    shader = shaders.get(settings.shader_variant(write_view_depth))
+    shader = shaders.get(settings.shader_variant(write_view_depth, depth_bias))
     ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport))
-    view_projection = view.projection @ view.view_matrix
 
     shader.bind()
     shader.uniform_block("params", ubo)
     gpu.state.depth_test_set("LESS_EQUAL")
     gpu.state.depth_mask_set(True)
-    flip = np.linalg.det(view_projection[:3, :3]) < 0.0
+    # Window-space winding flips with a mirroring view or a projection that
+    # mirrors x or y (the z flip of a GL projection does not change winding).
+    flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
     try:
         for item in items:
             mesh = item.mesh
@@ -172,9 +182,48 @@ def draw(items, view: View, settings: DrawSettings, *, write_view_depth: bool = 
             shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
             shader.uniform_sampler("vertex_positions", mesh.positions)
             shader.uniform_sampler("triangle_vertices", mesh.triangles)
+            shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
             mesh.batch.draw(shader)
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     finally:
         gpu.state.face_culling_set("NONE")
+    return stats
+
+
+# NDC depth bias of the viewport overlay (2^-18: 32 steps of a 24-bit depth
+# buffer, about 4 float32 ULPs of z/w near 1). Enough to win the tie with
+# Blender's own depth of the same surface (a few ULPs off, computed from other
+# float32 matrices); small enough that a surface more than a hair behind
+# another stays hidden. See DEPTH_BIAS in shaders/solidwire_vert.glsl.
+OVERLAY_DEPTH_BIAS = 2.0**-18
+
+
+def draw_overlay(items, view: View, settings: DrawSettings, *, depth_bias: float = OVERLAY_DEPTH_BIAS) -> DrawStats:
+    """Draw ``items`` over a bound framebuffer that already holds the scene's
+    colour and depth (a 3D viewport after its own drawing).
+
+    Two passes: a depth-only pre-pass, then the colour pass with
+    premultiplied alpha blending and depth test LESS_EQUAL. The pre-pass makes
+    only the nearest of our own surfaces pass the colour pass (no back
+    edges show through where the scene depth is empty, as in X-ray or
+    Wireframe shading); the scene's depth hides wires behind other geometry.
+    GPU state is restored afterwards."""
+    import gpu
+
+    saved_blend = gpu.state.blend_get()
+    saved_depth_test = gpu.state.depth_test_get()
+    saved_depth_mask = gpu.state.depth_mask_get()
+    try:
+        gpu.state.blend_set("NONE")
+        gpu.state.color_mask_set(False, False, False, False)
+        draw(items, view, settings, depth_bias=depth_bias)
+        gpu.state.color_mask_set(True, True, True, True)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        stats = draw(items, view, settings, depth_bias=depth_bias)
+    finally:
+        gpu.state.color_mask_set(True, True, True, True)
+        gpu.state.blend_set(saved_blend)
+        gpu.state.depth_test_set(saved_depth_test)
+        gpu.state.depth_mask_set(saved_depth_mask)
     return stats

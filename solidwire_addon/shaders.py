@@ -47,6 +47,9 @@ class ShaderVariant:
     use_fill: bool = False
     use_fade: bool = False
     write_view_depth: bool = False
+    # Viewport overlay: NDC depth bias towards the camera (0 = none); see
+    # DEPTH_BIAS in solidwire_vert.glsl and draw.OVERLAY_DEPTH_BIAS.
+    depth_bias: float = 0.0
 
 
 _cache: dict[ShaderVariant, object] = {}
@@ -68,6 +71,7 @@ def _create_info(variant: ShaderVariant):
         iface.flat("VEC3", f"edge_line{i}")
         iface.flat("VEC2", f"edge_span{i}")
     iface.flat("INT", "triangle_flags")
+    iface.flat("INT", "ngon_corner_start")
     iface.smooth("FLOAT", "view_depth")
 
     info = gpu.types.GPUShaderCreateInfo()
@@ -77,6 +81,7 @@ def _create_info(variant: ShaderVariant):
     info.push_constant("VEC4", "object_to_view_z")
     info.sampler(0, "FLOAT_2D", "vertex_positions")
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
+    info.sampler(2, "FLOAT_2D", "ngon_corners")
     info.vertex_in(0, "INT", "edge_flags")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_color")
@@ -88,8 +93,10 @@ def _create_info(variant: ShaderVariant):
         info.define("USE_FILL", "1")
     if variant.use_fade:
         info.define("USE_FADE", "1")
+    if variant.depth_bias:
+        info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
 
-    common = read_source("common.glsl")
+    common = read_source("common.glsl") + read_source("edge_geometry.glsl")
     info.vertex_source(common + read_source("solidwire_vert.glsl"))
     info.fragment_source(common + read_source("solidwire_frag.glsl"))
     return info
