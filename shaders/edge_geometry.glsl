@@ -51,3 +51,14 @@ void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
   span = vec2(dot(dir, window_point(a_front)), dot(dir, window_point(b_front)));
 }
 
+/* Edges run from their lower vertex id: the two triangles sharing a diagonal
+ * then measure its pattern from the same end (no seam along the diagonal). */
+void edge_setup_from_lower(vec4 a, vec4 b, float id_a, float id_b, out vec3 line, out vec2 span)
+{
+  if (id_b < id_a) {
+    edge_setup(b, a, line, span);
+  }
+  else {
+    edge_setup(a, b, line, span);
+  }
+}

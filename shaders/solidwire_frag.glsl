@@ -43,6 +43,15 @@ float pattern_mask(float t)
 }
 #endif
 
+void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float best, inout vec3 best_line, inout vec2 best_span)
+{
+  if (candidate && d < best) {
+    best = d;
+    best_line = line;
+    best_span = span;
+  }
+}
+
 void main()
 {
   vec2 p = gl_FragCoord.xy;
@@ -78,18 +87,32 @@ void main()
   float intensity = line_profile(d_real);
 
 #if DIAGONALS >= 1
-  float diag0 = real0 ? NO_EDGE : d0;
-  float diag1 = real1 ? NO_EDGE : d1;
-  float diag2 = real2 ? NO_EDGE : d2;
-  float d_diag = min(diag0, min(diag1, diag2));
+  /* The nearest diagonal, with its line and span for the pattern. */
+  float d_diag = NO_EDGE;
+  vec3 diag_line = vec3(0.0, 0.0, NO_EDGE);
+  vec2 diag_span = vec2(0.0);
+  keep_nearest(!real0, d0, edge_line0, edge_span0, d_diag, diag_line, diag_span);
+  keep_nearest(!real1, d1, edge_line1, edge_span1, d_diag, diag_line, diag_span);
+  keep_nearest(!real2, d2, edge_line2, edge_span2, d_diag, diag_line, diag_span);
+  if ((triangle_flags & IS_NGON) != 0) {
+    /* Every diagonal of the n-gon, not only this triangle's own. */
+    int corners = triangle_flags >> NGON_SHIFT;
+    for (int k = 0; k < corners - 3; k++) {
+      int slot = ngon_corner_start + corners + 2 * k;
+      float id_a = fetch_texel(ngon_corners, slot).x;
+      float id_b = fetch_texel(ngon_corners, slot + 1).x;
+      vec3 line;
+      vec2 span;
+      edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
+      keep_nearest(true, edge_distance(line, span, p), line, span, d_diag, diag_line, diag_span);
+    }
+  }
   float diag_intensity = line_profile(d_diag);
 #  if DIAGONALS == 2
-  /* Position along the nearest diagonal, from its end that the vertex stage
-   * chose (stable for a still camera whatever the settings). */
-  vec3 line = (diag0 <= diag1 && diag0 <= diag2) ? edge_line0 : ((diag1 <= diag2) ? edge_line1 : edge_line2);
-  vec2 span = (diag0 <= diag1 && diag0 <= diag2) ? edge_span0 : ((diag1 <= diag2) ? edge_span1 : edge_span2);
-  float along = dot(vec2(-line.y, line.x), p);
-  diag_intensity *= pattern_mask(abs(along - span.x));
+  /* Position along the nearest diagonal from its lower-id end (stable for a
+   * still camera whatever the settings). */
+  float along = dot(vec2(-diag_line.y, diag_line.x), p);
+  diag_intensity *= pattern_mask(abs(along - diag_span.x));
 #  endif
   intensity = max(intensity, diag_intensity);
 #endif

@@ -17,18 +17,6 @@
  * needs the near plane: it is clipped in clip space (z + w >= 0), which is
  * where only the part of an edge in front of the near plane has a projection. */
 
-/* Edges run from their lower vertex id: the two triangles sharing a diagonal
- * then measure its pattern from the same end (no seam along the diagonal). */
-void edge_setup_from_lower(vec4 a, vec4 b, float id_a, float id_b, out vec3 line, out vec2 span)
-{
-  if (id_b < id_a) {
-    edge_setup(b, a, line, span);
-  }
-  else {
-    edge_setup(a, b, line, span);
-  }
-}
-
 void main()
 {
   int triangle = gl_VertexID / 3;

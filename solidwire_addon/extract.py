@@ -145,18 +145,41 @@ def build_arrays(
         real[:, 0] * EDGE0_REAL + real[:, 1] * EDGE1_REAL + real[:, 2] * EDGE2_REAL + is_quad * HAS_QUAD_CORNER
     ).astype(np.int32)
 
-    # N-gons: the fragment stage walks the whole outline (see solidwire_frag.glsl),
-    # so pack the outlines of the n-gons that have triangles here.
+    # N-gons: the fragment stage walks the polygon's whole outline and all of
+    # its diagonals (see solidwire_frag.glsl), so pack, per n-gon with
+    # triangles here, a block of n outline ids (loop order) followed by its
+    # n - 3 diagonals as id pairs. Column 3 of an n-gon triangle says where
+    # its polygon's block starts.
     ngon_corners = np.zeros(0, dtype=np.int32)
     is_ngon_tri = total[:, 0] > 4
     if is_ngon_tri.any():
+        corner_vert = np.asarray(corner_vert)
         ngon_polys = np.unique(tri_polygons[is_ngon_tri])
         sizes = loop_total[ngon_polys].astype(np.int64)
-        offsets = np.cumsum(sizes) - sizes
-        corner_loops = np.repeat(loop_start[ngon_polys].astype(np.int64) - offsets, sizes) + np.arange(sizes.sum())
-        ngon_corners = np.asarray(corner_vert)[corner_loops].astype(np.int32)
-        poly_offset = offsets[np.searchsorted(ngon_polys, tri_polygons[is_ngon_tri])]
-        triangles[is_ngon_tri, 3] = poly_offset
+        block = 3 * sizes - 6
+        offsets = np.cumsum(block) - block
+        ngon_corners = np.zeros(int(block.sum()), dtype=np.int32)
+        rank_in_outline = np.arange(sizes.sum()) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+        outline_loops = np.repeat(loop_start[ngon_polys].astype(np.int64), sizes) + rank_in_outline
+        ngon_corners[np.repeat(offsets, sizes) + rank_in_outline] = corner_vert[outline_loops]
+        # Diagonals default to a degenerate pair (a point: no edge) so a
+        # triangulation that yields fewer than n - 3 still fills the block.
+        diag_slots = np.repeat(offsets + sizes, 2 * (sizes - 3)) + (
+            np.arange(2 * (sizes - 3).sum()) - np.repeat(np.cumsum(2 * (sizes - 3)) - 2 * (sizes - 3), 2 * (sizes - 3))
+        )
+        ngon_corners[diag_slots] = np.repeat(corner_vert[loop_start[ngon_polys]], 2 * (sizes - 3))
+        tri_ids = triangles[is_ngon_tri, :3]
+        pairs = np.stack([tri_ids, np.roll(tri_ids, -1, axis=1)], axis=2)[~real[is_ngon_tri]]  # (D, 2)
+        pair_poly = np.repeat(tri_polygons[is_ngon_tri], (~real[is_ngon_tri]).sum(axis=1))
+        diag = np.unique(np.column_stack([pair_poly, pairs.min(axis=1), pairs.max(axis=1)]), axis=0)
+        poly_rank = np.searchsorted(ngon_polys, diag[:, 0])
+        first_of_poly = np.searchsorted(diag[:, 0], diag[:, 0], side="left")
+        rank = np.arange(len(diag)) - first_of_poly
+        ok = rank < sizes[poly_rank] - 3
+        slot = offsets[poly_rank] + sizes[poly_rank] + 2 * rank
+        ngon_corners[slot[ok]] = diag[ok, 1]
+        ngon_corners[slot[ok] + 1] = diag[ok, 2]
+        triangles[is_ngon_tri, 3] = offsets[np.searchsorted(ngon_polys, tri_polygons[is_ngon_tri])]
         flags[is_ngon_tri] |= IS_NGON | (total[is_ngon_tri, 0] << NGON_SHIFT).astype(np.int32)
 
     if finite_vertex.any():

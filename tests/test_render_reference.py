@@ -190,3 +190,14 @@ def test_depth_pass(output_dir):
     assert np.allclose(depth[covered], ref.depth[covered], rtol=1e-4)
     assert np.all(depth[ref.face < 0 & ~ref.on_silhouette] >= 1e9)
     assert result is not None
+
+
+@pytest.mark.parametrize("mode", ["SOLID", "DOTTED", "DASHED"])
+def test_ngon_and_quad_diagonals_match_reference(mode, output_dir):
+    """Every diagonal of an n-gon counts (not only the fragment's own
+    triangle's), and patterns are measured from the same end everywhere."""
+    scene = scenes.empty_scene(200, 150, diagonal_mode=mode, pattern_period=6.0)
+    _mixed_mesh(scene)
+    report = accuracy.measure(scene, f"diagonals_{mode.lower()}", output_dir)
+    print(report)
+    accuracy.assert_accurate(report)
