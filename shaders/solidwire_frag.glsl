@@ -19,29 +19,44 @@ float edge_distance(vec3 line, vec2 span, vec2 p)
 
 /* SPEC 1.4 profile: 1 inside the core, 2^(-2 x^2) falloff over two softness
  * widths, cut to 0 beyond (the step there is 2^-8, one 8-bit level). */
-float line_profile(float d)
+float line_profile(float d, float half_thickness)
 {
-  float x = max(d - params.half_thickness, 0.0) / params.softness;
+  float x = max(d - half_thickness, 0.0) / params.softness;
   return (x < 2.0) ? exp2(-2.0 * x * x) : 0.0;
 }
 
-#if DIAGONALS == 2
+/* Half the core width at this fragment (THICKNESS_MODE, issue 7):
+ * 0 constant in pixels; 1 a width in scene units, i.e. pixels per unit at
+ *   this depth (gl_FragCoord.w = 1 / clip w, exact for perspective and
+ *   orthographic views); 2 Baerentzen's depth cue, from the near thickness to
+ *   the far one across [thickness_depth_start, thickness_depth_end]. */
+float half_thickness_here()
+{
+#if THICKNESS_MODE == 1
+  return params.world_half_thickness_px * gl_FragCoord.w;
+#elif THICKNESS_MODE == 2
+  float range = params.thickness_depth_end - params.thickness_depth_start;
+  float t = (range > 0.0) ? clamp((view_depth - params.thickness_depth_start) / range, 0.0, 1.0) :
+                            ((view_depth <= params.thickness_depth_start) ? 0.0 : 1.0);
+  return mix(params.half_thickness, params.half_thickness_far, t);
+#else
+  return params.half_thickness;
+#endif
+}
+
 /* Integral of the on/off square wave (on for the first `duty` of each
  * period) from 0 to t: the box-filtered mask is a difference of two of these,
  * which anti-aliases the dash ends over one pixel exactly. */
-float pattern_integral(float t)
+float pattern_integral(float t, float period, float duty)
 {
-  float period = params.pattern_period;
   float cycles = floor(t / period);
-  return cycles * params.pattern_duty * period +
-         clamp(t - cycles * period, 0.0, params.pattern_duty * period);
+  return cycles * duty * period + clamp(t - cycles * period, 0.0, duty * period);
 }
 
-float pattern_mask(float t)
+float pattern_mask(float t, float period, float duty)
 {
-  return pattern_integral(t + 0.5) - pattern_integral(t - 0.5);
+  return pattern_integral(t + 0.5, period, duty) - pattern_integral(t - 0.5, period, duty);
 }
-#endif
 
 void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float best, inout vec3 best_line, inout vec2 best_span)
 {
@@ -65,28 +80,47 @@ void main()
   bool real1 = (triangle_flags & EDGE1_REAL) != 0;
   bool real2 = (triangle_flags & EDGE2_REAL) != 0;
 
-  /* Quad edges p2-p3 and p3-p0 are NO_EDGE unless the triangle has them. */
-  float d_real = min(min(d3, d4),
-                     min(real0 ? d0 : NO_EDGE, min(real1 ? d1 : NO_EDGE, real2 ? d2 : NO_EDGE)));
+  /* The nearest real edge, with its line and span (for the hidden-line
+   * dashes; unused otherwise and compiled away). Quad edges p2-p3 and p3-p0
+   * are NO_EDGE unless the triangle has them. */
+  float d_real = NO_EDGE;
+  vec3 real_line = vec3(0.0, 0.0, NO_EDGE);
+  vec2 real_span = vec2(0.0);
+  keep_nearest(real0, d0, edge_line0, edge_span0, d_real, real_line, real_span);
+  keep_nearest(real1, d1, edge_line1, edge_span1, d_real, real_line, real_span);
+  keep_nearest(real2, d2, edge_line2, edge_span2, d_real, real_line, real_span);
+  keep_nearest(true, d3, edge_line3, edge_span3, d_real, real_line, real_span);
+  keep_nearest(true, d4, edge_line4, edge_span4, d_real, real_line, real_span);
   if ((triangle_flags & IS_NGON) != 0) {
     /* An n-gon's boundary edges may pass near this fragment although they
      * belong to another of its triangles (thin ears, concave outlines): walk
      * the whole outline. Only n-gon fragments pay for this loop. */
     int corners = triangle_flags >> NGON_SHIFT;
-    vec4 first = vertex_clip(fetch_texel(ngon_corners, ngon_corner_start).x);
+    float first_id = fetch_texel(ngon_corners, ngon_corner_start).x;
+    vec4 first = vertex_clip(first_id);
+    float id_a = first_id;
     vec4 a = first;
     for (int k = 1; k <= corners; k++) {
-      vec4 b = (k == corners) ? first : vertex_clip(fetch_texel(ngon_corners, ngon_corner_start + k).x);
+      float id_b = (k == corners) ? first_id : fetch_texel(ngon_corners, ngon_corner_start + k).x;
+      vec4 b = (k == corners) ? first : vertex_clip(id_b);
       vec3 line;
       vec2 span;
-      edge_setup(a, b, line, span);
-      d_real = min(d_real, edge_distance(line, span, p));
+      edge_setup_from_lower(a, b, id_a, id_b, line, span);
+      keep_nearest(true, edge_distance(line, span, p), line, span, d_real, real_line, real_span);
       a = b;
+      id_a = id_b;
     }
   }
-  float intensity = line_profile(d_real);
+  float half_thickness = half_thickness_here();
+  float intensity = line_profile(d_real, half_thickness);
 
-#if DIAGONALS >= 1
+#ifdef HIDDEN_PASS
+  /* Hidden-line style (issue 7): this face is behind the visible surface;
+   * its real edges are drawn dimmed and dashed along the nearest edge, from
+   * that edge's lower-id end. No diagonals, no fill. */
+  float along_real = dot(vec2(-real_line.y, real_line.x), p);
+  intensity *= params.hidden_alpha * pattern_mask(abs(along_real - real_span.x), params.hidden_period, params.hidden_duty);
+#elif DIAGONALS >= 1
   /* The nearest diagonal, with its line and span for the pattern. */
   float d_diag = NO_EDGE;
   vec3 diag_line = vec3(0.0, 0.0, NO_EDGE);
@@ -107,12 +141,12 @@ void main()
       keep_nearest(true, edge_distance(line, span, p), line, span, d_diag, diag_line, diag_span);
     }
   }
-  float diag_intensity = line_profile(d_diag);
+  float diag_intensity = line_profile(d_diag, half_thickness);
 #  if DIAGONALS == 2
   /* Position along the nearest diagonal from its lower-id end (stable for a
    * still camera whatever the settings). */
   float along = dot(vec2(-diag_line.y, diag_line.x), p);
-  diag_intensity *= pattern_mask(abs(along - diag_span.x));
+  diag_intensity *= pattern_mask(abs(along - diag_span.x), params.pattern_period, params.pattern_duty);
 #  endif
   intensity = max(intensity, diag_intensity);
 #endif
@@ -125,13 +159,13 @@ void main()
 #endif
 
   float wire_weight = intensity * params.wire_color.a;
-#ifdef USE_FILL
+#if defined(USE_FILL) && !defined(HIDDEN_PASS)
   frag_color = vec4(mix(params.fill_color.rgb, params.wire_color.rgb, wire_weight), 1.0);
 #else
   /* Premultiplied: what the render pass expects and what blending needs. */
   frag_color = vec4(params.wire_color.rgb * wire_weight, wire_weight);
 #endif
-#ifdef WRITE_VIEW_DEPTH
+#if defined(WRITE_VIEW_DEPTH) && !defined(HIDDEN_PASS)
   frag_view_depth = view_depth;
 #endif
 }

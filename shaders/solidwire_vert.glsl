@@ -37,8 +37,8 @@ void main()
   ngon_corner_start = int(ids.w);
   if ((edge_flags & HAS_QUAD_CORNER) != 0) {
     vec4 c3 = vertex_clip(ids.w);
-    edge_setup(c2, c3, edge_line3, edge_span3);
-    edge_setup(c3, c0, edge_line4, edge_span4);
+    edge_setup_from_lower(c2, c3, ids.z, ids.w, edge_line3, edge_span3);
+    edge_setup_from_lower(c3, c0, ids.w, ids.x, edge_line4, edge_span4);
   }
   else {
     edge_line3 = edge_line4 = vec3(0.0, 0.0, NO_EDGE);

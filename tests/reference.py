@@ -56,6 +56,9 @@ class _Geometry:
     edge_face: np.ndarray  # (E,) global face id
     edge_real: np.ndarray  # (E,) bool: polygon boundary (else diagonal)
     edge_origin_first: np.ndarray  # (E,) bool: pattern measured from endpoint 0
+    # Silhouette candidates (issue 7): real edges with one or two faces.
+    sil_edges: np.ndarray = None  # (S, 2, 3) view-space endpoints
+    sil_third: np.ndarray = None  # (S, 2, 3) third vertex of the face on each side (NaN: none)
 
 
 # ---------------------------------------------------------------- scene input
@@ -76,6 +79,7 @@ def _camera(scene, depsgraph, width, height):
 
 def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
     tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
+    sil_edges, sil_third = [], []
     face_offset = 0
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -118,6 +122,7 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
         # Diagonals: triangle edges that are not polygon edges of that polygon.
         key_real = set(zip(loop_poly.tolist(), np.minimum(real_a, real_b).tolist(), np.maximum(real_a, real_b).tolist()))
         diag = set()
+        half_edges: dict = {}  # real edge -> third vertices of its triangles
         for t in range(ntri):  # small meshes only (reference)
             p = int(tri_p[t])
             for k in range(3):
@@ -125,21 +130,40 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
                 key = (p, min(a, b), max(a, b))
                 if key not in key_real:
                     diag.add(key)
+                else:
+                    half_edges.setdefault((min(a, b), max(a, b)), []).append(int(tri_v[t, (k + 2) % 3]))
         diag = np.array(sorted(diag), dtype=np.int64).reshape(-1, 3)
 
+        # A face with a non-finite (NaN/Inf) corner is not drawn at all.
         finite = np.isfinite(vco).all(axis=1)
-        tri_ok = finite[tri_v].all(axis=1)
-        tris.append(vco[tri_v[tri_ok]])
+        sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2]
+        if sil:
+            sa = np.array([e[0] for e in sil])
+            sb = np.array([e[1] for e in sil])
+            of = np.array([e[2][0] for e in sil])
+            og = np.array([e[2][1] if len(e[2]) == 2 else -1 for e in sil])
+            ok_s = finite[sa] & finite[sb] & finite[of] & ((og < 0) | finite[np.maximum(og, 0)])
+            sa, sb, of, og = sa[ok_s], sb[ok_s], of[ok_s], og[ok_s]
+            sil_edges.append(np.stack([vco[sa], vco[sb]], axis=1))
+            third_g = np.where((og >= 0)[:, None], vco[np.maximum(og, 0)], np.nan)
+            sil_third.append(np.stack([vco[of], third_g], axis=1))
+        poly_ok = np.bincount(loop_poly, weights=~finite[loop_vert], minlength=npoly) == 0
+        tri_ok = poly_ok[tri_p]
+        # The front side is the side the (transformed) normal points to: a
+        # mirroring object or camera matrix reverses view-space winding, so
+        # reverse it back for the back-face test (as Blender draws them).
+        front_winding = tri_v[:, ::-1] if np.linalg.det(to_view[:3, :3]) < 0.0 else tri_v
+        tris.append(vco[front_winding[tri_ok]])
         tri_faces.append(face_offset + tri_p[tri_ok])
         ra, rb = real_a, real_b
-        ok = finite[ra] & finite[rb]
+        ok = poly_ok[loop_poly]
         edges.append(np.stack([vco[ra[ok]], vco[rb[ok]]], axis=1))
         edge_faces.append(face_offset + loop_poly[ok])
         edge_real.append(np.ones(ok.sum(), bool))
         edge_origin.append(ra[ok] < rb[ok])
         if len(diag):
             da, db = diag[:, 1], diag[:, 2]
-            ok = finite[da] & finite[db]
+            ok = poly_ok[diag[:, 0]]
             edges.append(np.stack([vco[da[ok]], vco[db[ok]]], axis=1))
             edge_faces.append(face_offset + diag[ok, 0])
             edge_real.append(np.zeros(ok.sum(), bool))
@@ -156,6 +180,8 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
         cat(edge_faces, (0,), np.int64),
         cat(edge_real, (0,), bool),
         cat(edge_origin, (0,), bool),
+        cat(sil_edges, (0, 2, 3), np.float64),
+        cat(sil_third, (0, 2, 3), np.float64),
     )
 
 
@@ -219,8 +245,11 @@ def _rays(inv_proj, px, py, width, height):
     return near, far - near
 
 
-def _visibility(geo, proj, width, height, rows, backface_culling):
-    """Nearest face for the sample of each pixel of ``rows`` and its 4 offsets."""
+def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None):
+    """Nearest face for the sample of each pixel of ``rows`` and its 4 offsets.
+
+    With a list as ``all_hits``, every hit of the centre sample is appended
+    to it as (pixel, depth, face) arrays (hidden-line style)."""
     inv_proj = np.linalg.inv(proj)
     n_rows = len(rows)
     row_of = np.full(height, -1, np.int64)
@@ -278,6 +307,8 @@ def _visibility(geo, proj, width, height, rows, backface_culling):
             hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
             depth = -(origin[:, 2] + t * direction[:, 2])
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
+            if s == 0 and all_hits is not None:
+                all_hits.append((h_pix, h_depth, h_face))
             # Nearest hit per pixel (ties: lowest face id, deterministic).
             order = np.lexsort((h_face, h_depth, h_pix))
             h_pix, h_depth, h_face = h_pix[order], h_depth[order], h_face[order]
@@ -377,6 +408,147 @@ def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_a
     return best, best_along
 
 
+def _thickness_at(s, z, proj, height):
+    """Core width T at view depth z for the thickness mode (issue 7)."""
+    mode = getattr(s, "thickness_mode", "PIXELS")
+    if mode == "WORLD":
+        clip_w = proj[3, 2] * (-z) + proj[3, 3]  # z for perspective, 1 for orthographic
+        return float(s.world_thickness) * 0.5 * height * abs(proj[1, 1]) / clip_w
+    if mode == "DEPTH":
+        start, end = float(s.thickness_depth_start), float(s.thickness_depth_end)
+        if end > start:
+            t = np.clip((z - start) / (end - start), 0.0, 1.0)
+        else:
+            t = (z > start).astype(np.float64)
+        return float(s.thickness) + t * (float(s.thickness_far) - float(s.thickness))
+    return np.full_like(z, float(s.thickness))
+
+
+def _eye(proj):
+    """Homogeneous view-space camera centre: the null vector of the x, y and
+    w rows of the projection ((0,0,0,1) perspective, (0,0,1,0) orthographic)."""
+    _u, _s, vt = np.linalg.svd(proj[[0, 1, 3]])
+    return vt[-1]
+
+
+def _outer_half(s, geo, proj, width, height, rows, depth):
+    """Outer-half intensity per pixel of ``rows`` (issue 7 definition, see
+    solidwire_addon/silhouettes.py): max over silhouette edges whose outer
+    side holds the sample and whose nearest point q is not behind the
+    visible surface there, of P(d) * fade with thickness and fade at q."""
+    out = np.zeros(len(rows) * width)
+    if geo.sil_edges is None or len(geo.sil_edges) == 0:
+        return out
+    eye = _eye(proj)
+    a, b = geo.sil_edges[:, 0], geo.sil_edges[:, 1]
+    ones = np.ones((len(a), 1))
+
+    def side(o):
+        m = np.stack([np.hstack([a, ones]), np.hstack([b, ones]), np.hstack([o, ones]), np.tile(eye, (len(a), 1))], axis=1)
+        return np.linalg.det(m)
+
+    side_f = side(geo.sil_third[:, 0])
+    boundary = ~np.isfinite(geo.sil_third[:, 1]).all(axis=1)
+    side_g = np.where(boundary, 0.0, side(np.nan_to_num(geo.sil_third[:, 1])))
+    silhouette = (boundary | (side_f * side_g > 0)) & (side_f != 0)
+    a, b, third = a[silhouette], b[silhouette], geo.sil_third[silhouette, 0]
+    wa, wb, valid = _clip_edges_to_window(proj, np.stack([a, b], axis=1), width, height)
+    a, b, third, wa, wb = a[valid], b[valid], third[valid], wa[valid], wb[valid]
+    if len(a) == 0:
+        return out
+    # Clipped 3D endpoints (for q's depth) and their clip w.
+    xyz, w = _to_clip(proj, np.stack([a, b], axis=1))
+    fa, fb = xyz[:, 0, 2] + w[:, 0], xyz[:, 1, 2] + w[:, 1]
+    ta = np.where(fa < 0, fa / (fa - fb), 0.0)
+    tb = np.where(fb < 0, fb / (fb - fa), 0.0)
+    a3 = a + ta[:, None] * (b - a)
+    b3 = b + tb[:, None] * (a - b)
+    _x, wa_clip = _to_clip(proj, a3)
+    _x, wb_clip = _to_clip(proj, b3)
+    # Interior side: a point just inside the face from the segment's middle.
+    mid = 0.5 * (a3 + b3)
+    inner = _window(proj, mid + 1e-6 * (third - mid), width, height)
+    ab = wb - wa
+    inner_side = np.sign(ab[:, 0] * (inner[:, 1] - wa[:, 1]) - ab[:, 1] * (inner[:, 0] - wa[:, 0]))
+
+    softness = float(s.softness)
+    z_ends = -np.stack([a3[:, 2], b3[:, 2]], axis=1)
+    t_max = np.max(_thickness_at(s, z_ends.ravel(), proj, height).reshape(-1, 2), axis=1)
+    reach = 0.5 * t_max + 2.0 * softness + 1.0
+    x0 = np.clip(np.floor(np.minimum(wa[:, 0], wb[:, 0]) - reach), 0, width).astype(np.int64)
+    x1 = np.clip(np.ceil(np.maximum(wa[:, 0], wb[:, 0]) + reach), -1, width - 1).astype(np.int64)
+    y0 = np.clip(np.floor(np.minimum(wa[:, 1], wb[:, 1]) - reach), 0, height).astype(np.int64)
+    y1 = np.clip(np.ceil(np.maximum(wa[:, 1], wb[:, 1]) + reach), -1, height - 1).astype(np.int64)
+    row_of = np.full(height, -1, np.int64)
+    row_of[rows] = np.arange(len(rows))
+    for e in range(len(a)):  # few silhouette edges in reference scenes
+        if x1[e] < x0[e] or y1[e] < y0[e]:
+            continue
+        ys = np.arange(y0[e], y1[e] + 1)
+        ys = ys[row_of[ys] >= 0]
+        if len(ys) == 0:
+            continue
+        xs = np.arange(x0[e], x1[e] + 1)
+        px, py = np.meshgrid(xs + 0.5, ys + 0.5)
+        px, py = px.ravel(), py.ravel()
+        pixel = row_of[(py - 0.5).astype(np.int64)] * width + (px - 0.5).astype(np.int64)
+        rel = np.stack([px - wa[e, 0], py - wa[e, 1]], axis=1)
+        cross = ab[e, 0] * rel[:, 1] - ab[e, 1] * rel[:, 0]
+        outer = cross * inner_side[e] <= 0
+        len2 = ab[e] @ ab[e]
+        sp = np.clip(rel @ ab[e] / len2, 0.0, 1.0) if len2 > 0 else np.zeros(len(px))
+        d = np.linalg.norm(rel - sp[:, None] * ab[e], axis=1)
+        u = sp * wa_clip[e] / (sp * wa_clip[e] + (1.0 - sp) * wb_clip[e])
+        zq = -(a3[e, 2] + u * (b3[e, 2] - a3[e, 2]))
+        seen = depth[pixel] >= zq
+        value = profile(d, _thickness_at(s, zq, proj, height), softness) * _fade(s, zq)
+        value = np.where(outer & seen, value, 0.0)
+        np.maximum.at(out, pixel, value)
+    return out
+
+
+def _fade(s, z):
+    if not s.use_fade:
+        return np.ones_like(z)
+    fs, fe = float(s.fade_start), float(s.fade_end)
+    if fe > fs:
+        return np.clip((fe - z) / (fe - fs), 0.0, 1.0)
+    return (z <= fs).astype(np.float64)
+
+
+def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha):
+    """Alpha of the hidden-line layer per pixel (issue 7 definition): every
+    face hit behind the visible surface contributes
+    a_k = wire_alpha * hidden_alpha * P(d_real) * dash(t) * fade(z_k), with
+    t measured along its nearest real edge from that edge's lower-id end;
+    layers combine as 1 - prod(1 - a_k)."""
+    coverage = np.zeros(len(face))
+    if not all_hits:
+        return coverage
+    pix = np.concatenate([h[0] for h in all_hits])
+    z = np.concatenate([h[1] for h in all_hits])
+    f = np.concatenate([h[2] for h in all_hits])
+    behind = (face[pix] >= 0) & (f != face[pix]) & (z > depth[pix])
+    pix, z, f = pix[behind], z[behind], f[behind]
+    # One hit per (pixel, face): a face's two triangles may both report a
+    # sample that lies on their shared diagonal.
+    order = np.lexsort((z, f, pix))
+    pix, z, f = pix[order], z[order], f[order]
+    first = np.ones(len(pix), bool)
+    first[1:] = (pix[1:] != pix[:-1]) | (f[1:] != f[:-1])
+    pix, z, f = pix[first], z[first], f[first]
+    if len(pix) == 0:
+        return coverage
+    xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
+    d, along = _min_distance_per_pixel(f, xy, geo, wa, wb, valid, geo.edge_real, want_along=True)
+    a = profile(d, _thickness_at(s, z, proj, height), float(s.softness))
+    a *= float(s.hidden_alpha) * pattern_mask(np.abs(along), float(s.hidden_period), float(s.hidden_duty))
+    a *= _fade(s, z) * wire_alpha
+    transmit = np.ones(len(face))
+    np.multiply.at(transmit, pix, 1.0 - a)
+    return 1.0 - transmit
+
+
 # ---------------------------------------------------------------- entry point
 
 
@@ -397,7 +569,9 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
 
     view_matrix, proj = _camera(scene, depsgraph, width, height)
     geo = _gather_geometry(depsgraph, view_matrix)
-    faces, depths = _visibility(geo, proj, width, height, rows, bool(s.use_backface_culling))
+    hidden_lines = bool(getattr(s, "use_hidden_lines", False))
+    all_hits = [] if hidden_lines else None
+    faces, depths = _visibility(geo, proj, width, height, rows, bool(s.use_backface_culling), all_hits)
 
     face = faces[0]
     depth = depths[0]
@@ -409,7 +583,8 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         pix_xy = np.stack([covered % width + 0.5, rows[covered // width] + 0.5], axis=1).astype(np.float64)
         pix_face = face[covered]
         wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
-        thickness, softness = float(s.thickness), float(s.softness)
+        softness = float(s.softness)
+        thickness = _thickness_at(s, depth[covered], proj, height)
         d_real, _ = _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, geo.edge_real)
         value = profile(d_real, thickness, softness)
         mode = s.diagonal_mode
@@ -421,14 +596,21 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
             if mode in ("DOTTED", "DASHED"):
                 diag_value *= pattern_mask(np.abs(along), float(s.pattern_period), float(s.pattern_duty))
             value = np.maximum(value, diag_value)
-        if s.use_fade:
-            z = depth[covered]
-            fs, fe = float(s.fade_start), float(s.fade_end)
-            if fe > fs:
-                value *= np.clip((fe - z) / (fe - fs), 0.0, 1.0)
-            else:
-                value *= (z <= fs).astype(np.float64)
+        value *= _fade(s, depth[covered])
+        if hidden_lines:
+            wire_alpha = float(s.wire_color[3])
+            hidden = _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha)
+            # The visible wire over the hidden lines ("over" with one colour),
+            # expressed as an intensity relative to the wire alpha.
+            a_vis = value * wire_alpha
+            value = (a_vis + (1.0 - a_vis) * hidden[covered]) / max(wire_alpha, 1e-12)
         intensity[covered] = value
+
+    if getattr(s, "use_silhouettes", False):
+        wire_alpha = float(s.wire_color[3])
+        a_out = _outer_half(s, geo, proj, width, height, rows, depth) * wire_alpha
+        a_base = intensity * wire_alpha
+        intensity = (a_out + (1.0 - a_out) * a_base) / max(wire_alpha, 1e-12)
 
     shape = (len(rows), width)
     return ReferenceResult(

@@ -1,0 +1,55 @@
+/* SolidWire full-width silhouettes, fragment stage: exact distance to the
+ * fin's near-clipped edge, outer-side test, occlusion against the main
+ * pass's depth at this pixel, and the intensity written both as colour and
+ * as depth (1 - I) so that a LESS test keeps the maximum over fins. */
+
+float line_profile(float d, float half_thickness)
+{
+  float x = max(d - half_thickness, 0.0) / params.softness;
+  return (x < 2.0) ? exp2(-2.0 * x * x) : 0.0;
+}
+
+void main()
+{
+  vec2 p = gl_FragCoord.xy;
+  /* Only the side away from the face: the face draws its own inner half. */
+  if (dot(fin_line, vec3(p, 1.0)) * fin_inner_sign > 0.0) {
+    discard;
+  }
+  vec2 wa = window_point(fin_a), wb = window_point(fin_b);
+  vec2 ab = wb - wa;
+  float len2 = dot(ab, ab);
+  float s = (len2 > 0.0) ? clamp(dot(p - wa, ab) / len2, 0.0, 1.0) : 0.0;
+  float d = length(p - (wa + s * ab));
+  /* Window parameter s -> parameter u along the clip-space segment
+   * (perspective-correct), then q's depth in NDC and view space. */
+  float u = s * fin_a.w / (s * fin_a.w + (1.0 - s) * fin_b.w);
+  vec4 q = mix(fin_a, fin_b, u);
+  float q_depth = 0.5 * (q.z / q.w) + 0.5;
+  float q_view_depth = mix(fin_view_depth.x, fin_view_depth.y, u);
+  float scene = texelFetch(scene_depth, ivec2(p), 0).r;
+  if (scene < q_depth) {
+    discard; /* a nearer surface hides this part of the outer half */
+  }
+
+  float half_thickness = params.half_thickness;
+#if THICKNESS_MODE == 1
+  half_thickness = params.world_half_thickness_px / q.w;
+#elif THICKNESS_MODE == 2
+  float range = params.thickness_depth_end - params.thickness_depth_start;
+  float t = (range > 0.0) ? clamp((q_view_depth - params.thickness_depth_start) / range, 0.0, 1.0) :
+                            ((q_view_depth <= params.thickness_depth_start) ? 0.0 : 1.0);
+  half_thickness = mix(params.half_thickness, params.half_thickness_far, t);
+#endif
+  float intensity = line_profile(d, half_thickness);
+#ifdef USE_FADE
+  float fade_range = params.fade_end - params.fade_start;
+  intensity *= (fade_range > 0.0) ? clamp((params.fade_end - q_view_depth) / fade_range, 0.0, 1.0) :
+                                    ((q_view_depth <= params.fade_start) ? 1.0 : 0.0);
+#endif
+  if (intensity <= 0.0) {
+    discard;
+  }
+  frag_intensity = intensity;
+  gl_FragDepth = 1.0 - intensity;
+}

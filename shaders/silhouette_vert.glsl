@@ -1,0 +1,62 @@
+/* SolidWire full-width silhouettes, vertex stage: one screen-space fin
+ * (two triangles, six corners) per candidate edge, pulled from
+ * `silhouette_edges` by gl_VertexID / 6. See solidwire_addon/silhouettes.py
+ * for the definition. Fins of edges that are not silhouettes in this view
+ * collapse to nothing here. */
+
+/* Outside the clip volume: the rasteriser drops the triangle. */
+const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
+
+void main()
+{
+  int edge = gl_VertexID / 6;
+  int corner = fin_corner;
+  vec4 ids = fetch_texel(silhouette_edges, edge);
+  vec4 a = vertex_clip(ids.x);
+  vec4 b = vertex_clip(ids.y);
+  vec3 l = cross(window_homogeneous(a), window_homogeneous(b));
+  /* Side of the line each adjacent face lies on (no division by w: the
+   * sign of l . o_h is the side of the face's interior next to the edge). */
+  float side_f = dot(l, window_homogeneous(vertex_clip(ids.z)));
+  bool boundary = ids.w < 0.0;
+  float side_g = boundary ? 0.0 : dot(l, window_homogeneous(vertex_clip(ids.w)));
+  bool contour = !boundary && side_f * side_g > 0.0;
+  float depth_a = a.z + a.w, depth_b = b.z + b.w;
+  if (edge >= edge_count || !(boundary || contour) || side_f == 0.0 || (depth_a < 0.0 && depth_b < 0.0) ||
+      dot(l.xy, l.xy) == 0.0)
+  {
+    gl_Position = COLLAPSED;
+    return;
+  }
+  /* The part in front of the near plane, in clip and window space. */
+  vec4 a_front = (depth_a < 0.0) ? mix(a, b, depth_a / (depth_a - depth_b)) : a;
+  vec4 b_front = (depth_b < 0.0) ? mix(b, a, depth_b / (depth_b - depth_a)) : b;
+  fin_a = a_front;
+  fin_b = b_front;
+  fin_line = l * inversesqrt(dot(l.xy, l.xy));
+  fin_inner_sign = sign(side_f);
+  vec3 pa = vec3(fetch_texel(vertex_positions, int(ids.x)).xyz);
+  vec3 pb = vec3(fetch_texel(vertex_positions, int(ids.y)).xyz);
+  float za = -dot(object_to_view_z, vec4(pa, 1.0)), zb = -dot(object_to_view_z, vec4(pb, 1.0));
+  float ta = (depth_a < 0.0) ? depth_a / (depth_a - depth_b) : 0.0;
+  float tb = (depth_b < 0.0) ? depth_b / (depth_b - depth_a) : 0.0;
+  fin_view_depth = vec2(mix(za, zb, ta), mix(zb, za, tb));
+
+  /* Quad around the window segment, widened by the reach of the profile
+   * (plus a pixel so every sample the profile reaches is rasterised). */
+  vec2 wa = window_point(a_front), wb = window_point(b_front);
+  vec2 dir = wb - wa;
+  float len = length(dir);
+  dir = (len > 0.0) ? dir / len : vec2(1.0, 0.0);
+  vec2 normal = vec2(-dir.y, dir.x);
+  float reach = max(params.half_thickness, params.half_thickness_far) + 2.0 * params.softness + 1.0;
+#if THICKNESS_MODE == 1
+  reach = max(reach, params.world_half_thickness_px / max(min(a_front.w, b_front.w), 1e-6) + 2.0 * params.softness + 1.0);
+#endif
+  /* corners 0..5: (a,-), (b,-), (b,+), (a,-), (b,+), (a,+) */
+  bool at_b = (corner == 1 || corner == 2 || corner == 4);
+  bool plus = (corner == 2 || corner == 4 || corner == 5);
+  vec2 w = (at_b ? wb + dir * reach : wa - dir * reach) + normal * (plus ? reach : -reach);
+  vec2 ndc = (w - params.viewport.xy) / params.viewport.zw * 2.0 - 1.0;
+  gl_Position = vec4(ndc, 0.0, 1.0);
+}

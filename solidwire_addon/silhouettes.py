@@ -1,0 +1,139 @@
+"""Full-width silhouettes (issue 7): the outer half of contour and boundary
+edges, which the single-pass method cannot draw (a face only covers its own
+side of an edge).
+
+Definition (the README's technical section has it in full; tests/reference.py
+evaluates it in float64):
+- Candidates are real polygon edges with one adjacent face (boundary) or two.
+  For an edge with two faces, it is a *contour* in this view when both faces
+  project to the same side of the edge's window line (the surface folds
+  over). Boundary and contour edges are *silhouette* edges. Non-manifold
+  edges (three or more faces) are not.
+- At a sample p on the outer side of a silhouette edge e (opposite to its
+  face's side), with q the point of e's near-clipped segment whose projection
+  is nearest to p, e contributes P(d_e(p)) (thickness and fade taken at q's
+  depth) unless the visible surface at p is nearer than q. The outer
+  intensity is the maximum over edges, and it is composited over the image
+  ("over" with the wire colour).
+
+Method: screen-space fins. Each candidate edge is a quad expanded in window
+space around its near-clipped segment (vertex pulling, like the main pass);
+the fragment stage recomputes the exact distance, tests the side and the
+occlusion against the main pass's depth texture itself, and writes
+1 - intensity as its depth so a LESS depth test keeps the maximum over
+overlapping fins (there is no MAX blend in Blender's gpu module). Non-contour
+fins are collapsed in the vertex stage, so the contour test is per view and
+costs no CPU work when the camera moves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
+
+NO_FACE = -1.0
+
+
+def candidate_edges(triangles: np.ndarray, edge_flags: np.ndarray) -> np.ndarray:
+    """(E, 4) float32 rows (a, b, o_f, o_g): the real edges with one or two
+    adjacent faces; o_f / o_g are the third vertices of the triangles on
+    either side (o_g = -1 for a boundary edge)."""
+    tris = triangles[:, :3].astype(np.int64)
+    real = np.stack(
+        [(edge_flags & EDGE0_REAL) != 0, (edge_flags & EDGE1_REAL) != 0, (edge_flags & EDGE2_REAL) != 0], axis=1
+    )
+    a = tris
+    b = np.roll(tris, -1, axis=1)
+    o = np.roll(tris, -2, axis=1)
+    a, b, o = a[real], b[real], o[real]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    order = np.lexsort((hi, lo))
+    lo, hi, o = lo[order], hi[order], o[order]
+    start = np.ones(len(lo), bool)
+    start[1:] = (lo[1:] != lo[:-1]) | (hi[1:] != hi[:-1])
+    group = np.cumsum(start) - 1
+    counts = np.bincount(group)
+    first = np.nonzero(start)[0]
+    keep = counts <= 2  # non-manifold edges are not silhouettes
+    first = first[keep]
+    two = counts[keep] == 2
+    rows = np.empty((len(first), 4), dtype=np.float32)
+    rows[:, 0] = lo[first]
+    rows[:, 1] = hi[first]
+    rows[:, 2] = o[first]
+    rows[:, 3] = np.where(two, o[np.minimum(first + 1, len(o) - 1)], NO_FACE)
+    return rows
+
+
+def edge_table(mesh):
+    """(texture, count) of ``mesh``'s candidate edges, built on first use."""
+    if mesh.silhouette_edges is None:
+        from .cache import _table_texture
+
+        rows = candidate_edges(mesh.triangles_cpu, mesh.edge_flags_cpu)
+        mesh.silhouette_edges = (_table_texture(rows), len(rows))
+        mesh.gpu_bytes += mesh.silhouette_edges[0].width * mesh.silhouette_edges[0].height * 16
+    return mesh.silhouette_edges
+
+
+_fin_batches: dict[int, object] = {}
+
+
+def _fin_batch(edge_count: int):
+    """A vertex-less-in-spirit batch of 6 vertices per edge (two triangles);
+    shared by all meshes of the same edge count class (next power of two)."""
+    import gpu
+
+    size = 1 << max(int(edge_count - 1).bit_length(), 6)
+    batch = _fin_batches.get(size)
+    if batch is None:
+        fmt = gpu.types.GPUVertFormat()
+        fmt.attr_add(id="fin_corner", comp_type="I32", len=1, fetch_mode="INT")
+        vbo = gpu.types.GPUVertBuf(fmt, 6 * size)
+        vbo.attr_fill("fin_corner", np.tile(np.arange(6, dtype=np.int32), size))
+        batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+        _fin_batches[size] = batch
+    return batch
+
+
+def release() -> None:
+    _fin_batches.clear()
+
+
+def draw_silhouettes(items, view, settings, scene_depth_texture) -> None:
+    """Draw the outer halves into the bound framebuffer (R32F intensity +
+    a depth buffer cleared to 1): see the module docstring."""
+    import gpu
+
+    from . import draw as draw_mod
+    from . import shaders
+
+    shader = shaders.get_silhouette(settings.shader_variant())
+    ubo = gpu.types.GPUUniformBuf(draw_mod.pack_params(settings, view.viewport, view.projection))
+    shader.bind()
+    shader.uniform_block("params", ubo)
+    shader.uniform_sampler("scene_depth", scene_depth_texture)
+    gpu.state.depth_test_set("LESS")
+    gpu.state.depth_mask_set(True)
+    gpu.state.face_culling_set("NONE")
+    # View depth is compiled in only for fade and depth-cue thickness.
+    try:
+        shader.uniform_from_name("object_to_view_z")
+        uses_view_depth = True
+    except ValueError:
+        uses_view_depth = False
+    for item in items:
+        mesh = item.mesh
+        table, count = edge_table(mesh)
+        if count == 0:
+            continue
+        object_to_view = view.view_matrix @ item.matrix @ draw_mod.translation(mesh.centre)
+        object_to_clip = view.projection @ object_to_view
+        shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
+        if uses_view_depth:
+            shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
+        shader.uniform_sampler("vertex_positions", mesh.positions)
+        shader.uniform_sampler("silhouette_edges", table)
+        shader.uniform_int("edge_count", count)
+        _fin_batch(count).draw_range(shader, elem_start=0, elem_count=6 * count)
