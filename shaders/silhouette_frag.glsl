@@ -27,10 +27,12 @@ void main()
   vec4 q = mix(fin_a, fin_b, u);
   float q_depth = 0.5 * (q.z / q.w) + 0.5;
   float q_view_depth = mix(fin_view_depth.x, fin_view_depth.y, u);
+#ifndef OVERLAY_FINS
   float scene = texelFetch(scene_depth, ivec2(p), 0).r;
   if (scene < q_depth) {
     discard; /* a nearer surface hides this part of the outer half */
   }
+#endif
 
   float half_thickness = params.half_thickness;
 #if THICKNESS_MODE == 1
@@ -50,6 +52,18 @@ void main()
   if (intensity <= 0.0) {
     discard;
   }
+#ifdef OVERLAY_FINS
+  /* Viewport: the fixed-function depth test against the viewport's depth
+   * (every object Blender drew) does the occlusion; q is moved towards the
+   * camera by the overlay's depth bias (draw.OVERLAY_DEPTH_BIAS, NDC, so half
+   * of it in window depth) so the surface beyond the outline never wins a
+   * tie. Fins blend "over", so two fins meeting at a convex corner compound
+   * slightly there; the render keeps the exact maximum. */
+  float weight = intensity * params.wire_color.a;
+  frag_color = vec4(params.wire_color.rgb * weight, weight);
+  gl_FragDepth = q_depth - 0.5 * OVERLAY_FINS;
+#else
   frag_intensity = intensity;
   gl_FragDepth = 1.0 - intensity;
+#endif
 }

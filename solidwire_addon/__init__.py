@@ -3,17 +3,19 @@ on the filled triangles from the exact window-space distance to each face's
 edges.
 
 Data flows one way: scene -> gather/extract -> GPU cache -> draw -> targets
-(render engine, command line; viewport overlay). ``register()`` and
+(render engine, command line, viewport overlay). ``register()`` and
 ``unregister()`` are safe to call repeatedly and leave nothing behind.
 """
 
 from __future__ import annotations
 
+import atexit
+
 import bpy
 
-from . import engine, log, offscreen, runtime, settings, shaders
+from . import engine, log, offscreen, ops, ops_composite, overlay, runtime, settings, shaders, silhouettes, ui
 
-_classes = (*settings.classes, *engine.classes)
+_classes = (*settings.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
 _registered = False
 
 
@@ -25,6 +27,10 @@ def register() -> None:
         bpy.utils.register_class(cls)
     settings.register_properties()
     engine.register_compat()
+    ui.register_appends()
+    ops.register_keymaps()
+    overlay.register()
+    atexit.register(release_gpu)
     _registered = True
 
 
@@ -32,15 +38,29 @@ def unregister() -> None:
     global _registered
     if not _registered:
         return
+    overlay.unregister()
+    ops.unregister_keymaps()
+    ui.unregister_appends()
     engine.unregister_compat()
     settings.unregister_properties()
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)
-    offscreen.release()
-    runtime.release()
-    shaders.clear()
+    release_gpu()
+    atexit.unregister(release_gpu)
     log.forget()
     _registered = False
+
+
+def release_gpu() -> None:
+    """Free every GPU object the add-on holds (targets, meshes, shaders).
+
+    Also runs at interpreter exit while registered: a GPU object still alive
+    when Blender has torn down its GPU context crashes the process on exit
+    (seen with the bpy module: exit code 139 after a render)."""
+    offscreen.release()
+    runtime.release()
+    silhouettes.release()
+    shaders.clear()
 
 
 def stats() -> dict:

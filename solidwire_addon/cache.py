@@ -51,6 +51,11 @@ class GPUMesh:
         ngon = np.zeros((max(len(arrays.ngon_corners), 1), 4), dtype=np.float32)
         ngon[: len(arrays.ngon_corners), 0] = arrays.ngon_corners
         self.ngon_corners = _table_texture(ngon)
+        # Kept (no copy) so the silhouette pass can derive its edge table on
+        # first use without re-extracting; see silhouettes.py.
+        self.triangles_cpu = arrays.triangles
+        self.edge_flags_cpu = arrays.edge_flags
+        self.silhouette_edges = None  # (texture, count), built lazily
 
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
@@ -66,15 +71,34 @@ class GPUMesh:
 
 
 class MeshCache:
-    """GPU meshes by key, with counters for stats()."""
+    """GPU meshes by key, with counters for stats().
+
+    Keys are plain tuples (see gather.py: a depsgraph mode plus session_uid
+    based identity), never Blender data, so nothing here dangles across undo
+    or file load. Each entry remembers two validity tokens:
+
+    * ``fast``: cheap proof that nothing changed (the evaluated mesh's
+      pointer plus the update counters of runtime's depsgraph handler); only
+      set by callers that trust depsgraph updates (the viewport);
+    * ``fingerprint``: counts plus a checksum of positions and topology,
+      compared when ``fast`` does not match (every render: a render's
+      depsgraph is new each frame unless persistent data is on, so pointers
+      and update lists say nothing about what changed since the last frame).
+    """
 
     def __init__(self):
         self._entries: dict[object, GPUMesh] = {}
+        self._tokens: dict[object, tuple] = {}  # key -> (fast, fingerprint)
         self.extracted = 0
         self.reused = 0
+        self.culled = 0  # instances culled before their mesh was ever extracted
+        self.ms_upload = 0.0
 
     def __len__(self) -> int:
         return len(self._entries)
+
+    def __contains__(self, key) -> bool:
+        return key in self._entries
 
     def get(self, key, make_arrays) -> GPUMesh | None:
         """The cached GPU mesh for ``key``, built from ``make_arrays()`` if new.
@@ -84,29 +108,72 @@ class MeshCache:
         if entry is not None:
             self.reused += 1
             return entry
-        arrays = make_arrays()
+        return self._build(key, make_arrays(), None)
+
+    def peek(self, key) -> GPUMesh | None:
+        return self._entries.get(key)
+
+    def get_validated(self, key, fast, fingerprint, make_arrays):
+        """The GPU mesh for ``key`` if it is still valid, else a rebuilt one.
+
+        ``fast`` is a token or None; ``fingerprint()`` computes the content
+        fingerprint (called only when the fast token does not match) and
+        returns ``(fingerprint, context)``; ``make_arrays(context)`` extracts
+        (``context`` lets it reuse what the fingerprint already read).
+        Returns ``(GPUMesh or None, extracted: bool)``."""
+        entry = self._entries.get(key)
+        tokens = self._tokens.get(key)
+        if entry is not None and fast is not None and tokens is not None and tokens[0] == fast:
+            self.reused += 1
+            return entry, False
+        content, context = fingerprint()
+        if entry is not None and tokens is not None and tokens[1] == content:
+            self._tokens[key] = (fast, content)
+            self.reused += 1
+            return entry, False
+        self._entries.pop(key, None)  # free the old upload before making the new one
+        mesh = self._build(key, make_arrays(context), (fast, content))
+        return mesh, True
+
+    def _build(self, key, arrays, tokens) -> GPUMesh | None:
+        import time
+
         self.extracted += 1
         if arrays is None or arrays.triangle_count == 0:
+            self._entries.pop(key, None)
+            self._tokens.pop(key, None)
             return None
+        start = time.perf_counter()
         entry = GPUMesh(arrays)
+        self.ms_upload += (time.perf_counter() - start) * 1000.0
         self._entries[key] = entry
+        if tokens is not None:
+            self._tokens[key] = tokens
         return entry
 
     def discard(self, key) -> None:
         self._entries.pop(key, None)
+        self._tokens.pop(key, None)
 
-    def keep_only(self, keys) -> None:
-        """Drop every entry whose key is not in ``keys`` (frees GPU memory)."""
+    def keep_only(self, keys, *, scope=None) -> None:
+        """Drop every entry whose key is not in ``keys`` (frees GPU memory).
+
+        With ``scope``, only entries whose key starts with ``scope`` are
+        considered (a render frame must not evict the viewport's meshes)."""
         keys = set(keys)
         for key in [k for k in self._entries if k not in keys]:
-            del self._entries[key]
+            if scope is None or (isinstance(key, tuple) and key[: len(scope)] == scope):
+                self.discard(key)
 
     def clear(self) -> None:
         self._entries.clear()
+        self._tokens.clear()
 
     def reset_counters(self) -> None:
         self.extracted = 0
         self.reused = 0
+        self.culled = 0
+        self.ms_upload = 0.0
 
     @property
     def gpu_bytes(self) -> int:

@@ -15,7 +15,7 @@ import bpy
 import numpy as np
 
 from . import gather, offscreen, runtime
-from .gpu_context import is_init_scene
+from .gpu_context import ensure_gpu, is_init_scene
 from .view import NoCameraError, camera_view, render_size
 
 
@@ -40,11 +40,16 @@ def composite_film(rgba: np.ndarray, scene) -> np.ndarray:
 def render_scene(depsgraph, size=None):
     """Render ``depsgraph``'s scene from its camera: (rgba premultiplied over
     the film, view depth, stats dict). Shared by the engine and the CLI."""
+    ensure_gpu()  # uploads start in gather(), before anything is drawn
     scene = depsgraph.scene
     view = camera_view(scene, depsgraph, size)
     settings = scene.solidwire.snapshot()
-    frame = runtime.begin_frame()
-    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache)
+    # Reuse: unchanged meshes are recognised by their content fingerprint
+    # (runtime.py says why), so a multi-frame render re-extracts only what
+    # changed on each frame.
+    frame = runtime.begin_frame(reuse=True)
+    # The view lets gather skip extracting meshes that are wholly off-screen.
+    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, view=view)
     start = time.perf_counter()
     rgba, depth, draw_stats = offscreen.render(items, view, settings)
     runtime.end_frame(frame, draw_stats, ms_extract, (time.perf_counter() - start) * 1000.0, seen)
@@ -107,7 +112,10 @@ _COMPAT_PANELS = (
 def _compat_panels():
     for name in _COMPAT_PANELS:
         panel = getattr(bpy.types, name, None)
-        if panel is not None and hasattr(panel, "COMPAT_ENGINES"):
+        # Only a panel's own set: an inherited one is shared by its siblings
+        # (CYCLES_RENDER_PT_film_transparency shares CyclesButtonsPanel's with
+        # 84 Cycles panels, which would all show for SolidWire).
+        if panel is not None and isinstance(panel.__dict__.get("COMPAT_ENGINES"), set):
             yield panel
 
 

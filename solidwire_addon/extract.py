@@ -1,8 +1,12 @@
 """Extraction: an evaluated Blender mesh -> GPU-ready numpy arrays.
 
-Only bulk reads (``foreach_get``) and vectorised numpy: no per-element Python
-loops. The triangles are Blender's own (``loop_triangles``), so the faces we
-draw are exactly the faces Blender draws. For each triangle we record which of
+Only bulk reads (``foreach_get`` on attribute arrays) and vectorised numpy:
+no per-element Python loops. The triangles are exactly Blender's own
+(``loop_triangles``), so the faces we draw are the faces Blender draws; the
+fast path (:func:`extract_mesh`) builds the triangles of tris and quads
+itself with Blender's own quad split rule (reading ``loop_triangles`` through
+RNA costs ~0.1 s per million triangles, most of our budget) and asks Blender
+only for n-gons and for quads whose split is numerically undecided. For each triangle we record which of
 its three edges are polygon boundary edges ("real") and which are diagonals
 added by triangulation, and for a quad the id of its 4th corner so a fragment
 can measure the distance to all four quad edges (clean corners next to a
@@ -16,6 +20,7 @@ its 4th corner joins p2 and p0.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -46,6 +51,9 @@ class MeshArrays:
     # Vertex ids of every n-gon's outline in loop order, one polygon after
     # another; an n-gon triangle's column 3 says where its polygon starts.
     ngon_corners: np.ndarray = None
+    # Triangles that use one vertex twice (a corrupt face such as (0, 1, 1, 2)):
+    # zero area, so never rasterised; counted for the user message only.
+    degenerate_triangles: int = 0
 
     @property
     def triangle_count(self) -> int:
@@ -71,21 +79,224 @@ def _read(collection, attr: str, count: int, dtype, width: int = 1) -> np.ndarra
     return out if width == 1 else out.reshape(count, width)
 
 
+def _read_attribute(mesh, name: str, prop: str, count: int, dtype, width: int = 1):
+    """A generic attribute array read through ``mesh.attributes`` (a raw
+    memcpy: ~10x faster than ``vertices.co`` / ``loops.vertex_index``, which
+    go through RNA per element). None when the attribute is missing."""
+    attribute = mesh.attributes.get(name)
+    if attribute is None:
+        return None
+    out = np.empty(count * width, dtype=dtype)
+    if count:
+        attribute.data.foreach_get(prop, out)
+    return out if width == 1 else out.reshape(count, width)
+
+
+def read_positions(mesh) -> np.ndarray:
+    """(V, 3) float32 vertex positions."""
+    count = len(mesh.vertices)
+    out = _read_attribute(mesh, "position", "vector", count, np.float32, 3)
+    return out if out is not None else _read(mesh.vertices, "co", count, np.float32, 3)
+
+
+def read_corner_verts(mesh) -> np.ndarray:
+    """(L,) int32 vertex of each face corner (loop)."""
+    count = len(mesh.loops)
+    out = _read_attribute(mesh, ".corner_vert", "value", count, np.int32)
+    return out if out is not None else _read(mesh.loops, "vertex_index", count, np.int32)
+
+
+def read_face_offsets(mesh) -> np.ndarray:
+    """(P + 1,) int32 face offsets: face i owns corners offsets[i]:offsets[i+1].
+
+    Blender stores faces as offsets into the corner arrays, so the sizes come
+    from ``loop_triangle_polygons`` (a raw int array, a face of n corners has
+    n - 2 triangles) with one bincount, ~6x cheaper than reading
+    ``polygons.loop_start``. The RNA read is the fallback if the counts do not
+    add up (they always should)."""
+    face_count = len(mesh.polygons)
+    corner_count = len(mesh.loops)
+    offsets = np.empty(face_count + 1, dtype=np.int32)
+    offsets[0] = 0
+    tri_count = corner_count - 2 * face_count
+    tri_polygons = mesh.loop_triangle_polygons
+    if face_count and len(tri_polygons) == tri_count:
+        tri_faces = _read(tri_polygons, "value", tri_count, np.int32)
+        sizes = np.bincount(tri_faces, minlength=face_count)
+        if len(sizes) == face_count:
+            sizes += 2
+            np.cumsum(sizes, out=offsets[1:])
+            if offsets[-1] == corner_count:
+                return offsets
+    offsets[:-1] = _read(mesh.polygons, "loop_start", face_count, np.int32)
+    offsets[-1] = corner_count
+    return offsets
+
+
 def read_mesh(mesh) -> dict[str, np.ndarray]:
-    """Bulk-read the raw topology of a Blender mesh (evaluated or not)."""
-    vertex_count = len(mesh.vertices)
-    loop_count = len(mesh.loops)
-    polygon_count = len(mesh.polygons)
+    """Bulk-read a Blender mesh with Blender's triangles (``loop_triangles``):
+    the input of :func:`build_arrays` (the reference path)."""
+    offsets = read_face_offsets(mesh)
     loop_tris = mesh.loop_triangles  # computed lazily by Blender and cached on the mesh
     tri_count = len(loop_tris)
     return {
-        "positions": _read(mesh.vertices, "co", vertex_count, np.float32, 3),
-        "corner_vert": _read(mesh.loops, "vertex_index", loop_count, np.int32),
-        "loop_start": _read(mesh.polygons, "loop_start", polygon_count, np.int32),
-        "loop_total": _read(mesh.polygons, "loop_total", polygon_count, np.int32),
+        "positions": read_positions(mesh),
+        "corner_vert": read_corner_verts(mesh),
+        "loop_start": offsets[:-1],
+        "loop_total": np.diff(offsets),
         "tri_loops": _read(loop_tris, "loops", tri_count, np.int32, 3),
         "tri_polygons": _read(mesh.loop_triangle_polygons, "value", tri_count, np.int32),
     }
+
+
+def _check_vertex_count(positions: np.ndarray) -> None:
+    if positions.shape[0] >= MAX_VERTICES:
+        raise ExtractError(f"mesh has {positions.shape[0]:,} vertices; SolidWire draws at most {MAX_VERTICES - 1:,} per mesh")
+
+
+def _triangles_from_loops(tri_loops, tri_polygons, loop_start, loop_total, corner_vert):
+    """Blender triangles (corner ids) -> (triangles (T, 4) int32, real (3, T)
+    bool, is_quad (T,) bool), quads rotated so the diagonal is edge 2.
+
+    Column-wise int32 arithmetic: no int64 casts, no modulo, no fancy row
+    re-ordering (each ``np.where`` is one pass over a column)."""
+    a0, a1, a2 = (np.ascontiguousarray(tri_loops[:, k]) for k in range(3))
+    start = loop_start[tri_polygons]
+    total = loop_total[tri_polygons]
+    end = start + total
+
+    def next_corner(x):  # the next corner in the polygon's cycle
+        y = x + 1
+        return np.where(y == end, start, y)
+
+    n0, n1, n2 = next_corner(a0), next_corner(a1), next_corner(a2)
+    # Edge k joins corners k and k+1 (mod 3); it is a real polygon edge when
+    # the two corners are neighbours in the polygon's cycle.
+    r0 = (a1 == n0) | (a0 == n1)
+    r1 = (a2 == n1) | (a1 == n2)
+    r2 = (a0 == n2) | (a2 == n0)
+
+    # Quads: rotate (never reflect: winding is kept) so the diagonal is edge 2.
+    is_quad = total == 4
+    d0 = is_quad & ~r0
+    d1 = is_quad & ~r1
+
+    def rotate(x0, x1, x2):
+        return (
+            np.where(d0, x1, np.where(d1, x2, x0)),
+            np.where(d0, x2, np.where(d1, x0, x1)),
+            np.where(d0, x0, np.where(d1, x1, x2)),
+        )
+
+    a0, a1, a2 = rotate(a0, a1, a2)
+    r0, r1, r2 = rotate(r0, r1, r2)
+    # A quad's 4th corner is the one its triangle does not use (corner ranks
+    # within the quad sum to 0+1+2+3 = 6).
+    fourth = np.where(is_quad, start + 6 - ((a0 - start) + (a1 - start) + (a2 - start)), a0)
+
+    triangles = np.empty((len(a0), 4), dtype=np.int32)
+    for k, loops in enumerate((a0, a1, a2, fourth)):
+        triangles[:, k] = corner_vert[loops]
+    return triangles, np.stack([r0, r1, r2]), is_quad
+
+
+def _edge_flags(real, is_quad) -> np.ndarray:
+    flags = real[0].astype(np.int32)
+    flags += real[1] * EDGE1_REAL
+    flags += real[2] * EDGE2_REAL
+    flags += is_quad * HAS_QUAD_CORNER
+    return flags
+
+
+def _pack_ngons(tri_ids, real, tri_polygons, loop_start, loop_total, corner_vert):
+    """N-gons: the fragment stage walks the polygon's whole outline and all of
+    its diagonals (see solidwire_frag.glsl), so pack, per n-gon with triangles
+    here, a block of n outline ids (loop order) followed by its n - 3
+    diagonals as id pairs. Returns (ngon_corners, the block start of each
+    given triangle's polygon). ``tri_ids`` (N, 3), ``real`` (N, 3) and
+    ``tri_polygons`` (N,) are the n-gon triangles only."""
+    ngon_polys = np.unique(tri_polygons)
+    sizes = loop_total[ngon_polys].astype(np.int64)
+    block = 3 * sizes - 6
+    offsets = np.cumsum(block) - block
+    ngon_corners = np.zeros(int(block.sum()), dtype=np.int32)
+    rank_in_outline = np.arange(sizes.sum()) - np.repeat(np.cumsum(sizes) - sizes, sizes)
+    outline_loops = np.repeat(loop_start[ngon_polys].astype(np.int64), sizes) + rank_in_outline
+    ngon_corners[np.repeat(offsets, sizes) + rank_in_outline] = corner_vert[outline_loops]
+    # Diagonals default to a degenerate pair (a point: no edge) so a
+    # triangulation that yields fewer than n - 3 still fills the block.
+    diag_slots = np.repeat(offsets + sizes, 2 * (sizes - 3)) + (
+        np.arange(2 * (sizes - 3).sum()) - np.repeat(np.cumsum(2 * (sizes - 3)) - 2 * (sizes - 3), 2 * (sizes - 3))
+    )
+    ngon_corners[diag_slots] = np.repeat(corner_vert[loop_start[ngon_polys]], 2 * (sizes - 3))
+    pairs = np.stack([tri_ids, np.roll(tri_ids, -1, axis=1)], axis=2)[~real]  # (D, 2)
+    pair_poly = np.repeat(tri_polygons, (~real).sum(axis=1))
+    diag = np.unique(np.column_stack([pair_poly, pairs.min(axis=1), pairs.max(axis=1)]), axis=0)
+    poly_rank = np.searchsorted(ngon_polys, diag[:, 0])
+    first_of_poly = np.searchsorted(diag[:, 0], diag[:, 0], side="left")
+    rank = np.arange(len(diag)) - first_of_poly
+    ok = rank < sizes[poly_rank] - 3
+    slot = offsets[poly_rank] + sizes[poly_rank] + 2 * rank
+    ngon_corners[slot[ok]] = diag[ok, 1]
+    ngon_corners[slot[ok] + 1] = diag[ok, 2]
+    return ngon_corners, offsets[np.searchsorted(ngon_polys, tri_polygons)]
+
+
+def _recentre(positions: np.ndarray, finite_vertex: np.ndarray | None, columns: np.ndarray | None = None):
+    """(local float32, centre, bounds_min, bounds_max); ``finite_vertex`` None
+    means every vertex is finite. min/max are exact in float32, so only the
+    subtraction needs float64."""
+    if finite_vertex is None:
+        if len(positions):
+            # Reductions over an (N, 3) array's short axis are slow in numpy:
+            # reduce each contiguous column of the transposed copy instead.
+            columns = np.ascontiguousarray(positions.T) if columns is None else columns
+            bounds_min = np.array([c.min() for c in columns], dtype=np.float64)
+            bounds_max = np.array([c.max() for c in columns], dtype=np.float64)
+        else:
+            bounds_min = bounds_max = np.zeros(3)
+        centre = 0.5 * (bounds_min + bounds_max)
+        # float64 subtraction, cast straight into the float32 result (no
+        # (N, 3) float64 temporary).
+        local = np.empty_like(positions)
+        np.subtract(positions, centre, out=local, dtype=np.float64, casting="unsafe")
+        return local, centre, bounds_min, bounds_max
+    if not finite_vertex.any():
+        zero = np.zeros(3)
+        return np.zeros_like(positions), zero, zero.copy(), zero.copy()
+    pos64 = positions.astype(np.float64)
+    bounds_min = pos64[finite_vertex].min(axis=0)
+    bounds_max = pos64[finite_vertex].max(axis=0)
+    centre = 0.5 * (bounds_min + bounds_max)
+    local = np.where(finite_vertex[:, None], pos64 - centre, 0.0).astype(np.float32)
+    return local, centre, bounds_min, bounds_max
+
+
+def _finite_vertices(positions: np.ndarray) -> np.ndarray | None:
+    """None when every vertex is finite, else the per-vertex mask. One
+    contiguous sum answers the common case (NaN/Inf propagate; a sum that
+    overflows only sends us to the exact check)."""
+    if np.isfinite(positions.sum(dtype=np.float64)):
+        return None
+    finite = np.isfinite(positions).all(axis=1)
+    return None if finite.all() else finite
+
+
+def _finite_faces(finite_vertex: np.ndarray, corner_vert: np.ndarray, loop_start: np.ndarray) -> np.ndarray:
+    """Per face: True when every corner's vertex is finite."""
+    ok = np.ones(len(loop_start), dtype=bool)
+    bad_corners = np.flatnonzero(~finite_vertex[corner_vert])
+    if len(bad_corners):
+        order = np.argsort(loop_start, kind="stable")
+        # The face of a corner: the last face starting at or before it.
+        ok[order[np.searchsorted(loop_start[order], bad_corners, side="right") - 1]] = False
+    return ok
+
+
+def _degenerate_count(triangles: np.ndarray) -> int:
+    """Triangles that use one vertex twice (corrupt faces such as (0, 1, 1, 2))."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    return int(np.count_nonzero((a == b) | (b == c) | (c == a)))
 
 
 def build_arrays(
@@ -96,104 +307,288 @@ def build_arrays(
     tri_loops: np.ndarray,
     tri_polygons: np.ndarray,
 ) -> MeshArrays:
-    """Pure-numpy part of extraction (testable without Blender)."""
+    """Pure-numpy part of extraction from Blender's own triangles (testable
+    without Blender; the reference for :func:`build_arrays_fast`)."""
     positions = np.asarray(positions, dtype=np.float32).reshape(-1, 3)
-    if positions.shape[0] >= MAX_VERTICES:
-        raise ExtractError(f"mesh has {positions.shape[0]:,} vertices; SolidWire draws at most {MAX_VERTICES - 1:,} per mesh")
-    tri_loops = np.asarray(tri_loops, dtype=np.int64).reshape(-1, 3)
+    _check_vertex_count(positions)
+    corner_vert = np.asarray(corner_vert, dtype=np.int32)
+    loop_start = np.asarray(loop_start, dtype=np.int32)
+    loop_total = np.asarray(loop_total, dtype=np.int32)
+    tri_loops = np.asarray(tri_loops, dtype=np.int32).reshape(-1, 3)
     tri_polygons = np.asarray(tri_polygons, dtype=np.int32)
 
-    # A vertex at NaN/Inf cannot be projected: drop the triangles that use it
-    # (and keep its bounds out of the centre) rather than poison the image.
-    finite_vertex = np.isfinite(positions).all(axis=1)
+    # A vertex at NaN/Inf cannot be projected: drop every triangle of each
+    # face that uses it (the whole face: a kept triangle of it would draw
+    # edges to a corner that has no position) and keep its bounds out of the
+    # centre, rather than poison the image.
+    finite_vertex = _finite_vertices(positions)
     dropped = 0
-    if not finite_vertex.all():
-        keep = finite_vertex[np.asarray(corner_vert)[tri_loops]].all(axis=1)
+    if finite_vertex is not None:
+        keep = _finite_faces(finite_vertex, corner_vert, loop_start)[tri_polygons]
         dropped = int((~keep).sum())
         tri_loops, tri_polygons = tri_loops[keep], tri_polygons[keep]
 
-    start = loop_start[tri_polygons].astype(np.int64)[:, None]
-    total = loop_total[tri_polygons].astype(np.int64)[:, None]
+    triangles, real, is_quad = _triangles_from_loops(tri_loops, tri_polygons, loop_start, loop_total, corner_vert)
+    flags = _edge_flags(real, is_quad)
 
-    # Edge k of a triangle joins corner k and corner k+1 (mod 3). It is a real
-    # polygon edge when the two loops are neighbours in the polygon's cycle.
-    a = tri_loops
-    b = np.roll(tri_loops, -1, axis=1)
-    next_of_a = start + (a - start + 1) % total
-    next_of_b = start + (b - start + 1) % total
-    real = (b == next_of_a) | (a == next_of_b)  # (T, 3) bool
-
-    # Quads: rotate the corners so the diagonal is edge 2, then the 4th
-    # corner is the polygon's one loop this triangle does not use.
-    is_quad = total[:, 0] == 4
-    diag_at_0 = is_quad & ~real[:, 0]
-    diag_at_1 = is_quad & ~real[:, 1]
-    order = np.tile(np.arange(3), (len(a), 1))
-    order[diag_at_0] = (1, 2, 0)
-    order[diag_at_1] = (2, 0, 1)
-    rows = np.arange(len(a))[:, None]
-    tri_loops = tri_loops[rows, order]
-    real = real[rows, order]
-    fourth_loop = 4 * start[:, 0] + 6 - tri_loops.sum(axis=1)
-    fourth_loop = np.where(is_quad, fourth_loop, tri_loops[:, 0])
-
-    triangles = np.empty((len(a), 4), dtype=np.int32)
-    triangles[:, :3] = corner_vert[tri_loops]
-    triangles[:, 3] = corner_vert[fourth_loop]
-
-    flags = (
-        real[:, 0] * EDGE0_REAL + real[:, 1] * EDGE1_REAL + real[:, 2] * EDGE2_REAL + is_quad * HAS_QUAD_CORNER
-    ).astype(np.int32)
-
-    # N-gons: the fragment stage walks the polygon's whole outline and all of
-    # its diagonals (see solidwire_frag.glsl), so pack, per n-gon with
-    # triangles here, a block of n outline ids (loop order) followed by its
-    # n - 3 diagonals as id pairs. Column 3 of an n-gon triangle says where
-    # its polygon's block starts.
     ngon_corners = np.zeros(0, dtype=np.int32)
-    is_ngon_tri = total[:, 0] > 4
+    is_ngon_tri = loop_total[tri_polygons] > 4
     if is_ngon_tri.any():
-        corner_vert = np.asarray(corner_vert)
-        ngon_polys = np.unique(tri_polygons[is_ngon_tri])
-        sizes = loop_total[ngon_polys].astype(np.int64)
-        block = 3 * sizes - 6
-        offsets = np.cumsum(block) - block
-        ngon_corners = np.zeros(int(block.sum()), dtype=np.int32)
-        rank_in_outline = np.arange(sizes.sum()) - np.repeat(np.cumsum(sizes) - sizes, sizes)
-        outline_loops = np.repeat(loop_start[ngon_polys].astype(np.int64), sizes) + rank_in_outline
-        ngon_corners[np.repeat(offsets, sizes) + rank_in_outline] = corner_vert[outline_loops]
-        # Diagonals default to a degenerate pair (a point: no edge) so a
-        # triangulation that yields fewer than n - 3 still fills the block.
-        diag_slots = np.repeat(offsets + sizes, 2 * (sizes - 3)) + (
-            np.arange(2 * (sizes - 3).sum()) - np.repeat(np.cumsum(2 * (sizes - 3)) - 2 * (sizes - 3), 2 * (sizes - 3))
+        ngon_corners, block_start = _pack_ngons(
+            triangles[is_ngon_tri, :3], real[:, is_ngon_tri].T, tri_polygons[is_ngon_tri], loop_start, loop_total, corner_vert
         )
-        ngon_corners[diag_slots] = np.repeat(corner_vert[loop_start[ngon_polys]], 2 * (sizes - 3))
-        tri_ids = triangles[is_ngon_tri, :3]
-        pairs = np.stack([tri_ids, np.roll(tri_ids, -1, axis=1)], axis=2)[~real[is_ngon_tri]]  # (D, 2)
-        pair_poly = np.repeat(tri_polygons[is_ngon_tri], (~real[is_ngon_tri]).sum(axis=1))
-        diag = np.unique(np.column_stack([pair_poly, pairs.min(axis=1), pairs.max(axis=1)]), axis=0)
-        poly_rank = np.searchsorted(ngon_polys, diag[:, 0])
-        first_of_poly = np.searchsorted(diag[:, 0], diag[:, 0], side="left")
-        rank = np.arange(len(diag)) - first_of_poly
-        ok = rank < sizes[poly_rank] - 3
-        slot = offsets[poly_rank] + sizes[poly_rank] + 2 * rank
-        ngon_corners[slot[ok]] = diag[ok, 1]
-        ngon_corners[slot[ok] + 1] = diag[ok, 2]
-        triangles[is_ngon_tri, 3] = offsets[np.searchsorted(ngon_polys, tri_polygons[is_ngon_tri])]
-        flags[is_ngon_tri] |= IS_NGON | (total[is_ngon_tri, 0] << NGON_SHIFT).astype(np.int32)
+        triangles[is_ngon_tri, 3] = block_start
+        flags[is_ngon_tri] |= IS_NGON | (loop_total[tri_polygons[is_ngon_tri]] << NGON_SHIFT)
 
-    if finite_vertex.any():
-        pos64 = positions.astype(np.float64)
-        bounds_min = pos64[finite_vertex].min(axis=0)
-        bounds_max = pos64[finite_vertex].max(axis=0)
-        centre = 0.5 * (bounds_min + bounds_max)
-        local = np.where(finite_vertex[:, None], pos64 - centre, 0.0).astype(np.float32)
+    local, centre, bounds_min, bounds_max = _recentre(positions, finite_vertex)
+    return MeshArrays(
+        local, centre, triangles, flags, tri_polygons.copy(), bounds_min, bounds_max, dropped, ngon_corners,
+        degenerate_triangles=_degenerate_count(triangles),
+    )
+
+
+# ---------------------------------------------------------------------------
+# Fast path: Blender's quad split rule in numpy.
+
+# A quad is "undecided" when |dot| of the flip test is below this fraction of
+# its magnitude: there float32 rounding (or a compiler's FMA contraction in
+# Blender's build) could tip Blender's answer either way, so Blender is asked.
+# Exactly degenerate quads (zero-area halves, dot == 0) land here too.
+QUAD_UNDECIDED = 1.0e-5
+# Above this many triangles to ask Blender about, one bulk read of all of
+# ``loop_triangles`` is cheaper than reading them one by one.
+BLENDER_TRIS_ONE_BY_ONE = 4096
+
+
+def quad_flip(positions: np.ndarray, quads: np.ndarray, columns: np.ndarray | None = None):
+    """Blender's quad split test for (Q, 4) vertex ids: (flip, undecided).
+
+    Blender (``mesh_calc_tessellation_for_face_impl``, mesh_tessellate.cc)
+    splits quad (0, 1, 2, 3) into (0, 1, 2) + (0, 2, 3), unless
+    ``is_quad_flip_v3_first_third_fast`` says corners 1 and 3 lie on the same
+    side of diagonal 0-2 (the quad folds over it), then (0, 1, 3) + (1, 2, 3):
+
+        d12 = v2 - v1; d13 = v3 - v1; d14 = v4 - v1
+        flip = dot(cross(d12, d13), cross(d14, d13)) > 0
+
+    evaluated here in float32 in the same operation order, so the answer is
+    bit-identical wherever Blender's build does not contract to FMA; quads
+    within QUAD_UNDECIDED of the threshold are flagged for Blender to settle.
+    ``columns`` is ``positions.T`` made contiguous (1-D gathers per axis are
+    several times faster than gathering (N, 3) rows)."""
+    with np.errstate(invalid="ignore", over="ignore"):  # NaN/Inf vertices: see build_arrays
+        return _quad_flip(positions, quads, columns)
+
+
+def _quad_flip(positions, quads, columns):
+    if columns is None:
+        columns = np.ascontiguousarray(np.asarray(positions, dtype=np.float32).T)
+    i1, i2, i3, i4 = (np.ascontiguousarray(quads[:, k]) for k in range(4))
+    d12, d13, d14 = [], [], []
+    for axis in columns:
+        v1 = axis.take(i1)
+        d12.append(axis.take(i2) - v1)
+        d13.append(axis.take(i3) - v1)
+        d14.append(axis.take(i4) - v1)
+    x12, y12, z12 = d12
+    x13, y13, z13 = d13
+    x14, y14, z14 = d14
+    # cross_v3_v3v3(r, a, b): r = (a1 b2 - a2 b1, a2 b0 - a0 b2, a0 b1 - a1 b0)
+    ax = y12 * z13 - z12 * y13
+    ay = z12 * x13 - x12 * z13
+    az = x12 * y13 - y12 * x13
+    bx = y14 * z13 - z14 * y13
+    by = z14 * x13 - x14 * z13
+    bz = x14 * y13 - y14 * x13
+    dot = ax * bx
+    dot += ay * by  # dot_v3v3: left to right
+    dot += az * bz
+    flip = dot > np.float32(0.0)
+    # Undecided: |dot| <= eps |d12| |d13|^2 |d14|, the size of its products.
+    n12 = x12 * x12 + y12 * y12 + z12 * z12
+    n14 = x14 * x14 + y14 * y14 + z14 * z14
+    n13 = x13 * x13 + y13 * y13 + z13 * z13
+    n12 *= n14
+    np.sqrt(n12, out=n12)
+    n12 *= n13
+    n12 *= np.float32(QUAD_UNDECIDED)
+    undecided = np.abs(dot) <= n12
+    return flip, undecided
+
+
+def build_arrays_fast(
+    positions: np.ndarray,
+    corner_vert: np.ndarray,
+    face_offsets: np.ndarray,
+    blender_tris: Callable[[np.ndarray], np.ndarray] | None = None,
+) -> MeshArrays:
+    """Same result as :func:`build_arrays` on Blender's triangles, with tris
+    and quads triangulated here.
+
+    ``blender_tris(tri_indices) -> (N, 3) corner ids`` returns Blender's own
+    triangles by index; it is asked for n-gon triangles and undecided quads
+    only (and is only needed when the mesh has those)."""
+    positions = np.asarray(positions, dtype=np.float32).reshape(-1, 3)
+    _check_vertex_count(positions)
+    corner_vert = np.asarray(corner_vert, dtype=np.int32)
+    offsets = np.asarray(face_offsets, dtype=np.int32)
+    face_count = len(offsets) - 1
+    sizes = np.diff(offsets)
+    loop_start = offsets[:-1]
+    # Blender stores a face's triangles at poly_to_tri_count(i, start) = start - 2 i.
+    tri_start = loop_start - 2 * np.arange(face_count, dtype=np.int32)
+    tri_count = int(offsets[-1]) - 2 * face_count
+
+    def ask_blender(tri_indices):
+        if blender_tris is None:
+            raise ValueError("this mesh needs Blender's triangulation (n-gons or undecided quads)")
+        return np.asarray(blender_tris(tri_indices), dtype=np.int32).reshape(-1, 3)
+
+    finite_vertex = _finite_vertices(positions)
+    all_quads = face_count > 0 and tri_count == 2 * face_count and int(sizes.min()) == 4
+    if all_quads:
+        quad_faces = None
+        quads = corner_vert.reshape(face_count, 4)
+        quad_loop_start, quad_tri_start = loop_start, tri_start
     else:
-        bounds_min = bounds_max = centre = np.zeros(3)
-        local = np.zeros_like(positions)
-    return MeshArrays(local, centre, triangles, flags, tri_polygons.copy(), bounds_min, bounds_max, dropped, ngon_corners)
+        quad_faces = np.flatnonzero(sizes == 4)
+        quad_loop_start = loop_start[quad_faces]
+        quad_tri_start = tri_start[quad_faces]
+        quads = corner_vert[quad_loop_start[:, None] + np.arange(4, dtype=np.int32)]
+    tri_faces = None if all_quads else np.flatnonzero(sizes == 3)
+    ngon_faces = None if all_quads else np.flatnonzero(sizes > 4)
+
+    columns = np.ascontiguousarray(positions.T)  # (3, V): see quad_flip
+    flip, undecided = quad_flip(positions, quads, columns) if len(quads) else (np.zeros(0, bool), np.zeros(0, bool))
+    undecided = np.flatnonzero(undecided)
+    if len(undecided):
+        # Blender's first triangle of a flipped quad is (0, 1, 3).
+        first = ask_blender(quad_tri_start[undecided])
+        flip[undecided] = first[:, 2] == quad_loop_start[undecided] + 3
+
+    if finite_vertex is not None:
+        # Rare: hand the full triangle list to the reference path, which
+        # drops triangles with non-finite corners and repacks n-gons.
+        tri_loops = np.empty((tri_count, 3), dtype=np.int32)
+        ql = quad_loop_start[:, None] + np.where(flip[:, None], [[0, 1, 3]], [[0, 1, 2]]).astype(np.int32)
+        tri_loops[quad_tri_start] = ql
+        tri_loops[quad_tri_start + 1] = quad_loop_start[:, None] + np.where(flip[:, None], [[1, 2, 3]], [[0, 2, 3]]).astype(np.int32)
+        if tri_faces is not None and len(tri_faces):
+            tri_loops[tri_start[tri_faces]] = loop_start[tri_faces, None] + np.arange(3, dtype=np.int32)
+        if ngon_faces is not None and len(ngon_faces):
+            rows = _ngon_tri_rows(tri_start, sizes, ngon_faces)
+            tri_loops[rows] = ask_blender(rows)
+        tri_polygons = np.repeat(np.arange(face_count, dtype=np.int32), sizes - 2)
+        return build_arrays(positions, corner_vert, loop_start, sizes, tri_loops, tri_polygons)
+
+    triangles = np.empty((tri_count, 4), dtype=np.int32)
+    flags = np.empty(tri_count, dtype=np.int32)
+    # Quad rows, diagonal as edge 2 and the 4th corner in column 3 (what
+    # build_arrays' rotation gives for Blender's triangles):
+    #   not flipped: (0, 1, 2 | 3) and (2, 3, 0 | 1)
+    #   flipped:     (3, 0, 1 | 2) and (1, 2, 3 | 0)
+    q = [quads[:, k] for k in range(4)]
+    order_first = ((0, 1, 2, 3), (3, 0, 1, 2))  # (not flipped, flipped)
+    order_second = ((2, 3, 0, 1), (1, 2, 3, 0))
+
+    def fill_quad_rows(rows_first, rows_second):
+        # One np.where per output column: no (Q, 4) temporaries.
+        for k in range(4):
+            rows_first[:, k] = np.where(flip, q[order_first[1][k]], q[order_first[0][k]])
+            rows_second[:, k] = np.where(flip, q[order_second[1][k]], q[order_second[0][k]])
+
+    quad_flags = EDGE0_REAL | EDGE1_REAL | HAS_QUAD_CORNER
+    if all_quads:
+        pairs = triangles.reshape(face_count, 2, 4)
+        fill_quad_rows(pairs[:, 0], pairs[:, 1])
+        flags[:] = quad_flags
+        tri_polygons = np.repeat(np.arange(face_count, dtype=np.int32), 2)
+        ngon_corners = np.zeros(0, dtype=np.int32)
+    else:
+        first_rows = np.empty((len(quads), 4), dtype=np.int32)
+        second_rows = np.empty((len(quads), 4), dtype=np.int32)
+        fill_quad_rows(first_rows, second_rows)
+        triangles[quad_tri_start] = first_rows
+        triangles[quad_tri_start + 1] = second_rows
+        flags[quad_tri_start] = quad_flags
+        flags[quad_tri_start + 1] = quad_flags
+        tri_polygons = np.repeat(np.arange(face_count, dtype=np.int32), sizes - 2)
+        if len(tri_faces):
+            rows = tri_start[tri_faces]
+            corners = corner_vert[loop_start[tri_faces, None] + np.arange(3, dtype=np.int32)]
+            triangles[rows, :3] = corners
+            triangles[rows, 3] = corners[:, 0]
+            flags[rows] = EDGE0_REAL | EDGE1_REAL | EDGE2_REAL
+        ngon_corners = np.zeros(0, dtype=np.int32)
+        if len(ngon_faces):
+            rows = _ngon_tri_rows(tri_start, sizes, ngon_faces)
+            polys = tri_polygons[rows]
+            ngon_tris, real, is_quad = _triangles_from_loops(ask_blender(rows), polys, loop_start, sizes, corner_vert)
+            ngon_flags = _edge_flags(real, is_quad)
+            ngon_corners, block_start = _pack_ngons(ngon_tris[:, :3], real.T, polys, loop_start, sizes, corner_vert)
+            ngon_tris[:, 3] = block_start
+            ngon_flags |= IS_NGON | (sizes[polys] << NGON_SHIFT)
+            triangles[rows] = ngon_tris
+            flags[rows] = ngon_flags
+
+    local, centre, bounds_min, bounds_max = _recentre(positions, None, columns)
+    return MeshArrays(
+        local, centre, triangles, flags, tri_polygons, bounds_min, bounds_max, 0, ngon_corners, degenerate_triangles=_degenerate_count(triangles)
+    )
 
 
-def extract_mesh(mesh) -> MeshArrays:
-    """Evaluated Blender mesh -> :class:`MeshArrays`."""
+def _ngon_tri_rows(tri_start, sizes, ngon_faces) -> np.ndarray:
+    """Indices of every triangle of the given faces (in Blender's order)."""
+    counts = sizes[ngon_faces] - 2
+    first = np.repeat(tri_start[ngon_faces], counts)
+    rank = np.arange(int(counts.sum()), dtype=np.int32) - np.repeat(np.cumsum(counts) - counts, counts).astype(np.int32)
+    return first + rank
+
+
+def blender_triangles(mesh) -> Callable[[np.ndarray], np.ndarray]:
+    """``tri_indices -> (N, 3) corner ids`` of Blender's own ``loop_triangles``:
+    one by one for a few, one bulk read for many."""
+    cache = {}
+
+    def lookup(tri_indices: np.ndarray) -> np.ndarray:
+        tri_indices = np.asarray(tri_indices)
+        loop_tris = mesh.loop_triangles
+        if "all" in cache or len(tri_indices) > BLENDER_TRIS_ONE_BY_ONE:
+            if "all" not in cache:
+                cache["all"] = _read(loop_tris, "loops", len(loop_tris), np.int32, 3)
+            return cache["all"][tri_indices]
+        out = np.empty((len(tri_indices), 3), dtype=np.int32)
+        for row, index in enumerate(tri_indices.tolist()):  # few: see BLENDER_TRIS_ONE_BY_ONE
+            out[row] = loop_tris[index].loops
+        return out
+
+    return lookup
+
+
+def read_mesh_fast(mesh) -> dict:
+    """Bulk-read a mesh for :func:`build_arrays_fast` (no triangle reads)."""
+    return {
+        "positions": read_positions(mesh),
+        "corner_vert": read_corner_verts(mesh),
+        "face_offsets": read_face_offsets(mesh),
+        "blender_tris": blender_triangles(mesh),
+    }
+
+
+def extract_mesh(mesh, *, positions=None, corner_vert=None) -> MeshArrays:
+    """Evaluated Blender mesh -> :class:`MeshArrays` (fast path).
+
+    ``positions`` / ``corner_vert`` may be passed when the caller has just
+    read them (the GPU cache reads them for its change fingerprint)."""
+    data = read_mesh_fast(mesh) if positions is None else {
+        "positions": positions,
+        "corner_vert": corner_vert if corner_vert is not None else read_corner_verts(mesh),
+        "face_offsets": read_face_offsets(mesh),
+        "blender_tris": blender_triangles(mesh),
+    }
+    return build_arrays_fast(**data)
+
+
+def extract_mesh_naive(mesh) -> MeshArrays:
+    """The reference path: Blender's ``loop_triangles`` for every face."""
     return build_arrays(**read_mesh(mesh))

@@ -1,68 +1,258 @@
 """Scene -> draw items: walk the evaluated depsgraph's object instances, get
-each drawn mesh from the GPU cache (extracting it only when the cache does
-not have it) and pair it with its instance matrix."""
+each drawn mesh from the GPU cache (extracting it only when it is new or its
+evaluated geometry changed) and pair it with its instance matrix.
+
+Cache keys say *which* mesh, stably across depsgraphs, undo and frames, and
+never hold Blender data (see cache.MeshCache for *whether* it is still valid):
+
+* ``(mode, "mesh", mesh uid)``: an object drawn with its mesh datablock as is
+  (no modifiers, no shape keys): every linked duplicate and every collection
+  instance of such objects shares this one upload;
+* ``(mode, "object", object uid)``: an object whose own evaluation made its
+  geometry (modifiers, shape keys, Edit Mode);
+* ``(mode, "instances", parent uid, n)``: the n-th distinct mesh that a
+  geometry-nodes object instances (its instances of one geometry share it).
+
+``mode`` is the depsgraph's (viewport and render levels differ).
+"""
 
 from __future__ import annotations
 
 import time
+import zlib
 
 import numpy as np
 
-from . import extract
+from . import extract, runtime
 from .cache import MeshCache
-from .draw import DrawItem
+from .draw import DrawItem, outside_frustum_many
 from .log import warn_once
 
 
-def mesh_key(obj_eval):
-    """Cache key of an evaluated object's mesh.
+class SeenKeys(set):
+    """The keys a frame drew, plus the scope (depsgraph mode) they cover."""
 
-    Instances of one evaluated mesh share the same pointer, so linked
-    duplicates and instances share one upload. The pointer is only trusted
-    within one evaluation: callers drop keys the depsgraph reports as updated
-    (see cache invalidation in the targets)."""
+    scope: tuple | None = None
+
+
+def mesh_key(obj_eval):
+    """Pointer of an evaluated object's mesh: shared by the instances of one
+    evaluated mesh within one evaluation (kept for callers of the old API)."""
     return obj_eval.data.as_pointer()
 
 
-def gather(depsgraph, cache: MeshCache, *, object_filter=None):
-    """(items, timing) for every drawn mesh instance of ``depsgraph``.
+def _is_plain(obj_orig) -> bool:
+    """Its evaluated mesh is its mesh datablock as is (shared by duplicates)."""
+    data = obj_orig.data
+    return (
+        len(obj_orig.modifiers) == 0
+        and getattr(data, "shape_keys", None) is None
+        and obj_orig.mode != "EDIT"
+    )
+
+
+def fingerprint(mesh):
+    """(fingerprint, (positions, corner_vert)) of a mesh's drawn geometry.
+
+    Counts plus CRC32 of the vertex positions and corner vertices (~4 GB/s),
+    read with the same bulk reads extraction needs, which then reuses them."""
+    positions = extract.read_positions(mesh)
+    corner_vert = extract.read_corner_verts(mesh)
+    content = (
+        len(positions),
+        len(mesh.edges),
+        len(corner_vert),
+        len(mesh.polygons),
+        zlib.crc32(memoryview(positions).cast("B")),
+        zlib.crc32(memoryview(corner_vert).cast("B")),
+    )
+    return content, (positions, corner_vert)
+
+
+def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None):
+    """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
-    (viewport visibility, per-object opt-out) before any extraction."""
+    (viewport visibility, per-object opt-out) before any extraction.
+    ``trust_updates`` (default: viewport depsgraphs) lets an unchanged mesh be
+    recognised by pointer and depsgraph update counters alone; otherwise
+    (renders) a changed pointer is settled by the content fingerprint.
+    With ``view`` (a draw.View), a mesh the cache does not hold yet is not
+    extracted at all while every instance of it lies outside the view
+    frustum (its evaluated bound box against the clip planes); those
+    instances count as culled."""
+    mode = depsgraph.mode
+    if trust_updates is None:
+        trust_updates = mode == "VIEWPORT"
+    depsgraph_id = depsgraph.as_pointer()
+    versions = runtime.geometry_version
+    epoch = runtime.epoch
+
     items: list[DrawItem] = []
-    seen = set()
+    seen = SeenKeys()
+    seen.scope = (mode,)
     ms_extract = 0.0
+    by_pointer: dict[int, object] = {}  # evaluated mesh -> GPUMesh (or None) this frame
+    key_pointer: dict[tuple, int] = {}  # key -> the evaluated mesh it stands for this frame
+    instancer_meshes: dict[int, int] = {}  # geometry-nodes parent uid -> distinct meshes so far
+    view_projection = None if view is None else view.projection @ view.view_matrix
+    deferred: dict[int, tuple] = {}  # culled, never-extracted mesh -> (key, uids, bound box, instances culled)
+
     for instance in depsgraph.object_instances:
         obj = instance.object
         if obj.type != "MESH":
             continue
-        if not instance.is_instance and not instance.show_self:
+        is_instance = instance.is_instance
+        if not is_instance and not instance.show_self:
             continue
-        if object_filter is not None and not object_filter(obj.original):
+        # An instance is as visible as the object that instances it (its
+        # source may well be hidden or in an excluded collection).
+        parent = instance.parent if is_instance else None
+        owner = parent if parent is not None else obj
+        if object_filter is not None and not object_filter(owner.original):
             continue
-        key = mesh_key(obj)
-        seen.add(key)
-
-        def make_arrays(obj=obj):
-            nonlocal ms_extract
-            start = time.perf_counter()
+        data = obj.data
+        pointer = data.as_pointer()
+        if pointer in deferred:
+            key, uids, box, culled = deferred[pointer]
+            if _outside(view_projection, instance, box):
+                deferred[pointer] = (key, uids, box, culled + 1)
+                continue
+            # A visible instance after all: extract now (the earlier ones are
+            # outside the view and stay culled).
+            del deferred[pointer]
+            cache.culled += culled
+            seen.add(key)
+            mesh = None
             try:
-                arrays = extract.extract_mesh(obj.data)
-            except extract.ExtractError as exc:
-                warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
-                return None
-            finally:
-                ms_extract += (time.perf_counter() - start) * 1000.0
-            if arrays.dropped_triangles:
+                mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions)
+                ms_extract += ms
+            except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
+                warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
+            by_pointer[pointer] = mesh
+        if pointer in by_pointer:
+            mesh = by_pointer[pointer]
+        else:
+            mesh = None
+            # Objects without faces are never extracted; in Edit Mode the
+            # evaluated mesh can be an empty wrapper (see get_source below).
+            if len(data.polygons) or obj.original.mode == "EDIT":
+                try:
+                    key, uids = _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes)
+                    if view_projection is not None and key not in cache:
+                        box = _bound_box(obj)
+                        if box is not None and _outside(view_projection, instance, box):
+                            deferred[pointer] = (key, uids, box, 1)
+                            continue
+                    seen.add(key)
+                    mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions)
+                    ms_extract += ms
+                except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
+                    warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
+            elif len(data.vertices):  # (an empty mesh, e.g. a pure instancer's own, says nothing)
                 warn_once(
-                    ("nonfinite", obj.name),
-                    f"SolidWire: object '{obj.name}' has {arrays.dropped_triangles} triangles with "
-                    "non-finite (NaN/Inf) vertices; they are not drawn",
+                    ("nofaces", obj.name),
+                    f"SolidWire: object '{obj.name}' has no faces; nothing to draw "
+                    "(loose edges and vertices are not drawn)",
                 )
-            return arrays
-
-        mesh = cache.get(key, make_arrays)
-        if mesh is None:
-            continue
-        items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64)))
+            by_pointer[pointer] = mesh
+        if mesh is not None:
+            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64)))
+    for _key, _uids, _box, culled in deferred.values():
+        cache.culled += culled  # never extracted: every instance outside the view
     return items, seen, ms_extract
+
+
+def _bound_box(obj):
+    """(lo, hi) of the evaluated object's bound box in its own space, or None
+    when Blender has none for it (then it is not culled before extraction)."""
+    try:
+        corners = np.array(obj.bound_box, dtype=np.float64)
+    except (AttributeError, TypeError, ValueError):
+        return None
+    if corners.shape != (8, 3) or not np.isfinite(corners).all() or not corners.any():
+        return None
+    return corners.min(axis=0), corners.max(axis=0)
+
+
+def _outside(view_projection, instance, box) -> bool:
+    object_to_clip = view_projection @ np.array(instance.matrix_world, dtype=np.float64)
+    return bool(outside_frustum_many(object_to_clip[None], *box)[0])
+
+
+def _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions):
+    trust = (depsgraph_id, epoch) if trust_updates else None
+    return _mesh_for(obj, data, pointer, key, uids, cache, trust, versions)
+
+
+def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
+    """(cache key, session_uids whose geometry updates invalidate it)."""
+    obj_orig = obj.original
+    uids = [obj_orig.session_uid]
+    if parent is not None and parent.original == obj_orig:
+        # Geometry made by a geometry-nodes (or other) instancer: the n-th
+        # distinct mesh it instances this frame.
+        number = instancer_meshes.get(uids[0], 0)
+        instancer_meshes[uids[0]] = number + 1
+        key = (mode, "instances", uids[0], number)
+    elif _is_plain(obj_orig):
+        mesh_uid = obj_orig.data.session_uid
+        uids.append(mesh_uid)
+        key = (mode, "mesh", mesh_uid)
+        if key_pointer.get(key, pointer) != pointer:
+            key = (mode, "object", uids[0])  # not the shared mesh after all
+    else:
+        key = (mode, "object", uids[0])
+    if key_pointer.get(key, pointer) != pointer:
+        key = (*key, pointer)  # never let two different meshes share an entry in one frame
+    key_pointer[key] = pointer
+    return key, uids
+
+
+def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions):
+    """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
+    obj_orig = obj.original
+    fast = None
+    if trust is not None:
+        fast = (*trust, pointer, *(versions.get(uid, 0) for uid in uids))
+
+    in_edit_mode = obj_orig.mode == "EDIT"
+    start = time.perf_counter()
+    upload_before = cache.ms_upload
+    source = []  # made on first use: an unchanged mesh needs no to_mesh()
+
+    def get_source():
+        if not source:
+            # In Edit Mode the evaluated mesh can be an empty wrapper around
+            # the BMesh being edited; to_mesh() gives its current geometry.
+            source.append(obj.to_mesh() if in_edit_mode else data)
+        return source[0]
+
+    def make_arrays(context):
+        positions, corner_vert = context
+        try:
+            arrays = extract.extract_mesh(get_source(), positions=positions, corner_vert=corner_vert)
+        except extract.ExtractError as exc:
+            warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
+            return None
+        if arrays.dropped_triangles:
+            warn_once(
+                ("nonfinite", obj.name),
+                f"SolidWire: object '{obj.name}' has {arrays.dropped_triangles} triangles in faces with "
+                "non-finite (NaN/Inf) vertex coordinates; those faces are not drawn",
+            )
+        if arrays.degenerate_triangles:
+            warn_once(
+                ("degenerate", obj.name),
+                f"SolidWire: object '{obj.name}' has {arrays.degenerate_triangles} degenerate triangles "
+                "(a face uses one vertex twice); they are not drawn (Mesh > Clean Up can fix this)",
+            )
+        return arrays
+
+    try:
+        mesh, _extracted = cache.get_validated(key, fast, lambda: fingerprint(get_source()), make_arrays)
+    finally:
+        if in_edit_mode and source:
+            obj.to_mesh_clear()
+    # Upload time is reported apart (stats "ms_upload").
+    return mesh, (time.perf_counter() - start) * 1000.0 - (cache.ms_upload - upload_before)

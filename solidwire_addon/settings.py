@@ -140,6 +140,102 @@ class SolidWireSettings(bpy.types.PropertyGroup):
         default=_DEFAULTS.use_backface_culling,
         update=redraw_viewports,
     )
+    thickness_mode: EnumProperty(
+        name="Thickness Mode",
+        description="How the line width varies with distance from the camera",
+        items=(
+            ("PIXELS", "Pixels", "The same width in pixels everywhere"),
+            ("WORLD", "World", "A width in scene units: lines thin out with distance, like real wires"),
+            ("DEPTH", "Depth Cue", "Width goes from Thickness at Near to Far Thickness at Far"),
+        ),
+        default=_DEFAULTS.thickness_mode,
+        update=redraw_viewports,
+    )
+    world_thickness: FloatProperty(
+        name="World Thickness",
+        description="Full core width of an interior edge in scene units",
+        default=_DEFAULTS.world_thickness,
+        min=0.0,
+        soft_max=1.0,
+        subtype="DISTANCE",
+        update=redraw_viewports,
+    )
+    thickness_far: FloatProperty(
+        name="Far Thickness",
+        description="Core width at the far end of the depth-cue range, in pixels",
+        default=_DEFAULTS.thickness_far,
+        min=0.0,
+        max=1000.0,
+        soft_max=20.0,
+        subtype="PIXEL",
+        update=redraw_viewports,
+    )
+    thickness_depth_start: FloatProperty(
+        name="Near",
+        description="View depth where the depth cue starts (Thickness before it)",
+        default=_DEFAULTS.thickness_depth_start,
+        min=0.0,
+        subtype="DISTANCE",
+        update=redraw_viewports,
+    )
+    thickness_depth_end: FloatProperty(
+        name="Far",
+        description="View depth where the depth cue ends (Far Thickness beyond it)",
+        default=_DEFAULTS.thickness_depth_end,
+        min=0.0,
+        subtype="DISTANCE",
+        update=redraw_viewports,
+    )
+    use_silhouettes: BoolProperty(
+        name="Full Silhouettes",
+        description=(
+            "Give silhouette and boundary edges their outer half too, so outlines are as wide as "
+            "interior edges (renders; hidden by nearer surfaces)"
+        ),
+        default=_DEFAULTS.use_silhouettes,
+        update=redraw_viewports,
+    )
+    use_hidden_lines: BoolProperty(
+        name="Hidden Lines",
+        description="Also draw edges hidden behind surfaces, dimmed and dashed (technical-drawing style)",
+        default=_DEFAULTS.use_hidden_lines,
+        update=redraw_viewports,
+    )
+    hidden_alpha: FloatProperty(
+        name="Hidden Opacity",
+        description="Opacity of hidden edges relative to the wire",
+        default=_DEFAULTS.hidden_alpha,
+        min=0.0,
+        max=1.0,
+        subtype="FACTOR",
+        update=redraw_viewports,
+    )
+    hidden_period: FloatProperty(
+        name="Hidden Dash Period",
+        description="Length of one dash cycle of hidden edges, in pixels",
+        default=_DEFAULTS.hidden_period,
+        min=1.0,
+        max=1000.0,
+        soft_max=64.0,
+        subtype="PIXEL",
+        update=redraw_viewports,
+    )
+    hidden_duty: FloatProperty(
+        name="Hidden Dash Duty",
+        description="Fraction of each hidden-edge dash cycle that is drawn",
+        default=_DEFAULTS.hidden_duty,
+        min=0.0,
+        max=1.0,
+        subtype="FACTOR",
+        update=redraw_viewports,
+    )
+    # Viewport overlay only (the render draws every renderable mesh).
+    only_selected: BoolProperty(
+        name="Only Selected",
+        description="Draw the viewport overlay on selected objects only",
+        default=False,
+        update=redraw_viewports,
+    )
 
     def snapshot(self) -> DrawSettings:
         return DrawSettings.from_properties(self)
@@ -150,8 +246,17 @@ classes = (SolidWireSettings,)
 
 def register_properties() -> None:
     bpy.types.Scene.solidwire = bpy.props.PointerProperty(type=SolidWireSettings)
+    # Per-object opt-out of the viewport overlay.
+    bpy.types.Object.solidwire_exclude = BoolProperty(
+        name="Exclude from SolidWire Overlay",
+        description="Do not draw the SolidWire overlay on this object in 3D viewports",
+        default=False,
+        update=redraw_viewports,
+    )
 
 
 def unregister_properties() -> None:
     if hasattr(bpy.types.Scene, "solidwire"):
         del bpy.types.Scene.solidwire
+    if hasattr(bpy.types.Object, "solidwire_exclude"):
+        del bpy.types.Object.solidwire_exclude

@@ -28,11 +28,21 @@ struct SolidWireParams {
   float fade_end;
   float pattern_period;
   float pattern_duty;
+  float hidden_alpha;
+  float hidden_duty;
+  float half_thickness_far;
+  float thickness_depth_start;
+  float thickness_depth_end;
+  float world_half_thickness_px;
+  float hidden_period;
   float _pad0;
   float _pad1;
+  float _pad2;
 };
 """
-PARAMS_FLOATS = 20
+PARAMS_FLOATS = 28
+
+THICKNESS_PIXELS, THICKNESS_WORLD, THICKNESS_DEPTH = 0, 1, 2
 
 EDGE_COUNT = 5  # three triangle edges + two edges to a quad's 4th corner
 
@@ -50,7 +60,24 @@ class ShaderVariant:
     # Viewport overlay: NDC depth bias towards the camera (0 = none); see
     # DEPTH_BIAS in solidwire_vert.glsl and draw.OVERLAY_DEPTH_BIAS.
     depth_bias: float = 0.0
+    thickness_mode: int = THICKNESS_PIXELS
+    # Hidden-line style (issue 7): the pass that draws faces behind the
+    # visible surface, real edges only, dimmed and dashed, no fill.
+    hidden_pass: bool = False
+    # Developer/benchmark switch, not user-facing: which distance method the
+    # shader implements. "exact" is the add-on's own path; the others are
+    # faithful variants of the published methods (see METHODS and
+    # shaders/methods/), compared by scripts/bench.py.
+    method: str = "exact"
+    # Scale (issue 5): many instances of one mesh in one draw_instanced call,
+    # each reading its matrices from a float texture by gl_InstanceID (see
+    # INSTANCING_* below and draw.py).
+    instanced: bool = False
 
+
+# Method variants compiled from shaders/methods/ (the vertex-pulling triangle
+# variants; "offset_lines" has its own line pass, see methods.py).
+METHODS = ("exact", "nvidia2007", "kakadu_clip", "barycentric", "fill_only", "offset_lines")
 
 _cache: dict[ShaderVariant, object] = {}
 
@@ -66,6 +93,9 @@ def read_source(name: str) -> str:
 def _create_info(variant: ShaderVariant):
     import gpu
 
+    if variant.method != "exact":
+        return _method_create_info(variant)
+
     iface = gpu.types.GPUStageInterfaceInfo("solidwire_iface")
     for i in range(EDGE_COUNT):
         iface.flat("VEC3", f"edge_line{i}")
@@ -77,8 +107,13 @@ def _create_info(variant: ShaderVariant):
     info = gpu.types.GPUShaderCreateInfo()
     info.typedef_source(PARAMS_TYPEDEF)
     info.uniform_buf(0, "SolidWireParams", "params")
-    info.push_constant("MAT4", "object_to_clip")
-    info.push_constant("VEC4", "object_to_view_z")
+    if variant.instanced:
+        info.push_constant("INT", "instance_base")
+        info.sampler(3, "FLOAT_2D", "instance_table")
+        iface.flat("INT", "instance_slot")
+    else:
+        info.push_constant("MAT4", "object_to_clip")
+        info.push_constant("VEC4", "object_to_view_z")
     info.sampler(0, "FLOAT_2D", "vertex_positions")
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     info.sampler(2, "FLOAT_2D", "ngon_corners")
@@ -89,6 +124,9 @@ def _create_info(variant: ShaderVariant):
         info.fragment_out(1, "FLOAT", "frag_view_depth")
         info.define("WRITE_VIEW_DEPTH", "1")
     info.define("DIAGONALS", str(variant.diagonals))
+    info.define("THICKNESS_MODE", str(variant.thickness_mode))
+    if variant.hidden_pass:
+        info.define("HIDDEN_PASS", "1")
     if variant.use_fill:
         info.define("USE_FILL", "1")
     if variant.use_fade:
@@ -97,9 +135,145 @@ def _create_info(variant: ShaderVariant):
         info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
 
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
-    info.vertex_source(common + read_source("solidwire_vert.glsl"))
-    info.fragment_source(common + read_source("solidwire_frag.glsl"))
+    if variant.instanced:
+        info.vertex_source(INSTANCING_PRELUDE + common + read_source("solidwire_vert.glsl") + INSTANCING_VERT_MAIN)
+        info.fragment_source(INSTANCING_PRELUDE + common + read_source("solidwire_frag.glsl") + INSTANCING_FRAG_MAIN)
+    else:
+        info.vertex_source(common + read_source("solidwire_vert.glsl"))
+        info.fragment_source(common + read_source("solidwire_frag.glsl"))
     return info
+
+
+# Instanced variant of the exact path, wrapped around the unchanged stage
+# sources: `object_to_clip` / `object_to_view_z` become calls that read the
+# instance's values from `instance_table` (INSTANCE_TEXELS texels per
+# instance: the four columns of the float64-composed object -> clip matrix
+# rounded to float32, then the view-z row; exactly the values the per-object
+# path passes as push constants, so both paths draw the same image). They are
+# fetched once per invocation and kept in globals. The vertex stage finds its
+# instance by gl_InstanceID and hands it to the fragment stage (n-gon
+# outlines are set up there) in `instance_slot`.
+INSTANCE_TEXELS = 5
+INSTANCING_PRELUDE = """
+#define object_to_clip sw_instance_to_clip()
+#define object_to_view_z sw_instance_to_view_z()
+mat4 sw_instance_to_clip();
+vec4 sw_instance_to_view_z();
+"""
+_INSTANCING_LOAD = """
+mat4 sw_clip_matrix;
+vec4 sw_view_z;
+bool sw_loaded = false;
+void sw_load_instance()
+{
+  if (sw_loaded) {
+    return;
+  }
+  sw_loaded = true;
+  int slot = SW_INSTANCE_SLOT;
+  sw_clip_matrix = mat4(fetch_texel(instance_table, slot),
+                        fetch_texel(instance_table, slot + 1),
+                        fetch_texel(instance_table, slot + 2),
+                        fetch_texel(instance_table, slot + 3));
+  sw_view_z = fetch_texel(instance_table, slot + 4);
+}
+mat4 sw_instance_to_clip()
+{
+  sw_load_instance();
+  return sw_clip_matrix;
+}
+vec4 sw_instance_to_view_z()
+{
+  sw_load_instance();
+  return sw_view_z;
+}
+"""
+INSTANCING_VERT_MAIN = """
+#define SW_INSTANCE_SLOT (instance_slot = instance_base + 5 * gl_InstanceID)
+""" + _INSTANCING_LOAD
+INSTANCING_FRAG_MAIN = """
+#define SW_INSTANCE_SLOT instance_slot
+""" + _INSTANCING_LOAD
+
+
+def _method_create_info(variant: ShaderVariant):
+    """Create-info of a method variant (shaders/methods/<file>_{vert,frag}.glsl).
+
+    Same inputs as the exact path (position and triangle tables, per-corner
+    edge flags), same parameter block and outputs; only the varyings and the
+    distance computation differ."""
+    import gpu
+
+    method = variant.method
+    files = {"kakadu_clip": "nvidia2007", "offset_lines": "offset_lines"}.get(method, method)
+    if method not in METHODS:
+        raise ValueError(f"unknown SolidWire method {method!r}; one of {METHODS}")
+
+    iface = gpu.types.GPUStageInterfaceInfo(f"solidwire_{method}_iface")
+    if files == "nvidia2007":
+        # Whitepaper: heights interpolated without perspective correction;
+        # the tricky case's (A, Adir), (B, Bdir) are constant per triangle.
+        iface.no_perspective("VEC3", "edge_heights")
+        iface.flat("VEC4", "line_a")
+        iface.flat("VEC4", "line_b")
+        iface.flat("INT", "case_id")
+        iface.flat("INT", "line_mask")
+    elif files == "barycentric":
+        iface.smooth("VEC3", "barycentric")
+        iface.flat("INT", "line_mask")
+    iface.smooth("FLOAT", "view_depth")
+
+    info = gpu.types.GPUShaderCreateInfo()
+    info.typedef_source(PARAMS_TYPEDEF)
+    info.uniform_buf(0, "SolidWireParams", "params")
+    info.push_constant("MAT4", "object_to_clip")
+    info.push_constant("VEC4", "object_to_view_z")
+    info.sampler(0, "FLOAT_2D", "vertex_positions")
+    info.sampler(1, "FLOAT_2D", "triangle_vertices")
+    if method == "offset_lines":
+        info.vertex_in(0, "INT", "line_vertex")
+        info.define("LINE_DEPTH_OFFSET", repr(float(variant.depth_bias)))
+    else:
+        info.vertex_in(0, "INT", "edge_flags")
+    info.vertex_out(iface)
+    info.fragment_out(0, "VEC4", "frag_color")
+    if variant.write_view_depth:
+        info.fragment_out(1, "FLOAT", "frag_view_depth")
+        info.define("WRITE_VIEW_DEPTH", "1")
+    info.define("DIAGONALS", str(variant.diagonals))
+    if variant.use_fill:
+        info.define("USE_FILL", "1")
+    if variant.use_fade:
+        info.define("USE_FADE", "1")
+    if method == "kakadu_clip":
+        info.define("KAKADU_CLIP", "1")
+
+    common = read_source("common.glsl")
+    info.vertex_source(common + read_source("methods/pull_vert.glsl") + read_source(f"methods/{files}_vert.glsl"))
+    info.fragment_source(common + read_source("methods/output_frag.glsl") + read_source(f"methods/{files}_frag.glsl"))
+    return info
+
+
+def downsample_shader(factor: int):
+    """Box filter from a ``factor`` times bigger colour/view-depth pair (the
+    supersampled offset_lines variants). Compiled once per factor."""
+    key = ("downsample", int(factor))
+    shader = _cache.get(key)
+    if shader is None:
+        import gpu
+
+        info = gpu.types.GPUShaderCreateInfo()
+        info.sampler(0, "FLOAT_2D", "source_color")
+        info.sampler(1, "FLOAT_2D", "source_depth")
+        info.vertex_in(0, "VEC2", "position")
+        info.fragment_out(0, "VEC4", "frag_color")
+        info.fragment_out(1, "FLOAT", "frag_view_depth")
+        info.define("FACTOR", str(int(factor)))
+        info.vertex_source(read_source("methods/downsample_vert.glsl"))
+        info.fragment_source(read_source("methods/downsample_frag.glsl"))
+        shader = gpu.shader.create_from_info(info)
+        _cache[key] = shader
+    return shader
 
 
 def get(variant: ShaderVariant):
@@ -115,3 +289,51 @@ def get(variant: ShaderVariant):
 
 def clear() -> None:
     _cache.clear()
+    _silhouette_cache.clear()
+
+
+# Full-width silhouettes (issue 7): the fin pass of silhouettes.py. Shares
+# the parameter block, vertex pulling and edge geometry with the exact path.
+_silhouette_cache: dict[ShaderVariant, object] = {}
+
+
+def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
+    """The fin shader; ``overlay_bias`` > 0 gives the viewport-overlay form
+    (colour output, fixed-function occlusion; see silhouette_frag.glsl)."""
+    key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias)
+    shader = _silhouette_cache.get(key)
+    if shader is None:
+        import gpu
+
+        iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
+        iface.flat("VEC4", "fin_a")
+        iface.flat("VEC4", "fin_b")
+        iface.flat("VEC3", "fin_line")
+        iface.flat("FLOAT", "fin_inner_sign")
+        iface.flat("VEC2", "fin_view_depth")
+        info = gpu.types.GPUShaderCreateInfo()
+        info.typedef_source(PARAMS_TYPEDEF)
+        info.uniform_buf(0, "SolidWireParams", "params")
+        info.push_constant("MAT4", "object_to_clip")
+        info.push_constant("VEC4", "object_to_view_z")
+        info.push_constant("INT", "edge_count")
+        info.sampler(0, "FLOAT_2D", "vertex_positions")
+        info.sampler(1, "FLOAT_2D", "silhouette_edges")
+        info.sampler(2, "DEPTH_2D", "scene_depth")
+        info.vertex_in(0, "INT", "fin_corner")
+        info.vertex_out(iface)
+        if key.depth_bias:
+            info.fragment_out(0, "VEC4", "frag_color")
+            info.define("OVERLAY_FINS", repr(float(key.depth_bias)))
+        else:
+            info.fragment_out(0, "FLOAT", "frag_intensity")
+        info.depth_write("ANY")
+        info.define("THICKNESS_MODE", str(key.thickness_mode))
+        if key.use_fade:
+            info.define("USE_FADE", "1")
+        common = read_source("common.glsl") + read_source("edge_geometry.glsl")
+        info.vertex_source(common + read_source("silhouette_vert.glsl"))
+        info.fragment_source(common + read_source("silhouette_frag.glsl"))
+        shader = gpu.shader.create_from_info(info)
+        _silhouette_cache[key] = shader
+    return shader

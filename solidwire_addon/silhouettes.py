@@ -101,21 +101,29 @@ def release() -> None:
     _fin_batches.clear()
 
 
-def draw_silhouettes(items, view, settings, scene_depth_texture) -> None:
-    """Draw the outer halves into the bound framebuffer (R32F intensity +
-    a depth buffer cleared to 1): see the module docstring."""
+def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay_bias: float = 0.0) -> None:
+    """Draw the outer halves into the bound framebuffer.
+
+    Render: an R32F intensity target with its own depth buffer cleared to 1,
+    ``scene_depth_texture`` the main pass's depth (see the module docstring).
+    Viewport overlay (``overlay_bias`` > 0): straight into the viewport with
+    "over" blending, occluded by its depth buffer; the caller sets the blend."""
     import gpu
 
     from . import draw as draw_mod
     from . import shaders
 
-    shader = shaders.get_silhouette(settings.shader_variant())
+    shader = shaders.get_silhouette(settings.shader_variant(), overlay_bias)
     ubo = gpu.types.GPUUniformBuf(draw_mod.pack_params(settings, view.viewport, view.projection))
     shader.bind()
     shader.uniform_block("params", ubo)
-    shader.uniform_sampler("scene_depth", scene_depth_texture)
-    gpu.state.depth_test_set("LESS")
-    gpu.state.depth_mask_set(True)
+    if overlay_bias:
+        gpu.state.depth_test_set("LESS_EQUAL")
+        gpu.state.depth_mask_set(False)
+    else:
+        shader.uniform_sampler("scene_depth", scene_depth_texture)
+        gpu.state.depth_test_set("LESS")
+        gpu.state.depth_mask_set(True)
     gpu.state.face_culling_set("NONE")
     # View depth is compiled in only for fade and depth-cue thickness.
     try:

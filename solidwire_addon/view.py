@@ -24,8 +24,6 @@ def camera_view(scene, depsgraph, size: tuple[int, int] | None = None) -> View:
     Perspective and orthographic cameras, lens shift, sensor fit and pixel
     aspect all come from ``calc_matrix_camera``. The camera's scale is
     ignored, as in Blender's renderers."""
-    from mathutils import Matrix
-
     camera = scene.camera
     if camera is None:
         raise NoCameraError(f"scene '{scene.name}' has no camera")
@@ -35,8 +33,14 @@ def camera_view(scene, depsgraph, size: tuple[int, int] | None = None) -> View:
     projection = camera.calc_matrix_camera(
         depsgraph, x=width, y=height, scale_x=r.pixel_aspect_x, scale_y=r.pixel_aspect_y
     )
-    location, rotation, _scale = camera.matrix_world.decompose()
-    camera_to_world = np.array(Matrix.LocRotScale(location, rotation, None), dtype=np.float64)
+    # Scale is dropped by normalising the axes, as Blender's renderers do
+    # (normalize_m4): a negatively scaled camera stays mirrored. (decompose()
+    # would turn a mirror into a half turn and look the other way.)
+    camera_to_world = np.array(camera.matrix_world, dtype=np.float64)
+    axis_length = np.linalg.norm(camera_to_world[:3, :3], axis=0)
+    if not (np.isfinite(camera_to_world).all() and (axis_length > 0.0).all()):
+        raise NoCameraError(f"camera '{camera.name}' has a zero or non-finite scale or transform")
+    camera_to_world[:3, :3] /= axis_length
     return View(np.linalg.inv(camera_to_world), np.array(projection, dtype=np.float64), (0, 0, width, height))
 
 

@@ -155,3 +155,138 @@ def orbit_location(distance: float, azimuth_deg: float, elevation_deg: float):
         distance * math.cos(el) * math.sin(az),
         distance * math.sin(el),
     )
+
+
+# ------------------------------------------------ benchmark and stress scenes
+#
+# Shared by scripts/bench.py (at 1280 x 720) and tests/test_stress.py (small).
+# Each builder adds objects and a camera to a scene made by empty_scene() and
+# returns the objects that the benchmark turns (empty: the scene stays still).
+
+MESH_DIR = Path(__file__).resolve().parent.parent / "cache" / "meshes"
+
+
+def load_obj(scene, name: str, path: Path, **kwargs):
+    """A triangle/polygon OBJ (``v`` and ``f`` lines only) as a mesh object."""
+    verts, faces = [], []
+    with open(path, encoding="ascii", errors="replace") as source:
+        for line in source:
+            if line.startswith("v "):
+                verts.append(tuple(float(c) for c in line.split()[1:4]))
+            elif line.startswith("f "):
+                faces.append(tuple(int(c.split("/")[0]) - 1 for c in line.split()[1:]))
+    return from_pydata(scene, name, verts, faces, **kwargs)
+
+
+def frame_object(scene, obj, *, lens: float = 50.0, azimuth: float = -60.0, elevation: float = 20.0, fill: float = 1.6):
+    """Camera looking at ``obj``'s bounding-box sphere, ``fill`` times that
+    sphere's radius per half frame height (the sphere is loose around these
+    meshes: 1.6 makes them fill most of the frame, as in the papers' views)."""
+    from mathutils import Vector
+
+    corners = [obj.matrix_world @ Vector(c) for c in obj.bound_box]
+    centre = sum(corners, Vector()) / 8.0
+    radius = max((c - centre).length for c in corners)
+    sensor = 36.0
+    r = scene.render
+    half_fov = math.atan(0.5 * sensor * min(r.resolution_y / r.resolution_x, 1.0) / lens)
+    distance = radius / math.sin(half_fov) / fill
+    location = Vector(orbit_location(distance, azimuth, elevation)) + centre
+    return add_camera(scene, location=tuple(location), target=tuple(centre), lens=lens,
+                      clip=(distance * 0.01, distance * 10.0))
+
+
+def teapot_scene(scene):
+    obj = load_obj(scene, "Teapot", MESH_DIR / "teapot.obj")
+    frame_object(scene, obj)
+    return [obj]
+
+
+def bunny_scene(scene):
+    # glmark2's bunny is y-up; Blender is z-up.
+    obj = load_obj(scene, "Bunny", MESH_DIR / "bunny.obj", rotation_euler=(math.pi / 2, 0.0, 0.0))
+    bpy.context.view_layer.update()
+    frame_object(scene, obj)
+    return [obj]
+
+
+def suzanne_1m_scene(scene):
+    # Suzanne at subdivision level 5: 1,007,616 triangles (stands in for the
+    # papers' 1.09M-triangle Buddha).
+    obj = monkey(scene, "Suzanne5", subdivisions=5)
+    frame_object(scene, obj, azimuth=-75.0)
+    return [obj]
+
+
+def near_plane_scene(scene):
+    # A floor and a wall of big quads running past and behind a camera close
+    # to the floor: triangles with corners behind the viewpoint whose other
+    # corners project thousands of pixels away (the NVIDIA "tricky case" and
+    # the float32 cancellation the Kakadu article analyses).
+    grid(scene, "Floor", x_segments=4, y_segments=4, size=40.0, location=(0, 0, 0), rotation=(0, 0, 0.3))
+    grid(scene, "Wall", x_segments=4, y_segments=2, size=40.0, location=(-3, 0, 0), rotation=(0, math.pi / 2, 0.0))
+    monkey(scene, location=(0.5, 6.0, 1.0))
+    add_camera(scene, location=(0.4, -1.0, 0.5), target=(-1.0, 6.0, 0.6), lens=18.0, clip=(0.05, 300.0))
+    return []
+
+
+def far_scene(offset: float):
+    def build(scene):
+        monkey(scene, subdivisions=1, location=(offset, offset, 0.0))
+        add_camera(scene, location=(offset + 3.0, offset - 3.0, 1.5), target=(offset, offset, 0.0))
+        return []
+
+    return build
+
+
+def slivers_scene(scene):
+    # 100 columns of two triangles each, 100 units long and 0.01 wide:
+    # aspect 1e4, about 1.3 px wide and ~1e4 px long on screen, tilted.
+    n, length, width = 100, 100.0, 0.01
+    verts, faces = [], []
+    for i in range(n):
+        x0 = (i - n / 2) * width
+        base = len(verts)
+        verts += [(x0, -length / 2, 0.0), (x0 + width, -length / 2, 0.0), (x0 + width, length / 2, 0.0), (x0, length / 2, 0.0)]
+        faces += [(base, base + 1, base + 2), (base, base + 2, base + 3)]
+    from_pydata(scene, "Slivers", verts, faces, rotation_euler=(0.0, 0.0, 0.5))
+    add_camera(scene, location=(0.0, -0.5, 9.0), target=(0.0, 0.0, 0.0), lens=50.0)
+    return []
+
+
+def subpixel_scene(scene):
+    # Suzanne at level 3 (~63k triangles) about 150 px wide: most triangles
+    # are smaller than a pixel.
+    monkey(scene, subdivisions=3)
+    add_camera(scene, location=(0.0, -30.0, 4.0), target=(0.0, 0.0, 0.0), lens=50.0)
+    return []
+
+
+def ortho_scene(scene):
+    monkey(scene, subdivisions=2, rotation=(0.3, 0.0, 0.6))
+    cube(scene, location=(2.5, 0.5, -0.5), size=1.0)
+    add_camera(scene, location=(6, -6, 4), target=(0, 0, 0), ortho_scale=6.0, shift=(0.1, -0.05))
+    return []
+
+
+def lens_6mm_scene(scene):
+    # Inside a room with a 6 mm lens: extreme perspective, faces all around
+    # and behind the camera.
+    cube(scene, "Room", size=8.0)
+    uv_sphere(scene, location=(1.0, 2.0, -1.5), radius=1.0, segments=32, rings=16)
+    monkey(scene, location=(-1.5, 2.5, 0.5), subdivisions=1)
+    add_camera(scene, location=(0.3, -2.5, 0.4), target=(0.0, 2.5, -0.2), lens=6.0, clip=(0.05, 50.0))
+    return []
+
+
+MESH_SCENES = {"teapot": teapot_scene, "bunny": bunny_scene, "suzanne_1m": suzanne_1m_scene}
+MESH_FILES = {"teapot": MESH_DIR / "teapot.obj", "bunny": MESH_DIR / "bunny.obj"}
+STRESS_SCENES = {
+    "near_plane": near_plane_scene,
+    "far_1e5": far_scene(1e5),
+    "far_1e6": far_scene(1e6),
+    "slivers": slivers_scene,
+    "subpixel": subpixel_scene,
+    "ortho": ortho_scene,
+    "lens_6mm": lens_6mm_scene,
+}

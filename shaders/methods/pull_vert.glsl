@@ -39,6 +39,7 @@ int edge_bit(int i, int j)
  * diagonals are hidden, every triangle edge otherwise (the variants have no
  * patterned diagonals and ignore a quad's 4th corner: they are per-triangle
  * methods, as published). */
+#ifndef LINE_DEPTH_OFFSET /* the line pass has no per-corner edge flags */
 int drawn_edges()
 {
 #if DIAGONALS == 0
@@ -47,6 +48,7 @@ int drawn_edges()
   return EDGE0_REAL | EDGE1_REAL | EDGE2_REAL;
 #endif
 }
+#endif
 
 /* gl_Position and view_depth of this corner. */
 void emit_corner(vec3 local, vec4 clip)

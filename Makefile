@@ -1,0 +1,53 @@
+# Set-up, demo and tests. `make demo` and `make test` are the two commands in
+# the README; both create the project venv first (once; a stamp file records
+# that requirements-dev.txt has been installed).
+
+# bpy 5.0.1 is built for Python 3.11: prefer python3.11, else python3.
+PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
+VENV := .venv
+VENV_PYTHON := $(VENV)/bin/python
+VENV_STAMP := $(VENV)/.solidwire-requirements-installed
+DEMO_IMAGE := out/demo.png
+DIST_DIR := dist
+
+# Blender's own extension validator/builder, shipped inside the bpy wheel.
+BLENDER_EXT = $(VENV_PYTHON) -c "import importlib.util, os; \
+	print(os.path.join(importlib.util.find_spec('bpy').submodule_search_locations[0], \
+	'5.0', 'scripts', 'addons_core', 'bl_pkg', 'cli', 'blender_ext.py'))"
+BLENDER_TAGS = $(VENV_PYTHON) -c "import importlib.util, os; \
+	print(os.path.join(importlib.util.find_spec('bpy').submodule_search_locations[0], \
+	'5.0', 'scripts', 'modules', '_bpy_internal', 'extensions', 'tags.py'))"
+
+.PHONY: demo test venv zip check-system clean
+
+venv: $(VENV_STAMP)
+
+$(VENV_STAMP): requirements-dev.txt
+	@test -n "$(PYTHON)" || { echo "error: no python3.11 or python3 on PATH" >&2; exit 1; }
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' || \
+		{ echo "error: $(PYTHON) is not Python 3.11, which bpy==5.0.1 needs (set PYTHON=/path/to/python3.11)" >&2; exit 1; }
+	$(PYTHON) -m venv $(VENV)
+	$(VENV_PYTHON) -m pip install --disable-pip-version-check -r requirements-dev.txt
+	touch $(VENV_STAMP)
+
+# bpy renders through EGL (Mesa's llvmpipe without a GPU); warn early instead
+# of failing later with an obscure import error.
+check-system:
+	@if command -v ldconfig >/dev/null 2>&1 && ! ldconfig -p | grep -q 'libEGL.so.1'; then \
+		echo "warning: libEGL.so.1 not found; on Debian/Ubuntu: sudo apt-get install libegl1 libgl1-mesa-dri" >&2; \
+	fi
+
+demo: $(VENV_STAMP) check-system
+	$(VENV_PYTHON) scripts/render.py --demo -o $(DEMO_IMAGE)
+
+test: $(VENV_STAMP) check-system
+	$(VENV_PYTHON) -m pytest tests
+
+# The installable extension zip, validated and built by Blender's own tool.
+zip: $(VENV_STAMP)
+	$(VENV_PYTHON) "$$($(BLENDER_EXT))" validate --valid-tags "$$($(BLENDER_TAGS))" .
+	mkdir -p $(DIST_DIR)
+	$(VENV_PYTHON) "$$($(BLENDER_EXT))" build --valid-tags "$$($(BLENDER_TAGS))" --source-dir . --output-dir $(DIST_DIR)
+
+clean:
+	rm -rf out $(DIST_DIR) tests/output

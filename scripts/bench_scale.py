@@ -1,0 +1,389 @@
+#!/usr/bin/env python3
+"""Scale benchmark (issue 5): what SolidWire costs as scenes grow.
+
+Measured in one run, each against the path it replaces:
+
+1. extraction ms per million triangles, Suzanne subdivided to level 5
+   (1,007,616 triangles): the fast path (own quad split, bulk attribute
+   reads) against the naive path (Blender's ``loop_triangles`` read through
+   RNA, same numpy core), best of ``--repeat``;
+2. first-frame and steady-state frame time of a 1000-object scene (every
+   object its own mesh), with the GPU cache reused vs cleared every frame;
+3. the same for 10,000 instances of one mesh (a geometry-nodes scatter of a cube),
+   drawn with one draw_instanced call vs one draw call per instance;
+4. GPU bytes per triangle (Suzanne level 5, from stats()["gpu_bytes"]);
+5. peak memory (RSS) for a ~10-million-triangle scene (run in a fresh
+   process so earlier parts do not count);
+6. the frame time of a 250-frame animation render (Blender's own
+   ``render(animation=True)``, the ``-a`` path) with one deforming object
+   among 100 static ones, with reuse vs without.
+
+Frame times are the wall time of ``bpy.ops.render.render`` (Blender's
+depsgraph evaluation included) and SolidWire's own share (stats
+``ms_total``). The GPU here may be a software rasteriser (Mesa llvmpipe):
+the table says which renderer ran, and draw times mean CPU time then.
+
+    python scripts/bench_scale.py [--quick] [--out out/bench_scale.md]
+
+Prints a Markdown table and writes it (plus a .json) under out/.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-bench-"))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+import scenes  # noqa: E402
+import solidwire_addon  # noqa: E402
+from solidwire_addon import draw, extract, runtime  # noqa: E402
+from solidwire_addon.gpu_context import ensure_gpu  # noqa: E402
+
+
+def rss_mib() -> float:
+    """Peak resident set size of this process so far, MiB (Linux: KiB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def renderer() -> str:
+    import gpu
+
+    try:
+        return f"{gpu.platform.renderer_get()} ({gpu.platform.backend_type_get()})"
+    except Exception:  # noqa: BLE001 - informational only
+        return "unknown"
+
+
+def render_once(scene) -> tuple[float, dict]:
+    start = time.perf_counter()
+    bpy.ops.render.render(scene=scene.name)
+    return (time.perf_counter() - start) * 1000.0, solidwire_addon.stats()
+
+
+def frames(scene, count: int) -> dict:
+    """First frame and the median of ``count - 1`` more, wall and SolidWire ms."""
+    first_wall, first = render_once(scene)
+    rest = [render_once(scene) for _ in range(max(count - 1, 1))]
+    return {
+        "first_wall_ms": first_wall,
+        "first_sw_ms": first["ms_total"],
+        "first_extract_ms": first["ms_extract"] + first.get("ms_upload", 0.0),
+        "steady_wall_ms": statistics.median(w for w, _ in rest),
+        "steady_sw_ms": statistics.median(s["ms_total"] for _, s in rest),
+        "steady_extract_ms": statistics.median(s["ms_extract"] + s.get("ms_upload", 0.0) for _, s in rest),
+        "steady_draw_ms": statistics.median(s["ms_draw"] for _, s in rest),
+        "meshes_extracted_steady": rest[-1][1]["meshes_extracted"],
+        "objects_drawn": rest[-1][1]["objects_drawn"],
+        "objects_culled": rest[-1][1]["objects_culled"],
+        "instanced_draws": rest[-1][1].get("instanced_draws", 0),
+        "triangles_drawn": rest[-1][1]["triangles_drawn"],
+    }
+
+
+# --------------------------------------------------------------------------
+# 1 + 4: extraction speed and GPU bytes per triangle
+
+
+def bench_extraction(level: int, repeat: int) -> dict:
+    scene = scenes.empty_scene(320, 240)
+    scenes.add_camera(scene, location=(0.0, -4.0, 0.5), target=(0.0, 0.0, 0.0))
+    obj = scenes.monkey(scene, subdivisions=level)
+    mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    tris = len(mesh.loop_triangles)
+
+    def best(func) -> float:
+        times = []
+        for _ in range(repeat):
+            start = time.perf_counter()
+            func()
+            times.append(time.perf_counter() - start)
+        return min(times) * 1000.0
+
+    fast = best(lambda: extract.extract_mesh(mesh))
+    naive = best(lambda: extract.extract_mesh_naive(mesh))
+    raw = extract.read_mesh(mesh)
+    core = best(lambda: extract.build_arrays(**raw))
+    fast_core_input = extract.read_mesh_fast(mesh)
+    fast_core = best(lambda: extract.build_arrays_fast(**fast_core_input))
+    _wall, stats = render_once(scene)
+    per_m = 1.0e6 / tris
+    return {
+        "triangles": tris,
+        "fast_ms": fast,
+        "naive_ms": naive,
+        "fast_ms_per_mtri": fast * per_m,
+        "naive_ms_per_mtri": naive * per_m,
+        "build_arrays_ms": core,
+        "build_arrays_fast_ms": fast_core,
+        "gpu_bytes": stats["gpu_bytes"],
+        "gpu_bytes_per_triangle": stats["gpu_bytes"] / tris,
+        "upload_ms": stats.get("ms_upload", float("nan")),
+    }
+
+
+# --------------------------------------------------------------------------
+# 2: many objects
+
+
+def many_objects_scene(count: int):
+    scene = scenes.empty_scene(640, 360)
+    side = int(np.ceil(np.sqrt(count)))
+    # The whole grid in view (nothing culled): the frame draws all of it.
+    scenes.add_camera(scene, location=(0.0, -2.6 * side, 2.4 * side), target=(0.0, 0.0, 0.0), clip=(0.1, 1.0e4))
+    template = scenes.monkey(scene, "Template")
+    for i in range(count - 1):
+        obj = bpy.data.objects.new(f"Obj{i}", template.data.copy())  # its own mesh each
+        scene.collection.objects.link(obj)
+        obj.location = (2.5 * (i % side) - 1.25 * side, 2.5 * (i // side) - 1.25 * side, 0.0)
+    return scene
+
+
+def bench_many_objects(count: int, frame_count: int) -> dict:
+    scene = many_objects_scene(count)
+    out = {}
+    for reuse in (True, False):
+        runtime.reuse_enabled = reuse
+        runtime.mesh_cache.clear()
+        out["reuse" if reuse else "no_reuse"] = frames(scene, frame_count)
+    runtime.reuse_enabled = True
+    return out
+
+
+# --------------------------------------------------------------------------
+# 3: many instances of one mesh
+
+
+def instances_scene(count: int):
+    scene = scenes.empty_scene(640, 360)
+    side = int(np.ceil(np.sqrt(count)))
+    scenes.add_camera(scene, location=(0.0, -3.0 * side, 2.8 * side), target=(0.0, 0.0, 0.0), clip=(0.1, 1.0e4))
+    # A small mesh (a cube, 12 triangles): the per-instance CPU cost is what
+    # instancing saves; a heavy mesh would only measure llvmpipe's raster.
+    scatter = scenes.cube(scene, "Scatter")
+    tree = bpy.data.node_groups.new("scatter", "GeometryNodeTree")
+    tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    group_in, group_out = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    grid = tree.nodes.new("GeometryNodeMeshGrid")
+    grid.inputs["Vertices X"].default_value = side
+    grid.inputs["Vertices Y"].default_value = count // side
+    grid.inputs["Size X"].default_value = grid.inputs["Size Y"].default_value = 2.5 * side
+    on_points = tree.nodes.new("GeometryNodeInstanceOnPoints")
+    tree.links.new(grid.outputs[0], on_points.inputs["Points"])
+    tree.links.new(group_in.outputs[0], on_points.inputs["Instance"])
+    tree.links.new(on_points.outputs[0], group_out.inputs[0])
+    scatter.modifiers.new("Scatter", "NODES").node_group = tree
+    return scene
+
+
+def bench_instances(count: int, frame_count: int) -> dict:
+    scene = instances_scene(count)
+    out = {}
+    saved = draw.INSTANCING_MIN
+    for mode, minimum in (("instanced", saved), ("per_instance", 10**9)):
+        draw.INSTANCING_MIN = minimum
+        render_once(scene)  # compile this mode's shader variant outside the timings
+        runtime.mesh_cache.clear()
+        out[mode] = frames(scene, frame_count)
+    draw.INSTANCING_MIN = saved
+    return out
+
+
+# --------------------------------------------------------------------------
+# 5: peak memory (own process)
+
+
+def bench_memory(objects: int, level: int) -> dict:
+    ensure_gpu()
+    scene = scenes.empty_scene(320, 240)
+    scenes.add_camera(scene, location=(0.0, -5.0 * objects, 2.5 * objects), target=(0.0, 0.0, 0.0), clip=(0.1, 1.0e4))
+    for i in range(objects):
+        scenes.monkey(scene, f"Heavy{i}", subdivisions=level, location=(3.0 * i - 1.5 * objects, 0.0, 0.0))
+    bpy.context.evaluated_depsgraph_get()
+    before = rss_mib()
+    wall, stats = render_once(scene)
+    wall2, stats2 = render_once(scene)
+    return {
+        "triangles": stats["triangles_drawn"],
+        "rss_before_render_mib": before,
+        "rss_peak_mib": rss_mib(),
+        "first_wall_ms": wall,
+        "second_wall_ms": wall2,
+        "first_extract_ms": stats["ms_extract"],
+        "first_upload_ms": stats.get("ms_upload", float("nan")),
+        "second_meshes_extracted": stats2["meshes_extracted"],
+        "gpu_bytes": stats["gpu_bytes"],
+    }
+
+
+# --------------------------------------------------------------------------
+# 6: animation
+
+
+def animation_scene(static: int, frame_end: int, directory: str):
+    scene = scenes.empty_scene(320, 240)
+    side = int(np.ceil(np.sqrt(static)))
+    scenes.add_camera(scene, location=(0.0, -3.2 * side, 3.0 * side), target=(0.0, 0.0, 0.0), clip=(0.1, 1.0e4))
+    template = scenes.monkey(scene, "Static", subdivisions=1)
+    template.location = (-1.25 * side, -1.25 * side, 0.0)
+    for i in range(static - 1):
+        obj = bpy.data.objects.new(f"Static{i}", template.data.copy())
+        scene.collection.objects.link(obj)
+        obj.location = (2.5 * ((i + 1) % side) - 1.25 * side, 2.5 * ((i + 1) // side) - 1.25 * side, 0.0)
+    mover = scenes.monkey(scene, "Deforming", subdivisions=1, location=(0.0, 0.0, 2.0))
+    mover.modifiers.new("Wave", "WAVE").height = 0.3  # time-dependent deformation
+    scene.frame_start, scene.frame_end = 1, frame_end
+    scene.render.filepath = os.path.join(directory, "frame_####")
+    scene.render.image_settings.file_format = "PNG"
+    return scene
+
+
+def bench_animation(static: int, frame_end: int) -> dict:
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="solidwire-anim-") as directory:
+        scene = animation_scene(static, frame_end, directory)
+        per_frame: list[dict] = []
+
+        def record(_scene, *_args):
+            per_frame.append(solidwire_addon.stats())
+
+        bpy.app.handlers.render_post.append(record)
+        try:
+            for reuse in (True, False):
+                runtime.reuse_enabled = reuse
+                runtime.mesh_cache.clear()
+                per_frame.clear()
+                start = time.perf_counter()
+                bpy.ops.render.render(animation=True, scene=scene.name)
+                wall = (time.perf_counter() - start) * 1000.0
+                later = per_frame[1:] or per_frame
+                out["reuse" if reuse else "no_reuse"] = {
+                    "frames": len(per_frame),
+                    "wall_ms_per_frame": wall / max(len(per_frame), 1),
+                    "sw_ms_per_frame": statistics.mean(s["ms_total"] for s in later),
+                    "extract_ms_per_frame": statistics.mean(s["ms_extract"] + s.get("ms_upload", 0.0) for s in later),
+                    "meshes_extracted_per_frame": statistics.mean(s["meshes_extracted"] for s in later),
+                }
+        finally:
+            bpy.app.handlers.render_post.remove(record)
+            runtime.reuse_enabled = True
+    return out
+
+
+# --------------------------------------------------------------------------
+
+
+def table(results: dict, args) -> str:
+    e = results["extraction"]
+    o = results["objects"]
+    i = results["instances"]
+    m = results["memory"]
+    a = results["animation"]
+    rows = [
+        ("Extraction, Suzanne L%d (%s tris), ms per M tris" % (args.level, f"{e['triangles']:,}"),
+         f"{e['fast_ms_per_mtri']:.0f}", f"{e['naive_ms_per_mtri']:.0f} (loop_triangles)"),
+        ("GPU bytes per triangle", f"{e['gpu_bytes_per_triangle']:.1f}", ""),
+        (f"{args.objects} objects (own mesh each, {o['reuse']['triangles_drawn']:,} tris drawn): first frame, ms (SolidWire share)",
+         f"{o['reuse']['first_wall_ms']:.0f} ({o['reuse']['first_sw_ms']:.0f})",
+         f"{o['no_reuse']['first_wall_ms']:.0f} ({o['no_reuse']['first_sw_ms']:.0f}) (no reuse)"),
+        (f"{args.objects} objects: steady frame, ms (SolidWire share)",
+         f"{o['reuse']['steady_wall_ms']:.0f} ({o['reuse']['steady_sw_ms']:.0f})",
+         f"{o['no_reuse']['steady_wall_ms']:.0f} ({o['no_reuse']['steady_sw_ms']:.0f}) (no reuse)"),
+        (f"{args.objects} objects: steady extraction+upload, ms",
+         f"{o['reuse']['steady_extract_ms']:.1f}", f"{o['no_reuse']['steady_extract_ms']:.1f} (no reuse)"),
+        (f"{args.instances:,} instances of one mesh ({i['instanced']['objects_drawn']:,} drawn): first frame, ms (SolidWire share)",
+         f"{i['instanced']['first_wall_ms']:.0f} ({i['instanced']['first_sw_ms']:.0f})",
+         f"{i['per_instance']['first_wall_ms']:.0f} ({i['per_instance']['first_sw_ms']:.0f}) (draw per instance)"),
+        (f"{args.instances:,} instances: steady frame, ms (SolidWire share)",
+         f"{i['instanced']['steady_wall_ms']:.0f} ({i['instanced']['steady_sw_ms']:.0f})",
+         f"{i['per_instance']['steady_wall_ms']:.0f} ({i['per_instance']['steady_sw_ms']:.0f}) (draw per instance)"),
+        (f"{args.instances:,} instances: draw call time, ms",
+         f"{i['instanced']['steady_draw_ms']:.0f}", f"{i['per_instance']['steady_draw_ms']:.0f} (draw per instance)"),
+        (f"Peak RSS, {m['triangles'] / 1e6:.1f}M-triangle scene, MiB",
+         f"{m['rss_peak_mib']:.0f}", f"{m['rss_before_render_mib']:.0f} before the first render"),
+        (f"Animation, {a['reuse']['frames']} frames, 1 deforming + {args.static} static: ms per frame (SolidWire share)",
+         f"{a['reuse']['wall_ms_per_frame']:.0f} ({a['reuse']['sw_ms_per_frame']:.0f})",
+         f"{a['no_reuse']['wall_ms_per_frame']:.0f} ({a['no_reuse']['sw_ms_per_frame']:.0f}) (no reuse)"),
+        ("Animation: meshes extracted per frame (after the first)",
+         f"{a['reuse']['meshes_extracted_per_frame']:.1f}", f"{a['no_reuse']['meshes_extracted_per_frame']:.1f} (no reuse)"),
+    ]
+    lines = [
+        f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPU cores, "
+        f"renderer {results['renderer']}; bpy {bpy.app.version_string}."
+        + (" --quick sizes." if args.quick else ""),
+        "",
+        "| measure | SolidWire | baseline |",
+        "|---|---|---|",
+    ]
+    lines += [f"| {name} | {ours} | {base} |" for name, ours, base in rows]
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="small sizes (a minute or so)")
+    parser.add_argument("--out", default=str(ROOT / "out" / "bench_scale.md"))
+    parser.add_argument("--part", choices=["memory"], help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    args.level = 4 if args.quick else 5
+    args.repeat = 3 if args.quick else 5
+    args.objects = 200 if args.quick else 1000
+    args.instances = 2000 if args.quick else 10000
+    args.frames = 4 if args.quick else 6
+    args.static = 100
+    args.anim_frames = 20 if args.quick else 250
+    args.memory_objects, args.memory_level = (2, 5) if args.quick else (10, 5)
+
+    solidwire_addon.register()
+    if args.part == "memory":
+        print(json.dumps(bench_memory(args.memory_objects, args.memory_level)), flush=True)
+        os._exit(0)  # skip Blender's teardown: only the numbers matter here
+
+    ensure_gpu()
+    results = {"renderer": renderer()}
+    print("extraction ...", file=sys.stderr)
+    results["extraction"] = bench_extraction(args.level, args.repeat)
+    print(f"{args.objects} objects ...", file=sys.stderr)
+    results["objects"] = bench_many_objects(args.objects, args.frames)
+    print(f"{args.instances} instances ...", file=sys.stderr)
+    results["instances"] = bench_instances(args.instances, args.frames)
+    print(f"animation, {args.anim_frames} frames ...", file=sys.stderr)
+    results["animation"] = bench_animation(args.static, args.anim_frames)
+    print("memory (own process) ...", file=sys.stderr)
+    child = subprocess.run(
+        [sys.executable, __file__, "--part", "memory"] + (["--quick"] if args.quick else []),
+        capture_output=True, text=True,
+    )
+    lines = [line for line in child.stdout.splitlines() if line.startswith("{")]
+    if not lines:
+        raise RuntimeError(f"memory part failed ({child.returncode}): {child.stderr[-2000:]}")
+    results["memory"] = json.loads(lines[-1])
+
+    text = table(results, args)
+    print(text)
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(text, encoding="utf-8")
+    out.with_suffix(".json").write_text(json.dumps(results, indent=2), encoding="utf-8")
+    sys.stdout.flush()
+    os._exit(0)  # Blender's teardown after heavy GPU use can crash; the results are written
+
+
+if __name__ == "__main__":
+    sys.exit(main())

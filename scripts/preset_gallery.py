@@ -1,0 +1,163 @@
+"""Render every built-in SolidWire preset on Suzanne and write a labelled
+gallery image (docs/presets.png by default).
+
+    .venv/bin/python scripts/preset_gallery.py [-o docs/presets.png]
+
+Overlay presets (no fill) are composited over Blender's own Solid shading of
+the same view (a Workbench render), which is how an artist sees them in the
+viewport; fill presets are opaque and replace it. The "Fade into Distance"
+cell uses the range that "Fade Range from Visible Objects" sets, as an artist
+would. Labels need Pillow; without it the grid is written unlabelled through
+Blender's image API.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+import bpy  # noqa: E402
+import numpy as np  # noqa: E402
+
+import scenes  # noqa: E402  (tests/scenes.py: scene builders shared with the tests)
+import solidwire_addon  # noqa: E402
+from solidwire_addon import engine, presets  # noqa: E402
+from solidwire_addon.gpu_context import ensure_gpu  # noqa: E402
+
+CELL = (460, 345)
+COLUMNS = 4
+LABEL_HEIGHT = 30
+BACKGROUND = (0.045, 0.045, 0.05)  # linear; close to the default viewport grey
+LABEL_BACKGROUND = (28, 28, 30)
+
+
+def srgb_encode(linear: np.ndarray) -> np.ndarray:
+    c = np.clip(linear, 0.0, 1.0)
+    return np.where(c <= 0.0031308, c * 12.92, 1.055 * np.power(c, 1 / 2.4) - 0.055)
+
+
+def srgb_decode(encoded: np.ndarray) -> np.ndarray:
+    c = np.clip(encoded, 0.0, 1.0)
+    return np.where(c <= 0.04045, c / 12.92, np.power((c + 0.055) / 1.055, 2.4))
+
+
+def build_scene():
+    scene = scenes.empty_scene(*CELL)
+    scenes.add_camera(scene, location=(2.3, -4.6, 1.4), target=(0.0, 0.0, 0.05), lens=60.0)
+    suzanne = scenes.monkey(scene, subdivisions=1)
+    suzanne.data.shade_smooth()
+    return scene
+
+
+def solid_shading(scene, folder: Path) -> np.ndarray:
+    """Blender's Solid shading of the view (Workbench), linear premultiplied."""
+    scene.render.engine = "BLENDER_WORKBENCH"
+    scene.display.shading.light = "STUDIO"
+    scene.display.shading.color_type = "MATERIAL"
+    straight = scenes.render_to_file(scene, folder / "solid.png")
+    scene.render.engine = "SOLIDWIRE"
+    rgb = srgb_decode(straight[..., :3]) * straight[..., 3:4]
+    return np.concatenate([rgb, straight[..., 3:4]], axis=-1)
+
+
+def over(top: np.ndarray, bottom_rgb: np.ndarray) -> np.ndarray:
+    """Premultiplied ``top`` over an opaque ``bottom_rgb``."""
+    return top[..., :3] + (1.0 - top[..., 3:4]) * bottom_rgb
+
+
+def render_cells(scene, folder: Path):
+    ensure_gpu()
+    base = solid_shading(scene, folder)
+    background = np.broadcast_to(np.asarray(BACKGROUND), base.shape[:2] + (3,))
+    shaded = over(base, background)
+    cells = []
+    for preset in presets.builtin_presets():
+        presets.apply(preset, scene.solidwire)
+        label = preset.name
+        if preset.values.get("use_fade"):
+            bpy.ops.solidwire.fade_from_visible()
+            props = scene.solidwire
+            label += f" (fitted {props.fade_start:.1f}-{props.fade_end:.1f})"
+        rgba, _depth = engine.render_scene(bpy.context.evaluated_depsgraph_get(), CELL)
+        under = background if preset.values.get("use_fill") else shaded
+        cells.append((label, over(rgba, under)))
+    cells.append(("Blender Solid shading, no overlay", shaded))
+    return cells
+
+
+def compose(cells) -> np.ndarray:
+    """(H, W, 3) uint8, top row first, with a label strip under each cell."""
+    width, height = CELL
+    rows = -(-len(cells) // COLUMNS)
+    sheet = np.zeros((rows * (height + LABEL_HEIGHT), COLUMNS * width, 3), dtype=np.uint8)
+    sheet[:] = LABEL_BACKGROUND
+    for index, (_label, linear) in enumerate(cells):
+        r, c = divmod(index, COLUMNS)
+        image = (srgb_encode(linear[::-1]) * 255.0 + 0.5).astype(np.uint8)  # bottom-up -> top-down
+        y0 = r * (height + LABEL_HEIGHT)
+        sheet[y0 : y0 + height, c * width : (c + 1) * width] = image
+    return sheet
+
+
+def write(sheet: np.ndarray, cells, path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        from PIL import Image, ImageDraw, ImageFont
+    except ImportError:
+        _write_with_blender(sheet, path)
+        return
+    image = Image.fromarray(sheet)
+    draw = ImageDraw.Draw(image)
+    try:
+        font = ImageFont.load_default(size=19)
+    except TypeError:  # Pillow < 10.1
+        font = ImageFont.load_default()
+    width, height = CELL
+    for index, (label, _linear) in enumerate(cells):
+        r, c = divmod(index, COLUMNS)
+        x = c * width + 10
+        y = r * (height + LABEL_HEIGHT) + height + 6
+        draw.text((x, y), label, fill=(235, 235, 235), font=font)
+    for c in range(1, COLUMNS):  # thin separators between columns
+        draw.line([(c * width, 0), (c * width, image.height)], fill=LABEL_BACKGROUND, width=2)
+    # An adaptive 256-colour palette keeps the anti-aliased lines smooth and
+    # the file small enough for a README.
+    image.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE).save(path, optimize=True)
+
+
+def _write_with_blender(sheet: np.ndarray, path: Path) -> None:
+    height, width, _ = sheet.shape
+    image = bpy.data.images.new("solidwire_gallery", width, height, alpha=False)
+    rgba = np.ones((height, width, 4), dtype=np.float32)
+    rgba[..., :3] = sheet[::-1] / 255.0
+    image.pixels.foreach_set(rgba.ravel())
+    image.filepath_raw = str(path)
+    image.file_format = "PNG"
+    image.save()
+    bpy.data.images.remove(image)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("-o", "--output", type=Path, default=ROOT / "docs" / "presets.png")
+    args = parser.parse_args(argv)
+    solidwire_addon.register()
+    try:
+        scene = build_scene()
+        with tempfile.TemporaryDirectory(prefix="solidwire-gallery-") as folder:
+            cells = render_cells(scene, Path(folder))
+        write(compose(cells), cells, args.output)
+    finally:
+        solidwire_addon.unregister()
+    print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

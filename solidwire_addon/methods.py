@@ -1,0 +1,231 @@
+"""Published wireframe methods kept for comparison: a developer/benchmark
+switch, never user-facing.
+
+The add-on always draws with the "exact" method (shaders/solidwire_*.glsl).
+scripts/bench.py and tests/test_stress.py compare it with faithful variants of
+the methods in the seed documents, all fed the same inputs (position and
+triangle tables, per-corner edge flags, vertex pulling) and the same SPEC 1.4
+intensity profile, so the comparison is about the distance computation:
+
+- ``nvidia2007``: NVIDIA "Solid Wireframe" whitepaper (2007): window-space
+  heights with no-perspective interpolation, and the tricky-case table for
+  triangles with corners behind the viewpoint (shaders/methods/nvidia2007_*).
+- ``kakadu_clip``: the same plus the Liang-Barsky clipping fix of the Kakadu
+  "Optimized Wireframe Rendering, Part III" article.
+- ``barycentric``: perspective barycentrics scaled by their screen-space
+  derivatives (the barycentric wireframe blog post).
+- ``offset_lines``: the classic two passes: filled triangles with depth, then
+  1 px line primitives moved towards the camera in depth; ``offset_lines_2x``
+  and ``offset_lines_4x`` render 2x / 4x bigger (lines 2 / 4 px, so still
+  1 px after filtering) and box-filter down.
+- ``fill_only``: the same triangles with a trivial shader (time lower bound).
+
+Select one with ``draw.draw(..., method=...)`` (single-pass methods and the
+line pass), :func:`draw_method` (any method, both offset passes) or
+``offscreen.render(..., method=...)`` (any method, supersampling included).
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+
+from . import draw as draw_mod
+from . import shaders
+
+SUPERSAMPLED = {"offset_lines_2x": 2, "offset_lines_4x": 4}
+ALL_METHODS = (
+    "exact",
+    "nvidia2007",
+    "kakadu_clip",
+    "barycentric",
+    "offset_lines",
+    "offset_lines_2x",
+    "offset_lines_4x",
+    "fill_only",
+)
+
+# NDC depth offset of the line pass towards the camera (the classic polygon-
+# offset trick, done in the vertex stage as z - b w because Blender's gpu
+# module exposes no glPolygonOffset). 2^-13 of the [-1, 1] NDC range: large
+# enough that lines beat the rasterised depth of their own triangles at
+# grazing angles in these scenes, which is also what lets them show through
+# nearby surfaces (the offset methods' known fault).
+LINE_DEPTH_OFFSET = 2.0**-13
+
+_line_batches: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def base_method(method: str) -> tuple[str, int]:
+    """(shader method, supersampling factor) of a benchmark method name."""
+    if method in SUPERSAMPLED:
+        return "offset_lines", SUPERSAMPLED[method]
+    if method not in shaders.METHODS:
+        raise ValueError(f"unknown SolidWire method {method!r}; one of {ALL_METHODS}")
+    return method, 1
+
+
+def _line_batch(mesh):
+    """LINES batch over every distinct triangle edge of ``mesh`` (each vertex
+    carries its vertex id; the shader pulls the position). Built once per GPU
+    mesh from its triangle table, so the cache needs no change for a
+    developer-only method."""
+    import gpu
+
+    texture = mesh.triangles
+    buf = texture.read()
+    buf.dimensions = texture.width * texture.height * 4
+    ids = np.array(buf, dtype=np.float32).reshape(-1, 4)[: mesh.triangle_count, :3].astype(np.int64)
+    edges = np.concatenate([ids[:, [0, 1]], ids[:, [1, 2]], ids[:, [2, 0]]])
+    edges.sort(axis=1)
+    edges = np.unique(edges, axis=0)
+    fmt = gpu.types.GPUVertFormat()
+    fmt.attr_add(id="line_vertex", comp_type="I32", len=1, fetch_mode="INT")
+    vbo = gpu.types.GPUVertBuf(fmt, edges.size)
+    vbo.attr_fill("line_vertex", edges.reshape(-1).astype(np.int32))
+    return gpu.types.GPUBatch(type="LINES", buf=vbo)
+
+
+def batch_for(mesh, method: str):
+    """The batch ``method`` draws for ``mesh`` (triangles, or lines)."""
+    if method != "offset_lines":
+        return mesh.batch
+    batch = _line_batches.get(mesh)
+    if batch is None:
+        batch = _line_batches[mesh] = _line_batch(mesh)
+    return batch
+
+
+def draw_method(items, view, settings, method: str, *, write_view_depth: bool = False, cull: bool = True, line_width: float = 1.0):
+    """Draw ``items`` with ``method`` into the bound framebuffer (no
+    supersampling here: that is a render-target matter, see Renderer)."""
+    import gpu
+
+    base, _factor = base_method(method)
+    if base != "offset_lines":
+        return draw_mod.draw(items, view, settings, write_view_depth=write_view_depth, cull=cull, method=base)
+    # Pass 1: the filled triangles write depth (and the fill colour, or a
+    # transparent film); pass 2: lines, depth-tested against pass 1.
+    stats = draw_mod.draw(items, view, settings, write_view_depth=write_view_depth, cull=cull, method="fill_only")
+    gpu.state.line_width_set(line_width)
+    try:
+        draw_mod.draw(
+            items,
+            view,
+            settings,
+            write_view_depth=write_view_depth,
+            cull=cull,
+            depth_bias=LINE_DEPTH_OFFSET,
+            method="offset_lines",
+        )
+    finally:
+        gpu.state.line_width_set(1.0)
+    return stats
+
+
+_fullscreen = None
+
+
+def _fullscreen_batch():
+    global _fullscreen
+    if _fullscreen is None:
+        import gpu
+
+        fmt = gpu.types.GPUVertFormat()
+        fmt.attr_add(id="position", comp_type="F32", len=2, fetch_mode="FLOAT")
+        vbo = gpu.types.GPUVertBuf(fmt, 3)
+        vbo.attr_fill("position", [(0.0, 0.0)] * 3)
+        _fullscreen = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+    return _fullscreen
+
+
+class Renderer:
+    """Offscreen targets for one method at one size, reusable across frames
+    (the benchmark draws many frames; supersampled methods keep a big target
+    and filter down on the GPU, so the timed frame ends on the GPU too)."""
+
+    def __init__(self, method: str, width: int, height: int):
+        from .offscreen import Targets
+
+        self.method = method
+        self.factor = base_method(method)[1]
+        self.size = (width, height)
+        self.final = Targets(width, height)
+        self.big = Targets(width * self.factor, height * self.factor) if self.factor > 1 else None
+
+    def draw(self, items, view, settings, *, cull: bool = True):
+        import gpu
+
+        from .gpu_context import ensure_gpu
+
+        ensure_gpu()
+        width, height = self.size
+        target = self.big or self.final
+        tw, th = target.size
+        draw_view = draw_mod.View(view.view_matrix, view.projection, (0, 0, tw, th))
+        framebuffer = target.framebuffer()
+        with framebuffer.bind():
+            framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+            gpu.state.viewport_set(0, 0, tw, th)
+            stats = draw_method(
+                items, draw_view, settings, self.method, write_view_depth=True, cull=cull, line_width=float(self.factor)
+            )
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+        if self.big is not None:
+            shader = shaders.downsample_shader(self.factor)
+            framebuffer = self.final.framebuffer()
+            with framebuffer.bind():
+                framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                gpu.state.viewport_set(0, 0, width, height)
+                shader.bind()
+                shader.uniform_sampler("source_color", self.big.color)
+                shader.uniform_sampler("source_depth", self.big.view_depth)
+                _fullscreen_batch().draw(shader)
+        return stats
+
+    def sync(self) -> None:
+        """Wait for the GPU: read back one pixel of the final image (glFinish
+        is not exposed by Blender's gpu module)."""
+        framebuffer = self.final.framebuffer()
+        with framebuffer.bind():
+            framebuffer.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+
+    def read(self):
+        """(rgba, view_depth) of the last frame, as offscreen.render returns them."""
+        from .offscreen import BACKGROUND_DEPTH, _read_texture
+
+        rgba = _read_texture(self.final.color, 4)
+        depth = _read_texture(self.final.view_depth, 1)[..., 0]
+        if self.big is None:
+            covered = _read_texture(self.final.depth, 1)[..., 0] < 1.0
+            depth = np.where(covered, depth, BACKGROUND_DEPTH)
+        return rgba, depth
+
+
+_renderers: dict = {}
+
+
+def renderer_for(method: str, width: int, height: int) -> Renderer:
+    key = (method, width, height)
+    renderer = _renderers.get(key)
+    if renderer is None:
+        _renderers.clear()  # one size at a time: free the old textures
+        renderer = _renderers[key] = Renderer(method, width, height)
+    return renderer
+
+
+def render(items, view, settings, method: str, *, cull: bool = True):
+    """offscreen.render for any method: (rgba, view_depth, stats)."""
+    renderer = renderer_for(method, view.width, view.height)
+    stats = renderer.draw(items, view, settings, cull=cull)
+    rgba, depth = renderer.read()
+    return rgba, depth, stats
+
+
+def release() -> None:
+    _renderers.clear()
+    _line_batches.clear()
+    global _fullscreen
+    _fullscreen = None

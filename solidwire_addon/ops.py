@@ -1,0 +1,218 @@
+"""Operators (toggle, fade range, presets) and the add-on keymap.
+
+Operators change settings or preset files and nothing else: drawing happens in
+the overlay handler, reacting to the settings' update callbacks.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+from bpy.props import StringProperty
+
+from . import presets
+from .overlay import viewport_object_filter
+from .settings import redraw_viewports
+
+# Default key of the overlay toggle in the 3D View: Ctrl+Shift+Alt+W ("W" for
+# wire). Shift+Alt+W is taken in Blender's default keymap (Sculpt: expand face
+# sets, Pose: selection sets) and mode keymaps win over the 3D View keymap, so
+# the plain chord would silently do nothing there. tests/test_ui.py checks the
+# chord against Blender's default keymap data.
+TOGGLE_KEY = {"type": "W", "value": "PRESS", "shift": True, "ctrl": True, "alt": True}
+
+_keymap_items: list = []
+
+# The name of the preset last applied or saved (shown on the presets menu and
+# removed by "-"), like Blender's own preset menus.
+active_preset_name = ""
+
+
+def _solidwire(context):
+    return context.scene.solidwire
+
+
+class SOLIDWIRE_OT_toggle_overlay(bpy.types.Operator):
+    """Show or hide the SolidWire overlay in 3D viewports"""
+
+    bl_idname = "solidwire.toggle_overlay"
+    bl_label = "Toggle SolidWire Overlay"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context.scene, "solidwire", None) is not None
+
+    def execute(self, context):
+        props = _solidwire(context)
+        props.show_overlay = not props.show_overlay
+        return {"FINISHED"}
+
+
+def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
+    """(nearest, farthest) view depth of the bounding boxes of the drawn mesh
+    objects, or None when there are none in front of the view.
+
+    Depth is distance along the viewing axis (as SPEC 1.4's fade uses), so
+    (start, end) = extent fades from the nearest object to the farthest."""
+    view = np.asarray(view_matrix, dtype=np.float64)
+    depths = []
+    for instance in depsgraph.object_instances:
+        obj = instance.object
+        if obj.type != "MESH":
+            continue
+        owner = instance.parent if instance.is_instance and instance.parent is not None else obj
+        if object_filter is not None and not object_filter(owner.original):
+            continue
+        corners = np.ones((8, 4))
+        corners[:, :3] = np.array(obj.bound_box, dtype=np.float64)
+        world = corners @ np.array(instance.matrix_world, dtype=np.float64).T
+        depths.append(-(world @ view[2]))
+    if not depths:
+        return None
+    depths = np.concatenate(depths)
+    near, far = max(float(depths.min()), 0.0), float(depths.max())
+    if far <= 0.0:
+        return None
+    return near, far
+
+
+class SOLIDWIRE_OT_fade_from_visible(bpy.types.Operator):
+    """Set the depth fade range to the depth extent of the visible objects, seen from this viewport (or from the scene camera outside a viewport), and turn depth fade on"""
+
+    bl_idname = "solidwire.fade_from_visible"
+    bl_label = "Fade Range from Visible Objects"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context.scene, "solidwire", None) is not None
+
+    def execute(self, context):
+        props = _solidwire(context)
+        space = context.space_data if getattr(context, "space_data", None) and context.space_data.type == "VIEW_3D" else None
+        # From the sidebar the current region is not the 3D region itself:
+        # fall back to the space's main 3D region.
+        region_3d = getattr(context, "region_data", None) or getattr(space, "region_3d", None)
+        if region_3d is not None and hasattr(region_3d, "view_matrix"):
+            view_matrix = region_3d.view_matrix
+        elif context.scene.camera is not None:
+            view_matrix = context.scene.camera.matrix_world.normalized().inverted()
+        else:
+            self.report({"ERROR"}, "SolidWire: no 3D viewport or scene camera to measure depth from")
+            return {"CANCELLED"}
+        keep = viewport_object_filter(context.view_layer, space, only_selected=props.only_selected)
+        extent = visible_depth_extent(context.evaluated_depsgraph_get(), view_matrix, keep)
+        if extent is None:
+            self.report({"WARNING"}, "SolidWire: no visible mesh in front of the view")
+            return {"CANCELLED"}
+        props.fade_start, props.fade_end = extent
+        props.use_fade = True
+        self.report({"INFO"}, f"SolidWire: depth fade {extent[0]:.3g} to {extent[1]:.3g}")
+        return {"FINISHED"}
+
+
+class SOLIDWIRE_OT_preset_apply(bpy.types.Operator):
+    """Apply a SolidWire preset"""
+
+    bl_idname = "solidwire.preset_apply"
+    bl_label = "Apply SolidWire Preset"
+    bl_options = {"REGISTER", "UNDO"}
+
+    name: StringProperty(name="Preset", description="Name of the preset to apply")
+
+    def execute(self, context):
+        global active_preset_name
+        try:
+            preset = presets.find(self.name)
+        except presets.PresetError as exc:
+            self.report({"ERROR"}, f"SolidWire: {exc}")
+            return {"CANCELLED"}
+        presets.apply(preset, _solidwire(context))
+        active_preset_name = preset.name
+        redraw_viewports()
+        return {"FINISHED"}
+
+
+class SOLIDWIRE_OT_preset_add(bpy.types.Operator):
+    """Save the current SolidWire settings as a user preset"""
+
+    bl_idname = "solidwire.preset_add"
+    bl_label = "Add SolidWire Preset"
+    bl_options = {"REGISTER"}
+
+    name: StringProperty(name="Name", description="Name of the new preset", default="My Preset", maxlen=64)
+
+    def invoke(self, context, event):
+        return context.window_manager.invoke_props_dialog(self)
+
+    def execute(self, context):
+        global active_preset_name
+        try:
+            path = presets.save(self.name, _solidwire(context))
+        except (presets.PresetError, OSError) as exc:
+            self.report({"ERROR"}, f"SolidWire: cannot save preset: {exc}")
+            return {"CANCELLED"}
+        active_preset_name = self.name.strip()
+        self.report({"INFO"}, f"SolidWire: saved preset '{active_preset_name}' to {path}")
+        return {"FINISHED"}
+
+
+class SOLIDWIRE_OT_preset_remove(bpy.types.Operator):
+    """Delete the active SolidWire user preset (built-in presets cannot be removed)"""
+
+    bl_idname = "solidwire.preset_remove"
+    bl_label = "Remove SolidWire Preset"
+    bl_options = {"REGISTER"}
+
+    name: StringProperty(name="Preset", description="User preset to delete (default: the active one)")
+
+    @classmethod
+    def poll(cls, context):
+        return bool(active_preset_name)
+
+    def invoke(self, context, event):
+        if not self.name:
+            self.name = active_preset_name
+        return context.window_manager.invoke_confirm(self, event)
+
+    def execute(self, context):
+        global active_preset_name
+        name = self.name or active_preset_name
+        try:
+            presets.remove(name)
+        except (presets.PresetError, OSError) as exc:
+            self.report({"ERROR"}, f"SolidWire: {exc}")
+            return {"CANCELLED"}
+        if active_preset_name == name:
+            active_preset_name = ""
+        return {"FINISHED"}
+
+
+classes = (
+    SOLIDWIRE_OT_toggle_overlay,
+    SOLIDWIRE_OT_fade_from_visible,
+    SOLIDWIRE_OT_preset_apply,
+    SOLIDWIRE_OT_preset_add,
+    SOLIDWIRE_OT_preset_remove,
+)
+
+
+def register_keymaps() -> None:
+    if _keymap_items:
+        return
+    keyconfig = bpy.context.window_manager.keyconfigs.addon
+    if keyconfig is None:  # no add-on keyconfig (some background sessions)
+        return
+    keymap = keyconfig.keymaps.new(name="3D View", space_type="VIEW_3D")
+    item = keymap.keymap_items.new(SOLIDWIRE_OT_toggle_overlay.bl_idname, **TOGGLE_KEY)
+    _keymap_items.append((keymap, item))
+
+
+def unregister_keymaps() -> None:
+    for keymap, item in _keymap_items:
+        try:
+            keymap.keymap_items.remove(item)
+        except (ReferenceError, RuntimeError):
+            pass  # already gone with its keyconfig
+    _keymap_items.clear()

@@ -1,0 +1,206 @@
+"""User interface: the SolidWire sidebar panel, the render-properties panel,
+the presets menu and the checkbox in the viewport's Overlays popover.
+
+The UI only shows settings and calls operators. Settings that do not apply
+right now are greyed out (``active = False``), never hidden, so the layout
+does not jump while the user works.
+"""
+
+from __future__ import annotations
+
+import bpy
+
+from . import ops, presets
+
+PATTERN_MODES = {"DOTTED", "DASHED"}
+
+
+def draw_look_settings(layout, props) -> None:
+    """The look: line, fill, diagonals, depth fade (shared by both panels)."""
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+
+    layout.prop(props, "thickness_mode")
+    col = layout.column(align=True)
+    row = col.row()
+    row.active = props.thickness_mode != "WORLD"
+    row.prop(props, "thickness")
+    row = col.row()
+    row.active = props.thickness_mode == "WORLD"
+    row.prop(props, "world_thickness")
+    col.prop(props, "softness")
+    col = layout.column(align=True)
+    col.active = props.thickness_mode == "DEPTH"
+    col.prop(props, "thickness_far")
+    col.prop(props, "thickness_depth_start")
+    col.prop(props, "thickness_depth_end")
+    layout.prop(props, "wire_color")
+    layout.prop(props, "use_silhouettes")
+
+    layout.prop(props, "use_fill")
+    row = layout.row()
+    row.active = props.use_fill
+    row.prop(props, "fill_color")
+
+    layout.prop(props, "diagonal_mode")
+    col = layout.column(align=True)
+    col.active = props.diagonal_mode in PATTERN_MODES
+    col.prop(props, "pattern_period")
+    col.prop(props, "pattern_duty")
+
+    layout.prop(props, "use_fade")
+    col = layout.column(align=True)
+    col.active = props.use_fade
+    col.prop(props, "fade_start")
+    col.prop(props, "fade_end")
+    col.operator(ops.SOLIDWIRE_OT_fade_from_visible.bl_idname, icon="DRIVER_DISTANCE")
+
+    layout.prop(props, "use_hidden_lines")
+    col = layout.column(align=True)
+    col.active = props.use_hidden_lines
+    col.prop(props, "hidden_alpha")
+    col.prop(props, "hidden_period")
+    col.prop(props, "hidden_duty")
+
+    layout.prop(props, "use_backface_culling")
+
+
+def draw_presets_header(layout) -> None:
+    """Presets menu with + and -, as in Blender's own preset menus."""
+    row = layout.row(align=True)
+    row.menu(SOLIDWIRE_MT_presets.bl_idname, text=ops.active_preset_name or "Presets", icon="PRESET")
+    row.operator(ops.SOLIDWIRE_OT_preset_add.bl_idname, text="", icon="ADD")
+    row.operator(ops.SOLIDWIRE_OT_preset_remove.bl_idname, text="", icon="REMOVE")
+
+
+class SOLIDWIRE_MT_presets(bpy.types.Menu):
+    bl_idname = "SOLIDWIRE_MT_presets"
+    bl_label = "SolidWire Presets"
+
+    def draw(self, context):
+        layout = self.layout
+        try:
+            builtin = presets.builtin_presets()
+            user, problems = presets.user_presets()
+        except presets.PresetError as exc:  # a broken install: say so in the menu
+            layout.label(text=str(exc), icon="ERROR")
+            return
+        for preset in builtin:
+            layout.operator(ops.SOLIDWIRE_OT_preset_apply.bl_idname, text=preset.name).name = preset.name
+        if user:
+            layout.separator()
+            for preset in user:
+                layout.operator(ops.SOLIDWIRE_OT_preset_apply.bl_idname, text=preset.name, icon="USER").name = (
+                    preset.name
+                )
+        for problem in problems:
+            layout.label(text=problem, icon="ERROR")
+
+
+class VIEW3D_PT_solidwire(bpy.types.Panel):
+    bl_idname = "VIEW3D_PT_solidwire"
+    bl_label = "SolidWire"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "SolidWire"
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context.scene, "solidwire", None) is not None
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.solidwire, "show_overlay", text="")
+
+    def draw_header_preset(self, context):
+        draw_presets_header(self.layout)
+
+    def draw(self, context):
+        props = context.scene.solidwire
+        layout = self.layout
+        draw_look_settings(layout, props)
+
+        layout.separator()
+        col = layout.column(heading="Overlay")
+        col.active = props.show_overlay
+        col.prop(props, "only_selected")
+        obj = context.object
+        row = col.row()
+        if obj is not None:
+            row.prop(obj, "solidwire_exclude", text=f"Exclude '{obj.name}'")
+        else:
+            row.enabled = False
+            row.label(text="No active object")
+
+        # Wire over a Cycles/EEVEE/Workbench render (ops_composite.py).
+        layout.separator()
+        layout.menu("SOLIDWIRE_MT_render_wire_over", text="Render Wire Over", icon="RENDER_STILL")
+
+
+class RENDER_PT_solidwire(bpy.types.Panel):
+    bl_idname = "RENDER_PT_solidwire"
+    bl_label = "SolidWire"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {"SOLIDWIRE"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES and getattr(context.scene, "solidwire", None) is not None
+
+    def draw_header_preset(self, context):
+        draw_presets_header(self.layout)
+
+    def draw(self, context):
+        draw_look_settings(self.layout, context.scene.solidwire)
+
+
+def draw_overlay_popover(self, context) -> None:
+    """Appended to the viewport's Overlays popover (VIEW3D_PT_overlay)."""
+    props = getattr(context.scene, "solidwire", None)
+    if props is None:
+        return
+    layout = self.layout
+    layout.separator()
+    row = layout.row(heading="SolidWire")
+    row.prop(props, "show_overlay", text="Solid Wireframe")
+
+
+def draw_object_visibility(self, context) -> None:
+    """Appended to Object Properties > Visibility: the per-object opt-out."""
+    obj = context.object
+    if obj is not None and obj.type == "MESH" and hasattr(obj, "solidwire_exclude"):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(obj, "solidwire_exclude", text="SolidWire Overlay Off")
+
+
+classes = (SOLIDWIRE_MT_presets, VIEW3D_PT_solidwire, RENDER_PT_solidwire)
+
+# (Blender panel, our draw function): appended at register, removed at unregister.
+_APPENDS = (
+    ("VIEW3D_PT_overlay", draw_overlay_popover),
+    ("OBJECT_PT_visibility", draw_object_visibility),
+)
+
+
+def register_appends() -> None:
+    for panel_name, function in _APPENDS:
+        panel = getattr(bpy.types, panel_name, None)
+        if panel is not None:
+            panel.remove(function)  # never twice, even after a failed unregister
+            panel.append(function)
+
+
+def unregister_appends() -> None:
+    for panel_name, function in _APPENDS:
+        panel = getattr(bpy.types, panel_name, None)
+        if panel is not None:
+            panel.remove(function)
+
+
+def appended_draw_functions(panel_name: str) -> list:
+    """Our functions in ``panel_name``'s draw list (for tests)."""
+    panel = getattr(bpy.types, panel_name, None)
+    functions = getattr(getattr(panel, "draw", None), "_draw_funcs", [])
+    return [f for f in functions if f in {fn for _name, fn in _APPENDS}]

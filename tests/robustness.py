@@ -1,0 +1,113 @@
+"""Helpers for the robustness tests (issue 6): float renders through the real
+engine, captured messages, and scans of the add-on's module state."""
+
+from __future__ import annotations
+
+import os
+import sys
+import types
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+import scenes
+
+# Opt-in suites (soak, large frames, compat): `SOLIDWIRE_SLOW=1 pytest ...`
+# or `pytest --run-slow` (see conftest.py); default CI skips them.
+SLOW = os.environ.get("SOLIDWIRE_SLOW", "") not in ("", "0")
+
+
+def render_exr(scene, path: Path) -> np.ndarray:
+    """Render ``scene`` through the SOLIDWIRE engine (``bpy.ops.render.render``
+    with ``write_still``: an error the engine reports raises RuntimeError) to a
+    32-bit float OpenEXR file, and read it back: (H, W, 4) float32, bottom row
+    first, premultiplied (alpha = wire alpha * I on a transparent film). Unlike
+    a PNG, the file keeps NaN and Inf, so a poisoned pixel cannot hide."""
+    path = Path(path).resolve()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    scene.render.filepath = str(path)
+    settings = scene.render.image_settings
+    settings.file_format = "OPEN_EXR"
+    settings.color_mode = "RGBA"
+    settings.color_depth = "32"
+    settings.exr_codec = "ZIP"
+    bpy.ops.render.render(write_still=True, scene=scene.name)
+    image = bpy.data.images.load(str(path), check_existing=False)
+    try:
+        width, height = image.size
+        pixels = np.empty(width * height * 4, dtype=np.float32)
+        image.pixels.foreach_get(pixels)
+    finally:
+        bpy.data.images.remove(image)
+    return pixels.reshape(height, width, 4)
+
+
+def lines_of(text: str, needle: str) -> list[str]:
+    return [line for line in text.splitlines() if needle in line]
+
+
+def addon_modules() -> list[types.ModuleType]:
+    return [m for name, m in sorted(sys.modules.items()) if name == "solidwire_addon" or name.startswith("solidwire_addon.")]
+
+
+def _walk(value, path, found, predicate, depth, seen):
+    if id(value) in seen or depth > 4:
+        return
+    seen.add(id(value))
+    if predicate(value):
+        found.append(path)
+        return
+    if isinstance(value, (str, bytes, int, float, bool, type(None), types.ModuleType, types.FunctionType, type)):
+        return
+    if isinstance(value, np.ndarray):
+        return
+    if isinstance(value, dict):
+        for key, item in list(value.items()):
+            _walk(key, f"{path}[key {key!r}]", found, predicate, depth + 1, seen)
+            _walk(item, f"{path}[{key!r}]", found, predicate, depth + 1, seen)
+    elif isinstance(value, (list, tuple, set, frozenset)):
+        for index, item in enumerate(list(value)):
+            _walk(item, f"{path}[{index}]", found, predicate, depth + 1, seen)
+    elif hasattr(value, "__dict__") and type(value).__module__.startswith("solidwire_addon"):
+        for key, item in list(vars(value).items()):
+            _walk(item, f"{path}.{key}", found, predicate, depth + 1, seen)
+
+
+def scan_module_state(predicate) -> list[str]:
+    """Paths ('module.name[...]') of every value in the add-on's module
+    globals (and the containers and add-on objects they hold, a few levels
+    deep) for which ``predicate(value)`` is true."""
+    found: list[str] = []
+    seen: set = set()
+    for module in addon_modules():
+        for name, value in list(vars(module).items()):
+            if name.startswith("__"):
+                continue
+            _walk(value, f"{module.__name__}.{name}", found, predicate, 0, seen)
+    return found
+
+
+def is_gpu_object(value) -> bool:
+    import gpu
+
+    return type(value).__module__ == "gpu.types" or isinstance(
+        value,
+        tuple(
+            t
+            for t in (getattr(gpu.types, n, None) for n in dir(gpu.types))
+            if isinstance(t, type) and t.__name__.startswith("GPU")
+        ),
+    )
+
+
+def is_blender_data(value) -> bool:
+    return isinstance(value, bpy.types.bpy_struct)
+
+
+def cube_beside(scene, bad_location=(2.6, 0.0, 0.0)):
+    """A reference object on the left of the view and a camera that also
+    sees ``bad_location`` on the right, where the faulty object goes."""
+    scenes.cube(scene, "GoodCube", size=1.6, location=(-1.6, 0.0, 0.0))
+    scenes.add_camera(scene, location=(0.5, -9.0, 2.0), target=(0.5, 0.0, 0.0), lens=35.0)
+    return bad_location

@@ -1,0 +1,249 @@
+"""Bad geometry never takes a render down (issue 6, item 1).
+
+Each faulty object sits beside a good one, out of its way in the picture.
+Every case checks, through the real engine and a float EXR file (which keeps
+NaN): no exception escapes, no NaN/Inf pixel, the picture matches the float64
+reference (the faulty object is skipped or drawn without its bad faces), the
+good object's pixels are exactly those of a render without the faulty object,
+and at most one message, printed once across two renders, names the object.
+"""
+
+from __future__ import annotations
+
+import math
+
+import bpy
+import numpy as np
+import pytest
+
+import accuracy
+import reference
+import robustness
+import scenes
+from solidwire_addon import extract, log
+
+W, H = 96, 64
+NAN, INF = math.nan, math.inf
+
+
+@pytest.fixture(autouse=True)
+def fresh_messages():
+    """Messages are said once per session; each test starts afresh."""
+    log.forget()
+    yield
+    log.forget()
+
+
+def _mesh_object(scene, name, verts, edges, faces, location):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([tuple(v) for v in verts], list(edges), [tuple(f) for f in faces])
+    mesh.update()  # no validate(): keep the bad data as it is
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    obj.location = location
+    return obj
+
+
+def _strip(n=3):
+    """A strip of n unit quads along x (vertex ids 2k, 2k+1 at x = k)."""
+    verts = [(k - n / 2, 0.0, z) for k in range(n + 1) for z in (-0.8, 0.8)]
+    faces = [(2 * k, 2 * k + 2, 2 * k + 3, 2 * k + 1) for k in range(n)]
+    return verts, faces
+
+
+def _nonfinite(scene, name, loc):
+    verts, faces = _strip(3)
+    verts[2] = (NAN, 0.0, -0.8)  # quad 0 and quad 1 share vertex 2
+    verts[7] = (1.5, INF, 0.8)  # quad 2
+    verts.append((0.0, -NAN, 2.0))  # loose and NaN
+    # plus a healthy triangle so something of the object is drawn
+    verts += [(-1.4, 0.0, 1.0), (-0.6, 0.0, 1.0), (-1.0, 0.0, 1.6)]
+    faces.append((9, 10, 11))
+    return _mesh_object(scene, name, verts, [], faces, loc)
+
+
+def _all_nonfinite(scene, name, loc):
+    verts, faces = _strip(2)
+    verts = [(NAN, y, z) for (_x, y, z) in verts]
+    return _mesh_object(scene, name, verts, [], faces, loc)
+
+
+def _zero_area(scene, name, loc):
+    # Distinct vertices on one line, and a quad whose corners coincide in
+    # pairs: zero area, never visible (SPEC 1.2).
+    verts = [(-1, 0, 0), (0, 0, 0), (1, 0, 0), (0, 0, 1), (0, 0, 1), (0.5, 0, 1), (0.5, 0, 1)]
+    return _mesh_object(scene, name, verts, [], [(0, 1, 2), (3, 4, 5, 6)], loc)
+
+
+def _repeated_vertex(scene, name, loc):
+    # Corrupt faces that use one vertex twice (Blender keeps them until
+    # Mesh > Clean Up): (0, 1, 1, 2) is a triangle with a zero-length edge,
+    # (3, 3, 3) a point, (4, 5, 4) a segment.
+    verts = [(-1, 0, -0.8), (1, 0, -0.8), (0, 0, 0.8), (0, 0, 1.5), (0.5, 0, 1.5), (1, 0, 1.5)]
+    return _mesh_object(scene, name, verts, [], [(0, 1, 1, 2), (3, 3, 3), (4, 5, 4)], loc)
+
+
+def _loose_only(scene, name, loc):
+    verts = [(-1, 0, 0), (1, 0, 0), (0, 0, 1), (0.5, 0.5, 0.5)]
+    return _mesh_object(scene, name, verts, [(0, 1), (1, 2)], [], loc)
+
+
+def _empty(scene, name, loc):
+    return _mesh_object(scene, name, [], [], [], loc)
+
+
+def _huge_far_away(scene, name, loc):
+    # 1e8-scale coordinates: a triangle 1e8 away and one spanning 1e8
+    # (both out of view here: the good object must not notice).
+    verts = [(1e8, 1e8, 0), (1e8 + 1, 1e8, 0), (1e8, 1e8 + 1, 0), (0, 5e7, 0), (-1e8, 5e7, 0), (0, 5e7, 1e8)]
+    return _mesh_object(scene, name, verts, [], [(0, 1, 2), (3, 4, 5)], loc)
+
+
+# case -> (builder, text the one message must contain or None, draws anything)
+CASES = {
+    "nan_and_inf_vertices": (_nonfinite, "non-finite", True),
+    "all_vertices_nan": (_all_nonfinite, "non-finite", False),
+    "zero_area_faces": (_zero_area, None, False),
+    "face_uses_vertex_twice": (_repeated_vertex, "uses one vertex twice", True),
+    "loose_edges_and_vertices_only": (_loose_only, "no faces", False),
+    # An empty mesh is also what a pure instancer evaluates to: no message.
+    "empty_mesh": (_empty, None, False),
+    "coordinates_1e8": (_huge_far_away, None, False),
+}
+
+
+def _base_scene():
+    scene = scenes.empty_scene(W, H, thickness=1.5)
+    location = robustness.cube_beside(scene)
+    return scene, location
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_bad_object_beside_a_good_one(case, output_dir, capfd):
+    build, message, draws = CASES[case]
+    scene, location = _base_scene()
+    without = robustness.render_exr(scene, output_dir / f"bad_{case}_without.exr")
+    name = f"Faulty_{case}"
+    build(scene, name, location)
+    capfd.readouterr()
+
+    # Two renders: the message must come once, not every frame.
+    first = robustness.render_exr(scene, output_dir / f"bad_{case}.exr")
+    second = robustness.render_exr(scene, output_dir / f"bad_{case}.exr")
+    err = capfd.readouterr()
+    said = robustness.lines_of(err.out + err.err, f"'{name}'")
+
+    for image in (first, second):
+        assert np.isfinite(image).all(), f"{case}: NaN/Inf pixels"
+    assert np.array_equal(first, second)
+
+    # The good object is drawn exactly as without the faulty one.
+    good = without[..., 3] > 0
+    assert good.sum() > 100
+    assert np.array_equal(first[good], without[good]), case
+    if not draws:
+        assert np.array_equal(first, without), f"{case}: the faulty object drew something"
+    else:
+        assert (first[..., 3] > 0.5).sum() > (without[..., 3] > 0.5).sum() + 20, f"{case}: its good faces are missing"
+
+    # And the whole picture is the image model's (bad faces are not drawn).
+    ref = reference.render_reference(scene)
+    report = reference.error_report(first[..., 3].astype(np.float64), ref)
+    accuracy.assert_accurate(report)
+
+    if message is None:
+        assert len(said) <= 1, said
+    else:
+        assert len(said) == 1, f"expected one message naming {name!r}, got: {said}"
+        assert message in said[0], said
+
+
+def test_a_face_with_a_nan_corner_is_dropped_whole():
+    """A quad with one NaN corner: both its triangles go (a kept half would
+    draw edges to a corner that has no position)."""
+    verts, faces = _strip(2)
+    verts[0] = (NAN, 0.0, 0.0)
+    arrays = extract.build_arrays(
+        positions=np.array(verts, np.float32),
+        corner_vert=np.array([v for f in faces for v in f], np.int32),
+        loop_start=np.array([0, 4], np.int32),
+        loop_total=np.array([4, 4], np.int32),
+        tri_loops=np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]], np.int32),
+        tri_polygons=np.array([0, 0, 1, 1], np.int32),
+    )
+    assert arrays.dropped_triangles == 2
+    assert arrays.triangle_polygons.tolist() == [1, 1]
+    assert np.isfinite(arrays.positions).all() and np.isfinite(arrays.centre).all()
+
+
+def test_degenerate_triangles_are_counted():
+    arrays = extract.build_arrays(
+        positions=np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0)], np.float32),
+        corner_vert=np.array([0, 1, 1, 2], np.int32),
+        loop_start=np.array([0], np.int32),
+        loop_total=np.array([4], np.int32),
+        tri_loops=np.array([[0, 1, 2], [0, 2, 3]], np.int32),
+        tri_polygons=np.array([0, 0], np.int32),
+    )
+    assert arrays.degenerate_triangles == 1
+
+
+def test_an_object_that_fails_to_upload_is_skipped_alone(output_dir, capfd, monkeypatch):
+    """Any failure while one object is prepared (here: its GPU upload) skips
+    that object with one message; the rest of the frame is drawn."""
+    from solidwire_addon import cache
+
+    scene, location = _base_scene()
+    without = robustness.render_exr(scene, output_dir / "upload_fail_without.exr")
+    scenes.monkey(scene, "Unlucky", location=location)
+
+    real = cache.GPUMesh
+
+    class FailingGPUMesh(real):
+        def __init__(self, arrays, *args, **kwargs):
+            if arrays.vertex_count == 507:  # Suzanne
+                raise MemoryError("GPU out of memory (simulated)")
+            super().__init__(arrays, *args, **kwargs)
+
+    monkeypatch.setattr(cache, "GPUMesh", FailingGPUMesh)
+    capfd.readouterr()
+    first = robustness.render_exr(scene, output_dir / "upload_fail.exr")
+    robustness.render_exr(scene, output_dir / "upload_fail.exr")
+    err = capfd.readouterr()
+    said = robustness.lines_of(err.out + err.err, "'Unlucky'")
+    assert np.array_equal(first, without)
+    assert len(said) == 1 and "MemoryError" in said[0], said
+
+
+def test_coordinates_1e8_in_view_match_reference(output_dir):
+    """A 2e8-wide floor under a small cube, camera close: float32 on the GPU
+    still matches the float64 reference (the far ends are only clipped)."""
+    scene = scenes.empty_scene(W, H)
+    scenes.grid(scene, "HugeFloor", x_segments=4, y_segments=4, size=2e8, location=(0.3, 0.2, -1.0))
+    scenes.cube(scene, size=1.0)
+    scenes.add_camera(scene, location=(3.0, -3.0, 1.5), target=(0, 0, 0), clip=(0.1, 1000.0))
+    report = accuracy.measure(scene, "coordinates_1e8_floor", output_dir)
+    accuracy.assert_accurate(report)
+    assert report["pixels"] > 0
+
+
+def test_object_1e8_from_origin_matches_reference(output_dir):
+    scene = scenes.empty_scene(W, H)
+    scenes.monkey(scene, location=(1e8, -1e8, 1e8))
+    scenes.add_camera(scene, location=(1e8 + 2.0, -1e8 - 4.0, 1e8 + 1.5), target=(1e8, -1e8, 1e8))
+    report = accuracy.measure(scene, "object_at_1e8", output_dir)
+    accuracy.assert_accurate(report)
+
+
+@pytest.mark.xfail(
+    reason="extraction re-centres on the bounding box of all vertices, loose ones included: one stray "
+    "vertex 1e6 away leaves the real faces at ~5e5 in float32 (reported to the lead)",
+    strict=False,
+)
+def test_stray_far_vertex_does_not_spoil_the_faces(output_dir):
+    scene = scenes.empty_scene(64, 48)
+    _mesh_object(scene, "Stray", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0), (1e6, 1e6, 1e6)], [], [(0, 1, 2, 3)],
+                 (0, 0, 0))
+    scenes.add_camera(scene, location=(0.5, -3.0, 3.0), target=(0, 0, 0))
+    report = accuracy.measure(scene, "stray_far_vertex", output_dir)
+    accuracy.assert_accurate(report)

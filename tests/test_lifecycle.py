@@ -1,0 +1,313 @@
+"""Lifecycle (issue 6, item 3): register/unregister leaves nothing behind
+(measured: classes, properties, handlers, draw handler, keymaps, timers,
+panel appends, exit hooks, GPU objects); the add-on keeps no Blender data; the
+overlay survives file load, undo, deletion, scene switch and renders."""
+
+from __future__ import annotations
+
+import atexit
+import gc
+import os
+import resource
+import subprocess
+import sys
+import textwrap
+import types
+from pathlib import Path
+
+import bpy
+import numpy as np
+import pytest
+
+import robustness
+import scenes
+import solidwire_addon
+from solidwire_addon import draw, engine, log, ops, overlay, runtime, ui
+from solidwire_addon.gpu_context import ensure_gpu
+from solidwire_addon.view import camera_view
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _handler_lists():
+    for name in dir(bpy.app.handlers):
+        value = getattr(bpy.app.handlers, name)
+        if isinstance(value, list):
+            yield name, value
+
+
+def _ours(func) -> bool:
+    return getattr(func, "__module__", "").startswith("solidwire_addon")
+
+
+def _addon_functions():
+    for module in robustness.addon_modules():
+        for value in vars(module).values():
+            if isinstance(value, types.FunctionType) and _ours(value):
+                yield value
+
+
+def leftovers() -> dict:
+    """Everything the add-on can leave in Blender or in its own module state,
+    by kind; empty lists when nothing is there."""
+    keyconfig = bpy.context.window_manager.keyconfigs.addon
+    keymap_items = []
+    if keyconfig is not None:
+        for keymap in keyconfig.keymaps:
+            keymap_items += [f"{keymap.name}:{k.idname}" for k in keymap.keymap_items if k.idname.startswith("solidwire.")]
+    compat = []
+    for name in dir(bpy.types):
+        engines = getattr(getattr(bpy.types, name, None), "COMPAT_ENGINES", None)
+        if isinstance(engines, set) and "SOLIDWIRE" in engines:
+            compat.append(name)
+    return {
+        "classes": [c.__name__ for c in solidwire_addon._classes if c.is_registered],
+        "bpy.types": [n for n in dir(bpy.types) if "solidwire" in n.lower()],
+        "properties": [
+            f"{t.__name__}.{p}"
+            for t in (bpy.types.Scene, bpy.types.Object, bpy.types.WindowManager, bpy.types.ViewLayer)
+            for p in t.bl_rna.properties.keys()
+            if "solidwire" in p
+        ],
+        "app handlers": [f"{name}:{f.__name__}" for name, funcs in _handler_lists() for f in funcs if _ours(f)],
+        "draw handler": [overlay._handle] if overlay._handle is not None else [],
+        "keymap items": keymap_items + [repr(k) for k in ops._keymap_items],
+        "panel appends": [f for p in ("VIEW3D_PT_overlay", "OBJECT_PT_visibility") for f in ui.appended_draw_functions(p)],
+        "compat panels": compat,
+        "timers": [f.__name__ for f in _addon_functions() if bpy.app.timers.is_registered(f)],
+        "exit hook": ["release_gpu"] if _exit_hook_registered() else [],
+        "GPU objects": robustness.scan_module_state(robustness.is_gpu_object),
+        "messages said": list(log._said),
+    }
+
+
+def _exit_hook_registered() -> bool:
+    """atexit cannot be listed (and its C array is invisible to gc): the
+    exit hook's reference count says whether atexit holds it. Unregistered,
+    only the package namespace and getrefcount's own argument refer to it."""
+    return sys.getrefcount(solidwire_addon.release_gpu) > 2
+
+
+def _measure() -> dict:
+    return leftovers()
+
+
+def _render_small(path):
+    scene = scenes.empty_scene(48, 36, show_overlay=True)
+    scenes.cube(scene)
+    scenes.add_camera(scene)
+    robustness.render_exr(scene, path)
+    return scene
+
+
+class Viewport:
+    """An offscreen stand-in for a 3D viewport's framebuffer (no 3D viewport
+    exists headless); the overlay draws into it exactly as into a region."""
+
+    def __init__(self, width=64, height=48):
+        import gpu
+
+        self.size = (width, height)
+        self.color = gpu.types.GPUTexture((width, height), format="SRGB8_A8")
+        self.depth = gpu.types.GPUTexture((width, height), format="DEPTH32F_STENCIL8")
+        self.framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.color,))
+
+    def draw(self, scene, depsgraph=None) -> tuple[dict, np.ndarray]:
+        import gpu
+
+        depsgraph = depsgraph or bpy.context.evaluated_depsgraph_get()
+        view = camera_view(scene, depsgraph, self.size)
+        with self.framebuffer.bind():
+            self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+            gpu.state.viewport_set(0, 0, *self.size)
+            stats = overlay.draw_scene_overlay(depsgraph, view, scene.solidwire.snapshot())
+        buf = self.color.read()
+        buf.dimensions = self.size[0] * self.size[1] * 4
+        alpha = np.array(buf, dtype=np.float64).reshape(self.size[1], self.size[0], 4)[..., 3] / 255.0
+        return stats, alpha
+
+
+def _rss_mb() -> float:
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+# ------------------------------------------------------- register cycles
+
+
+def test_registered_state_is_measurable(output_dir):
+    """The measurement sees what a registered, used add-on holds (so the
+    'nothing left' checks below can fail)."""
+    _render_small(output_dir / "lifecycle_probe.exr")
+    state = _measure()
+    for kind in ("classes", "bpy.types", "properties", "app handlers", "draw handler", "panel appends", "compat panels",
+                 "exit hook", "GPU objects"):
+        assert state[kind], f"cannot see {kind} while registered: {state}"
+
+
+def test_100_register_cycles_leave_nothing_behind(tmp_path):
+    solidwire_addon.unregister()
+    try:
+        clean = _measure()
+        assert not any(clean.values()), clean
+        rss = []
+        for cycle in range(100):
+            solidwire_addon.register()
+            if cycle % 10 == 0:
+                # Use it: shaders, meshes, targets, handlers, messages.
+                _render_small(tmp_path / "cycle.exr")
+                ensure_gpu()
+                Viewport().draw(bpy.context.scene)
+                log.warn_once(("lifecycle", cycle), "SolidWire: (lifecycle test message)")
+            solidwire_addon.unregister()
+            if cycle in (10, 99):
+                gc.collect()
+                rss.append(_rss_mb())
+            state = _measure()
+            assert not any(state.values()), f"after cycle {cycle}: {state}"
+        print(f"RSS after cycle 10: {rss[0]:.1f} MB, after cycle 99: {rss[1]:.1f} MB")
+        assert rss[1] - rss[0] < 40.0, rss
+    finally:
+        solidwire_addon.register()
+
+
+def test_register_and_unregister_are_idempotent():
+    solidwire_addon.register()
+    solidwire_addon.register()
+    assert overlay.is_registered()
+    solidwire_addon.unregister()
+    solidwire_addon.unregister()
+    try:
+        assert not any(_measure().values())
+    finally:
+        solidwire_addon.register()
+
+
+def test_process_exits_cleanly_after_rendering_while_registered(tmp_path):
+    """Blender tears its GPU context down at exit; a GPU object of ours still
+    alive then crashed the process (exit code 139) after writing the image."""
+    script = f"""
+        import sys; sys.path[:0] = [{str(ROOT)!r}, {str(ROOT / 'tests')!r}]
+        import bpy, solidwire_addon, scenes, robustness
+        solidwire_addon.register()
+        scene = scenes.empty_scene(32, 24); scenes.cube(scene); scenes.add_camera(scene)
+        robustness.render_exr(scene, {str(tmp_path / 'exit.exr')!r})
+        print("RENDERED")
+    """
+    env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
+    result = subprocess.run([sys.executable, "-c", textwrap.dedent(script)], capture_output=True, text=True,
+                            timeout=300, env=env)
+    assert "RENDERED" in result.stdout
+    assert result.returncode == 0, result.stderr[-2000:]
+
+
+# --------------------------------------------------- no Blender data held
+
+
+def test_addon_state_holds_no_blender_data(output_dir):
+    """Module state holds no bpy_struct (a stale one crashes after undo or
+    file load), except the keymap items Blender asks add-ons to keep."""
+    scene = _render_small(output_dir / "no_blender_data.exr")
+    ensure_gpu()
+    Viewport().draw(scene)
+    held = [p for p in robustness.scan_module_state(robustness.is_blender_data) if "_keymap_items" not in p]
+    assert held == []
+
+
+def test_handlers_are_persistent_and_hold_no_blender_data(output_dir):
+    _render_small(output_dir / "handlers.exr")
+    ours = [(name, f) for name, funcs in _handler_lists() for f in funcs if _ours(f)]
+    assert ours, "expected the cache invalidation handlers after a render"
+    for name, func in ours:
+        assert hasattr(func, "_bpy_persistent"), f"{name}:{func.__name__} is dropped by a file load"
+        captured = list(func.__defaults__ or ()) + [c.cell_contents for c in (func.__closure__ or ())]
+        assert not any(isinstance(v, bpy.types.bpy_struct) for v in captured), (name, func)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    after = [(name, f) for name, funcs in _handler_lists() for f in funcs if _ours(f)]
+    assert after == ours
+
+
+# ---------------------------------------------------------------- overlay
+
+
+def _overlay_scene():
+    scene = scenes.empty_scene(64, 48, show_overlay=True)
+    keep = scenes.cube(scene, "Keep", size=1.2, location=(-1.2, 0, 0))
+    gone = scenes.monkey(scene, "Gone", location=(1.3, 0, 0))
+    scenes.add_camera(scene, location=(0.0, -7.0, 1.0), target=(0, 0, 0))
+    return scene, keep, gone
+
+
+def test_overlay_handler_headless_is_quiet(capfd):
+    _overlay_scene()
+    capfd.readouterr()
+    overlay._draw_callback()  # no region headless: returns, never raises
+    err = capfd.readouterr()
+    assert "SolidWire" not in err.out + err.err
+
+
+def test_overlay_survives_deletion_load_scene_switch_and_renders(output_dir):
+    ensure_gpu()
+    viewport = Viewport()
+    scene, keep, gone = _overlay_scene()
+    stats, alpha_both = viewport.draw(scene)
+    assert stats["objects_drawn"] == 2
+
+    # Deletion: the deleted mesh is neither drawn nor kept on the GPU.
+    mesh = gone.data
+    bpy.data.objects.remove(gone)
+    bpy.data.meshes.remove(mesh)
+    stats, alpha_one = viewport.draw(scene)
+    assert stats["objects_drawn"] == 1 and stats["meshes_cached"] == 1
+    assert alpha_one.sum() < alpha_both.sum()
+
+    # Render while the overlay is on: both targets keep working.
+    robustness.render_exr(scene, output_dir / "overlay_render.exr")
+    stats, alpha_after_render = viewport.draw(scene)
+    assert np.array_equal(alpha_after_render, alpha_one)
+
+    # Scene switch: another scene's depsgraph draws that scene only.
+    other = bpy.data.scenes.new("Other")
+    other.render.engine = "SOLIDWIRE"
+    other.solidwire.show_overlay = True
+    scenes.uv_sphere(other, "Ball")
+    other.camera = scene.camera
+    other.collection.objects.link(scene.camera)
+    other_depsgraph = other.view_layers[0].depsgraph
+    other_depsgraph.update()  # not the window's scene headless: evaluate it here
+    stats, _ = viewport.draw(other, other_depsgraph)
+    assert stats["objects_drawn"] == 1
+    stats, alpha_back = viewport.draw(scene)
+    assert np.array_equal(alpha_back, alpha_one)
+
+    # File load: nothing of the old file is drawn or kept.
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    assert len(runtime.mesh_cache) == 0
+    new_scene, _keep, _gone = _overlay_scene()
+    stats, alpha_new = viewport.draw(new_scene)
+    assert stats["objects_drawn"] == 2
+    assert np.array_equal(alpha_new, alpha_both)
+
+
+def test_overlay_across_undo(output_dir):
+    """Undo replaces every datablock (memfile undo): the overlay must draw
+    the restored geometry, not a stale upload. Background mode only has an
+    undo stack after an explicit ed.undo_push()."""
+    ensure_gpu()
+    viewport = Viewport()
+    scene, keep, _gone = _overlay_scene()
+    bpy.ops.ed.undo_push(message="before edit")
+    _stats, alpha_before = viewport.draw(scene)
+    keep.data.vertices[0].co.x -= 0.8
+    keep.data.update()
+    bpy.ops.ed.undo_push(message="edit")
+    _stats, alpha_edited = viewport.draw(scene)
+    assert not np.array_equal(alpha_before, alpha_edited)
+    bpy.ops.ed.undo()
+    scene = bpy.context.scene  # the old Python objects are stale now
+    assert scene.objects["Keep"].data.vertices[0].co.x == pytest.approx(-0.6)
+    _stats, alpha_undone = viewport.draw(scene)
+    assert np.array_equal(alpha_undone, alpha_before)
+    bpy.ops.ed.redo()
+    _stats, alpha_redone = viewport.draw(bpy.context.scene)
+    assert np.array_equal(alpha_redone, alpha_edited)

@@ -1,0 +1,96 @@
+"""Numerical stress suite: the benchmark's stress scenes through the exact
+path, against the float64 reference (SPEC 1.5 thresholds, no NaN/Inf), and
+proof that the benchmark's near-plane scene really breaks the NVIDIA 2007
+method (so its tricky case is exercised). Nothing here is timed.
+
+The scenes are the ones scripts/bench.py measures (tests/scenes.py), at the
+benchmark's size (float32 error grows with window coordinates, so a smaller
+frame would hide it); the reference is evaluated on every ROW_STEP-th window
+row to keep the float64 numpy evaluation affordable.
+"""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+import pytest
+
+import accuracy
+import reference
+import scenes
+from solidwire_addon import draw as draw_mod
+from solidwire_addon import gather, offscreen
+from solidwire_addon import view as view_mod
+from solidwire_addon.cache import MeshCache
+
+SIZE = (1280, 720)
+ROW_STEP = 8
+# The SPEC defaults, and the benchmark's settings: the papers' prefiltered
+# profile (T = 0, s = 1, where no opaque core hides distance errors) with every
+# triangle edge drawn.
+LINE_SETTINGS = {
+    "defaults": {},
+    "bench": {"thickness": 0.0, "softness": 1.0, "diagonal_mode": "SOLID"},
+}
+
+
+def _stress_scene(name: str, **solidwire):
+    scene = scenes.empty_scene(*SIZE, **solidwire)
+    scenes.STRESS_SCENES[name](scene)
+    bpy.context.view_layer.update()
+    return scene
+
+
+@pytest.mark.parametrize("settings", list(LINE_SETTINGS))
+@pytest.mark.parametrize("name", list(scenes.STRESS_SCENES))
+def test_exact_path_meets_thresholds(name, settings, output_dir):
+    scene = _stress_scene(name, **LINE_SETTINGS[settings])
+    rgba = scenes.render_to_file(scene, output_dir / f"stress_{name}_{settings}.png")
+    ref = reference.render_reference(scene, rows=np.arange(ROW_STEP // 2, SIZE[1], ROW_STEP))
+    measured = rgba[ref.rows, :, 3]
+    report = reference.error_report(measured, ref)
+    report["name"] = f"{name}/{settings}"
+    accuracy.assert_accurate(report)
+
+
+def _method_intensity(scene, method: str) -> np.ndarray:
+    """Line intensity (alpha on a transparent film) of ``method``."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    items, _keys, _ms = gather.gather(depsgraph, MeshCache())
+    view = view_mod.camera_view(scene, depsgraph)
+    settings = draw_mod.DrawSettings.from_properties(scene.solidwire)
+    rgba, _depth, _stats = offscreen.render(items, view, settings, method=method)
+    return rgba[..., 3].astype(np.float64)
+
+
+def test_nvidia2007_fails_on_near_plane_scene():
+    scene = _stress_scene("near_plane", **LINE_SETTINGS["bench"])
+    ref = reference.render_reference(scene, rows=np.arange(ROW_STEP // 2, SIZE[1], ROW_STEP))
+    nvidia = _method_intensity(scene, "nvidia2007")[ref.rows]
+    kakadu = _method_intensity(scene, "kakadu_clip")[ref.rows]
+    report = reference.error_report(nvidia, ref)
+    # The published method misses the thresholds the exact path meets here ...
+    assert report["p999"] > accuracy.P999_LIMIT or report["max"] > accuracy.MAX_LIMIT, report
+    # ... and part of that is the tricky case: nvidia2007 and kakadu_clip run
+    # the same code except for the Liang-Barsky fix of tricky-case triangles,
+    # so pixels where they differ are tricky-case pixels with the float32
+    # cancellation glitch.
+    off_silhouette = ~ref.on_silhouette
+    glitch = np.abs(nvidia - kakadu)[off_silhouette]
+    assert np.count_nonzero(glitch > 2.0 / 255.0) > 0
+    assert np.abs(kakadu - ref.intensity)[off_silhouette][glitch > 2.0 / 255.0].mean() < glitch[glitch > 2.0 / 255.0].mean()
+
+
+@pytest.mark.parametrize("method", ["nvidia2007", "kakadu_clip", "barycentric", "offset_lines", "offset_lines_2x",
+                                    "fill_only"])
+def test_method_variants_render_finite_images(method):
+    """Every developer method compiles, draws and returns finite values."""
+    scene = scenes.empty_scene(320, 180, diagonal_mode="SOLID")
+    scenes.monkey(scene)
+    scenes.add_camera(scene, location=(4.0, -4.0, 3.0))
+    intensity = _method_intensity(scene, method)
+    assert np.isfinite(intensity).all()
+    if method == "fill_only":
+        assert intensity.max() == 0.0
+    else:
+        assert intensity.max() > 0.5

@@ -1,0 +1,265 @@
+"""Toggle operator, keymap, panels, menu and popover entry, headless.
+
+Panels cannot be drawn without a window, so their draw functions are called
+with a recording stand-in for ``UILayout``: it checks that every property and
+operator they name exists, and records which rows are greyed out.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+from types import SimpleNamespace
+
+import bpy
+import pytest
+
+import scenes
+import solidwire_addon
+from solidwire_addon import ops, presets, ui
+
+SPEC_PROPERTIES = (
+    "thickness",
+    "softness",
+    "wire_color",
+    "use_fill",
+    "fill_color",
+    "diagonal_mode",
+    "pattern_period",
+    "pattern_duty",
+    "use_fade",
+    "fade_start",
+    "fade_end",
+    "use_backface_culling",
+)
+
+
+class FakeLayout:
+    """Records what a draw function puts in a layout; fails on unknown names."""
+
+    def __init__(self, parent=None):
+        self.parent = parent
+        self.active = True
+        self.enabled = True
+        self.use_property_split = False
+        self.use_property_decorate = True
+        self.props: list[tuple] = []  # (data, name, greyed)
+        self.operators: list[str] = []
+        self.menus: list[str] = []
+        self.labels: list[str] = []
+        self.root = parent.root if parent else self
+
+    def greyed(self) -> bool:
+        node = self
+        while node is not None:
+            if not node.active or not node.enabled:
+                return True
+            node = node.parent
+        return False
+
+    def _child(self, *_args, **_kwargs):
+        return FakeLayout(self)
+
+    row = column = box = split = column_flow = grid_flow = _child
+
+    def separator(self, *_args, **_kwargs):
+        pass
+
+    def label(self, text="", **_kwargs):
+        self.root.labels.append(text)
+
+    def prop(self, data, name, **_kwargs):
+        assert name in data.bl_rna.properties, f"no property {name!r} on {data!r}"
+        self.root.props.append((data, name, self.greyed()))
+
+    def operator(self, idname, **_kwargs):
+        category, _, name = idname.partition(".")
+        assert hasattr(getattr(bpy.ops, category), name) and getattr(getattr(bpy.ops, category), name).get_rna_type()
+        self.root.operators.append(idname)
+        return SimpleNamespace()
+
+    def menu(self, idname, **_kwargs):
+        assert hasattr(bpy.types, idname), idname
+        self.root.menus.append(idname)
+
+    def operator_menu_enum(self, idname, property, **_kwargs):
+        self.operator(idname)
+        category, _, name = idname.partition(".")
+        rna = getattr(getattr(bpy.ops, category), name).get_rna_type()
+        assert property in rna.properties, f"{idname} has no property {property!r}"
+
+    def greyed_props(self) -> dict:
+        return {name: greyed for _data, name, greyed in self.props}
+
+
+def draw_with(function, context, owner=None):
+    layout = FakeLayout()
+    function(SimpleNamespace(layout=layout), context)
+    return layout
+
+
+def test_toggle_operator_flips_show_overlay():
+    scene = scenes.empty_scene()
+    assert scene.solidwire.show_overlay is False
+    assert bpy.ops.solidwire.toggle_overlay() == {"FINISHED"}
+    assert scene.solidwire.show_overlay is True
+    bpy.ops.solidwire.toggle_overlay()
+    assert scene.solidwire.show_overlay is False
+
+
+def _blender_default_keymap():
+    path = os.path.join(
+        bpy.utils.resource_path("LOCAL"), "scripts", "presets", "keyconfig", "keymap_data", "blender_default.py"
+    )
+    spec = importlib.util.spec_from_file_location("solidwire_test_blender_default", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.generate_keymaps(module.Params())
+
+
+def _chord(event: dict) -> tuple:
+    return (event["type"], *(bool(event.get(m)) for m in ("shift", "ctrl", "alt", "oskey")))
+
+
+def test_toggle_key_is_registered_and_free_in_blender_default_keymap():
+    keymap = bpy.context.window_manager.keyconfigs.addon.keymaps["3D View"]
+    items = [kmi for kmi in keymap.keymap_items if kmi.idname == "solidwire.toggle_overlay"]
+    assert len(items) == 1
+    kmi = items[0]
+    assert (kmi.type, kmi.shift, kmi.ctrl, kmi.alt) == ("W", True, True, True)
+
+    ours = _chord(ops.TOGGLE_KEY)
+    clashes = [
+        (name, idname)
+        for name, _params, data in _blender_default_keymap()
+        for idname, event, _props in data["items"]
+        if isinstance(event, dict) and not event.get("any") and _chord(event) == ours
+    ]
+    assert clashes == []
+    # ...while the obvious Shift+Alt+W is taken (why ours has Ctrl too).
+    plain = ("W", True, False, True, False)
+    assert any(
+        isinstance(event, dict) and _chord(event) == plain
+        for _name, _params, data in _blender_default_keymap()
+        for _idname, event, _props in data["items"]
+    )
+
+
+def test_unregister_leaves_nothing_behind():
+    def our_keymap_items():
+        keymap = bpy.context.window_manager.keyconfigs.addon.keymaps.get("3D View")
+        return [] if keymap is None else [k for k in keymap.keymap_items if k.idname.startswith("solidwire.")]
+
+    solidwire_addon.unregister()
+    try:
+        assert our_keymap_items() == []
+        assert ui.appended_draw_functions("VIEW3D_PT_overlay") == []
+        assert ui.appended_draw_functions("OBJECT_PT_visibility") == []
+        assert not hasattr(bpy.types, "VIEW3D_PT_solidwire")
+        assert not hasattr(bpy.types.Scene, "solidwire")
+        assert not hasattr(bpy.types.Object, "solidwire_exclude")
+        solidwire_addon.unregister()  # twice is fine
+    finally:
+        solidwire_addon.register()
+        solidwire_addon.register()  # and so is registering twice
+    assert len(our_keymap_items()) == 1
+    assert ui.appended_draw_functions("VIEW3D_PT_overlay") == [ui.draw_overlay_popover]
+
+
+def test_panels_menu_and_popover_are_registered():
+    for name in ("VIEW3D_PT_solidwire", "RENDER_PT_solidwire", "SOLIDWIRE_MT_presets"):
+        assert hasattr(bpy.types, name), name
+    assert bpy.types.VIEW3D_PT_solidwire.bl_region_type == "UI"
+    assert bpy.types.VIEW3D_PT_solidwire.bl_category == "SolidWire"
+    assert ui.appended_draw_functions("VIEW3D_PT_overlay") == [ui.draw_overlay_popover]
+    assert ui.appended_draw_functions("OBJECT_PT_visibility") == [ui.draw_object_visibility]
+
+
+@pytest.fixture
+def context():
+    scene = scenes.empty_scene()
+    obj = scenes.cube(scene)
+    return SimpleNamespace(scene=scene, object=obj, engine="SOLIDWIRE")
+
+
+def test_sidebar_panel_draws_every_setting(context):
+    layout = draw_with(ui.VIEW3D_PT_solidwire.draw, context)
+    drawn = layout.greyed_props()
+    for name in (*SPEC_PROPERTIES, "only_selected", "solidwire_exclude"):
+        assert name in drawn, name
+    assert "solidwire.fade_from_visible" in layout.operators
+
+    header = draw_with(ui.VIEW3D_PT_solidwire.draw_header, context)
+    assert header.greyed_props() == {"show_overlay": False}
+    preset_header = draw_with(ui.VIEW3D_PT_solidwire.draw_header_preset, context)
+    assert preset_header.menus == ["SOLIDWIRE_MT_presets"]
+    assert preset_header.operators == ["solidwire.preset_add", "solidwire.preset_remove"]
+
+
+def test_rows_that_do_not_apply_are_greyed_not_hidden(context):
+    props = context.scene.solidwire
+    props.use_fill, props.diagonal_mode, props.use_fade, props.show_overlay = False, "SOLID", False, False
+    greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
+    for name in ("fill_color", "pattern_period", "pattern_duty", "fade_start", "fade_end", "only_selected"):
+        assert greyed[name], f"{name} should be greyed"
+    assert not greyed["thickness"]
+
+    for name in ("hidden_alpha", "hidden_period", "hidden_duty", "world_thickness", "thickness_far"):
+        assert greyed[name], f"{name} should be greyed"
+
+    props.use_fill, props.diagonal_mode, props.use_fade, props.show_overlay = True, "DASHED", True, True
+    props.use_hidden_lines, props.thickness_mode = True, "DEPTH"
+    greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
+    assert {name for name, g in greyed.items() if g} == {"world_thickness"}
+
+    # World-space width: the pixel widths do not apply, the world width does.
+    props.thickness_mode = "WORLD"
+    greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
+    assert {name for name, g in greyed.items() if g} == {
+        "thickness", "thickness_far", "thickness_depth_start", "thickness_depth_end"
+    }
+    props.use_hidden_lines, props.thickness_mode = False, "PIXELS"
+
+
+def test_render_panel_and_its_poll(context):
+    assert ui.RENDER_PT_solidwire.poll(context)
+    assert not ui.RENDER_PT_solidwire.poll(SimpleNamespace(scene=context.scene, engine="CYCLES"))
+    drawn = draw_with(ui.RENDER_PT_solidwire.draw, context).greyed_props()
+    assert set(SPEC_PROPERTIES) <= set(drawn)
+
+
+def test_presets_menu_lists_builtin_and_user_presets(context):
+    folder = presets.user_dir()
+    bpy.ops.solidwire.preset_add(name="Menu Test")
+    (folder / "broken.json").write_text("{", encoding="utf-8")
+    try:
+        layout = draw_with(ui.SOLIDWIRE_MT_presets.draw, context)
+        assert layout.operators.count("solidwire.preset_apply") == len(presets.builtin_presets()) + 1
+        assert any(label.startswith("broken.json: not valid JSON") for label in layout.labels)
+    finally:
+        for path in folder.glob("*.json"):
+            path.unlink()
+        ops.active_preset_name = ""
+
+
+def test_overlay_popover_and_object_entries(context):
+    layout = draw_with(ui.draw_overlay_popover, context)
+    assert layout.greyed_props() == {"show_overlay": False}
+    layout = draw_with(ui.draw_object_visibility, context)
+    assert layout.greyed_props() == {"solidwire_exclude": False}
+
+
+def test_fade_range_from_visible_objects():
+    scene = scenes.empty_scene()
+    scenes.add_camera(scene, location=(0.0, -10.0, 0.0), target=(0.0, 0.0, 0.0))
+    scenes.cube(scene, "Near", size=2.0, location=(0.0, -4.0, 0.0))  # depth 5..7
+    scenes.cube(scene, "Far", size=2.0, location=(0.0, 6.0, 0.0))  # depth 15..17
+    hidden = scenes.cube(scene, "Hidden", size=2.0, location=(0.0, 30.0, 0.0))
+    hidden.hide_set(True)
+    excluded = scenes.cube(scene, "Excluded", size=2.0, location=(0.0, 40.0, 0.0))
+    excluded.solidwire_exclude = True
+    # Outside a viewport the scene camera is the view.
+    assert bpy.ops.solidwire.fade_from_visible() == {"FINISHED"}
+    props = scene.solidwire
+    assert props.use_fade
+    assert (props.fade_start, props.fade_end) == pytest.approx((5.0, 17.0), abs=1e-4)
