@@ -5,7 +5,8 @@ For every method x scene at 1280 x 720 (``--size``), this measures
 
 - the median time per frame over ``--frames`` frames after ``--warmup``
   frames, each frame synchronised with the GPU (one pixel read back; Blender's
-  gpu module exposes no glFinish). The mesh scenes turn around a vertical axis
+  gpu module exposes no glFinish). The methods take turns frame by frame, so
+  background load affects them alike. The mesh scenes turn around a vertical axis
   like the papers' benchmarks; the stress scenes stand still.
 - the error of one frame against the float64 reference of the image model
   (tests/reference.py, SPEC 1.5): mean, 99.9th percentile and max |dI| and
@@ -109,20 +110,28 @@ def turn_matrices(items, turning_names, frame: int, base):
 # ----------------------------------------------------------------- measuring
 
 
-def time_method(method, items, view, settings, turning, base, warmup: int, frames: int):
-    renderer = methods.Renderer(method, view.width, view.height)
-    times = []
+def time_methods(method_list, items, view, settings, turning, base, warmup: int, frames: int):
+    """{method: (times ms, frame-0 intensity)}. The methods take turns frame
+    by frame (round robin), so load from other processes on a shared machine
+    falls on all of them alike and the ratios of one run stay meaningful."""
+    renderers = {m: methods.Renderer(m, view.width, view.height) for m in method_list}
+    times = {m: [] for m in method_list}
     for frame in range(warmup + frames):
         turn_matrices(items, turning, frame, base)
-        start = time.perf_counter()
-        renderer.draw(items, view, settings)
-        renderer.sync()
-        if frame >= warmup:
-            times.append((time.perf_counter() - start) * 1000.0)
+        for method, renderer in renderers.items():
+            start = time.perf_counter()
+            renderer.draw(items, view, settings)
+            renderer.sync()
+            if frame >= warmup:
+                times[method].append((time.perf_counter() - start) * 1000.0)
     turn_matrices(items, turning, 0, base)
-    renderer.draw(items, view, settings)
-    rgba, _depth = renderer.read()
-    return times, rgba[..., 3].astype(np.float64)
+    out = {}
+    for method, renderer in renderers.items():
+        renderer.draw(items, view, settings)
+        rgba, _depth = renderer.read()
+        out[method] = (times[method], rgba[..., 3].astype(np.float64))
+    renderers.clear()
+    return out
 
 
 def error_numbers(intensity_full, ref):
@@ -325,6 +334,7 @@ def main(argv=None):
     parser.add_argument("--ref-row-step", type=int, default=None, help="reference on every N-th window row")
     parser.add_argument("--no-peers", action="store_true", help="skip Workbench and Freestyle")
     parser.add_argument("--out", default=str(ROOT / "out" / "bench"))
+    parser.add_argument("--docs", metavar="DIR", help="also copy the two pictures there (e.g. docs/, for the README)")
     args = parser.parse_args(argv)
 
     width, height = (int(v) for v in args.size.lower().split("x"))
@@ -380,8 +390,9 @@ def main(argv=None):
                   f"in {time.perf_counter() - start:.1f} s", flush=True)
 
         rows_out = []
+        measured = time_methods(method_list, items, view, settings, turning, base, warmup, frames)
         for method in method_list:
-            times, intensity = time_method(method, items, view, settings, turning, base, warmup, frames)
+            times, intensity = measured[method]
             row = {
                 "method": method,
                 "ms": statistics.median(times),
@@ -427,6 +438,14 @@ def main(argv=None):
     (out_dir / "results.json").write_text(json.dumps(data, indent=1), encoding="utf-8")
     write_markdown(results, meta, out_dir / "results.md")
     plot(results, out_dir / "time_vs_error.png", meta)
+    if args.docs:
+        import shutil
+
+        docs = Path(args.docs)
+        docs.mkdir(parents=True, exist_ok=True)
+        for name in ("time_vs_error.png", "near_plane_crops.png"):
+            if (out_dir / name).exists():
+                shutil.copyfile(out_dir / name, docs / f"bench_{name}")
     print(json.dumps(summary, indent=1))
     print(f"bench: wrote {out_dir}/results.json, results.md, time_vs_error.png"
           + (", near_plane_crops.png" if crop_images else ""))

@@ -169,13 +169,20 @@ def bench_many_objects(count: int, frame_count: int) -> dict:
 # 3: many instances of one mesh
 
 
-def instances_scene(count: int):
-    scene = scenes.empty_scene(640, 360)
+def instances_scene(count: int, *, tiny: bool = False):
+    # A small image: llvmpipe's rasterisation (the same work either way) would
+    # otherwise hide the per-instance CPU cost that instancing saves. ``tiny``
+    # goes further (one triangle per instance, 64 x 36 pixels) so the frame is
+    # almost only the cost of submitting the draws.
+    scene = scenes.empty_scene(64, 36) if tiny else scenes.empty_scene(160, 90)
     side = int(np.ceil(np.sqrt(count)))
     scenes.add_camera(scene, location=(0.0, -3.0 * side, 2.8 * side), target=(0.0, 0.0, 0.0), clip=(0.1, 1.0e4))
     # A small mesh (a cube, 12 triangles): the per-instance CPU cost is what
     # instancing saves; a heavy mesh would only measure llvmpipe's raster.
-    scatter = scenes.cube(scene, "Scatter")
+    if tiny:
+        scatter = scenes.from_pydata(scene, "Scatter", [(-1, 0, 0), (1, 0, 0), (0, 1, 0)], [(0, 1, 2)])
+    else:
+        scatter = scenes.cube(scene, "Scatter")
     tree = bpy.data.node_groups.new("scatter", "GeometryNodeTree")
     tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
     tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
@@ -192,8 +199,8 @@ def instances_scene(count: int):
     return scene
 
 
-def bench_instances(count: int, frame_count: int) -> dict:
-    scene = instances_scene(count)
+def bench_instances(count: int, frame_count: int, *, tiny: bool = False) -> dict:
+    scene = instances_scene(count, tiny=tiny)
     out = {}
     saved = draw.INSTANCING_MIN
     for mode, minimum in (("instanced", saved), ("per_instance", 10**9)):
@@ -293,6 +300,7 @@ def table(results: dict, args) -> str:
     e = results["extraction"]
     o = results["objects"]
     i = results["instances"]
+    t = results["instances_tiny"]
     m = results["memory"]
     a = results["animation"]
     rows = [
@@ -315,6 +323,9 @@ def table(results: dict, args) -> str:
          f"{i['per_instance']['steady_wall_ms']:.0f} ({i['per_instance']['steady_sw_ms']:.0f}) (draw per instance)"),
         (f"{args.instances:,} instances: draw call time, ms",
          f"{i['instanced']['steady_draw_ms']:.0f}", f"{i['per_instance']['steady_draw_ms']:.0f} (draw per instance)"),
+        (f"{args.instances:,} one-triangle instances, 64 x 36 px: steady frame / draw, ms",
+         f"{t['instanced']['steady_sw_ms']:.0f} / {t['instanced']['steady_draw_ms']:.0f}",
+         f"{t['per_instance']['steady_sw_ms']:.0f} / {t['per_instance']['steady_draw_ms']:.0f} (draw per instance)"),
         (f"Peak RSS, {m['triangles'] / 1e6:.1f}M-triangle scene, MiB",
          f"{m['rss_peak_mib']:.0f}", f"{m['rss_before_render_mib']:.0f} before the first render"),
         (f"Animation, {a['reuse']['frames']} frames, 1 deforming + {args.static} static: ms per frame (SolidWire share)",
@@ -363,6 +374,7 @@ def main(argv=None) -> int:
     results["objects"] = bench_many_objects(args.objects, args.frames)
     print(f"{args.instances} instances ...", file=sys.stderr)
     results["instances"] = bench_instances(args.instances, args.frames)
+    results["instances_tiny"] = bench_instances(args.instances, args.frames, tiny=True)
     print(f"animation, {args.anim_frames} frames ...", file=sys.stderr)
     results["animation"] = bench_animation(args.static, args.anim_frames)
     print("memory (own process) ...", file=sys.stderr)

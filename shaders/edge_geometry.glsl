@@ -28,18 +28,71 @@ vec2 window_point(vec4 clip)
   return h.xy / h.z;
 }
 
+/* The window line through a -> b (window points) and the interval the
+ * segment covers along it; see edge_setup for the conventions and why the
+ * line is anchored where it is. */
+void line_through(vec2 window_a, vec2 window_b, out vec3 line, out vec2 span)
+{
+  vec2 centre = params.viewport.xy + 0.5 * params.viewport.zw;
+  vec2 wa = window_a - centre;
+  vec2 wb = window_b - centre;
+  vec2 ab = wb - wa;
+  float len2 = dot(ab, ab);
+  if (!(len2 > 0.0)) {
+    /* Projects to a point (an edge along a view ray): the faces beside it
+     * are edge-on, and its ends belong to other edges. */
+    line = vec3(0.0, 0.0, NO_EDGE);
+    span = vec2(0.0);
+    return;
+  }
+  vec2 dir = ab * inversesqrt(len2);
+  vec2 normal = vec2(dir.y, -dir.x); /* so that dir == (-normal.y, normal.x) */
+  vec2 anchor = (dot(wa, wa) <= dot(wb, wb)) ? wa : wb;
+  line = vec3(normal, -dot(normal, anchor) - dot(normal, centre));
+  float along_centre = dot(dir, centre);
+  span = vec2(dot(dir, wa) + along_centre, dot(dir, wb) + along_centre);
+}
+
 /* Edge a->b as a unit-normal window line (n.x, n.y, c) and the interval
  * `span` = (s_a, s_b) its near-clipped segment covers along dir = (-n.y, n.x).
- * s_a belongs to endpoint a, so a pattern can be measured from a chosen end. */
+ * s_a belongs to endpoint a, so a pattern can be measured from a chosen end.
+ *
+ * Only the part in front of the near plane (clip z + w >= 0) has a
+ * projection, so the segment is clipped in clip space first; its ends then
+ * have w > 0 and project to finite window points, whatever side of the
+ * camera the original vertices were on: no special case for vertices behind
+ * the viewpoint.
+ *
+ * Precision: an edge wholly in front is anchored at its end nearer the
+ * viewport centre, in coordinates relative to that centre (line_through).
+ * The cross product of the two homogeneous window points gives the same
+ * line, but for a short edge it subtracts two nearly equal products of
+ * window coordinates: about 0.03 px / (edge length in px), which small
+ * triangles of dense meshes showed. For an edge that crosses the near plane
+ * the cross product is the better-conditioned choice (see below). */
 void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
 {
-  vec3 l = cross(window_homogeneous(a), window_homogeneous(b));
-  float len2 = dot(l.xy, l.xy);
   float depth_a = a.z + a.w; /* >= 0 in front of the near plane */
   float depth_b = b.z + b.w;
-  if (len2 == 0.0 || (depth_a < 0.0 && depth_b < 0.0)) {
-    /* Projects to a point (edge along a view ray) or lies wholly behind the
-     * near plane: it has no visible projection and no distance. */
+  if (depth_a < 0.0 && depth_b < 0.0) {
+    /* Wholly behind the near plane: no projection, no distance. */
+    line = vec3(0.0, 0.0, NO_EDGE);
+    span = vec2(0.0);
+    return;
+  }
+  if (depth_a >= 0.0 && depth_b >= 0.0) {
+    line_through(window_point(a), window_point(b), line, span);
+    return;
+  }
+  /* The edge crosses the near plane. Its clipped end is interpolated between
+   * two possibly far-apart points, so its position can carry a large
+   * rounding error: take the line itself from the unclipped ends instead, as
+   * the cross product of their homogeneous window coordinates (no division,
+   * valid on either side of the camera; long edges are well conditioned
+   * there). Only the span uses the clipped end. */
+  vec3 l = cross(window_homogeneous(a), window_homogeneous(b));
+  float len2 = dot(l.xy, l.xy);
+  if (!(len2 > 0.0)) {
     line = vec3(0.0, 0.0, NO_EDGE);
     span = vec2(0.0);
     return;
@@ -47,8 +100,13 @@ void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
   line = l * inversesqrt(len2);
   vec4 a_front = (depth_a < 0.0) ? mix(a, b, depth_a / (depth_a - depth_b)) : a;
   vec4 b_front = (depth_b < 0.0) ? mix(b, a, depth_b / (depth_b - depth_a)) : b;
+  vec2 wa = window_point(a_front), wb = window_point(b_front);
   vec2 dir = vec2(-line.y, line.x);
-  span = vec2(dot(dir, window_point(a_front)), dot(dir, window_point(b_front)));
+  if (dot(dir, wb - wa) < 0.0) {
+    line = -line; /* dir runs from a to b, so span.x < span.y */
+    dir = -dir;
+  }
+  span = vec2(dot(dir, wa), dot(dir, wb));
 }
 
 /* Edges run from their lower vertex id: the two triangles sharing a diagonal
@@ -60,5 +118,17 @@ void edge_setup_from_lower(vec4 a, vec4 b, float id_a, float id_b, out vec3 line
   }
   else {
     edge_setup(a, b, line, span);
+  }
+}
+
+/* The same for two ends already known to be in front of the near plane,
+ * from their window points (no clipping, no second division). */
+void line_through_from_lower(vec2 window_a, vec2 window_b, float id_a, float id_b, out vec3 line, out vec2 span)
+{
+  if (id_b < id_a) {
+    line_through(window_b, window_a, line, span);
+  }
+  else {
+    line_through(window_a, window_b, line, span);
   }
 }

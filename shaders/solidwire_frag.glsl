@@ -8,13 +8,16 @@
  *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
  */
 
-/* Distance from window point p to the segment stored as (line, span). */
-float edge_distance(vec3 line, vec2 span, vec2 p)
+/* Squared distance from window point p to the segment stored as (line,
+ * span); span.x < span.y always (edge_geometry.glsl orients dir from the
+ * segment's first end to its second). Squared, so that only the nearest edge
+ * of each kind pays for a square root. */
+float edge_distance_sq(vec3 line, vec2 span, vec2 p)
 {
   float across = dot(line, vec3(p, 1.0));
   float along = dot(vec2(-line.y, line.x), p);
-  float beyond = max(min(span.x, span.y) - along, 0.0) + max(along - max(span.x, span.y), 0.0);
-  return length(vec2(across, beyond));
+  float beyond = max(max(span.x - along, along - span.y), 0.0);
+  return across * across + beyond * beyond;
 }
 
 /* SPEC 1.4 profile: 1 inside the core, 2^(-2 x^2) falloff over two softness
@@ -70,11 +73,34 @@ void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float bes
 void main()
 {
   vec2 p = gl_FragCoord.xy;
-  float d0 = edge_distance(edge_line0, edge_span0, p);
-  float d1 = edge_distance(edge_line1, edge_span1, p);
-  float d2 = edge_distance(edge_line2, edge_span2, p);
-  float d3 = edge_distance(edge_line3, edge_span3, p);
-  float d4 = edge_distance(edge_line4, edge_span4, p);
+  /* Squared distances to the five candidate edges. */
+  float d0, d1, d2, d3, d4;
+  if ((triangle_flags & SIMPLE_TRIANGLE) != 0) {
+    /* Inside a convex polygon wholly in front of the camera the nearest
+     * boundary point of the nearest edge line lies on that edge's segment,
+     * so the line distance is exact and the segment ends need no test.
+     * (Diagonals too: where an obtuse corner puts the foot of a diagonal's
+     * line outside its segment, a real edge is nearer still.) On a GPU this
+     * branch is coherent per triangle; llvmpipe runs both sides. */
+    vec3 P = vec3(p, 1.0);
+    d0 = dot(edge_line0, P);
+    d1 = dot(edge_line1, P);
+    d2 = dot(edge_line2, P);
+    d3 = dot(edge_line3, P);
+    d4 = dot(edge_line4, P);
+    d0 *= d0;
+    d1 *= d1;
+    d2 *= d2;
+    d3 *= d3;
+    d4 *= d4;
+  }
+  else {
+    d0 = edge_distance_sq(edge_line0, edge_span0, p);
+    d1 = edge_distance_sq(edge_line1, edge_span1, p);
+    d2 = edge_distance_sq(edge_line2, edge_span2, p);
+    d3 = edge_distance_sq(edge_line3, edge_span3, p);
+    d4 = edge_distance_sq(edge_line4, edge_span4, p);
+  }
 
   bool real0 = (triangle_flags & EDGE0_REAL) != 0;
   bool real1 = (triangle_flags & EDGE1_REAL) != 0;
@@ -83,7 +109,7 @@ void main()
   /* The nearest real edge, with its line and span (for the hidden-line
    * dashes; unused otherwise and compiled away). Quad edges p2-p3 and p3-p0
    * are NO_EDGE unless the triangle has them. */
-  float d_real = NO_EDGE;
+  float d_real = NO_EDGE * NO_EDGE;
   vec3 real_line = vec3(0.0, 0.0, NO_EDGE);
   vec2 real_span = vec2(0.0);
   keep_nearest(real0, d0, edge_line0, edge_span0, d_real, real_line, real_span);
@@ -91,26 +117,23 @@ void main()
   keep_nearest(real2, d2, edge_line2, edge_span2, d_real, real_line, real_span);
   keep_nearest(true, d3, edge_line3, edge_span3, d_real, real_line, real_span);
   keep_nearest(true, d4, edge_line4, edge_span4, d_real, real_line, real_span);
-  if ((triangle_flags & IS_NGON) != 0) {
-    /* An n-gon's boundary edges may pass near this fragment although they
-     * belong to another of its triangles (thin ears, concave outlines): walk
-     * the whole outline. Only n-gon fragments pay for this loop. */
-    int corners = triangle_flags >> NGON_SHIFT;
-    float first_id = fetch_texel(ngon_corners, ngon_corner_start).x;
-    vec4 first = vertex_clip(first_id);
-    float id_a = first_id;
-    vec4 a = first;
-    for (int k = 1; k <= corners; k++) {
-      float id_b = (k == corners) ? first_id : fetch_texel(ngon_corners, ngon_corner_start + k).x;
-      vec4 b = (k == corners) ? first : vertex_clip(id_b);
-      vec3 line;
-      vec2 span;
-      edge_setup_from_lower(a, b, id_a, id_b, line, span);
-      keep_nearest(true, edge_distance(line, span, p), line, span, d_real, real_line, real_span);
-      a = b;
-      id_a = id_b;
-    }
+  /* An n-gon's boundary edges may pass near this fragment although they
+   * belong to another of its triangles (thin ears, concave outlines): walk
+   * the whole outline. Compiled only into the variant for meshes that have
+   * n-gons: llvmpipe pays for this loop on every fragment even when it runs
+   * zero times. */
+#ifdef USE_NGONS
+  int corners = triangle_flags >> NGON_SHIFT;
+  for (int k = 0; k < corners; k++) {
+    float id_a = fetch_texel(ngon_corners, ngon_corner_start + k).x;
+    float id_b = fetch_texel(ngon_corners, ngon_corner_start + (k + 1) % corners).x;
+    vec3 line;
+    vec2 span;
+    edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
+    keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_real, real_line, real_span);
   }
+#endif
+  d_real = sqrt(d_real);
   float half_thickness = half_thickness_here();
   float intensity = line_profile(d_real, half_thickness);
 
@@ -122,25 +145,25 @@ void main()
   intensity *= params.hidden_alpha * pattern_mask(abs(along_real - real_span.x), params.hidden_period, params.hidden_duty);
 #elif DIAGONALS >= 1
   /* The nearest diagonal, with its line and span for the pattern. */
-  float d_diag = NO_EDGE;
+  float d_diag = NO_EDGE * NO_EDGE;
   vec3 diag_line = vec3(0.0, 0.0, NO_EDGE);
   vec2 diag_span = vec2(0.0);
   keep_nearest(!real0, d0, edge_line0, edge_span0, d_diag, diag_line, diag_span);
   keep_nearest(!real1, d1, edge_line1, edge_span1, d_diag, diag_line, diag_span);
   keep_nearest(!real2, d2, edge_line2, edge_span2, d_diag, diag_line, diag_span);
-  if ((triangle_flags & IS_NGON) != 0) {
-    /* Every diagonal of the n-gon, not only this triangle's own. */
-    int corners = triangle_flags >> NGON_SHIFT;
-    for (int k = 0; k < corners - 3; k++) {
-      int slot = ngon_corner_start + corners + 2 * k;
-      float id_a = fetch_texel(ngon_corners, slot).x;
-      float id_b = fetch_texel(ngon_corners, slot + 1).x;
-      vec3 line;
-      vec2 span;
-      edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
-      keep_nearest(true, edge_distance(line, span, p), line, span, d_diag, diag_line, diag_span);
-    }
+  /* Every diagonal of an n-gon, not only this triangle's own. */
+#ifdef USE_NGONS
+  for (int k = 0; k < corners - 3; k++) {
+    int slot = ngon_corner_start + corners + 2 * k;
+    float id_a = fetch_texel(ngon_corners, slot).x;
+    float id_b = fetch_texel(ngon_corners, slot + 1).x;
+    vec3 line;
+    vec2 span;
+    edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
+    keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_diag, diag_line, diag_span);
   }
+#endif
+  d_diag = sqrt(d_diag);
   float diag_intensity = line_profile(d_diag, half_thickness);
 #  if DIAGONALS == 2
   /* Position along the nearest diagonal from its lower-id end (stable for a

@@ -27,23 +27,56 @@ void main()
   vec4 c1 = vertex_clip(ids.y);
   vec4 c2 = vertex_clip(ids.z);
 
-  edge_setup_from_lower(c0, c1, ids.x, ids.y, edge_line0, edge_span0);
-  edge_setup_from_lower(c1, c2, ids.y, ids.z, edge_line1, edge_span1);
-  edge_setup_from_lower(c2, c0, ids.z, ids.x, edge_line2, edge_span2);
-
-  triangle_flags = edge_flags;
-  /* For an n-gon triangle the 4th id is where its polygon's corners start
-   * in `ngon_corners`. */
+  bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
+  bool is_ngon = (edge_flags & IS_NGON) != 0;
+  /* For a quad the 4th id is its 4th corner; for an n-gon triangle it is
+   * where its polygon's block starts in `ngon_corners`. */
+  vec4 c3 = is_quad ? vertex_clip(ids.w) : c2;
   ngon_corner_start = int(ids.w);
-  if ((edge_flags & HAS_QUAD_CORNER) != 0) {
-    vec4 c3 = vertex_clip(ids.w);
-    edge_setup_from_lower(c2, c3, ids.z, ids.w, edge_line3, edge_span3);
-    edge_setup_from_lower(c3, c0, ids.w, ids.x, edge_line4, edge_span4);
+  bool in_front = min(min(c0.z + c0.w, c1.z + c1.w), min(c2.z + c2.w, c3.z + c3.w)) >= 0.0;
+  bool simple = false;
+  if (in_front) {
+    /* The common case: every corner projects; one division per corner. */
+    vec2 w0 = c0.xy / c0.w, w1 = c1.xy / c1.w, w2 = c2.xy / c2.w, w3 = c3.xy / c3.w;
+    vec2 to_window = 0.5 * params.viewport.zw;
+    vec2 origin = params.viewport.xy + to_window;
+    w0 = w0 * to_window + origin;
+    w1 = w1 * to_window + origin;
+    w2 = w2 * to_window + origin;
+    w3 = w3 * to_window + origin;
+    line_through_from_lower(w0, w1, ids.x, ids.y, edge_line0, edge_span0);
+    line_through_from_lower(w1, w2, ids.y, ids.z, edge_line1, edge_span1);
+    line_through_from_lower(w2, w0, ids.z, ids.x, edge_line2, edge_span2);
+    if (is_quad) {
+      line_through_from_lower(w2, w3, ids.z, ids.w, edge_line3, edge_span3);
+      line_through_from_lower(w3, w0, ids.w, ids.x, edge_line4, edge_span4);
+      /* Convex in projection: each diagonal separates the other two corners. */
+      vec2 d02 = w2 - w0, d13 = w3 - w1;
+      float s1 = d02.x * (w1.y - w0.y) - d02.y * (w1.x - w0.x);
+      float s3 = d02.x * (w3.y - w0.y) - d02.y * (w3.x - w0.x);
+      float t0 = d13.x * (w0.y - w1.y) - d13.y * (w0.x - w1.x);
+      float t2 = d13.x * (w2.y - w1.y) - d13.y * (w2.x - w1.x);
+      simple = s1 * s3 < 0.0 && t0 * t2 < 0.0;
+    }
+    else {
+      simple = !is_ngon;
+    }
   }
   else {
+    /* Some corner is behind the near plane: clip each edge (edge_setup). */
+    edge_setup_from_lower(c0, c1, ids.x, ids.y, edge_line0, edge_span0);
+    edge_setup_from_lower(c1, c2, ids.y, ids.z, edge_line1, edge_span1);
+    edge_setup_from_lower(c2, c0, ids.z, ids.x, edge_line2, edge_span2);
+    if (is_quad) {
+      edge_setup_from_lower(c2, c3, ids.z, ids.w, edge_line3, edge_span3);
+      edge_setup_from_lower(c3, c0, ids.w, ids.x, edge_line4, edge_span4);
+    }
+  }
+  if (!is_quad) {
     edge_line3 = edge_line4 = vec3(0.0, 0.0, NO_EDGE);
     edge_span3 = edge_span4 = vec2(0.0);
   }
+  triangle_flags = edge_flags | (simple ? SIMPLE_TRIANGLE : 0);
 
   vec4 position = (corner == 0) ? c0 : ((corner == 1) ? c1 : c2);
   vec3 local = fetch_texel(vertex_positions,

@@ -30,7 +30,7 @@ def register() -> None:
     ui.register_appends()
     ops.register_keymaps()
     overlay.register()
-    atexit.register(release_gpu)
+    atexit.register(_at_exit)
     _registered = True
 
 
@@ -46,17 +46,21 @@ def unregister() -> None:
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)
     release_gpu()
-    atexit.unregister(release_gpu)
+    atexit.unregister(_at_exit)
     log.forget()
     _registered = False
 
 
-def release_gpu() -> None:
-    """Free every GPU object the add-on holds (targets, meshes, shaders).
+def _at_exit() -> None:
+    """Interpreter exit while registered (the bpy module; Blender itself
+    disables add-ons when it quits): unregister as Blender would. A GPU object
+    or a draw handler that outlives Blender's GPU context crashes the process
+    on exit (exit code 139 after a render, bpy 4.5 and 5.0)."""
+    unregister()
 
-    Also runs at interpreter exit while registered: a GPU object still alive
-    when Blender has torn down its GPU context crashes the process on exit
-    (seen with the bpy module: exit code 139 after a render)."""
+
+def release_gpu() -> None:
+    """Free every GPU object the add-on holds (targets, meshes, shaders)."""
     offscreen.release()
     runtime.release()
     silhouettes.release()

@@ -51,6 +51,7 @@ class GPUMesh:
         ngon = np.zeros((max(len(arrays.ngon_corners), 1), 4), dtype=np.float32)
         ngon[: len(arrays.ngon_corners), 0] = arrays.ngon_corners
         self.ngon_corners = _table_texture(ngon)
+        self.has_ngons = len(arrays.ngon_corners) > 0
         # Kept (no copy) so the silhouette pass can derive its edge table on
         # first use without re-extracting; see silhouettes.py.
         self.triangles_cpu = arrays.triangles

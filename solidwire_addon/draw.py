@@ -271,6 +271,31 @@ def draw(
         from . import methods  # noqa: F401  (registers the method sources)
 
         variant = replace(variant, method=method)
+    ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
+    gpu.state.depth_test_set(depth_test)
+    gpu.state.depth_mask_set(depth_write)
+    # Window-space winding flips with a mirroring view or a projection that
+    # mirrors x or y (the z flip of a GL projection does not change winding).
+    flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
+    groups = list(_groups(items, view, cull, stats))
+    try:
+        # Meshes with n-gons need the fragment stage's outline walk; the rest
+        # use a variant without it (llvmpipe pays for a loop even when it runs
+        # zero times), so tri/quad meshes never pay for n-gons.
+        for with_ngons in (False, True):
+            batch = [g for g in groups if (method == "exact" and g[0].has_ngons) == with_ngons]
+            if batch:
+                _draw_groups(batch, replace(variant, ngons=with_ngons), ubo, settings, method, flip, stats)
+    finally:
+        gpu.state.face_culling_set("NONE")
+    return stats
+
+
+def _draw_groups(groups, variant, ubo, settings: DrawSettings, method: str, flip: bool, stats: DrawStats) -> None:
+    """Draw (mesh, world, object_to_view, object_to_clip) groups with one
+    shader variant: per object, or instanced for meshes with many instances."""
+    import gpu
+
     shader = shaders.get(variant)
     # The view depth is only computed when depth fade or the depth target
     # reads it; otherwise the compiler drops this uniform and setting it fails.
@@ -279,47 +304,39 @@ def draw(
         uses_view_depth = True
     except ValueError:
         uses_view_depth = False
-    ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
-
     shader.bind()
     shader.uniform_block("params", ubo)
-    gpu.state.depth_test_set(depth_test)
-    gpu.state.depth_mask_set(depth_write)
-    # Window-space winding flips with a mirroring view or a projection that
-    # mirrors x or y (the z flip of a GL projection does not change winding).
-    flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
     instanced = []  # (mesh, object_to_view, object_to_clip, mirrored) drawn with draw_instanced
-    try:
-        for mesh, world, object_to_view_all, object_to_clip_all in _groups(items, view, cull, stats):
-            mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
-            if method == "exact" and len(world) >= INSTANCING_MIN:
-                if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
-                    for side in (False, True):
-                        pick = mirrored_all == side
-                        instanced.append((mesh, object_to_view_all[pick], object_to_clip_all[pick], side))
-                else:
-                    instanced.append((mesh, object_to_view_all, object_to_clip_all, bool(mirrored_all[0])))
-                continue
-            for object_to_view, object_to_clip, mirrored in zip(object_to_view_all, object_to_clip_all, mirrored_all):
-                if settings.use_backface_culling:
-                    gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
-                shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
-                if uses_view_depth:
-                    shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
-                shader.uniform_sampler("vertex_positions", mesh.positions)
-                shader.uniform_sampler("triangle_vertices", mesh.triangles)
-                if method == "exact":
+    for mesh, world, object_to_view_all, object_to_clip_all in groups:
+        mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
+        if method == "exact" and len(world) >= INSTANCING_MIN:
+            if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
+                for side in (False, True):
+                    pick = mirrored_all == side
+                    instanced.append((mesh, object_to_view_all[pick], object_to_clip_all[pick], side))
+            else:
+                instanced.append((mesh, object_to_view_all, object_to_clip_all, bool(mirrored_all[0])))
+            continue
+        for object_to_view, object_to_clip, mirrored in zip(object_to_view_all, object_to_clip_all, mirrored_all):
+            if settings.use_backface_culling:
+                gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
+            shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
+            if uses_view_depth:
+                shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
+            shader.uniform_sampler("vertex_positions", mesh.positions)
+            shader.uniform_sampler("triangle_vertices", mesh.triangles)
+            if method == "exact":
+                if variant.ngons:
                     shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
-                    mesh.batch.draw(shader)
-                else:
-                    methods.batch_for(mesh, method).draw(shader)
-                stats.objects_drawn += 1
-                stats.triangles_drawn += mesh.triangle_count
-        if instanced:
-            _draw_instanced(instanced, variant, ubo, settings, stats)
-    finally:
-        gpu.state.face_culling_set("NONE")
-    return stats
+                mesh.batch.draw(shader)
+            else:
+                from . import methods
+
+                methods.batch_for(mesh, method).draw(shader)
+            stats.objects_drawn += 1
+            stats.triangles_drawn += mesh.triangle_count
+    if instanced:
+        _draw_instanced(instanced, variant, ubo, settings, stats)
 
 
 def _draw_instanced(groups, variant, ubo, settings: DrawSettings, stats: DrawStats) -> None:
@@ -342,7 +359,8 @@ def _draw_instanced(groups, variant, ubo, settings: DrawSettings, stats: DrawSta
         shader.uniform_int("instance_base", base)
         shader.uniform_sampler("vertex_positions", mesh.positions)
         shader.uniform_sampler("triangle_vertices", mesh.triangles)
-        shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
+        if variant.ngons:
+            shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
         mesh.batch.draw_instanced(shader, instance_start=0, instance_count=count)
         base += count * shaders.INSTANCE_TEXELS
         stats.objects_drawn += count

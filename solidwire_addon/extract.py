@@ -242,11 +242,28 @@ def _pack_ngons(tri_ids, real, tri_polygons, loop_start, loop_total, corner_vert
     return ngon_corners, offsets[np.searchsorted(ngon_polys, tri_polygons)]
 
 
-def _recentre(positions: np.ndarray, finite_vertex: np.ndarray | None, columns: np.ndarray | None = None):
-    """(local float32, centre, bounds_min, bounds_max); ``finite_vertex`` None
-    means every vertex is finite. min/max are exact in float32, so only the
-    subtraction needs float64."""
-    if finite_vertex is None:
+def _face_vertices(vertex_count: int, corners: np.ndarray) -> np.ndarray | None:
+    """Mask of the vertices some drawn face uses, or None when that is all of
+    them (the common case: no loose vertices)."""
+    used = np.zeros(vertex_count, dtype=bool)
+    used[corners] = True
+    return None if used.all() else used
+
+
+def _recentre(
+    positions: np.ndarray,
+    finite_vertex: np.ndarray | None,
+    columns: np.ndarray | None = None,
+    face_vertex: np.ndarray | None = None,
+):
+    """(local float32, centre, bounds_min, bounds_max).
+
+    Bounds and centre cover the finite vertices that drawn faces use
+    (``finite_vertex`` / ``face_vertex`` None: all of them): a loose vertex
+    far away must neither move the centre (the faces would lose float32
+    precision) nor widen the bounds used for culling. min/max are exact in
+    float32, so only the subtraction needs float64."""
+    if finite_vertex is None and face_vertex is None:
         if len(positions):
             # Reductions over an (N, 3) array's short axis are slow in numpy:
             # reduce each contiguous column of the transposed copy instead.
@@ -261,14 +278,18 @@ def _recentre(positions: np.ndarray, finite_vertex: np.ndarray | None, columns: 
         local = np.empty_like(positions)
         np.subtract(positions, centre, out=local, dtype=np.float64, casting="unsafe")
         return local, centre, bounds_min, bounds_max
-    if not finite_vertex.any():
+    counted = finite_vertex if face_vertex is None else (face_vertex if finite_vertex is None else finite_vertex & face_vertex)
+    if not counted.any():
         zero = np.zeros(3)
         return np.zeros_like(positions), zero, zero.copy(), zero.copy()
     pos64 = positions.astype(np.float64)
-    bounds_min = pos64[finite_vertex].min(axis=0)
-    bounds_max = pos64[finite_vertex].max(axis=0)
+    bounds_min = pos64[counted].min(axis=0)
+    bounds_max = pos64[counted].max(axis=0)
     centre = 0.5 * (bounds_min + bounds_max)
-    local = np.where(finite_vertex[:, None], pos64 - centre, 0.0).astype(np.float32)
+    if finite_vertex is None:
+        local = (pos64 - centre).astype(np.float32)
+    else:
+        local = np.where(finite_vertex[:, None], pos64 - centre, 0.0).astype(np.float32)
     return local, centre, bounds_min, bounds_max
 
 
@@ -340,7 +361,8 @@ def build_arrays(
         triangles[is_ngon_tri, 3] = block_start
         flags[is_ngon_tri] |= IS_NGON | (loop_total[tri_polygons[is_ngon_tri]] << NGON_SHIFT)
 
-    local, centre, bounds_min, bounds_max = _recentre(positions, finite_vertex)
+    face_vertex = _face_vertices(len(positions), triangles[:, :3].ravel())
+    local, centre, bounds_min, bounds_max = _recentre(positions, finite_vertex, face_vertex=face_vertex)
     return MeshArrays(
         local, centre, triangles, flags, tri_polygons.copy(), bounds_min, bounds_max, dropped, ngon_corners,
         degenerate_triangles=_degenerate_count(triangles),
@@ -531,7 +553,10 @@ def build_arrays_fast(
             triangles[rows] = ngon_tris
             flags[rows] = ngon_flags
 
-    local, centre, bounds_min, bounds_max = _recentre(positions, None, columns)
+    # Every corner of a face is a corner of one of its triangles: the same
+    # vertex set as build_arrays' triangles[:, :3], read from fewer entries.
+    face_vertex = _face_vertices(len(positions), corner_vert)
+    local, centre, bounds_min, bounds_max = _recentre(positions, None, columns, face_vertex)
     return MeshArrays(
         local, centre, triangles, flags, tri_polygons, bounds_min, bounds_max, 0, ngon_corners, degenerate_triangles=_degenerate_count(triangles)
     )

@@ -5,10 +5,19 @@ from __future__ import annotations
 import sys
 
 _said: set = set()
+# A scene with thousands of broken objects, or an error whose text changes
+# every redraw, must not flood the console (nor grow this set) forever.
+MAX_MESSAGES = 100
+_SUPPRESSED = ("solidwire", "suppressed")
 
 
 def warn_once(key, message: str) -> None:
     if key in _said:
+        return
+    if len(_said) >= MAX_MESSAGES:
+        if _SUPPRESSED not in _said:
+            _said.add(_SUPPRESSED)
+            print(f"SolidWire: more than {MAX_MESSAGES} messages; further ones are not shown", file=sys.stderr)
         return
     _said.add(key)
     print(message, file=sys.stderr)

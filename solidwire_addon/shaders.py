@@ -13,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from . import compat
+
 SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
 
 # std140 layout of the per-frame parameter block; keep in sync with
@@ -64,6 +66,9 @@ class ShaderVariant:
     # Hidden-line style (issue 7): the pass that draws faces behind the
     # visible surface, real edges only, dimmed and dashed, no fill.
     hidden_pass: bool = False
+    # The mesh has n-gons: the fragment stage walks their outlines and
+    # diagonals (USE_NGONS); tri/quad meshes get a variant without that code.
+    ngons: bool = False
     # Developer/benchmark switch, not user-facing: which distance method the
     # shader implements. "exact" is the add-on's own path; the others are
     # faithful variants of the published methods (see METHODS and
@@ -127,6 +132,8 @@ def _create_info(variant: ShaderVariant):
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
+    if variant.ngons:
+        info.define("USE_NGONS", "1")
     if variant.use_fill:
         info.define("USE_FILL", "1")
     if variant.use_fade:
@@ -205,7 +212,7 @@ def _method_create_info(variant: ShaderVariant):
     import gpu
 
     method = variant.method
-    files = {"kakadu_clip": "nvidia2007", "offset_lines": "offset_lines"}.get(method, method)
+    files = {"kakadu_clip": "nvidia2007"}.get(method, method)  # kakadu_clip = nvidia2007 + KAKADU_CLIP
     if method not in METHODS:
         raise ValueError(f"unknown SolidWire method {method!r}; one of {METHODS}")
 
@@ -327,7 +334,7 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
             info.define("OVERLAY_FINS", repr(float(key.depth_bias)))
         else:
             info.fragment_out(0, "FLOAT", "frag_intensity")
-        info.depth_write("ANY")
+        compat.depth_write(info, "ANY")
         info.define("THICKNESS_MODE", str(key.thickness_mode))
         if key.use_fade:
             info.define("USE_FADE", "1")

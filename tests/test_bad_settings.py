@@ -239,7 +239,7 @@ def _run_bpy(script: str, tmp_path: Path) -> subprocess.CompletedProcess:
         [sys.executable, "-c", prelude + textwrap.dedent(script)],
         capture_output=True, text=True, timeout=300, env=env, cwd=str(tmp_path),
     )
-    assert result.returncode == 0, f"exit {result.returncode}\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
+    assert robustness.exited_cleanly(result.returncode), f"exit {result.returncode}\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
     return result
 
 

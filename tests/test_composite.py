@@ -452,7 +452,7 @@ def test_cli_over_errors(tmp_path, args, message):
 
 
 @pytest.mark.skipif(not os.environ.get("SOLIDWIRE_TEST_EEVEE"),
-                    reason="EEVEE compiles its shaders for minutes on llvmpipe; set SOLIDWIRE_TEST_EEVEE=1")
+                    reason="EEVEE's first render compiles shaders for minutes on llvmpipe; set SOLIDWIRE_TEST_EEVEE=1")
 def test_wire_over_eevee(tmp_path):
     scene = occlusion_scene()
     scene.eevee.taa_render_samples = 1

@@ -15,7 +15,6 @@ import os
 
 import bpy
 import numpy as np
-import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
@@ -100,8 +99,8 @@ def cameras(draw):
 def line_settings(draw):
     mode = draw(st.sampled_from(["HIDDEN", "SOLID", "DOTTED", "DASHED"]))
     values = {
-        "thickness": draw(st.sampled_from([0.0, 0.5, 1.5, 3.0, draw(st.floats(0.0, 8.0))])),
-        "softness": draw(st.sampled_from([0.25, 1.0, 2.5, draw(st.floats(0.25, 4.0))])),
+        "thickness": draw(st.sampled_from([0.0, 0.5, 1.5, 3.0, 40.0, draw(st.floats(0.0, 8.0))])),
+        "softness": draw(st.sampled_from([0.01, 0.25, 1.0, 2.5, 100.0, draw(st.floats(0.25, 4.0))])),
         "diagonal_mode": mode,
         "use_backface_culling": draw(st.booleans()),
         "use_fade": draw(st.booleans()),
@@ -109,7 +108,8 @@ def line_settings(draw):
         "fade_end": draw(st.floats(0.0, 15.0)),
     }
     if mode in ("DOTTED", "DASHED"):
-        values["pattern_period"] = draw(st.floats(2.0, 20.0))
+        values["pattern_period"] = draw(st.floats(1.0, 20.0))
+        values["pattern_duty"] = draw(st.sampled_from([0.0, 0.25, 0.5, 1.0, draw(st.floats(0.0, 1.0))]))
     return values
 
 
@@ -118,11 +118,22 @@ def transforms(draw):
     sign = draw(st.sampled_from([(1, 1, 1), (1, 1, 1), (-1, 1, 1), (1, -1, -1)]))
     scale = tuple(s * draw(st.floats(0.3, 2.0)) for s in sign)
     rotation = tuple(draw(st.floats(-math.pi, math.pi)) for _ in range(3))
-    return {"rotation": rotation, "scale": scale, "location": draw(st.tuples(*[st.floats(-0.5, 0.5)] * 3))}
+    return {
+        "rotation": rotation,
+        "scale": scale,
+        "location": draw(st.tuples(*[st.floats(-0.5, 0.5)] * 3)),
+        "pixel_aspect": draw(st.sampled_from([1.0, 1.0, 1.0, 2.0])),
+    }
 
 
 def build(mesh, camera, line, transform):
+    # diagonal_mode's update resets the duty: set the mode first.
+    line = dict(line)
+    duty = line.pop("pattern_duty", None)
     scene = scenes.empty_scene(W, H, **line)
+    if duty is not None:
+        scene.solidwire.pattern_duty = duty
+    scene.render.pixel_aspect_x = transform.get("pixel_aspect", 1.0)
     verts, faces = mesh
     data = bpy.data.meshes.new("Fuzz")
     data.from_pydata(verts, [], faces)

@@ -20,7 +20,14 @@
  * measures distances to the lines (A, Adir), (B, Bdir) and, when A != B, AB.
  *
  * Everything is float32, as on the GPU the paper targets: that is the point
- * of this variant (it reproduces the paper's behaviour, glitches included). */
+ * of this variant (it reproduces the paper's behaviour, glitches included).
+ *
+ * Platform note (measured on Mesa llvmpipe 15, not on hardware): when the
+ * rasteriser has to clip a triangle because a corner projects far outside
+ * the viewport (a corner just in front of the viewpoint), llvmpipe
+ * interpolates `noperspective` varyings wrongly (tens of pixels off, NaN in
+ * extreme cases), so the general case's heights break there too. The exact
+ * path uses only flat varyings and is not affected. */
 
 /* Table 1 of the whitepaper, by case id: (A, B, A', B') corner indices.
  * Case 0 is the general case and case 7 (all corners behind) is not visible;
