@@ -140,7 +140,7 @@ def translation(offset) -> np.ndarray:
 
 
 def pack_params(settings: DrawSettings, viewport, projection=None) -> bytes:
-    """The std140 parameter block (see shaders.PARAMS_TYPEDEF).
+    """The std140 parameter block (see shaders/params.glsl).
 
     ``projection`` (the view's) is needed for world-space thickness: window
     pixels per scene unit across the view at clip w = 1 are
@@ -219,7 +219,7 @@ def _groups(items, view: View, cull: bool, stats: DrawStats):
 
 def _instance_rows(object_to_view: np.ndarray, object_to_clip: np.ndarray) -> np.ndarray:
     """(N * INSTANCE_TEXELS, 4) float32: per instance the 4 columns of
-    object_to_clip then the view-z row (shaders.INSTANCING_PRELUDE)."""
+    object_to_clip then the view-z row (shaders/instancing.glsl)."""
     rows = np.empty((len(object_to_clip), shaders.INSTANCE_TEXELS, 4), dtype=np.float32)
     rows[:, :4, :] = np.swapaxes(object_to_clip, 1, 2)
     rows[:, 4, :] = object_to_view[:, 2, :]

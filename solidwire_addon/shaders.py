@@ -17,31 +17,9 @@ from . import compat
 
 SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
 
-# std140 layout of the per-frame parameter block; keep in sync with
-# draw.pack_params (which asserts the size).
-PARAMS_TYPEDEF = """
-struct SolidWireParams {
-  vec4 wire_color;
-  vec4 fill_color;
-  vec4 viewport;
-  float half_thickness;
-  float softness;
-  float fade_start;
-  float fade_end;
-  float pattern_period;
-  float pattern_duty;
-  float hidden_alpha;
-  float hidden_duty;
-  float half_thickness_far;
-  float thickness_depth_start;
-  float thickness_depth_end;
-  float world_half_thickness_px;
-  float hidden_period;
-  float _pad0;
-  float _pad1;
-  float _pad2;
-};
-"""
+# The per-frame parameter block (std140) lives in shaders/params.glsl; keep
+# PARAMS_FLOATS in sync with it and with draw.pack_params (which asserts it).
+PARAMS_FILE = "params.glsl"
 PARAMS_FLOATS = 28
 
 THICKNESS_PIXELS, THICKNESS_WORLD, THICKNESS_DEPTH = 0, 1, 2
@@ -76,7 +54,7 @@ class ShaderVariant:
     method: str = "exact"
     # Scale (issue 5): many instances of one mesh in one draw_instanced call,
     # each reading its matrices from a float texture by gl_InstanceID (see
-    # INSTANCING_* below and draw.py).
+    # shaders/instancing.glsl and draw.py).
     instanced: bool = False
 
 
@@ -110,7 +88,7 @@ def _create_info(variant: ShaderVariant):
     iface.smooth("FLOAT", "view_depth")
 
     info = gpu.types.GPUShaderCreateInfo()
-    info.typedef_source(PARAMS_TYPEDEF)
+    info.typedef_source(read_source(PARAMS_FILE))
     info.uniform_buf(0, "SolidWireParams", "params")
     if variant.instanced:
         info.push_constant("INT", "instance_base")
@@ -143,64 +121,21 @@ def _create_info(variant: ShaderVariant):
 
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
     if variant.instanced:
-        info.vertex_source(INSTANCING_PRELUDE + common + read_source("solidwire_vert.glsl") + INSTANCING_VERT_MAIN)
-        info.fragment_source(INSTANCING_PRELUDE + common + read_source("solidwire_frag.glsl") + INSTANCING_FRAG_MAIN)
+        instancing = read_source("instancing.glsl")
+        info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + read_source("solidwire_vert.glsl"))
+        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + read_source("solidwire_frag.glsl"))
     else:
         info.vertex_source(common + read_source("solidwire_vert.glsl"))
         info.fragment_source(common + read_source("solidwire_frag.glsl"))
     return info
 
 
-# Instanced variant of the exact path, wrapped around the unchanged stage
-# sources: `object_to_clip` / `object_to_view_z` become calls that read the
-# instance's values from `instance_table` (INSTANCE_TEXELS texels per
-# instance: the four columns of the float64-composed object -> clip matrix
-# rounded to float32, then the view-z row; exactly the values the per-object
-# path passes as push constants, so both paths draw the same image). They are
-# fetched once per invocation and kept in globals. The vertex stage finds its
-# instance by gl_InstanceID and hands it to the fragment stage (n-gon
-# outlines are set up there) in `instance_slot`.
+# Instanced variant of the exact path: shaders/instancing.glsl is prepended
+# to the unchanged stage sources (it turns the two push constants into reads
+# from `instance_table`); each stage says where its instance's texels start.
 INSTANCE_TEXELS = 5
-INSTANCING_PRELUDE = """
-#define object_to_clip sw_instance_to_clip()
-#define object_to_view_z sw_instance_to_view_z()
-mat4 sw_instance_to_clip();
-vec4 sw_instance_to_view_z();
-"""
-_INSTANCING_LOAD = """
-mat4 sw_clip_matrix;
-vec4 sw_view_z;
-bool sw_loaded = false;
-void sw_load_instance()
-{
-  if (sw_loaded) {
-    return;
-  }
-  sw_loaded = true;
-  int slot = SW_INSTANCE_SLOT;
-  sw_clip_matrix = mat4(fetch_texel(instance_table, slot),
-                        fetch_texel(instance_table, slot + 1),
-                        fetch_texel(instance_table, slot + 2),
-                        fetch_texel(instance_table, slot + 3));
-  sw_view_z = fetch_texel(instance_table, slot + 4);
-}
-mat4 sw_instance_to_clip()
-{
-  sw_load_instance();
-  return sw_clip_matrix;
-}
-vec4 sw_instance_to_view_z()
-{
-  sw_load_instance();
-  return sw_view_z;
-}
-"""
-INSTANCING_VERT_MAIN = """
-#define SW_INSTANCE_SLOT (instance_slot = instance_base + 5 * gl_InstanceID)
-""" + _INSTANCING_LOAD
-INSTANCING_FRAG_MAIN = """
-#define SW_INSTANCE_SLOT instance_slot
-""" + _INSTANCING_LOAD
+_INSTANCE_SLOT_VERT = "#define SW_INSTANCE_SLOT (instance_slot = instance_base + 5 * gl_InstanceID)\n"
+_INSTANCE_SLOT_FRAG = "#define SW_INSTANCE_SLOT instance_slot\n"
 
 
 def _method_create_info(variant: ShaderVariant):
@@ -231,7 +166,7 @@ def _method_create_info(variant: ShaderVariant):
     iface.smooth("FLOAT", "view_depth")
 
     info = gpu.types.GPUShaderCreateInfo()
-    info.typedef_source(PARAMS_TYPEDEF)
+    info.typedef_source(read_source(PARAMS_FILE))
     info.uniform_buf(0, "SolidWireParams", "params")
     info.push_constant("MAT4", "object_to_clip")
     info.push_constant("VEC4", "object_to_view_z")
@@ -319,7 +254,7 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         iface.flat("FLOAT", "fin_inner_sign")
         iface.flat("VEC2", "fin_view_depth")
         info = gpu.types.GPUShaderCreateInfo()
-        info.typedef_source(PARAMS_TYPEDEF)
+        info.typedef_source(read_source(PARAMS_FILE))
         info.uniform_buf(0, "SolidWireParams", "params")
         info.push_constant("MAT4", "object_to_clip")
         info.push_constant("VEC4", "object_to_view_z")
