@@ -28,12 +28,20 @@ vec2 window_point(vec4 clip)
   return h.xy / h.z;
 }
 
+/* Lines and spans are stored relative to the viewport centre: the fragment
+ * stage evaluates them at gl_FragCoord.xy - viewport_centre(), an exact
+ * subtraction that halves the size of the numbers it rounds. */
+vec2 viewport_centre()
+{
+  return params.viewport.xy + 0.5 * params.viewport.zw;
+}
+
 /* The window line through a -> b (window points) and the interval the
  * segment covers along it; see edge_setup for the conventions and why the
  * line is anchored where it is. */
 void line_through(vec2 window_a, vec2 window_b, out vec3 line, out vec2 span)
 {
-  vec2 centre = params.viewport.xy + 0.5 * params.viewport.zw;
+  vec2 centre = viewport_centre();
   vec2 wa = window_a - centre;
   vec2 wb = window_b - centre;
   vec2 ab = wb - wa;
@@ -48,9 +56,8 @@ void line_through(vec2 window_a, vec2 window_b, out vec3 line, out vec2 span)
   vec2 dir = ab * inversesqrt(len2);
   vec2 normal = vec2(dir.y, -dir.x); /* so that dir == (-normal.y, normal.x) */
   vec2 anchor = (dot(wa, wa) <= dot(wb, wb)) ? wa : wb;
-  line = vec3(normal, -dot(normal, anchor) - dot(normal, centre));
-  float along_centre = dot(dir, centre);
-  span = vec2(dot(dir, wa) + along_centre, dot(dir, wb) + along_centre);
+  line = vec3(normal, -dot(normal, anchor));
+  span = vec2(dot(dir, wa), dot(dir, wb));
 }
 
 /* Edge a->b as a unit-normal window line (n.x, n.y, c) and the interval
@@ -64,7 +71,8 @@ void line_through(vec2 window_a, vec2 window_b, out vec3 line, out vec2 span)
  * the viewpoint.
  *
  * Precision: an edge wholly in front is anchored at its end nearer the
- * viewport centre, in coordinates relative to that centre (line_through).
+ * viewport centre, in coordinates relative to that centre (line_through;
+ * `line` and `span` are relative to it, see viewport_centre()).
  * The cross product of the two homogeneous window points gives the same
  * line, but for a short edge it subtracts two nearly equal products of
  * window coordinates: about 0.03 px / (edge length in px), which small
@@ -97,10 +105,12 @@ void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
     span = vec2(0.0);
     return;
   }
+  vec2 centre = viewport_centre();
   line = l * inversesqrt(len2);
+  line.z += dot(line.xy, centre); /* relative to the viewport centre, like line_through */
   vec4 a_front = (depth_a < 0.0) ? mix(a, b, depth_a / (depth_a - depth_b)) : a;
   vec4 b_front = (depth_b < 0.0) ? mix(b, a, depth_b / (depth_b - depth_a)) : b;
-  vec2 wa = window_point(a_front), wb = window_point(b_front);
+  vec2 wa = window_point(a_front) - centre, wb = window_point(b_front) - centre;
   vec2 dir = vec2(-line.y, line.x);
   if (dot(dir, wb - wa) < 0.0) {
     line = -line; /* dir runs from a to b, so span.x < span.y */

@@ -3,12 +3,6 @@
  * pass's depth at this pixel, and the intensity written both as colour and
  * as depth (1 - I) so that a LESS test keeps the maximum over fins. */
 
-float line_profile(float d, float half_thickness)
-{
-  float x = max(d - half_thickness, 0.0) / params.softness;
-  return (x < 2.0) ? exp2(-2.0 * x * x) : 0.0;
-}
-
 void main()
 {
   vec2 p = gl_FragCoord.xy;
@@ -34,20 +28,9 @@ void main()
   }
 #endif
 
-  float half_thickness = params.half_thickness;
-#if THICKNESS_MODE == 1
-  half_thickness = params.world_half_thickness_px / q.w;
-#elif THICKNESS_MODE == 2
-  float range = params.thickness_depth_end - params.thickness_depth_start;
-  float t = (range > 0.0) ? clamp((q_view_depth - params.thickness_depth_start) / range, 0.0, 1.0) :
-                            ((q_view_depth <= params.thickness_depth_start) ? 0.0 : 1.0);
-  half_thickness = mix(params.half_thickness, params.half_thickness_far, t);
-#endif
-  float intensity = line_profile(d, half_thickness);
+  float intensity = line_profile(d, half_thickness_at(q_view_depth, 1.0 / q.w));
 #ifdef USE_FADE
-  float fade_range = params.fade_end - params.fade_start;
-  intensity *= (fade_range > 0.0) ? clamp((params.fade_end - q_view_depth) / fade_range, 0.0, 1.0) :
-                                    ((q_view_depth <= params.fade_start) ? 1.0 : 0.0);
+  intensity *= depth_fade(q_view_depth);
 #endif
   if (intensity <= 0.0) {
     discard;

@@ -20,47 +20,6 @@ float edge_distance_sq(vec3 line, vec2 span, vec2 p)
   return across * across + beyond * beyond;
 }
 
-/* SPEC 1.4 profile: 1 inside the core, 2^(-2 x^2) falloff over two softness
- * widths, cut to 0 beyond (the step there is 2^-8, one 8-bit level). */
-float line_profile(float d, float half_thickness)
-{
-  float x = max(d - half_thickness, 0.0) / params.softness;
-  return (x < 2.0) ? exp2(-2.0 * x * x) : 0.0;
-}
-
-/* Half the core width at this fragment (THICKNESS_MODE, issue 7):
- * 0 constant in pixels; 1 a width in scene units, i.e. pixels per unit at
- *   this depth (gl_FragCoord.w = 1 / clip w, exact for perspective and
- *   orthographic views); 2 Baerentzen's depth cue, from the near thickness to
- *   the far one across [thickness_depth_start, thickness_depth_end]. */
-float half_thickness_here()
-{
-#if THICKNESS_MODE == 1
-  return params.world_half_thickness_px * gl_FragCoord.w;
-#elif THICKNESS_MODE == 2
-  float range = params.thickness_depth_end - params.thickness_depth_start;
-  float t = (range > 0.0) ? clamp((view_depth - params.thickness_depth_start) / range, 0.0, 1.0) :
-                            ((view_depth <= params.thickness_depth_start) ? 0.0 : 1.0);
-  return mix(params.half_thickness, params.half_thickness_far, t);
-#else
-  return params.half_thickness;
-#endif
-}
-
-/* Integral of the on/off square wave (on for the first `duty` of each
- * period) from 0 to t: the box-filtered mask is a difference of two of these,
- * which anti-aliases the dash ends over one pixel exactly. */
-float pattern_integral(float t, float period, float duty)
-{
-  float cycles = floor(t / period);
-  return cycles * duty * period + clamp(t - cycles * period, 0.0, duty * period);
-}
-
-float pattern_mask(float t, float period, float duty)
-{
-  return pattern_integral(t + 0.5, period, duty) - pattern_integral(t - 0.5, period, duty);
-}
-
 void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float best, inout vec3 best_line, inout vec2 best_span)
 {
   if (candidate && d < best) {
@@ -72,7 +31,8 @@ void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float bes
 
 void main()
 {
-  vec2 p = gl_FragCoord.xy;
+  /* Window position relative to the viewport centre (edge_geometry.glsl). */
+  vec2 p = gl_FragCoord.xy - viewport_centre();
   /* Squared distances to the five candidate edges. */
   float d0, d1, d2, d3, d4;
   if ((triangle_flags & SIMPLE_TRIANGLE) != 0) {
@@ -134,7 +94,7 @@ void main()
   }
 #endif
   d_real = sqrt(d_real);
-  float half_thickness = half_thickness_here();
+  float half_thickness = half_thickness_at(view_depth, gl_FragCoord.w);
   float intensity = line_profile(d_real, half_thickness);
 
 #ifdef HIDDEN_PASS
@@ -175,10 +135,7 @@ void main()
 #endif
 
 #ifdef USE_FADE
-  float fade_range = params.fade_end - params.fade_start;
-  float fade = (fade_range > 0.0) ? clamp((params.fade_end - view_depth) / fade_range, 0.0, 1.0) :
-                                    ((view_depth <= params.fade_start) ? 1.0 : 0.0);
-  intensity *= fade;
+  intensity *= depth_fade(view_depth);
 #endif
 
   float wire_weight = intensity * params.wire_color.a;

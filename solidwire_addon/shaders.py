@@ -120,13 +120,14 @@ def _create_info(variant: ShaderVariant):
         info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
 
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
+    style = read_source("line_style.glsl")
     if variant.instanced:
         instancing = read_source("instancing.glsl")
         info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + read_source("solidwire_frag.glsl"))
+        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + style + read_source("solidwire_frag.glsl"))
     else:
         info.vertex_source(common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(common + read_source("solidwire_frag.glsl"))
+        info.fragment_source(common + style + read_source("solidwire_frag.glsl"))
     return info
 
 
@@ -192,7 +193,9 @@ def _method_create_info(variant: ShaderVariant):
 
     common = read_source("common.glsl")
     info.vertex_source(common + read_source("methods/pull_vert.glsl") + read_source(f"methods/{files}_vert.glsl"))
-    info.fragment_source(common + read_source("methods/output_frag.glsl") + read_source(f"methods/{files}_frag.glsl"))
+    info.fragment_source(
+        common + read_source("line_style.glsl") + read_source("methods/output_frag.glsl") + read_source(f"methods/{files}_frag.glsl")
+    )
     return info
 
 
@@ -275,7 +278,7 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
             info.define("USE_FADE", "1")
         common = read_source("common.glsl") + read_source("edge_geometry.glsl")
         info.vertex_source(common + read_source("silhouette_vert.glsl"))
-        info.fragment_source(common + read_source("silhouette_frag.glsl"))
+        info.fragment_source(common + read_source("line_style.glsl") + read_source("silhouette_frag.glsl"))
         shader = gpu.shader.create_from_info(info)
         _silhouette_cache[key] = shader
     return shader

@@ -5,19 +5,16 @@
  * a benchmark difference between variants is a difference in the distance
  * computation only. */
 
+/* The constant-width profile (line_style.glsl): the variants draw in px. */
 float line_profile(float d)
 {
-  float x = max(d - params.half_thickness, 0.0) / params.softness;
-  return (x < 2.0) ? exp2(-2.0 * x * x) : 0.0;
+  return line_profile(d, params.half_thickness);
 }
 
 void write_output(float intensity)
 {
 #ifdef USE_FADE
-  float fade_range = params.fade_end - params.fade_start;
-  float fade = (fade_range > 0.0) ? clamp((params.fade_end - view_depth) / fade_range, 0.0, 1.0) :
-                                    ((view_depth <= params.fade_start) ? 1.0 : 0.0);
-  intensity *= fade;
+  intensity *= depth_fade(view_depth);
 #endif
   float wire_weight = intensity * params.wire_color.a;
 #ifdef USE_FILL

@@ -1,0 +1,53 @@
+"""Error of the exact path against the float64 reference (SPEC 1.5) on the
+core test scenes, as a Markdown table for the README.
+
+    .venv/bin/python scripts/accuracy_report.py [--size 200x150]
+
+Renders each scene of tests/test_render_reference.py through the SOLIDWIRE
+engine to a 16-bit PNG (so the numbers include file quantisation) and
+compares its alpha with the reference's line intensity.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests"))
+
+import accuracy  # noqa: E402
+import scenes  # noqa: E402
+import solidwire_addon  # noqa: E402
+import test_render_reference as cases  # noqa: E402
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", default="200x150", help="render size WxH")
+    args = parser.parse_args(argv)
+    width, height = (int(v) for v in args.size.lower().split("x"))
+    solidwire_addon.register()
+    rows = []
+    try:
+        with tempfile.TemporaryDirectory(prefix="solidwire-accuracy-") as folder:
+            for name, build in cases.SCENES.items():
+                scene = scenes.empty_scene(width, height, thickness=1.5)
+                build(scene)
+                rows.append(accuracy.measure(scene, name, Path(folder)))
+    finally:
+        solidwire_addon.unregister()
+    print(f"| scene ({width} x {height}) | mean abs dI | p99.9 | max | px > 2/255 | silhouette px |")
+    print("|---|---:|---:|---:|---:|---:|")
+    for r in rows:
+        print(f"| {r['name']} | {r['mean']:.1e} | {r['p999']:.1e} | {r['max']:.1e} | {r['over_2_255']} | {r['silhouette_pixels']} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
