@@ -18,7 +18,7 @@ BLENDER_TAGS = $(VENV_PYTHON) -c "import importlib.util, os; \
 	print(os.path.join(importlib.util.find_spec('bpy').submodule_search_locations[0], \
 	'5.0', 'scripts', 'modules', '_bpy_internal', 'extensions', 'tags.py'))"
 
-.PHONY: demo test venv zip check-system clean
+.PHONY: demo test venv zip check-system clean bench bench-scale fetch-meshes test-slow soak fuzz compat
 
 venv: $(VENV_STAMP)
 
@@ -48,6 +48,30 @@ zip: $(VENV_STAMP)
 	$(VENV_PYTHON) "$$($(BLENDER_EXT))" validate --valid-tags "$$($(BLENDER_TAGS))" .
 	mkdir -p $(DIST_DIR)
 	$(VENV_PYTHON) "$$($(BLENDER_EXT))" build --valid-tags "$$($(BLENDER_TAGS))" --source-dir . --output-dir $(DIST_DIR)
+
+# Benchmarks (numbers in the README; matplotlib is a benchmark-only dependency).
+fetch-meshes: $(VENV_STAMP)
+	$(VENV_PYTHON) scripts/fetch_meshes.py
+
+bench: $(VENV_STAMP) check-system
+	$(VENV_PYTHON) -m pip install --disable-pip-version-check -q -r requirements-bench.txt
+	$(VENV_PYTHON) scripts/bench.py $(BENCH_ARGS)
+
+bench-scale: $(VENV_STAMP) check-system
+	$(VENV_PYTHON) scripts/bench_scale.py $(BENCH_ARGS)
+
+# Opt-in robustness runs (not part of `make test` / CI); see README "Robustness".
+test-slow: $(VENV_STAMP) check-system
+	SOLIDWIRE_SLOW=1 $(VENV_PYTHON) -m pytest tests
+
+soak: $(VENV_STAMP) check-system
+	SOLIDWIRE_SLOW=1 $(VENV_PYTHON) -m pytest tests/test_soak.py -s
+
+fuzz: $(VENV_STAMP) check-system
+	SOLIDWIRE_FUZZ_EXAMPLES=$(or $(FUZZ_EXAMPLES),500) $(VENV_PYTHON) -m pytest tests/test_fuzz.py -s
+
+compat: check-system
+	scripts/compat.sh $(COMPAT_VERSIONS)
 
 clean:
 	rm -rf out $(DIST_DIR) tests/output

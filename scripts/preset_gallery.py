@@ -31,7 +31,7 @@ from solidwire_addon import engine, presets  # noqa: E402
 from solidwire_addon.gpu_context import ensure_gpu  # noqa: E402
 
 CELL = (460, 345)
-COLUMNS = 4
+COLUMNS = 3
 LABEL_HEIGHT = 30
 BACKGROUND = (0.045, 0.045, 0.05)  # linear; close to the default viewport grey
 LABEL_BACKGROUND = (28, 28, 30)

@@ -166,11 +166,18 @@ def main() -> int:
         layers = composite.render_wire_over(scene, args.out / "wire_over_suzanne.png", "CYCLES")
         print(f"wrote {args.out / 'wire_over_suzanne.png'}", flush=True)
         save_rgb(scene, layers_strip(layers), args.out / "wire_over_layers.png")
+        # The same shot with full-width silhouettes (outer halves of outlines).
+        scene.solidwire.use_silhouettes = True
+        composite.render_wire_over(scene, args.out / "wire_over_suzanne_silhouettes.png", "CYCLES")
+        print(f"wrote {args.out / 'wire_over_suzanne_silhouettes.png'}", flush=True)
         bunny = scenes.MESH_DIR / "bunny.obj"
         if bunny.is_file():
             scene = bunny_scene(args.samples, args.bunny_ratio)
             composite.render_wire_over(scene, args.out / "wire_over_bunny.png", "CYCLES")
             print(f"wrote {args.out / 'wire_over_bunny.png'}", flush=True)
+            scene.solidwire.use_silhouettes = True
+            composite.render_wire_over(scene, args.out / "wire_over_bunny_silhouettes.png", "CYCLES")
+            print(f"wrote {args.out / 'wire_over_bunny_silhouettes.png'}", flush=True)
         else:
             print(f"skipped the bunny: {bunny} is missing (scripts/fetch_meshes.py)", flush=True)
     finally:

@@ -41,6 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
+from . import compat
+
 ENGINE_ID = "SOLIDWIRE"
 
 # Friendly and older names of Blender's engines (EEVEE was BLENDER_EEVEE_NEXT
@@ -274,8 +276,7 @@ def _exr_output(scene, multilayer: bool) -> None:
     and Blender 5.0 fails to write one with more than one pass and
     non-square pixels: "Conflicting attributes ... pixelAspectRatio".)"""
     image = scene.render.image_settings
-    if hasattr(image, "media_type"):  # Blender 5: the family first
-        image.media_type = "MULTI_LAYER_IMAGE" if multilayer else "IMAGE"
+    compat.set_media_type(image, "MULTI_LAYER_IMAGE" if multilayer else "IMAGE")  # Blender 5: the family first
     image.file_format = "OPEN_EXR_MULTILAYER" if multilayer else "OPEN_EXR"
     image.color_mode = "RGBA"
     image.color_depth = "32"
