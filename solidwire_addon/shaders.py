@@ -73,6 +73,22 @@ def read_source(name: str) -> str:
         raise RuntimeError(f"SolidWire shader file missing: {path.name} ({exc.strerror})") from None
 
 
+def _pulling_info(*, push_matrices: bool = True):
+    """Create-info with what every SolidWire shader shares: the parameter
+    block, the position table (vertex pulling) and, unless the matrices come
+    from an instance table, the object -> clip and view-z push constants."""
+    import gpu
+
+    info = gpu.types.GPUShaderCreateInfo()
+    info.typedef_source(read_source(PARAMS_FILE))
+    info.uniform_buf(0, "SolidWireParams", "params")
+    if push_matrices:
+        info.push_constant("MAT4", "object_to_clip")
+        info.push_constant("VEC4", "object_to_view_z")
+    info.sampler(0, "FLOAT_2D", "vertex_positions")
+    return info
+
+
 def _create_info(variant: ShaderVariant):
     import gpu
 
@@ -87,17 +103,11 @@ def _create_info(variant: ShaderVariant):
     iface.flat("INT", "ngon_corner_start")
     iface.smooth("FLOAT", "view_depth")
 
-    info = gpu.types.GPUShaderCreateInfo()
-    info.typedef_source(read_source(PARAMS_FILE))
-    info.uniform_buf(0, "SolidWireParams", "params")
+    info = _pulling_info(push_matrices=not variant.instanced)
     if variant.instanced:
         info.push_constant("INT", "instance_base")
         info.sampler(3, "FLOAT_2D", "instance_table")
         iface.flat("INT", "instance_slot")
-    else:
-        info.push_constant("MAT4", "object_to_clip")
-        info.push_constant("VEC4", "object_to_view_z")
-    info.sampler(0, "FLOAT_2D", "vertex_positions")
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     info.sampler(2, "FLOAT_2D", "ngon_corners")
     info.vertex_in(0, "INT", "edge_flags")
@@ -166,12 +176,7 @@ def _method_create_info(variant: ShaderVariant):
         iface.flat("INT", "line_mask")
     iface.smooth("FLOAT", "view_depth")
 
-    info = gpu.types.GPUShaderCreateInfo()
-    info.typedef_source(read_source(PARAMS_FILE))
-    info.uniform_buf(0, "SolidWireParams", "params")
-    info.push_constant("MAT4", "object_to_clip")
-    info.push_constant("VEC4", "object_to_view_z")
-    info.sampler(0, "FLOAT_2D", "vertex_positions")
+    info = _pulling_info()
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     if method == "offset_lines":
         info.vertex_in(0, "INT", "line_vertex")
@@ -256,13 +261,8 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         iface.flat("VEC3", "fin_line")
         iface.flat("FLOAT", "fin_inner_sign")
         iface.flat("VEC2", "fin_view_depth")
-        info = gpu.types.GPUShaderCreateInfo()
-        info.typedef_source(read_source(PARAMS_FILE))
-        info.uniform_buf(0, "SolidWireParams", "params")
-        info.push_constant("MAT4", "object_to_clip")
-        info.push_constant("VEC4", "object_to_view_z")
+        info = _pulling_info()
         info.push_constant("INT", "edge_count")
-        info.sampler(0, "FLOAT_2D", "vertex_positions")
         info.sampler(1, "FLOAT_2D", "silhouette_edges")
         info.sampler(2, "DEPTH_2D", "scene_depth")
         info.vertex_in(0, "INT", "fin_corner")
