@@ -76,12 +76,7 @@ def main(argv=None) -> int:
     try:
         scene = build_scene()
         cells = render_cells(scene)
-        columns = preset_gallery.COLUMNS
-        preset_gallery.COLUMNS = 3
-        try:
-            preset_gallery.write(preset_gallery.compose(cells), cells, args.output)
-        finally:
-            preset_gallery.COLUMNS = columns
+        preset_gallery.write(preset_gallery.compose(cells, columns=3), cells, args.output, columns=3)
     finally:
         solidwire_addon.unregister()
     print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")

@@ -91,21 +91,21 @@ def render_cells(scene, folder: Path):
     return cells
 
 
-def compose(cells) -> np.ndarray:
+def compose(cells, columns: int = COLUMNS) -> np.ndarray:
     """(H, W, 3) uint8, top row first, with a label strip under each cell."""
     width, height = CELL
-    rows = -(-len(cells) // COLUMNS)
-    sheet = np.zeros((rows * (height + LABEL_HEIGHT), COLUMNS * width, 3), dtype=np.uint8)
+    rows = -(-len(cells) // columns)
+    sheet = np.zeros((rows * (height + LABEL_HEIGHT), columns * width, 3), dtype=np.uint8)
     sheet[:] = LABEL_BACKGROUND
     for index, (_label, linear) in enumerate(cells):
-        r, c = divmod(index, COLUMNS)
+        r, c = divmod(index, columns)
         image = (srgb_encode(linear[::-1]) * 255.0 + 0.5).astype(np.uint8)  # bottom-up -> top-down
         y0 = r * (height + LABEL_HEIGHT)
         sheet[y0 : y0 + height, c * width : (c + 1) * width] = image
     return sheet
 
 
-def write(sheet: np.ndarray, cells, path: Path) -> None:
+def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         from PIL import Image, ImageDraw, ImageFont
@@ -120,11 +120,11 @@ def write(sheet: np.ndarray, cells, path: Path) -> None:
         font = ImageFont.load_default()
     width, height = CELL
     for index, (label, _linear) in enumerate(cells):
-        r, c = divmod(index, COLUMNS)
+        r, c = divmod(index, columns)
         x = c * width + 10
         y = r * (height + LABEL_HEIGHT) + height + 6
         draw.text((x, y), label, fill=(235, 235, 235), font=font)
-    for c in range(1, COLUMNS):  # thin separators between columns
+    for c in range(1, columns):  # thin separators between columns
         draw.line([(c * width, 0), (c * width, image.height)], fill=LABEL_BACKGROUND, width=2)
     # An adaptive 256-colour palette keeps the anti-aliased lines smooth and
     # the file small enough for a README.

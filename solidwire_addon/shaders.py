@@ -89,6 +89,20 @@ def _pulling_info(*, push_matrices: bool = True):
     return info
 
 
+def _output_and_feature_defines(info, variant: ShaderVariant) -> None:
+    """Fragment outputs and the feature defines the exact path and the
+    method variants share (same outputs, same profile and colour rules)."""
+    info.fragment_out(0, "VEC4", "frag_color")
+    if variant.write_view_depth:
+        info.fragment_out(1, "FLOAT", "frag_view_depth")
+        info.define("WRITE_VIEW_DEPTH", "1")
+    info.define("DIAGONALS", str(variant.diagonals))
+    if variant.use_fill:
+        info.define("USE_FILL", "1")
+    if variant.use_fade:
+        info.define("USE_FADE", "1")
+
+
 def _create_info(variant: ShaderVariant):
     import gpu
 
@@ -112,20 +126,12 @@ def _create_info(variant: ShaderVariant):
     info.sampler(2, "FLOAT_2D", "ngon_corners")
     info.vertex_in(0, "INT", "edge_flags")
     info.vertex_out(iface)
-    info.fragment_out(0, "VEC4", "frag_color")
-    if variant.write_view_depth:
-        info.fragment_out(1, "FLOAT", "frag_view_depth")
-        info.define("WRITE_VIEW_DEPTH", "1")
-    info.define("DIAGONALS", str(variant.diagonals))
+    _output_and_feature_defines(info, variant)
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
     if variant.ngons:
         info.define("USE_NGONS", "1")
-    if variant.use_fill:
-        info.define("USE_FILL", "1")
-    if variant.use_fade:
-        info.define("USE_FADE", "1")
     if variant.depth_bias:
         info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
 
@@ -184,15 +190,7 @@ def _method_create_info(variant: ShaderVariant):
     else:
         info.vertex_in(0, "INT", "edge_flags")
     info.vertex_out(iface)
-    info.fragment_out(0, "VEC4", "frag_color")
-    if variant.write_view_depth:
-        info.fragment_out(1, "FLOAT", "frag_view_depth")
-        info.define("WRITE_VIEW_DEPTH", "1")
-    info.define("DIAGONALS", str(variant.diagonals))
-    if variant.use_fill:
-        info.define("USE_FILL", "1")
-    if variant.use_fade:
-        info.define("USE_FADE", "1")
+    _output_and_feature_defines(info, variant)
     if method == "kakadu_clip":
         info.define("KAKADU_CLIP", "1")
 
