@@ -55,10 +55,10 @@ fetch-meshes: $(VENV_STAMP)
 
 bench: $(VENV_STAMP) check-system
 	$(VENV_PYTHON) -m pip install --disable-pip-version-check -q -r requirements-bench.txt
-	$(VENV_PYTHON) scripts/bench.py $(BENCH_ARGS)
+	$(VENV_PYTHON) -m scripts.bench $(BENCH_ARGS)
 
 bench-scale: $(VENV_STAMP) check-system
-	$(VENV_PYTHON) scripts/bench_scale.py $(BENCH_ARGS)
+	$(VENV_PYTHON) -m scripts.bench_scale $(BENCH_ARGS)
 
 # Opt-in robustness runs (not part of `make test` / CI); see README "Robustness".
 test-slow: $(VENV_STAMP) check-system

@@ -1,7 +1,7 @@
 """Error of the exact path against the float64 reference (SPEC 1.5) on the
 core test scenes, as a Markdown table for the README.
 
-    .venv/bin/python scripts/accuracy_report.py [--size 200x150]
+    .venv/bin/python -m scripts.accuracy_report [--size 200x150]
 
 Renders each scene of tests/test_render_reference.py through the SOLIDWIRE
 engine to a 16-bit PNG (so the numbers include file quantisation) and
@@ -18,11 +18,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
 
-import accuracy  # noqa: E402
-import scenes  # noqa: E402
+from tests.support import accuracy  # noqa: E402
+from tests.support import scenes  # noqa: E402
 import solidwire_addon  # noqa: E402
 import test_render_reference as cases  # noqa: E402
 

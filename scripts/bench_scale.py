@@ -23,7 +23,7 @@ depsgraph evaluation included) and SolidWire's own share (stats
 ``ms_total``). The GPU here may be a software rasteriser (Mesa llvmpipe):
 the table says which renderer ran, and draw times mean CPU time then.
 
-    python scripts/bench_scale.py [--quick] [--out out/bench_scale.md]
+    python -m scripts.bench_scale [--quick] [--out out/bench_scale.md]
 
 Prints a Markdown table and writes it (plus a .json) under out/.
 """
@@ -43,17 +43,17 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-bench-"))
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-import scenes  # noqa: E402
+from tests.support import scenes  # noqa: E402
 import solidwire_addon  # noqa: E402
-from solidwire_addon import draw, extract, runtime  # noqa: E402
-from solidwire_addon.gpu_context import ensure_gpu  # noqa: E402
+from solidwire_addon.core import draw
+from solidwire_addon.core import extract
+from solidwire_addon.blender import runtime
+from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
 
 
 def rss_mib() -> float:

@@ -13,7 +13,7 @@ OBJ files into cache/meshes/ (cache/ is git-ignored):
 - bunny.obj: the Stanford bunny as glmark2-data ships it (``models/bunny.obj``,
   69,666 triangles), copied unchanged.
 
-Suzanne at subdivision level 5 needs no download (scripts/bench.py builds it
+Suzanne at subdivision level 5 needs no download (scripts/bench/ builds it
 in Blender). Without apt (not Debian, no network), this prints a message and
 exits 0; the benchmark then skips the scenes whose mesh is missing.
 

@@ -2,7 +2,7 @@
 (full-width silhouettes, hidden lines, world-space and depth-cue thickness)
 next to the plain SPEC look, and write a labelled sheet (docs/line_styles.png).
 
-    .venv/bin/python scripts/line_styles_gallery.py [-o docs/line_styles.png]
+    .venv/bin/python -m scripts.line_styles_gallery [-o docs/line_styles.png]
 """
 
 from __future__ import annotations
@@ -12,18 +12,15 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
-sys.path.insert(0, str(ROOT / "scripts"))
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-import preset_gallery  # noqa: E402  (compose/write: the same sheet layout as the presets gallery)
-import scenes  # noqa: E402
+from scripts import preset_gallery  # noqa: E402  (compose/write: the same sheet layout as the presets gallery)
+from tests.support import scenes  # noqa: E402
 import solidwire_addon  # noqa: E402
-from solidwire_addon import engine  # noqa: E402
-from solidwire_addon.gpu_context import ensure_gpu  # noqa: E402
+from solidwire_addon.blender import engine
+from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
 
 CELL = preset_gallery.CELL
 PAPER = (0.93, 0.92, 0.88)

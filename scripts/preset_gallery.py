@@ -1,7 +1,7 @@
 """Render every built-in SolidWire preset on Suzanne and write a labelled
 gallery image (docs/presets.png by default).
 
-    .venv/bin/python scripts/preset_gallery.py [-o docs/presets.png]
+    .venv/bin/python -m scripts.preset_gallery [-o docs/presets.png]
 
 Overlay presets (no fill) are composited over Blender's own Solid shading of
 the same view (a Workbench render), which is how an artist sees them in the
@@ -19,16 +19,15 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-import scenes  # noqa: E402  (tests/scenes.py: scene builders shared with the tests)
+from tests.support import scenes  # noqa: E402  (tests/support/scenes.py: scene builders shared with the tests)
 import solidwire_addon  # noqa: E402
-from solidwire_addon import engine, presets  # noqa: E402
-from solidwire_addon.gpu_context import ensure_gpu  # noqa: E402
+from solidwire_addon.blender import engine
+from solidwire_addon.blender import presets
+from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
 
 CELL = (460, 345)
 COLUMNS = 3

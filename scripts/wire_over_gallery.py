@@ -1,7 +1,7 @@
 """Gallery images of the wire pass over a shaded Cycles render (README,
 "Wire over EEVEE / Cycles renders"):
 
-    .venv/bin/python scripts/wire_over_gallery.py [--out docs] [--samples 48]
+    .venv/bin/python -m scripts.wire_over_gallery [--out docs] [--samples 48]
 
 writes docs/wire_over_suzanne.png (Suzanne, subdivision level 1, wire over a
 Cycles render), docs/wire_over_layers.png (the beauty, the wire pass on a
@@ -20,16 +20,14 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 from mathutils import Vector  # noqa: E402
 
-import scenes  # noqa: E402  (tests/scenes.py: scene builders)
+from tests.support import scenes  # noqa: E402  (tests/support/scenes.py: scene builders)
 import solidwire_addon  # noqa: E402
-from solidwire_addon import composite  # noqa: E402
+from solidwire_addon.blender import composite
 
 SIZE = (640, 400)
 

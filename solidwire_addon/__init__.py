@@ -2,9 +2,11 @@
 on the filled triangles from the exact window-space distance to each face's
 edges.
 
-Data flows one way: scene -> gather/extract -> GPU cache -> draw -> targets
-(render engine, command line, viewport overlay). ``register()`` and
-``unregister()`` are safe to call repeatedly and leave nothing behind.
+Data flows one way: scene -> gather/extract -> GPU cache -> pass plan -> draw
+-> targets (render engine, command line, viewport overlay). ``core`` holds the
+plain-data and GPU side, ``blender`` everything that faces Blender; the image
+model is defined in docs/image_model.md. ``register()`` and ``unregister()``
+are safe to call repeatedly and leave nothing behind.
 """
 
 from __future__ import annotations
@@ -13,9 +15,10 @@ import atexit
 
 import bpy
 
-from . import engine, log, offscreen, ops, ops_composite, overlay, runtime, settings, shaders, silhouettes, ui
+from .blender import cli, engine, ops, ops_composite, overlay, properties, runtime, ui
+from .core import log, shaders, silhouettes, targets
 
-_classes = (*settings.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
+_classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
 _registered = False
 
 
@@ -25,11 +28,12 @@ def register() -> None:
         return
     for cls in _classes:
         bpy.utils.register_class(cls)
-    settings.register_properties()
+    properties.register_properties()
     engine.register_compat()
     ui.register_appends()
     ops.register_keymaps()
     overlay.register()
+    cli.register_command()
     atexit.register(_at_exit)
     _registered = True
 
@@ -38,11 +42,12 @@ def unregister() -> None:
     global _registered
     if not _registered:
         return
+    cli.unregister_command()
     overlay.unregister()
     ops.unregister_keymaps()
     ui.unregister_appends()
     engine.unregister_compat()
-    settings.unregister_properties()
+    properties.unregister_properties()
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)
     release_gpu()
@@ -61,12 +66,12 @@ def _at_exit() -> None:
 
 def release_gpu() -> None:
     """Free every GPU object the add-on holds (targets, meshes, shaders)."""
-    offscreen.release()
+    targets.release()
     runtime.release()
     silhouettes.release()
     shaders.clear()
 
 
 def stats() -> dict:
-    """Statistics of the last drawn frame (SPEC section 2)."""
+    """Statistics of the last drawn frame (see README, "Command line")."""
     return runtime.stats()

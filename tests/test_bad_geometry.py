@@ -16,11 +16,12 @@ import bpy
 import numpy as np
 import pytest
 
-import accuracy
-import reference
-import robustness
-import scenes
-from solidwire_addon import extract, log
+from tests.support import accuracy
+from tests.support import reference
+from tests.support import robustness
+from tests.support import scenes
+from solidwire_addon.core import extract
+from solidwire_addon.core import log
 
 W, H = 96, 64
 NAN, INF = math.nan, math.inf
@@ -161,7 +162,7 @@ def test_bad_object_beside_a_good_one(case, output_dir, capfd):
 def test_overlay_with_every_bad_object(capfd):
     """The viewport overlay goes through the same path: all the faulty
     objects at once, two redraws, no exception, no NaN, one message each."""
-    from solidwire_addon.gpu_context import ensure_gpu
+    from solidwire_addon.blender.gpu_context import ensure_gpu
 
     scene, location = _base_scene()
     ensure_gpu()
@@ -215,7 +216,7 @@ def test_degenerate_triangles_are_counted():
 def test_an_object_that_fails_to_upload_is_skipped_alone(output_dir, capfd, monkeypatch):
     """Any failure while one object is prepared (here: its GPU upload) skips
     that object with one message; the rest of the frame is drawn."""
-    from solidwire_addon import cache
+    from solidwire_addon.core import cache
 
     scene, location = _base_scene()
     without = robustness.render_exr(scene, output_dir / "upload_fail_without.exr")

@@ -14,12 +14,13 @@ import bpy
 import numpy as np
 import pytest
 
-import accuracy
-import reference
-import robustness
-import scenes
-from solidwire_addon import log, offscreen
-from solidwire_addon.view import NoCameraError
+from tests.support import accuracy
+from tests.support import reference
+from tests.support import robustness
+from tests.support import scenes
+from solidwire_addon.core import log
+from solidwire_addon.core import passes as offscreen
+from solidwire_addon.blender.views import NoCameraError
 
 ROOT = Path(__file__).resolve().parent.parent
 W, H = 80, 60
@@ -91,7 +92,7 @@ def test_non_finite_setting_falls_back_to_its_default(name, value, output_dir, c
     """Scripts and drivers can store NaN in a float property (the panel
     cannot): the default is used instead (per colour component), with one
     message naming the setting, printed once."""
-    from solidwire_addon.draw import DrawSettings
+    from solidwire_addon.core.settings import DrawSettings
 
     scene = _monkey_scene(use_fade=True, diagonal_mode="DASHED", use_fill=name == "fill_color")
     default = getattr(DrawSettings(), name)
@@ -116,7 +117,7 @@ def test_non_finite_setting_falls_back_to_its_default(name, value, output_dir, c
 
 
 def test_no_camera_is_a_clear_error(output_dir):
-    from solidwire_addon import engine
+    from solidwire_addon.blender import engine
 
     scene = scenes.empty_scene(32, 24)
     scenes.cube(scene)
@@ -234,7 +235,7 @@ def test_engine_failure_is_reported_not_a_silent_black_frame(tmp_path, monkeypat
 
 def _run_bpy(script: str, tmp_path: Path) -> subprocess.CompletedProcess:
     env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
-    prelude = f"import sys; sys.path.insert(0, {str(ROOT)!r}); sys.path.insert(0, {str(ROOT / 'tests')!r})\n"
+    prelude = f"import sys; sys.path.insert(0, {str(ROOT)!r})\n"
     result = subprocess.run(
         [sys.executable, "-c", prelude + textwrap.dedent(script)],
         capture_output=True, text=True, timeout=300, env=env, cwd=str(tmp_path),
@@ -247,7 +248,8 @@ def test_blend_saved_with_addon_opens_without_it_and_settings_survive(tmp_path):
     blend = tmp_path / "with_addon.blend"
     _run_bpy(
         f"""
-        import bpy, solidwire_addon, scenes
+        import bpy, solidwire_addon
+        from tests.support import scenes
         solidwire_addon.register()
         scene = scenes.empty_scene(48, 36, thickness=7.25, diagonal_mode="DASHED", show_overlay=True)
         scene.solidwire.wire_color = (0.2, 0.4, 0.6, 0.8)
@@ -264,7 +266,8 @@ def test_blend_saved_with_addon_opens_without_it_and_settings_survive(tmp_path):
         print("ENGINE", scene.render.engine)
         print("HAS_SETTINGS", hasattr(scene, "solidwire"))
         # Register after load: the stored values come back.
-        import solidwire_addon, robustness
+        import solidwire_addon
+        from tests.support import robustness
         solidwire_addon.register()
         s = scene.solidwire
         print("VALUES", round(s.thickness, 3), s.diagonal_mode, s.show_overlay, [round(c, 3) for c in s.wire_color])
@@ -288,7 +291,8 @@ def test_blend_saved_without_addon_opens_with_it(tmp_path):
     blend = tmp_path / "without_addon.blend"
     _run_bpy(
         f"""
-        import bpy, scenes
+        import bpy
+        from tests.support import scenes
         bpy.ops.wm.read_factory_settings(use_empty=True)
         scene = bpy.context.scene
         scene.render.resolution_x, scene.render.resolution_y = 48, 36
@@ -299,8 +303,9 @@ def test_blend_saved_without_addon_opens_with_it(tmp_path):
     )
     result = _run_bpy(
         f"""
-        import bpy, numpy as np, solidwire_addon, robustness
-        from solidwire_addon.draw import DrawSettings
+        import bpy, numpy as np, solidwire_addon
+        from tests.support import robustness
+        from solidwire_addon.core.settings import DrawSettings
         solidwire_addon.register()
         bpy.ops.wm.open_mainfile(filepath={str(blend)!r})
         scene = bpy.context.scene

@@ -22,7 +22,8 @@ import bpy
 import numpy as np
 import pytest
 
-import scenes
+from solidwire_addon.blender import cli as render_cli
+from tests.support import scenes
 
 ROOT = Path(__file__).resolve().parent.parent
 RENDER_SCRIPT = ROOT / "scripts" / "render.py"
@@ -36,7 +37,6 @@ def _load_script_module(name: str, path: Path):
     return module
 
 
-render_cli = _load_script_module("solidwire_render_cli", RENDER_SCRIPT)
 demo_scene = _load_script_module("solidwire_demo_scene", ROOT / "scripts" / "demo_scene.py")
 
 
@@ -301,7 +301,7 @@ def test_a_failing_render_exits_1_with_a_clear_line(tmp_path):
         import runpy, sys
         sys.path.insert(0, {str(ROOT)!r})
         import solidwire_addon
-        from solidwire_addon import engine
+        from solidwire_addon.blender import engine
         solidwire_addon.register()
 
         def broken_render(*args, **kwargs):

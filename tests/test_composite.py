@@ -17,8 +17,8 @@ import bpy
 import numpy as np
 import pytest
 
-import scenes
-from solidwire_addon import composite
+from tests.support import scenes
+from solidwire_addon.blender import composite
 
 ROOT = Path(__file__).resolve().parent.parent
 W, H = 96, 72

@@ -9,8 +9,8 @@ import bpy
 import numpy as np
 import pytest
 
-import scenes
-from solidwire_addon import extract
+from tests.support import scenes
+from solidwire_addon.core import extract
 
 FIELDS = ("positions", "centre", "triangles", "edge_flags", "triangle_polygons", "bounds_min", "bounds_max", "ngon_corners")
 

@@ -17,11 +17,15 @@ import bpy
 import numpy as np
 import pytest
 
-import robustness
-import scenes
+from tests.support import robustness
+from tests.support import scenes
 import solidwire_addon
-from solidwire_addon import log, ops, overlay, runtime, ui
-from solidwire_addon.gpu_context import ensure_gpu
+from solidwire_addon.core import log
+from solidwire_addon.blender import ops
+from solidwire_addon.blender import overlay
+from solidwire_addon.blender import runtime
+from solidwire_addon.blender import ui
+from solidwire_addon.blender.gpu_context import ensure_gpu
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -158,8 +162,9 @@ def test_process_exits_cleanly_after_rendering_while_registered(tmp_path):
     """Blender tears its GPU context down at exit; a GPU object of ours still
     alive then crashed the process (exit code 139) after writing the image."""
     script = f"""
-        import sys; sys.path[:0] = [{str(ROOT)!r}, {str(ROOT / 'tests')!r}]
-        import bpy, solidwire_addon, scenes, robustness
+        import sys; sys.path[:0] = [{str(ROOT)!r}]
+        import bpy, solidwire_addon
+        from tests.support import scenes, robustness
         solidwire_addon.register()
         scene = scenes.empty_scene(32, 24); scenes.cube(scene); scenes.add_camera(scene)
         robustness.render_exr(scene, {str(tmp_path / 'exit.exr')!r})

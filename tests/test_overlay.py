@@ -16,12 +16,18 @@ import numpy as np
 import pytest
 from mathutils import Matrix
 
-import scenes
-from solidwire_addon import draw, engine, log, overlay, runtime
-from solidwire_addon.gather import gather
-from solidwire_addon.gpu_context import ensure_gpu
-from solidwire_addon.offscreen import BACKGROUND_DEPTH
-from solidwire_addon.view import camera_view
+from tests.support import scenes
+from solidwire_addon.core import draw
+from solidwire_addon.blender import engine
+from solidwire_addon.core import log
+from solidwire_addon.blender import overlay
+from solidwire_addon.blender import runtime
+from solidwire_addon.blender.gather import gather
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.core.targets import BACKGROUND_DEPTH
+from solidwire_addon.blender.views import camera_view
+from solidwire_addon.core import passes
+from solidwire_addon.core.view import View
 
 WIDTH, HEIGHT = 200, 150
 
@@ -45,7 +51,7 @@ class FakeViewport:
         with self.framebuffer.bind():
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
 
-    def depth_pass(self, depsgraph, view: draw.View, objects) -> None:
+    def depth_pass(self, depsgraph, view: View, objects) -> None:
         """Blender-like depth of ``objects``: object-space float32 positions and
         a float32 model-view-projection (no re-centring, no float64)."""
         import gpu
@@ -244,10 +250,10 @@ def test_depth_bias_is_needed_and_small():
         viewport.depth_pass(depsgraph, view, objects)
         with viewport.framebuffer.bind():
             gpu.state.viewport_set(0, 0, WIDTH, HEIGHT)
-            draw.draw_overlay(items, view, settings, depth_bias=bias)
+            passes.draw_over_viewport(items, view, settings, depth_bias=bias)
         return viewport.rgba()[..., 3]
 
-    biased = coverage(draw.OVERLAY_DEPTH_BIAS)
+    biased = coverage(passes.OVERLAY_DEPTH_BIAS)
     unbiased = coverage(0.0)
     runtime.end_frame(frame, draw.DrawStats(), 0.0, 0.0, seen)
     lit = biased > 0.5
@@ -261,7 +267,7 @@ def test_depth_bias_is_needed_and_small():
     z = 12.0
     # NDC z(z_view) = (f+n)/(f-n) - 2fn/((f-n) z): dz_view = bias / (dNDC/dz).
     dndc_dz = 2 * f * n / ((f - n) * z * z)
-    assert draw.OVERLAY_DEPTH_BIAS / dndc_dz < 0.01 * z
+    assert passes.OVERLAY_DEPTH_BIAS / dndc_dz < 0.01 * z
 
 
 def test_visibility_filter():
@@ -350,7 +356,7 @@ def test_draw_handler_never_raises(monkeypatch, capsys):
     def broken(*_args, **_kwargs):
         raise RuntimeError("boom")
 
-    monkeypatch.setattr(overlay, "region_view", lambda *_a: draw.View(np.eye(4), np.eye(4), (0, 0, 8, 8)))
+    monkeypatch.setattr(overlay, "region_view", lambda *_a: View(np.eye(4), np.eye(4), (0, 0, 8, 8)))
     monkeypatch.setattr(overlay, "draw_scene_overlay", broken)
 
     class FakeContext:

@@ -11,10 +11,12 @@ import bpy
 import numpy as np
 import pytest
 
-import scenes
+from tests.support import scenes
 import solidwire_addon
-from solidwire_addon import engine, ops, presets
-from solidwire_addon.gpu_context import ensure_gpu
+from solidwire_addon.blender import engine
+from solidwire_addon.blender import ops
+from solidwire_addon.blender import presets
+from solidwire_addon.blender.gpu_context import ensure_gpu
 
 SIZE = (240, 180)
 
@@ -59,15 +61,16 @@ def test_builtin_presets_are_complete_and_distinct():
 
 
 def test_field_ranges_match_the_settings():
-    """presets.FIELDS repeats the hard limits of scene.solidwire: keep them equal."""
+    """Presets validate with the same hard limits the properties enforce
+    (both are made from the schema)."""
     rna = bpy.context.scene.solidwire.bl_rna.properties
     for key, field in presets.FIELDS.items():
         prop = rna[key]
-        if field.kind == "float":
+        if field.kind == "FLOAT":
             assert (field.minimum, field.maximum) == pytest.approx((prop.hard_min, min(prop.hard_max, 1e9))), key
-        elif field.kind == "enum":
+        elif field.kind == "ENUM":
             assert set(field.choices) == {item.identifier for item in prop.enum_items}, key
-        elif field.kind == "color":
+        elif field.kind == "COLOR":
             assert (prop.array_length, prop.hard_min, prop.hard_max) == (4, 0.0, 1.0), key
         else:
             assert prop.type == "BOOLEAN", key

@@ -10,9 +10,9 @@ import bmesh
 import numpy as np
 import pytest
 
-import accuracy
-import reference
-import scenes
+from tests.support import accuracy
+from tests.support import reference
+from tests.support import scenes
 
 
 def _floor_and_wall(scene):
@@ -181,7 +181,7 @@ def test_depth_pass(output_dir):
     bpy.ops.render.render(scene=scene.name)
     result = bpy.data.images["Render Result"]
     # Read the Depth pass through the compositor-free path: viewer of the render result.
-    from solidwire_addon import engine
+    from solidwire_addon.blender import engine
 
     depsgraph = bpy.context.evaluated_depsgraph_get()
     _rgba, depth = engine.render_scene(depsgraph)

@@ -8,9 +8,11 @@ import bpy
 import numpy as np
 import pytest
 
-import scenes
+from tests.support import scenes
 import solidwire_addon
-from solidwire_addon import draw, runtime
+from solidwire_addon.core import draw
+from solidwire_addon.core.view import outside_frustum_many
+from solidwire_addon.blender import runtime
 
 
 def render(scene) -> dict:
@@ -193,7 +195,7 @@ def test_animation_reextracts_only_the_deforming_object():
 
 
 def test_instanced_drawing_matches_per_object_drawing(monkeypatch):
-    from solidwire_addon import engine
+    from solidwire_addon.blender import engine
 
     scene = scenes.empty_scene(160, 120, diagonal_mode="DASHED", use_backface_culling=True)
     scenes.add_camera(scene, location=(0.0, -30.0, 20.0), target=(0.0, 0.0, 0.0))
@@ -229,8 +231,14 @@ def test_vectorised_frustum_culling_matches_per_instance():
     rng = np.random.default_rng(5)
     matrices = rng.normal(size=(200, 4, 4))
     lo, hi = np.array([-1.0, -2.0, -0.5]), np.array([1.0, 0.5, 2.0])
-    many = draw.outside_frustum_many(matrices, lo, hi)
-    one_by_one = [draw.outside_frustum(m, lo, hi) for m in matrices]
+    many = outside_frustum_many(matrices, lo, hi)
+
+    def outside(matrix):  # the plain definition: all 8 corners beyond one clip plane
+        corners = np.array([[x, y, z, 1.0] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+        x, y, z, w = (corners @ matrix.T).T
+        return any(((x > w).all(), (x < -w).all(), (y > w).all(), (y < -w).all(), (z > w).all(), (z < -w).all()))
+
+    one_by_one = [outside(m) for m in matrices]
     np.testing.assert_array_equal(many, one_by_one)
     assert many.any() and not many.all()
 
@@ -239,8 +247,8 @@ def test_viewport_trusts_depsgraph_updates(monkeypatch):
     """The viewport's depsgraph reports edits through runtime's handler, so an
     unchanged mesh is reused without even a fingerprint; an edited one is
     re-extracted."""
-    from solidwire_addon import gather
-    from solidwire_addon.gpu_context import ensure_gpu
+    from solidwire_addon.blender import gather
+    from solidwire_addon.blender.gpu_context import ensure_gpu
 
     scene, cubes = ten_cubes()
     ensure_gpu()

@@ -15,13 +15,13 @@ from pathlib import Path
 import bpy
 import pytest
 
-import robustness
-import scenes
-from solidwire_addon import presets
+from tests.support import robustness
+from tests.support import scenes
+from solidwire_addon.blender import presets
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "solidwire_addon"
-SOURCES = sorted(PACKAGE.glob("*.py"))
+SOURCES = sorted(PACKAGE.rglob("*.py"))
 
 # Modules an add-on that needs no network, no processes and no code loading
 # has no business importing at run time.

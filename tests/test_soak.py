@@ -18,8 +18,8 @@ import os
 import bpy
 import pytest
 
-import robustness
-import scenes
+from tests.support import robustness
+from tests.support import scenes
 import solidwire_addon
 
 FRAMES = int(os.environ.get("SOLIDWIRE_SOAK_FRAMES", "1000"))

@@ -3,7 +3,7 @@ path, against the float64 reference (SPEC 1.5 thresholds, no NaN/Inf), and
 proof that the benchmark's near-plane scene really breaks the NVIDIA 2007
 method (so its tricky case is exercised). Nothing here is timed.
 
-The scenes are the ones scripts/bench.py measures (tests/scenes.py), at the
+The scenes are the ones scripts/bench/ measures (tests/support/scenes.py), at the
 benchmark's size (float32 error grows with window coordinates, so a smaller
 frame would hide it); the reference is evaluated on every ROW_STEP-th window
 row to keep the float64 numpy evaluation affordable.
@@ -15,14 +15,15 @@ import bpy
 import numpy as np
 import pytest
 
-import accuracy
-import reference
-import scenes
-from solidwire_addon import draw as draw_mod
-from solidwire_addon import gather, offscreen
-from solidwire_addon import view as view_mod
-from solidwire_addon.cache import MeshCache
-from solidwire_addon.gpu_context import ensure_gpu
+from tests.support import accuracy
+from tests.support import reference
+from tests.support import scenes
+from solidwire_addon.blender import gather
+from solidwire_addon.blender import views as view_mod
+from solidwire_addon.core.cache import MeshCache
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.core.settings import DrawSettings
+from scripts.bench import methods
 
 SIZE = (1280, 720)
 ROW_STEP = 8
@@ -60,8 +61,8 @@ def _method_intensity(scene, method: str) -> np.ndarray:
     depsgraph = bpy.context.evaluated_depsgraph_get()
     items, _keys, _ms = gather.gather(depsgraph, MeshCache())
     view = view_mod.camera_view(scene, depsgraph)
-    settings = draw_mod.DrawSettings.from_properties(scene.solidwire)
-    rgba, _depth, _stats = offscreen.render(items, view, settings, method=method)
+    settings = DrawSettings.from_properties(scene.solidwire)
+    rgba, _depth, _stats = methods.render(items, view, settings, method)
     return rgba[..., 3].astype(np.float64)
 
 

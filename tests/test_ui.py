@@ -14,9 +14,11 @@ from types import SimpleNamespace
 import bpy
 import pytest
 
-import scenes
+from tests.support import scenes
 import solidwire_addon
-from solidwire_addon import ops, presets, ui
+from solidwire_addon.blender import ops
+from solidwire_addon.blender import presets
+from solidwire_addon.blender import ui
 
 SPEC_PROPERTIES = (
     "thickness",

@@ -23,9 +23,11 @@ import time
 
 import bpy
 
-from . import draw, gather, runtime
-from .log import warn_once
-from .view import region_view
+from ..core import passes
+from ..core.log import warn_once
+from ..core.view import View
+from . import gather, runtime
+from .views import region_view
 
 _handle = None
 
@@ -55,7 +57,7 @@ def viewport_object_filter(view_layer, space_view3d=None, *, only_selected: bool
     return keep
 
 
-def draw_scene_overlay(depsgraph, view: draw.View, settings: draw.DrawSettings, *, object_filter=None) -> dict:
+def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None) -> dict:
     """Draw the overlay of ``depsgraph``'s scene into the bound framebuffer,
     which already holds the scene's colour and depth. Returns the frame stats."""
     # Meshes are reused across redraws: the viewport depsgraph reports every
@@ -63,7 +65,7 @@ def draw_scene_overlay(depsgraph, view: draw.View, settings: draw.DrawSettings, 
     frame = runtime.begin_frame(reuse=True)
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter)
     start = time.perf_counter()
-    stats = draw.draw_overlay(items, view, settings)
+    stats = passes.draw_over_viewport(items, view, settings)
     ms_draw = (time.perf_counter() - start) * 1000.0
     return runtime.end_frame(frame, stats, ms_extract, ms_draw, seen)
 

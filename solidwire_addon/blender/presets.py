@@ -5,14 +5,14 @@ A preset file is a JSON object::
     {"solidwire_preset": 1, "name": "Blueprint", "description": "...",
      "settings": {"thickness": 1.0, "wire_color": [1, 1, 1, 1], ...}}
 
-``settings`` holds any subset of :data:`FIELDS` (built-in presets hold all of
+``settings`` holds any subset of :data:`FIELDS` (the schema's preset settings) (built-in presets hold all of
 them, so applying one gives the same look whatever was set before). Loading
 never executes anything (no ``exec``/``eval``, unlike Blender's Python preset
 files): the file is parsed as JSON with a size limit, every key, type and range
 is checked, and only a fully valid preset is applied. Problems raise
 :class:`PresetError` with one line that says which file and what is wrong.
 
-Built-in presets ship in ``presets/`` next to this file and are read-only.
+Built-in presets ship in ``presets_builtin/`` next to this file and are read-only.
 User presets live in the extension's user directory
 (``bpy.utils.extension_path_user``), never inside the add-on folder, which an
 upgrade replaces.
@@ -21,57 +21,24 @@ upgrade replaces.
 from __future__ import annotations
 
 import json
-import math
 import os
 import re
 import stat
 from dataclasses import dataclass
 from pathlib import Path
 
-from .draw import DIAGONAL_MODES
+from ..core import schema
 
 FORMAT_VERSION = 1
 MAX_FILE_BYTES = 64 * 1024  # a preset is a few hundred bytes; refuse anything huge
-BUILTIN_DIR = Path(__file__).resolve().parent / "presets"
+BUILTIN_DIR = Path(__file__).resolve().parent / "presets_builtin"
 _TOP_LEVEL_KEYS = {"solidwire_preset", "name", "description", "settings"}
 MAX_NAME_LENGTH = 64
 
-
-@dataclass(frozen=True)
-class Field:
-    kind: str  # "float", "bool", "color", "enum"
-    minimum: float = -math.inf
-    maximum: float = math.inf
-    choices: tuple = ()
-
-
-# Keep ranges equal to the hard limits in settings.py (tests compare them).
-# Order matters when applying: diagonal_mode's update callback resets
-# pattern_duty, so the mode is set before the duty.
-FIELDS: dict[str, Field] = {
-    "thickness": Field("float", 0.0, 1000.0),
-    "softness": Field("float", 0.01, 100.0),
-    "wire_color": Field("color"),
-    "use_fill": Field("bool"),
-    "fill_color": Field("color"),
-    "diagonal_mode": Field("enum", choices=DIAGONAL_MODES),
-    "pattern_period": Field("float", 1.0, 1000.0),
-    "pattern_duty": Field("float", 0.0, 1.0),
-    "use_fade": Field("bool"),
-    "fade_start": Field("float", 0.0, 1.0e9),
-    "fade_end": Field("float", 0.0, 1.0e9),
-    "use_backface_culling": Field("bool"),
-    "thickness_mode": Field("enum", choices=("PIXELS", "WORLD", "DEPTH")),
-    "world_thickness": Field("float", 0.0, 1.0e9),
-    "thickness_far": Field("float", 0.0, 1000.0),
-    "thickness_depth_start": Field("float", 0.0, 1.0e9),
-    "thickness_depth_end": Field("float", 0.0, 1.0e9),
-    "use_silhouettes": Field("bool"),
-    "use_hidden_lines": Field("bool"),
-    "hidden_alpha": Field("float", 0.0, 1.0),
-    "hidden_period": Field("float", 1.0, 1000.0),
-    "hidden_duty": Field("float", 0.0, 1.0),
-}
+# The settings a preset may hold, in the order they are applied (see
+# schema.preset_settings: diagonal_mode before pattern_duty). Types and hard
+# ranges are the schema's, the same the properties enforce.
+FIELDS: dict[str, schema.Setting] = {s.name: s for s in schema.preset_settings()}
 
 
 class PresetError(ValueError):
@@ -90,34 +57,15 @@ class Preset:
 # ---------------------------------------------------------------- validation
 
 
-def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
-
-
 def validate_value(key: str, value):
     """The value to apply for ``key``, or PresetError."""
-    field = FIELDS.get(key)
-    if field is None:
+    setting = FIELDS.get(key)
+    if setting is None:
         raise PresetError(f"unknown setting '{key}' (known: {', '.join(FIELDS)})")
-    if field.kind == "bool":
-        if not isinstance(value, bool):
-            raise PresetError(f"'{key}' must be true or false, not {json.dumps(value)}")
-        return value
-    if field.kind == "enum":
-        if value not in field.choices:
-            raise PresetError(f"'{key}' must be one of {', '.join(field.choices)}, not {json.dumps(value)}")
-        return value
-    if field.kind == "color":
-        if not (isinstance(value, list) and len(value) == 4 and all(_is_number(c) for c in value)):
-            raise PresetError(f"'{key}' must be a list of 4 numbers (RGBA, linear), not {json.dumps(value)}")
-        if not all(0.0 <= c <= 1.0 for c in value):
-            raise PresetError(f"'{key}' components must lie in 0..1, got {json.dumps(value)}")
-        return tuple(float(c) for c in value)
-    if not _is_number(value):
-        raise PresetError(f"'{key}' must be a number, not {json.dumps(value)}")
-    if not (field.minimum <= value <= field.maximum):
-        raise PresetError(f"'{key}' = {value} is out of range {field.minimum:g}..{field.maximum:g}")
-    return float(value)
+    try:
+        return setting.check(value)
+    except ValueError as exc:
+        raise PresetError(str(exc)) from None
 
 
 def _reject_constant(token: str):
@@ -256,11 +204,11 @@ def find(name: str) -> Preset:
 def values_of(props) -> dict:
     """The preset values of a ``scene.solidwire`` property group."""
     values = {}
-    for key, field in FIELDS.items():
+    for key, setting in FIELDS.items():
         value = getattr(props, key)
-        if field.kind == "color":
+        if setting.kind == schema.COLOR:
             value = [round(float(c), 6) for c in value]
-        elif field.kind == "float":
+        elif setting.kind == schema.FLOAT:
             value = round(float(value), 6)
         values[key] = value
     return values

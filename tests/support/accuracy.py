@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-import reference
-import scenes
+from tests.support import reference
+from tests.support import scenes
 
 # Core thresholds of the exact path (issue 2 / SPEC 1.5).
 P999_LIMIT = 2.0 / 255.0

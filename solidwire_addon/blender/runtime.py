@@ -2,14 +2,14 @@
 said changed, and the statistics of the last drawn frame
 (``solidwire_addon.stats()``).
 
-Invalidation (issue 5). Two sources, both holding no Blender data:
+Invalidation. Two sources, both holding no Blender data:
 
 * A persistent ``depsgraph_update_post`` handler counts geometry updates per
   session_uid (``geometry_version``); ``frame_change_post``, undo/redo and
   file loads bump a global ``epoch``. The viewport, whose depsgraph lives on
   and reports every edit through that handler before it is drawn, trusts
   these: an unchanged mesh costs one dict lookup.
-* Renders compare a content fingerprint per mesh instead (gather.py). A
+* Renders compare a content fingerprint per mesh instead (blender/gather.py). A
   render's depsgraph is rebuilt for every frame unless persistent data is on,
   so its pointers and its ``updates`` (everything, on a new depsgraph) say
   nothing about what changed since the previous frame, and
@@ -26,7 +26,10 @@ from __future__ import annotations
 
 import time
 
-from .cache import MeshCache
+import bpy
+from bpy.app.handlers import persistent
+
+from ..core.cache import MeshCache
 
 mesh_cache = MeshCache()
 _last_stats: dict = {}
@@ -36,13 +39,6 @@ epoch = 0  # bumped by frame changes, undo/redo and file loads
 # Benchmark switch (scripts/bench_scale.py): False makes every frame start
 # from an empty cache, the behaviour before reuse, to compare against.
 reuse_enabled = True
-_handlers_installed = False
-
-
-def _persistent(func):
-    from bpy.app.handlers import persistent
-
-    return persistent(func)
 
 
 def _on_depsgraph_update(_scene, depsgraph) -> None:
@@ -81,34 +77,26 @@ _installed: list = []
 
 def install_handlers() -> None:
     """Add the (persistent) handlers once; :func:`release` removes them."""
-    global _handlers_installed
-    if _handlers_installed:
+    if _installed:
         return
-    import bpy
-
     for name, func in _HANDLERS:
-        handler = _persistent(func)
+        handler = persistent(func)
         getattr(bpy.app.handlers, name).append(handler)
         _installed.append((name, handler))
-    _handlers_installed = True
 
 
 def remove_handlers() -> None:
-    global _handlers_installed
-    import bpy
-
     for name, handler in _installed:
         handlers = getattr(bpy.app.handlers, name)
         if handler in handlers:
             handlers.remove(handler)
     _installed.clear()
-    _handlers_installed = False
 
 
 def begin_frame(*, reuse: bool = False) -> float:
     """Start counting a frame. Without ``reuse`` the cache starts empty.
 
-    With ``reuse`` every mesh is validated (gather.py): unchanged meshes are
+    With ``reuse`` every mesh is validated (blender/gather.py): unchanged meshes are
     drawn from the cache, changed ones re-extracted."""
     install_handlers()
     if not (reuse and reuse_enabled):

@@ -9,14 +9,17 @@ scene rendered by the SOLIDWIRE engine, whose render() returns at once for it.
 
 from __future__ import annotations
 
+import bpy
+import gpu
+
+from ..core.ids import ENGINE_ID
+
 INIT_SCENE_NAME = ".solidwire_gpu_init"
 
 _ready = False
 
 
 def gpu_available() -> bool:
-    import gpu
-
     try:
         gpu.types.GPUOffScreen(1, 1)
     except SystemError:
@@ -36,15 +39,13 @@ def ensure_gpu() -> None:
     if gpu_available():
         _ready = True
         return
-    import bpy
-
     scene = bpy.data.scenes.new(INIT_SCENE_NAME)
     camera_data = bpy.data.cameras.new(INIT_SCENE_NAME)
     camera = bpy.data.objects.new(INIT_SCENE_NAME, camera_data)
     try:
         scene.collection.objects.link(camera)
         scene.camera = camera
-        scene.render.engine = "SOLIDWIRE"
+        scene.render.engine = ENGINE_ID
         scene.render.resolution_x = scene.render.resolution_y = 4
         scene.render.resolution_percentage = 100
         bpy.ops.render.render(scene=scene.name)

@@ -1,8 +1,8 @@
-"""Full-width silhouettes (issue 7): the outer half of contour and boundary
+"""Full-width silhouettes (image model §5.5): the outer half of contour and boundary
 edges, which the single-pass method cannot draw (a face only covers its own
 side of an edge).
 
-Definition (the README's technical section has it in full; tests/reference.py
+Definition (docs/image_model.md §5.5 has it in full; tests/support/reference.py
 evaluates it in float64):
 - Candidates are real polygon edges with one adjacent face (boundary) or two.
   For an edge with two faces, it is a *contour* in this view when both faces
@@ -28,9 +28,15 @@ costs no CPU work when the camera moves.
 
 from __future__ import annotations
 
+import gpu
 import numpy as np
 
+from . import shaders
+from .cache import table_texture
+from .draw import shader_variant
 from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
+from .settings import pack_params
+from .view import translation
 
 NO_FACE = -1.0
 
@@ -69,10 +75,8 @@ def candidate_edges(triangles: np.ndarray, edge_flags: np.ndarray) -> np.ndarray
 def edge_table(mesh):
     """(texture, count) of ``mesh``'s candidate edges, built on first use."""
     if mesh.silhouette_edges is None:
-        from .cache import _table_texture
-
         rows = candidate_edges(mesh.triangles_cpu, mesh.edge_flags_cpu)
-        mesh.silhouette_edges = (_table_texture(rows), len(rows))
+        mesh.silhouette_edges = (table_texture(rows), len(rows))
         mesh.gpu_bytes += mesh.silhouette_edges[0].width * mesh.silhouette_edges[0].height * 16
     return mesh.silhouette_edges
 
@@ -83,8 +87,6 @@ _fin_batches: dict[int, object] = {}
 def _fin_batch(edge_count: int):
     """A vertex-less-in-spirit batch of 6 vertices per edge (two triangles);
     shared by all meshes of the same edge count class (next power of two)."""
-    import gpu
-
     size = 1 << max(int(edge_count - 1).bit_length(), 6)
     batch = _fin_batches.get(size)
     if batch is None:
@@ -108,13 +110,8 @@ def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay
     ``scene_depth_texture`` the main pass's depth (see the module docstring).
     Viewport overlay (``overlay_bias`` > 0): straight into the viewport with
     "over" blending, occluded by its depth buffer; the caller sets the blend."""
-    import gpu
-
-    from . import draw as draw_mod
-    from . import shaders
-
-    shader = shaders.get_silhouette(settings.shader_variant(), overlay_bias)
-    ubo = gpu.types.GPUUniformBuf(draw_mod.pack_params(settings, view.viewport, view.projection))
+    shader = shaders.get_silhouette(shader_variant(settings), overlay_bias)
+    ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
     shader.bind()
     shader.uniform_block("params", ubo)
     if overlay_bias:
@@ -126,17 +123,13 @@ def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay
         gpu.state.depth_mask_set(True)
     gpu.state.face_culling_set("NONE")
     # View depth is compiled in only for fade and depth-cue thickness.
-    try:
-        shader.uniform_from_name("object_to_view_z")
-        uses_view_depth = True
-    except ValueError:
-        uses_view_depth = False
+    uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
     for item in items:
         mesh = item.mesh
         table, count = edge_table(mesh)
         if count == 0:
             continue
-        object_to_view = view.view_matrix @ item.matrix @ draw_mod.translation(mesh.centre)
+        object_to_view = view.view_matrix @ item.matrix @ translation(mesh.centre)
         object_to_clip = view.projection @ object_to_view
         shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
         if uses_view_depth:

@@ -12,7 +12,7 @@ from bpy.props import StringProperty
 
 from . import presets
 from .overlay import viewport_object_filter
-from .settings import redraw_viewports
+from .properties import redraw_viewports
 
 # Default key of the overlay toggle in the 3D View: Ctrl+Shift+Alt+W ("W" for
 # wire). Shift+Alt+W is taken in Blender's default keymap (Sculpt: expand face
@@ -53,7 +53,7 @@ def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
     """(nearest, farthest) view depth of the bounding boxes of the drawn mesh
     objects, or None when there are none in front of the view.
 
-    Depth is distance along the viewing axis (as SPEC 1.4's fade uses), so
+    Depth is distance along the viewing axis (as the depth fade uses, docs/image_model.md §4), so
     (start, end) = extent fades from the nearest object to the farthest."""
     view = np.asarray(view_matrix, dtype=np.float64)
     depths = []

@@ -23,22 +23,17 @@ import zlib
 
 import numpy as np
 
-from . import extract, runtime
-from .cache import MeshCache
-from .draw import DrawItem, outside_frustum_many
-from .log import warn_once
+from ..core import extract
+from ..core.cache import MeshCache
+from ..core.log import warn_once
+from ..core.view import DrawItem, outside_frustum_many
+from . import runtime
 
 
 class SeenKeys(set):
     """The keys a frame drew, plus the scope (depsgraph mode) they cover."""
 
     scope: tuple | None = None
-
-
-def mesh_key(obj_eval):
-    """Pointer of an evaluated object's mesh: shared by the instances of one
-    evaluated mesh within one evaluation (kept for callers of the old API)."""
-    return obj_eval.data.as_pointer()
 
 
 def _is_plain(obj_orig) -> bool:
@@ -77,7 +72,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     ``trust_updates`` (default: viewport depsgraphs) lets an unchanged mesh be
     recognised by pointer and depsgraph update counters alone; otherwise
     (renders) a changed pointer is settled by the content fingerprint.
-    With ``view`` (a draw.View), a mesh the cache does not hold yet is not
+    With ``view`` (a core.view.View), a mesh the cache does not hold yet is not
     extracted at all while every instance of it lies outside the view
     frustum (its evaluated bound box against the clip planes); those
     instances count as culled."""

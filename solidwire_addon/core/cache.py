@@ -3,13 +3,16 @@
 A :class:`GPUMesh` holds what the vertex stage pulls from (a position table
 and a triangle table, both RGBA32F textures) and a triangle-list batch whose
 only attribute is the per-corner edge-flag word. Entries are keyed by the
-caller (see gather.py: the evaluated mesh's identity plus a change counter),
+caller (see blender/gather.py: the evaluated mesh's identity plus a change counter),
 never hold Blender data, and are dropped when the key is invalidated or no
 longer seen, which frees their GPU memory.
 """
 
 from __future__ import annotations
 
+import time
+
+import gpu
 import numpy as np
 
 from .extract import MeshArrays
@@ -17,10 +20,8 @@ from .extract import MeshArrays
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
 
-def _table_texture(rows4: np.ndarray):
+def table_texture(rows4: np.ndarray):
     """(N, 4) float32 -> RGBA32F texture, row-major with TABLE_WIDTH texels a row."""
-    import gpu
-
     count = max(len(rows4), 1)
     width = min(count, TABLE_WIDTH)
     height = -(-count // width)
@@ -37,8 +38,6 @@ class GPUMesh:
     """GPU resources of one extracted mesh."""
 
     def __init__(self, arrays: MeshArrays):
-        import gpu
-
         self.triangle_count = arrays.triangle_count
         self.centre = arrays.centre
         self.bounds_min = arrays.bounds_min - arrays.centre
@@ -46,11 +45,11 @@ class GPUMesh:
 
         positions = np.zeros((arrays.vertex_count, 4), dtype=np.float32)
         positions[:, :3] = arrays.positions
-        self.positions = _table_texture(positions)
-        self.triangles = _table_texture(arrays.triangles.astype(np.float32))
+        self.positions = table_texture(positions)
+        self.triangles = table_texture(arrays.triangles.astype(np.float32))
         ngon = np.zeros((max(len(arrays.ngon_corners), 1), 4), dtype=np.float32)
         ngon[: len(arrays.ngon_corners), 0] = arrays.ngon_corners
-        self.ngon_corners = _table_texture(ngon)
+        self.ngon_corners = table_texture(ngon)
         self.has_ngons = len(arrays.ngon_corners) > 0
         # Kept (no copy) so the silhouette pass can derive its edge table on
         # first use without re-extracting; see silhouettes.py.
@@ -74,7 +73,7 @@ class GPUMesh:
 class MeshCache:
     """GPU meshes by key, with counters for stats().
 
-    Keys are plain tuples (see gather.py: a depsgraph mode plus session_uid
+    Keys are plain tuples (see blender/gather.py: a depsgraph mode plus session_uid
     based identity), never Blender data, so nothing here dangles across undo
     or file load. Each entry remembers two validity tokens:
 
@@ -101,19 +100,6 @@ class MeshCache:
     def __contains__(self, key) -> bool:
         return key in self._entries
 
-    def get(self, key, make_arrays) -> GPUMesh | None:
-        """The cached GPU mesh for ``key``, built from ``make_arrays()`` if new.
-
-        ``make_arrays`` returns a MeshArrays or None (nothing to draw)."""
-        entry = self._entries.get(key)
-        if entry is not None:
-            self.reused += 1
-            return entry
-        return self._build(key, make_arrays(), None)
-
-    def peek(self, key) -> GPUMesh | None:
-        return self._entries.get(key)
-
     def get_validated(self, key, fast, fingerprint, make_arrays):
         """The GPU mesh for ``key`` if it is still valid, else a rebuilt one.
 
@@ -137,8 +123,6 @@ class MeshCache:
         return mesh, True
 
     def _build(self, key, arrays, tokens) -> GPUMesh | None:
-        import time
-
         self.extracted += 1
         if arrays is None or arrays.triangle_count == 0:
             self._entries.pop(key, None)

@@ -14,9 +14,11 @@ import time
 import bpy
 import numpy as np
 
-from . import gather, offscreen, runtime
+from ..core import passes
+from ..core.ids import ENGINE_ID
+from . import gather, runtime
 from .gpu_context import ensure_gpu, is_init_scene
-from .view import NoCameraError, camera_view, render_size
+from .views import NoCameraError, camera_view, render_size
 
 
 def world_color(scene) -> tuple[float, float, float]:
@@ -51,13 +53,21 @@ def render_scene(depsgraph, size=None):
     # The view lets gather skip extracting meshes that are wholly off-screen.
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, view=view)
     start = time.perf_counter()
-    rgba, depth, draw_stats = offscreen.render(items, view, settings)
+    rgba, depth, draw_stats = passes.render(items, view, settings)
     runtime.end_frame(frame, draw_stats, ms_extract, (time.perf_counter() - start) * 1000.0, seen)
     return composite_film(rgba, scene), depth
 
 
+def write_pass(render_pass, array: np.ndarray) -> None:
+    """Copy ``array`` ((H*W, channels) or any shape of that size) into
+    ``render_pass``. ``bpy_prop_array.foreach_set`` takes a contiguous float32
+    buffer in one copy; assigning to ``RenderPass.rect`` instead walks every
+    pixel through Python's sequence protocol (about 0.5 s at 1280x720)."""
+    render_pass.rect.foreach_set(np.ascontiguousarray(array, dtype=np.float32).reshape(-1))
+
+
 class SolidWireRenderEngine(bpy.types.RenderEngine):
-    bl_idname = "SOLIDWIRE"
+    bl_idname = ENGINE_ID
     bl_label = "SolidWire"
     bl_use_gpu_context = True
     bl_use_preview = False
@@ -77,10 +87,10 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
             return
         result = self.begin_result(0, 0, width, height)
         layer = result.layers[0]
-        layer.passes["Combined"].rect = rgba.reshape(-1, 4)
+        write_pass(layer.passes["Combined"], rgba)
         depth_pass = layer.passes.find("Depth")
         if depth_pass != -1:
-            layer.passes[depth_pass].rect = depth.reshape(-1, 1)
+            write_pass(layer.passes[depth_pass], depth)
         self.end_result(result)
 
     def update_render_passes(self, scene=None, renderlayer=None):

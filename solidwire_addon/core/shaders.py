@@ -13,14 +13,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import compat
+import gpu
 
-SHADER_DIR = Path(__file__).resolve().parent.parent / "shaders"
+from . import compat, schema
 
-# The per-frame parameter block (std140) lives in shaders/params.glsl; keep
-# PARAMS_FLOATS in sync with it and with draw.pack_params (which asserts it).
-PARAMS_FILE = "params.glsl"
-PARAMS_FLOATS = 28
+# The extension root's shaders/ folder (this file is solidwire_addon/core/shaders.py).
+SHADER_DIR = Path(__file__).resolve().parents[2] / "shaders"
 
 THICKNESS_PIXELS, THICKNESS_WORLD, THICKNESS_DEPTH = 0, 1, 2
 
@@ -41,46 +39,46 @@ class ShaderVariant:
     # DEPTH_BIAS in solidwire_vert.glsl and draw.OVERLAY_DEPTH_BIAS.
     depth_bias: float = 0.0
     thickness_mode: int = THICKNESS_PIXELS
-    # Hidden-line style (issue 7): the pass that draws faces behind the
+    # Hidden-line style (image model §5.4): the pass that draws faces behind the
     # visible surface, real edges only, dimmed and dashed, no fill.
     hidden_pass: bool = False
     # The mesh has n-gons: the fragment stage walks their outlines and
     # diagonals (USE_NGONS); tri/quad meshes get a variant without that code.
     ngons: bool = False
-    # Developer/benchmark switch, not user-facing: which distance method the
-    # shader implements. "exact" is the add-on's own path; the others are
-    # faithful variants of the published methods (see METHODS and
-    # shaders/methods/), compared by scripts/bench.py.
-    method: str = "exact"
-    # Scale (issue 5): many instances of one mesh in one draw_instanced call,
+    # Many instances of one mesh in one draw_instanced call,
     # each reading its matrices from a float texture by gl_InstanceID (see
     # shaders/instancing.glsl and draw.py).
     instanced: bool = False
 
 
-# Method variants compiled from shaders/methods/ (the vertex-pulling triangle
-# variants; "offset_lines" has its own line pass, see methods.py).
-METHODS = ("exact", "nvidia2007", "kakadu_clip", "barycentric", "fill_only", "offset_lines")
-
 _cache: dict[ShaderVariant, object] = {}
 
 
-def read_source(name: str) -> str:
-    path = SHADER_DIR / name
+def read_source(name: str, directory: Path = SHADER_DIR) -> str:
+    path = directory / name
     try:
         return path.read_text(encoding="utf-8")
     except OSError as exc:  # a broken install: say which file is missing
         raise RuntimeError(f"SolidWire shader file missing: {path.name} ({exc.strerror})") from None
 
 
-def _pulling_info(*, push_matrices: bool = True):
-    """Create-info with what every SolidWire shader shares: the parameter
-    block, the position table (vertex pulling) and, unless the matrices come
-    from an instance table, the object -> clip and view-z push constants."""
-    import gpu
+def uses_uniform(shader, name: str) -> bool:
+    """Whether the compiled ``shader`` kept uniform ``name`` (the compiler
+    drops one a variant does not read, and setting it then fails)."""
+    try:
+        shader.uniform_from_name(name)
+    except ValueError:
+        return False
+    return True
 
+
+def pulling_info(*, push_matrices: bool = True):
+    """Create-info with what every SolidWire shader shares: the parameter
+    block (generated from the schema), the position table (vertex pulling)
+    and, unless the matrices come from an instance table, the object -> clip
+    and view-z push constants."""
     info = gpu.types.GPUShaderCreateInfo()
-    info.typedef_source(read_source(PARAMS_FILE))
+    info.typedef_source(schema.param_block_glsl())
     info.uniform_buf(0, "SolidWireParams", "params")
     if push_matrices:
         info.push_constant("MAT4", "object_to_clip")
@@ -89,9 +87,9 @@ def _pulling_info(*, push_matrices: bool = True):
     return info
 
 
-def _output_and_feature_defines(info, variant: ShaderVariant) -> None:
+def output_and_feature_defines(info, variant: ShaderVariant) -> None:
     """Fragment outputs and the feature defines the exact path and the
-    method variants share (same outputs, same profile and colour rules)."""
+    benchmark's method variants share (same outputs, profile and colours)."""
     info.fragment_out(0, "VEC4", "frag_color")
     if variant.write_view_depth:
         info.fragment_out(1, "FLOAT", "frag_view_depth")
@@ -104,11 +102,6 @@ def _output_and_feature_defines(info, variant: ShaderVariant) -> None:
 
 
 def _create_info(variant: ShaderVariant):
-    import gpu
-
-    if variant.method != "exact":
-        return _method_create_info(variant)
-
     iface = gpu.types.GPUStageInterfaceInfo("solidwire_iface")
     for i in range(EDGE_COUNT):
         iface.flat("VEC3", f"edge_line{i}")
@@ -117,7 +110,7 @@ def _create_info(variant: ShaderVariant):
     iface.flat("INT", "ngon_corner_start")
     iface.smooth("FLOAT", "view_depth")
 
-    info = _pulling_info(push_matrices=not variant.instanced)
+    info = pulling_info(push_matrices=not variant.instanced)
     if variant.instanced:
         info.push_constant("INT", "instance_base")
         info.sampler(3, "FLOAT_2D", "instance_table")
@@ -126,7 +119,7 @@ def _create_info(variant: ShaderVariant):
     info.sampler(2, "FLOAT_2D", "ngon_corners")
     info.vertex_in(0, "INT", "edge_flags")
     info.vertex_out(iface)
-    _output_and_feature_defines(info, variant)
+    output_and_feature_defines(info, variant)
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
@@ -155,81 +148,10 @@ _INSTANCE_SLOT_VERT = "#define SW_INSTANCE_SLOT (instance_slot = instance_base +
 _INSTANCE_SLOT_FRAG = "#define SW_INSTANCE_SLOT instance_slot\n"
 
 
-def _method_create_info(variant: ShaderVariant):
-    """Create-info of a method variant (shaders/methods/<file>_{vert,frag}.glsl).
-
-    Same inputs as the exact path (position and triangle tables, per-corner
-    edge flags), same parameter block and outputs; only the varyings and the
-    distance computation differ."""
-    import gpu
-
-    method = variant.method
-    files = {"kakadu_clip": "nvidia2007"}.get(method, method)  # kakadu_clip = nvidia2007 + KAKADU_CLIP
-    if method not in METHODS:
-        raise ValueError(f"unknown SolidWire method {method!r}; one of {METHODS}")
-
-    iface = gpu.types.GPUStageInterfaceInfo(f"solidwire_{method}_iface")
-    if files == "nvidia2007":
-        # Whitepaper: heights interpolated without perspective correction;
-        # the tricky case's (A, Adir), (B, Bdir) are constant per triangle.
-        iface.no_perspective("VEC3", "edge_heights")
-        iface.flat("VEC4", "line_a")
-        iface.flat("VEC4", "line_b")
-        iface.flat("INT", "case_id")
-        iface.flat("INT", "line_mask")
-    elif files == "barycentric":
-        iface.smooth("VEC3", "barycentric")
-        iface.flat("INT", "line_mask")
-    iface.smooth("FLOAT", "view_depth")
-
-    info = _pulling_info()
-    info.sampler(1, "FLOAT_2D", "triangle_vertices")
-    if method == "offset_lines":
-        info.vertex_in(0, "INT", "line_vertex")
-        info.define("LINE_DEPTH_OFFSET", repr(float(variant.depth_bias)))
-    else:
-        info.vertex_in(0, "INT", "edge_flags")
-    info.vertex_out(iface)
-    _output_and_feature_defines(info, variant)
-    if method == "kakadu_clip":
-        info.define("KAKADU_CLIP", "1")
-
-    common = read_source("common.glsl")
-    info.vertex_source(common + read_source("methods/pull_vert.glsl") + read_source(f"methods/{files}_vert.glsl"))
-    info.fragment_source(
-        common + read_source("line_style.glsl") + read_source("methods/output_frag.glsl") + read_source(f"methods/{files}_frag.glsl")
-    )
-    return info
-
-
-def downsample_shader(factor: int):
-    """Box filter from a ``factor`` times bigger colour/view-depth pair (the
-    supersampled offset_lines variants). Compiled once per factor."""
-    key = ("downsample", int(factor))
-    shader = _cache.get(key)
-    if shader is None:
-        import gpu
-
-        info = gpu.types.GPUShaderCreateInfo()
-        info.sampler(0, "FLOAT_2D", "source_color")
-        info.sampler(1, "FLOAT_2D", "source_depth")
-        info.vertex_in(0, "VEC2", "position")
-        info.fragment_out(0, "VEC4", "frag_color")
-        info.fragment_out(1, "FLOAT", "frag_view_depth")
-        info.define("FACTOR", str(int(factor)))
-        info.vertex_source(read_source("methods/downsample_vert.glsl"))
-        info.fragment_source(read_source("methods/downsample_frag.glsl"))
-        shader = gpu.shader.create_from_info(info)
-        _cache[key] = shader
-    return shader
-
-
 def get(variant: ShaderVariant):
     """The compiled shader for ``variant`` (compiled once, then cached)."""
     shader = _cache.get(variant)
     if shader is None:
-        import gpu
-
         shader = gpu.shader.create_from_info(_create_info(variant))
         _cache[variant] = shader
     return shader
@@ -240,7 +162,7 @@ def clear() -> None:
     _silhouette_cache.clear()
 
 
-# Full-width silhouettes (issue 7): the fin pass of silhouettes.py. Shares
+# Full-width silhouettes (image model §5.5): the fin pass of silhouettes.py. Shares
 # the parameter block, vertex pulling and edge geometry with the exact path.
 _silhouette_cache: dict[ShaderVariant, object] = {}
 
@@ -251,15 +173,13 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
     key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias)
     shader = _silhouette_cache.get(key)
     if shader is None:
-        import gpu
-
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
         iface.flat("VEC4", "fin_a")
         iface.flat("VEC4", "fin_b")
         iface.flat("VEC3", "fin_line")
         iface.flat("FLOAT", "fin_inner_sign")
         iface.flat("VEC2", "fin_view_depth")
-        info = _pulling_info()
+        info = pulling_info()
         info.push_constant("INT", "edge_count")
         info.sampler(1, "FLOAT_2D", "silhouette_edges")
         info.sampler(2, "DEPTH_2D", "scene_depth")

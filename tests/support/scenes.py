@@ -159,7 +159,7 @@ def orbit_location(distance: float, azimuth_deg: float, elevation_deg: float):
 
 # ------------------------------------------------ benchmark and stress scenes
 #
-# Shared by scripts/bench.py (at 1280 x 720) and tests/test_stress.py (small).
+# Shared by scripts/bench/ (at 1280 x 720) and tests/test_stress.py (small).
 # Each builder adds objects and a camera to a scene made by empty_scene() and
 # returns the objects that the benchmark turns (empty: the scene stays still).
 

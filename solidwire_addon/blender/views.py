@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .draw import View
+from ..core.view import View
 
 
 class NoCameraError(ValueError):
@@ -19,7 +19,7 @@ def render_size(scene) -> tuple[int, int]:
 
 
 def camera_view(scene, depsgraph, size: tuple[int, int] | None = None) -> View:
-    """The scene camera's view exactly as Blender projects it (SPEC 1.1).
+    """The scene camera's view exactly as Blender projects it (docs/image_model.md §1).
 
     Perspective and orthographic cameras, lens shift, sensor fit and pixel
     aspect all come from ``calc_matrix_camera``. The camera's scale is

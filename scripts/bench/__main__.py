@@ -9,7 +9,7 @@ For every method x scene at 1280 x 720 (``--size``), this measures
   background load affects them alike. The mesh scenes turn around a vertical axis
   like the papers' benchmarks; the stress scenes stand still.
 - the error of one frame against the float64 reference of the image model
-  (tests/reference.py, SPEC 1.5): mean, 99.9th percentile and max |dI| and
+  (tests/support/reference.py, SPEC 1.5): mean, 99.9th percentile and max |dI| and
   the count of pixels with |dI| > 2/255, silhouette samples excluded. The
   reference is slow numpy, so it is evaluated on sampled window rows (every
   ``--ref-row-step``-th row, same camera as the full-size frame); the output
@@ -24,7 +24,7 @@ table), time_vs_error.png (one point per method and scene, log axes) and
 near_plane_crops.png (the near-plane glitch: nvidia2007 vs kakadu_clip vs
 exact). matplotlib is needed for the pictures only (requirements-bench.txt).
 
-    python scripts/bench.py [--quick] [--method exact --method nvidia2007 ...]
+    python -m scripts.bench [--quick] [--method exact --method nvidia2007 ...]
                             [--scene teapot ...] [--frames 20] [--no-peers]
 
 Run scripts/fetch_meshes.py first for the teapot and bunny (optional: their
@@ -50,25 +50,25 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "tests"))
+ROOT = Path(__file__).resolve().parents[2]
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-bench-"))
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
 import solidwire_addon  # noqa: E402
-from solidwire_addon import draw as draw_mod  # noqa: E402
-from solidwire_addon import gather, methods  # noqa: E402
-from solidwire_addon import view as view_mod  # noqa: E402
-from solidwire_addon.cache import MeshCache  # noqa: E402
-from solidwire_addon.gpu_context import ensure_gpu  # noqa: E402
+from solidwire_addon.blender import gather
+from scripts.bench import methods
+from solidwire_addon.blender import views as view_mod
+from solidwire_addon.core.cache import MeshCache  # noqa: E402
+from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
 
-import scenes  # noqa: E402  (tests/scenes.py: the scene builders)
+from tests.support import scenes  # noqa: E402  (tests/support/scenes.py: the scene builders)
+from solidwire_addon.core.settings import DrawSettings
+from solidwire_addon.core.view import translation
 
 try:  # written by the lead alongside this script; the bench times without it
-    import reference  # noqa: E402
+    from tests.support import reference  # noqa: E402
 except ImportError:  # pragma: no cover
     reference = None
 
@@ -103,8 +103,8 @@ def turn_matrices(items, turning_names, frame: int, base):
         if not turns:
             continue
         centre = matrix0 @ np.append(item.mesh.centre, 1.0)
-        to_centre = draw_mod.translation(centre[:3])
-        item.matrix = to_centre @ rotation @ draw_mod.translation(-centre[:3]) @ matrix0
+        to_centre = translation(centre[:3])
+        item.matrix = to_centre @ rotation @ translation(-centre[:3]) @ matrix0
 
 
 # ----------------------------------------------------------------- measuring
@@ -378,7 +378,7 @@ def main(argv=None):
         turning = [name in turning_names for name in instance_names][: len(items)]
         base = [it.matrix.copy() for it in items]
         view = view_mod.camera_view(scene, depsgraph)
-        settings = draw_mod.DrawSettings.from_properties(scene.solidwire)
+        settings = DrawSettings.from_properties(scene.solidwire)
         triangles = sum(it.mesh.triangle_count for it in items)
 
         ref = None

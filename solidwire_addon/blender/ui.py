@@ -10,59 +10,31 @@ from __future__ import annotations
 
 import bpy
 
+from ..core import schema
+from ..core.ids import ENGINE_ID
 from . import ops, presets
 
-PATTERN_MODES = {"DOTTED", "DASHED"}
+# Operators shown under a section's rows.
+_SECTION_OPERATORS = {"fade": ((ops.SOLIDWIRE_OT_fade_from_visible.bl_idname, "DRIVER_DISTANCE"),)}
 
 
 def draw_look_settings(layout, props) -> None:
-    """The look: line, fill, diagonals, depth fade (shared by both panels)."""
+    """The look, one column per schema section, rows in schema order
+    (shared by the sidebar and the render-properties panel). A row that does
+    not apply right now is greyed out by its setting's ``active_if``."""
     layout.use_property_split = True
     layout.use_property_decorate = False
-
-    layout.prop(props, "thickness_mode")
-    col = layout.column(align=True)
-    row = col.row()
-    row.active = props.thickness_mode != "WORLD"
-    row.prop(props, "thickness")
-    row = col.row()
-    row.active = props.thickness_mode == "WORLD"
-    row.prop(props, "world_thickness")
-    col.prop(props, "softness")
-    col = layout.column(align=True)
-    col.active = props.thickness_mode == "DEPTH"
-    col.prop(props, "thickness_far")
-    col.prop(props, "thickness_depth_start")
-    col.prop(props, "thickness_depth_end")
-    layout.prop(props, "wire_color")
-    layout.prop(props, "use_silhouettes")
-
-    layout.prop(props, "use_fill")
-    row = layout.row()
-    row.active = props.use_fill
-    row.prop(props, "fill_color")
-
-    layout.prop(props, "diagonal_mode")
-    col = layout.column(align=True)
-    col.active = props.diagonal_mode in PATTERN_MODES
-    col.prop(props, "pattern_period")
-    col.prop(props, "pattern_duty")
-
-    layout.prop(props, "use_fade")
-    col = layout.column(align=True)
-    col.active = props.use_fade
-    col.prop(props, "fade_start")
-    col.prop(props, "fade_end")
-    col.operator(ops.SOLIDWIRE_OT_fade_from_visible.bl_idname, icon="DRIVER_DISTANCE")
-
-    layout.prop(props, "use_hidden_lines")
-    col = layout.column(align=True)
-    col.active = props.use_hidden_lines
-    col.prop(props, "hidden_alpha")
-    col.prop(props, "hidden_period")
-    col.prop(props, "hidden_duty")
-
-    layout.prop(props, "use_backface_culling")
+    for section, _heading in schema.SECTIONS:
+        col = layout.column(align=True)
+        for setting in schema.settings_in(schema.SCENE):
+            if setting.section != section:
+                continue
+            row = col.row()
+            if setting.active_if is not None:
+                row.active = bool(setting.active_if(props))
+            row.prop(props, setting.name)
+        for idname, icon in _SECTION_OPERATORS.get(section, ()):
+            col.operator(idname, icon=icon)
 
 
 def draw_presets_header(layout) -> None:
@@ -142,7 +114,7 @@ class RENDER_PT_solidwire(bpy.types.Panel):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "render"
-    COMPAT_ENGINES = {"SOLIDWIRE"}
+    COMPAT_ENGINES = {ENGINE_ID}
 
     @classmethod
     def poll(cls, context):

@@ -1,0 +1,18 @@
+"""SolidWire's core: plain data and GPU work, no Blender UI or context.
+
+Nothing in this package imports ``bpy.types`` or reads ``bpy.context``; it
+takes plain data (numpy arrays, matrices, a settings snapshot) and draws with
+Blender's ``gpu`` module. Modules, in the order data flows through them:
+
+    schema      every setting, defined once
+    settings    the settings snapshot and the shader parameter block
+    view        View, DrawItem, DrawStats, frustum test
+    extract     evaluated mesh -> numpy arrays
+    cache       GPU meshes, keyed by the caller
+    shaders     the one loader of shaders/*.glsl
+    draw        one pass: shader variant + parameter block + batches
+    silhouettes the full-width silhouette fin pass
+    targets     offscreen float targets and their readback
+    passes      the pass plan, run offscreen or over a viewport
+    exr         reading back layers other engines rendered
+"""

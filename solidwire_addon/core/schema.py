@@ -1,0 +1,384 @@
+"""The settings schema: every user-facing setting, defined once.
+
+Everything else is made from this table and nothing else repeats it:
+
+* the Blender PropertyGroups (``blender/properties.py``: type, default, hard
+  and soft range, subtype, label, tooltip, enum items);
+* the plain, immutable snapshot the draw path takes (``core/settings.py``);
+* preset validation (``blender/presets.py``: which keys, types and ranges);
+* the command-line options (``blender/cli.py``: flag, parser, range check);
+* the panel rows (``blender/ui.py``: section, order, when a row is greyed);
+* the shader parameter block (``core/shaders.py`` generates the GLSL struct
+  ``SolidWireParams`` from :data:`PARAM_BLOCK`; ``core/settings.py`` packs it).
+
+Adding a setting is one :class:`Setting` entry here, plus the shader or draw
+code that uses it. The meaning of each setting is defined in
+``docs/image_model.md``; the tooltips here are the short form of it.
+
+This module imports nothing from Blender: it is plain data.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Callable
+
+# Where a setting lives in Blender: ``scene.solidwire``, ``object.solidwire``
+# or ``view_layer.solidwire``.
+SCENE, OBJECT, VIEW_LAYER = "SCENE", "OBJECT", "VIEW_LAYER"
+
+BOOL, FLOAT, COLOR, ENUM = "BOOL", "FLOAT", "COLOR", "ENUM"
+
+# Pass ``cli=NO_FLAG`` for a setting that has no command-line option.
+NO_FLAG = ""
+
+
+@dataclass(frozen=True)
+class Param:
+    """A slot of the shader parameter block (std140).
+
+    ``glsl`` is the member name in ``SolidWireParams``; ``pack(value)`` maps
+    the setting's value to what the shader reads (a float or 4 floats)."""
+
+    glsl: str
+    pack: Callable = float
+
+
+@dataclass(frozen=True)
+class Setting:
+    name: str
+    kind: str  # BOOL, FLOAT, COLOR (RGBA, scene linear) or ENUM
+    default: object
+    label: str
+    description: str
+    scope: str = SCENE
+    minimum: float = -math.inf  # hard range: nothing outside it is accepted
+    maximum: float = math.inf
+    soft_min: float | None = None  # slider range in the panel
+    soft_max: float | None = None
+    subtype: str = "NONE"  # Blender property subtype: PIXEL, DISTANCE, FACTOR, ...
+    items: tuple = ()  # ENUM: (identifier, label, description) triples
+    section: str | None = None  # panel section (see SECTIONS); None = not in the look panel
+    active_if: Callable | None = None  # props -> bool: row greyed out when False
+    cli: str | None = None  # flag; None = "--name-with-dashes", NO_FLAG = none
+    param: Param | None = None  # slot in the shader parameter block
+    in_snapshot: bool = True  # part of the draw path's settings snapshot
+    in_preset: bool = True  # saved in and applied from presets
+
+    @property
+    def choices(self) -> tuple:
+        return tuple(item[0] for item in self.items)
+
+    @property
+    def flag(self) -> str:
+        """The command-line flag ('' when there is none)."""
+        if self.cli is None:
+            return "--" + self.name.replace("_", "-")
+        return self.cli
+
+    def check(self, value):
+        """``value`` converted to this setting's Python type, or ValueError
+        with a one-line reason (used by presets and the command line)."""
+        if self.kind == BOOL:
+            if not isinstance(value, bool):
+                raise ValueError(f"'{self.name}' must be true or false, not {value!r}")
+            return value
+        if self.kind == ENUM:
+            if value not in self.choices:
+                raise ValueError(f"'{self.name}' must be one of {', '.join(self.choices)}, not {value!r}")
+            return value
+        if self.kind == COLOR:
+            if not (isinstance(value, (list, tuple)) and len(value) == 4 and all(_is_number(c) for c in value)):
+                raise ValueError(f"'{self.name}' must be a list of 4 numbers (RGBA, linear), not {value!r}")
+            if not all(0.0 <= c <= 1.0 for c in value):
+                raise ValueError(f"'{self.name}' components must lie in 0..1, got {list(value)}")
+            return tuple(float(c) for c in value)
+        if not _is_number(value):
+            raise ValueError(f"'{self.name}' must be a number, not {value!r}")
+        if not math.isfinite(value):
+            raise ValueError(f"'{self.name}' must be a finite number, not {value!r}")
+        if not (self.minimum <= value <= self.maximum):
+            raise ValueError(f"'{self.name}' = {value:g} is out of range {self.minimum:g}..{self.maximum:g}")
+        return float(value)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _half(value) -> float:
+    """Widths are set as full widths; the shaders work with half widths."""
+    return 0.5 * max(float(value), 0.0)
+
+
+def _clamp01(value) -> float:
+    return min(max(float(value), 0.0), 1.0)
+
+
+def _at_least(low: float) -> Callable:
+    return lambda value: max(float(value), low)
+
+
+# Panel sections, in panel order: (identifier, heading shown above it or "").
+SECTIONS = (
+    ("line", ""),
+    ("fill", ""),
+    ("diagonals", ""),
+    ("fade", ""),
+    ("hidden", ""),
+    ("culling", ""),
+)
+
+PATTERN_MODES = ("DOTTED", "DASHED")
+# Dotted and dashed have their own natural duty cycle (image model §4.3):
+# choosing one of these modes sets the duty.
+DEFAULT_DUTY = {"DOTTED": 0.25, "DASHED": 0.5}
+
+SETTINGS: tuple[Setting, ...] = (
+    Setting(
+        "show_overlay", BOOL, False, "SolidWire Overlay",
+        "Draw the solid wireframe over meshes in 3D viewports",
+        cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    # -- line ----------------------------------------------------------------
+    Setting(
+        "thickness_mode", ENUM, "PIXELS", "Thickness Mode",
+        "How the line width varies with distance from the camera",
+        items=(
+            ("PIXELS", "Pixels", "The same width in pixels everywhere"),
+            ("WORLD", "World", "A width in scene units: lines thin out with distance, like real wires"),
+            ("DEPTH", "Depth Cue", "Width goes from Thickness at Near to Far Thickness at Far"),
+        ),
+        section="line",
+    ),
+    Setting(
+        "thickness", FLOAT, 1.5, "Thickness",
+        "Full width of an interior edge's opaque core, in pixels",
+        minimum=0.0, maximum=1000.0, soft_max=20.0, subtype="PIXEL",
+        section="line", active_if=lambda p: p.thickness_mode != "WORLD",
+        param=Param("half_thickness", _half),
+    ),
+    Setting(
+        "world_thickness", FLOAT, 0.02, "World Thickness",
+        "Full core width of an interior edge in scene units",
+        minimum=0.0, maximum=1.0e9, soft_max=1.0, subtype="DISTANCE",
+        section="line", active_if=lambda p: p.thickness_mode == "WORLD",
+        # Packed with the view (see VIEW_PARAMS: world_half_thickness_px).
+    ),
+    Setting(
+        "softness", FLOAT, 1.0, "Softness",
+        "Width of the anti-aliased falloff on each side of the core, in pixels",
+        minimum=0.01, maximum=100.0, soft_min=0.25, soft_max=4.0, subtype="PIXEL",
+        section="line", param=Param("softness", _at_least(1e-4)),
+    ),
+    Setting(
+        "thickness_far", FLOAT, 0.5, "Far Thickness",
+        "Core width at the far end of the depth-cue range, in pixels",
+        minimum=0.0, maximum=1000.0, soft_max=20.0, subtype="PIXEL",
+        section="line", active_if=lambda p: p.thickness_mode == "DEPTH",
+        param=Param("half_thickness_far", _half),
+    ),
+    Setting(
+        "thickness_depth_start", FLOAT, 2.0, "Near",
+        "View depth where the depth cue starts (Thickness before it)",
+        minimum=0.0, maximum=1.0e9, subtype="DISTANCE",
+        section="line", active_if=lambda p: p.thickness_mode == "DEPTH",
+        param=Param("thickness_depth_start"),
+    ),
+    Setting(
+        "thickness_depth_end", FLOAT, 20.0, "Far",
+        "View depth where the depth cue ends (Far Thickness beyond it)",
+        minimum=0.0, maximum=1.0e9, subtype="DISTANCE",
+        section="line", active_if=lambda p: p.thickness_mode == "DEPTH",
+        param=Param("thickness_depth_end"),
+    ),
+    Setting(
+        "wire_color", COLOR, (0.0, 0.0, 0.0, 1.0), "Wire Color",
+        "Wire colour and opacity",
+        minimum=0.0, maximum=1.0, subtype="COLOR", section="line",
+        param=Param("wire_color", tuple),
+    ),
+    Setting(
+        "use_silhouettes", BOOL, False, "Full Silhouettes",
+        "Give silhouette and boundary edges their outer half too, so outlines are as wide as "
+        "interior edges (renders; hidden by nearer surfaces)",
+        section="line", cli="--silhouettes",
+    ),
+    # -- fill ----------------------------------------------------------------
+    Setting(
+        "use_fill", BOOL, False, "Fill",
+        "Fill faces with an opaque colour under the wire instead of drawing the wire alone",
+        section="fill", cli="--fill",
+    ),
+    Setting(
+        "fill_color", COLOR, (1.0, 1.0, 1.0, 1.0), "Fill Color",
+        "Colour of the faces when Fill is on (drawn opaque)",
+        minimum=0.0, maximum=1.0, subtype="COLOR",
+        section="fill", active_if=lambda p: p.use_fill,
+        param=Param("fill_color", tuple),
+    ),
+    # -- diagonals -----------------------------------------------------------
+    Setting(
+        "diagonal_mode", ENUM, "HIDDEN", "Diagonals",
+        "How edges added by triangulating quads and n-gons are drawn",
+        items=(
+            ("HIDDEN", "Hidden", "Show quads and n-gons as themselves: diagonals are not drawn"),
+            ("SOLID", "Solid", "Draw every triangle edge"),
+            ("DOTTED", "Dotted", "Draw diagonals as a dotted line"),
+            ("DASHED", "Dashed", "Draw diagonals as a dashed line"),
+        ),
+        section="diagonals", cli="--diagonals",
+    ),
+    Setting(
+        "pattern_period", FLOAT, 8.0, "Period",
+        "Length of one on/off cycle of the diagonal pattern, in pixels",
+        minimum=1.0, maximum=1000.0, soft_max=64.0, subtype="PIXEL",
+        section="diagonals", active_if=lambda p: p.diagonal_mode in PATTERN_MODES,
+        param=Param("pattern_period", _at_least(1e-3)),
+    ),
+    Setting(
+        "pattern_duty", FLOAT, 0.25, "Duty",
+        "Fraction of each period that is drawn",
+        minimum=0.0, maximum=1.0, subtype="FACTOR",
+        section="diagonals", active_if=lambda p: p.diagonal_mode in PATTERN_MODES,
+        param=Param("pattern_duty", _clamp01),
+    ),
+    # -- depth fade ----------------------------------------------------------
+    Setting(
+        "use_fade", BOOL, False, "Depth Fade",
+        "Fade the wire out with distance from the camera",
+        section="fade", cli=NO_FLAG,  # see CLI_RANGES: --fade START END / --no-fade
+    ),
+    Setting(
+        "fade_start", FLOAT, 10.0, "Fade Start",
+        "View depth where fading begins (full intensity before it)",
+        minimum=0.0, maximum=1.0e9, subtype="DISTANCE",
+        section="fade", active_if=lambda p: p.use_fade,
+        param=Param("fade_start"),
+    ),
+    Setting(
+        "fade_end", FLOAT, 50.0, "Fade End",
+        "View depth where the wire has faded out completely",
+        minimum=0.0, maximum=1.0e9, subtype="DISTANCE",
+        section="fade", active_if=lambda p: p.use_fade,
+        param=Param("fade_end"),
+    ),
+    # -- hidden lines --------------------------------------------------------
+    Setting(
+        "use_hidden_lines", BOOL, False, "Hidden Lines",
+        "Also draw edges hidden behind surfaces, dimmed and dashed (technical-drawing style)",
+        section="hidden", cli="--hidden-lines",
+    ),
+    Setting(
+        "hidden_alpha", FLOAT, 0.35, "Hidden Opacity",
+        "Opacity of hidden edges relative to the wire",
+        minimum=0.0, maximum=1.0, subtype="FACTOR",
+        section="hidden", active_if=lambda p: p.use_hidden_lines,
+        param=Param("hidden_alpha", _clamp01),
+    ),
+    Setting(
+        "hidden_period", FLOAT, 8.0, "Hidden Dash Period",
+        "Length of one dash cycle of hidden edges, in pixels",
+        minimum=1.0, maximum=1000.0, soft_max=64.0, subtype="PIXEL",
+        section="hidden", active_if=lambda p: p.use_hidden_lines,
+        param=Param("hidden_period", _at_least(1e-3)),
+    ),
+    Setting(
+        "hidden_duty", FLOAT, 0.5, "Hidden Dash Duty",
+        "Fraction of each hidden-edge dash cycle that is drawn",
+        minimum=0.0, maximum=1.0, subtype="FACTOR",
+        section="hidden", active_if=lambda p: p.use_hidden_lines,
+        param=Param("hidden_duty", _clamp01),
+    ),
+    # -- culling -------------------------------------------------------------
+    Setting(
+        "use_backface_culling", BOOL, False, "Backface Culling",
+        "Faces seen from behind neither draw nor hide what is behind them",
+        section="culling", cli="--backface-culling",
+    ),
+    # -- viewport overlay only (the render draws every renderable mesh) --------
+    Setting(
+        "only_selected", BOOL, False, "Only Selected",
+        "Draw the viewport overlay on selected objects only",
+        cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+)
+
+BY_NAME: dict[str, Setting] = {s.name: s for s in SETTINGS}
+
+
+def settings_in(scope: str) -> tuple[Setting, ...]:
+    return tuple(s for s in SETTINGS if s.scope == scope)
+
+
+def preset_settings() -> tuple[Setting, ...]:
+    """Settings saved in presets, in the order they are applied.
+
+    ``diagonal_mode`` comes before ``pattern_duty`` (choosing a pattern mode
+    resets the duty), which declaration order guarantees."""
+    return tuple(s for s in SETTINGS if s.in_preset and s.scope == SCENE)
+
+
+# Command-line options that set two settings at once, as (flag, (first,
+# second), metavars, the bool they switch on, the flag that switches it off).
+# The second value must not be smaller than the first.
+@dataclass(frozen=True)
+class CliRange:
+    flag: str
+    names: tuple
+    metavar: tuple
+    enables: str | None = None
+    off_flag: str | None = None
+    help: str = ""
+
+
+CLI_RANGES = (
+    CliRange(
+        "--fade", ("fade_start", "fade_end"), ("START", "END"), enables="use_fade", off_flag="--no-fade",
+        help="fade the wire out between these view depths (scene units; END beyond START)",
+    ),
+    CliRange(
+        "--thickness-depth", ("thickness_depth_start", "thickness_depth_end"), ("NEAR", "FAR"),
+        help="view depths where the depth cue starts and ends (DEPTH; FAR beyond NEAR)",
+    ),
+)
+
+
+# -- shader parameter block ----------------------------------------------------
+# Slots that depend on the view, not on one setting: (glsl name, kind).
+# ``core/settings.py`` fills them from the View.
+VIEW_PARAMS = (
+    ("viewport", "vec4"),  # x0, y0, width, height of the target, px
+    ("world_half_thickness_px", "float"),  # world_thickness / 2 in px at clip w = 1
+)
+
+
+@dataclass(frozen=True)
+class BlockMember:
+    glsl: str
+    glsl_type: str  # "vec4" or "float"
+    setting: Setting | None  # None: a view slot (VIEW_PARAMS) or padding
+
+
+def _param_block() -> tuple[BlockMember, ...]:
+    """The std140 layout: every vec4 first, then floats, padded to whole vec4s
+    (so no member needs alignment padding of its own)."""
+    members = [BlockMember(s.param.glsl, "vec4" if s.kind == COLOR else "float", s) for s in SETTINGS if s.param]
+    members += [BlockMember(name, kind, None) for name, kind in VIEW_PARAMS]
+    vec4s = [m for m in members if m.glsl_type == "vec4"]
+    floats = [m for m in members if m.glsl_type == "float"]
+    padding = [BlockMember(f"_pad{i}", "float", None) for i in range(-len(floats) % 4)]
+    return (*vec4s, *floats, *padding)
+
+
+PARAM_BLOCK: tuple[BlockMember, ...] = _param_block()
+PARAM_FLOATS = sum(4 if m.glsl_type == "vec4" else 1 for m in PARAM_BLOCK)
+
+
+def param_block_glsl() -> str:
+    """The GLSL declaration of the parameter block's struct."""
+    lines = ["/* Generated from solidwire_addon/core/schema.py (PARAM_BLOCK); std140. */", "struct SolidWireParams {"]
+    lines += [f"  {m.glsl_type} {m.glsl};" for m in PARAM_BLOCK]
+    lines.append("};\n")
+    return "\n".join(lines)

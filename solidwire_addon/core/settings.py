@@ -1,0 +1,83 @@
+"""The plain settings snapshot the draw path takes, and the parameter block
+packed from it. Both are made from the schema (``core/schema.py``).
+
+:class:`DrawSettings` is a frozen dataclass with one field per schema setting
+that is ``in_snapshot``; ``DrawSettings()`` holds the defaults. Non-finite
+numbers (a script or a driver can set NaN) fall back to the default with one
+message, so no frame turns NaN or silently blank.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from . import schema
+from .log import warn_once
+
+_SNAPSHOT = tuple(s for s in schema.SETTINGS if s.in_snapshot)
+
+
+def _post_init(self) -> None:
+    for setting in _SNAPSHOT:
+        value, default = getattr(self, setting.name), setting.default
+        if setting.kind == schema.FLOAT:
+            ok = isinstance(value, (int, float)) and math.isfinite(value)
+            fixed = float(value) if ok else default
+        elif setting.kind == schema.COLOR:
+            fixed = tuple(float(c) if math.isfinite(c) else d for c, d in zip(value, default))
+            ok = fixed == tuple(value)
+        else:
+            continue
+        if not ok:
+            warn_once(("setting", setting.name), f"SolidWire: setting '{setting.name}' is not a finite number ({value}); using {fixed}")
+        object.__setattr__(self, setting.name, fixed)
+
+
+@classmethod
+def _from_properties(cls, props) -> "DrawSettings":
+    """Snapshot of a property group made from the schema (or any object
+    with the same attribute names)."""
+    values = {}
+    for setting in _SNAPSHOT:
+        value = getattr(props, setting.name)
+        if setting.kind == schema.COLOR:
+            value = tuple(float(c) for c in value)
+        values[setting.name] = value
+    return cls(**values)
+
+
+DrawSettings = dataclasses.make_dataclass(
+    "DrawSettings",
+    [(s.name, type(s.default), dataclasses.field(default=s.default)) for s in _SNAPSHOT],
+    namespace={"__post_init__": _post_init, "from_properties": _from_properties, "__module__": __name__},
+    frozen=True,
+)
+DrawSettings.__doc__ = "A plain, immutable snapshot of the scene's SolidWire settings (see core/schema.py)."
+
+
+def pack_params(settings, viewport, projection=None) -> bytes:
+    """The std140 parameter block (layout: schema.PARAM_BLOCK).
+
+    ``projection`` (the view's) is needed for world-space thickness: window
+    pixels per scene unit across the view at clip w = 1 are
+    0.5 * height * projection[1][1]; the shader divides by the fragment's w."""
+    px_per_unit = 0.0 if projection is None else 0.5 * float(viewport[3]) * abs(float(projection[1][1]))
+    view_values = {
+        "viewport": tuple(float(v) for v in viewport),
+        "world_half_thickness_px": 0.5 * max(float(settings.world_thickness), 0.0) * px_per_unit,
+    }
+    values: list[float] = []
+    for member in schema.PARAM_BLOCK:
+        if member.setting is not None:
+            value = member.setting.param.pack(getattr(settings, member.setting.name))
+        else:
+            value = view_values.get(member.glsl, 0.0)
+        if member.glsl_type == "vec4":
+            values.extend(float(v) for v in value)
+        else:
+            values.append(float(value))
+    assert len(values) == schema.PARAM_FLOATS
+    return np.asarray(values, dtype=np.float32).tobytes()

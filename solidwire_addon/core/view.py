@@ -1,0 +1,67 @@
+"""Plain data every pass shares: the view, what is drawn, frame statistics,
+and the frustum test used to skip objects.
+
+A :class:`View` is float64 numpy matrices plus the viewport rectangle; a
+:class:`DrawItem` is a GPU mesh with its float64 object matrix. Nothing here
+touches Blender or the GPU.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class View:
+    """Camera or viewport view: float64 matrices and the viewport rectangle."""
+
+    view_matrix: np.ndarray  # world -> view (camera looks down -Z)
+    projection: np.ndarray  # view -> clip, GL conventions
+    viewport: tuple  # (x0, y0, width, height) in framebuffer pixels
+
+    @property
+    def width(self) -> int:
+        return int(self.viewport[2])
+
+    @property
+    def height(self) -> int:
+        return int(self.viewport[3])
+
+
+@dataclass
+class DrawItem:
+    """One drawn object or instance: a GPU mesh and its object -> world matrix."""
+
+    mesh: object  # core.cache.GPUMesh
+    matrix: np.ndarray  # (4, 4) float64
+
+
+@dataclass
+class DrawStats:
+    objects_drawn: int = 0
+    objects_culled: int = 0
+    triangles_drawn: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+def translation(offset) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = offset
+    return m
+
+
+_BOX_CORNERS = np.array([[x, y, z, 1.0] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
+
+
+def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.ndarray:
+    """(N,) bool: the box lies wholly outside one clip plane (conservative),
+    for (N, 4, 4) matrices at once (one einsum, no Python call per instance)."""
+    lo, hi = np.asarray(bounds_min), np.asarray(bounds_max)
+    corners = _BOX_CORNERS.copy()
+    corners[:, :3] = lo + corners[:, :3] * (hi - lo)
+    clip = np.einsum("kj,nij->nki", corners, object_to_clip)  # (N, 8, 4)
+    x, y, z, w = np.moveaxis(clip, 2, 0)
+    outside = (x > w).all(1) | (x < -w).all(1) | (y > w).all(1) | (y < -w).all(1) | (z > w).all(1) | (z < -w).all(1)
+    return outside

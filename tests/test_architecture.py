@@ -1,0 +1,173 @@
+"""The package's layering, read from its source: no import cycles (module- or
+function-level imports alike), nothing in ``core`` that faces Blender's UI or
+context, no private names used across modules, and a shader parameter block
+that is exactly the schema's.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+from solidwire_addon.core import schema, shaders
+from solidwire_addon.core.settings import DrawSettings, pack_params
+
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGE = ROOT / "solidwire_addon"
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _modules() -> dict[str, ast.Module]:
+    return {_module_name(p): ast.parse(p.read_text(encoding="utf-8")) for p in PACKAGE.rglob("*.py")}
+
+
+def _resolve(module: str, node: ast.ImportFrom, is_package: bool) -> str:
+    if node.level == 0:
+        return node.module or ""
+    base = module.split(".")
+    if not is_package:
+        base = base[:-1]
+    base = base[: len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def import_graph() -> dict[str, set[str]]:
+    """module -> the package modules it imports, anywhere in its body."""
+    modules = _modules()
+    packages = {name for name in modules if (PACKAGE.parent / name.replace(".", "/") / "__init__.py").exists()}
+    graph: dict[str, set[str]] = {name: set() for name in modules}
+    for name, tree in modules.items():
+        for node in ast.walk(tree):
+            targets = []
+            if isinstance(node, ast.Import):
+                targets = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = _resolve(name, node, name in packages)
+                targets = [f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base for alias in node.names]
+            for target in targets:
+                if target in modules and target != name:
+                    graph[name].add(target)
+    return graph
+
+
+def _cycle(graph) -> list[str] | None:
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(node):
+        state[node] = 1
+        stack.append(node)
+        for nxt in sorted(graph[node]):
+            if state.get(nxt) == 1:
+                return stack[stack.index(nxt):] + [nxt]
+            if nxt not in state:
+                found = visit(nxt)
+                if found:
+                    return found
+        stack.pop()
+        state[node] = 2
+        return None
+
+    for node in sorted(graph):
+        if node not in state:
+            found = visit(node)
+            if found:
+                return found
+    return None
+
+
+def test_the_import_graph_has_no_cycle():
+    graph = import_graph()
+    # The package's own __init__ registers everything: leave it out, as its
+    # submodules never import it (checked below).
+    graph = {k: {v for v in vs if v != "solidwire_addon"} for k, vs in graph.items()}
+    assert _cycle(graph) is None, " -> ".join(_cycle(graph))
+
+
+def test_a_cycle_would_be_found():
+    assert _cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert _cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_core_never_imports_the_blender_side():
+    for module, imports in import_graph().items():
+        if module.startswith("solidwire_addon.core"):
+            upward = sorted(i for i in imports if not i.startswith("solidwire_addon.core"))
+            assert not upward, f"{module} imports {upward}"
+
+
+def test_core_reads_no_blender_ui_or_context():
+    """core may draw with ``gpu`` but never imports ``bpy`` (so no
+    bpy.types, bpy.context or bpy.ops)."""
+    for name, tree in _modules().items():
+        if not name.startswith("solidwire_addon.core"):
+            continue
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                assert not any(a.name.split(".")[0] == "bpy" for a in node.names), f"{name} imports bpy"
+            elif isinstance(node, ast.ImportFrom) and node.level == 0:
+                assert (node.module or "").split(".")[0] != "bpy", f"{name} imports from bpy"
+
+
+def test_no_private_name_is_used_across_modules():
+    for name, tree in _modules().items():
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.module and node.level:
+                private = [a.name for a in node.names if a.name.startswith("_") and a.name != "__version__"]
+                assert not private, f"{name} imports private {private} from {node.module}"
+
+
+def test_the_parameter_block_is_the_schemas():
+    glsl = schema.param_block_glsl()
+    members = re.findall(r"^\s*(vec4|float) (\w+);", glsl, re.M)
+    assert [name for _kind, name in members] == [m.glsl for m in schema.PARAM_BLOCK]
+    floats = sum(4 if kind == "vec4" else 1 for kind, _name in members)
+    assert floats == schema.PARAM_FLOATS and floats % 4 == 0  # std140: whole vec4s
+    # Every vec4 comes before the first float: no std140 alignment holes.
+    kinds = [kind for kind, _name in members]
+    assert kinds == sorted(kinds, key=lambda k: k != "vec4")
+    packed = pack_params(DrawSettings(), (0, 0, 640, 480))
+    assert len(packed) == 4 * schema.PARAM_FLOATS
+    # Each setting's slot holds its packed value.
+    values = __import__("numpy").frombuffer(packed, dtype="float32")
+    offset = 0
+    for member in schema.PARAM_BLOCK:
+        size = 4 if member.glsl_type == "vec4" else 1
+        if member.setting is not None:
+            expected = member.setting.param.pack(getattr(DrawSettings(), member.setting.name))
+            assert values[offset : offset + size] == pytest.approx(expected if size == 4 else [expected]), member.glsl
+        offset += size
+
+
+def test_every_block_member_the_shaders_read_exists():
+    sources = "".join(p.read_text(encoding="utf-8") for p in shaders.SHADER_DIR.glob("*.glsl"))
+    used = set(re.findall(r"\bparams\.(\w+)", sources))
+    declared = {m.glsl for m in schema.PARAM_BLOCK}
+    assert used <= declared, sorted(used - declared)
+    unused = {m.glsl for m in schema.PARAM_BLOCK if m.setting is not None} - used
+    assert not unused, f"settings packed but never read by a shader: {sorted(unused)}"
+
+
+def test_a_new_setting_needs_only_a_schema_entry(monkeypatch):
+    """What a new setting gets for free: a property, a preset key, a CLI
+    option, a panel row and (with a param) a slot in the block."""
+    from solidwire_addon.blender import cli, properties
+
+    extra = schema.Setting(
+        "example_width", schema.FLOAT, 2.0, "Example Width", "An example", minimum=0.0, maximum=10.0,
+        subtype="PIXEL", section="line", param=schema.Param("example_width"),
+    )
+    monkeypatch.setattr(schema, "SETTINGS", (*schema.SETTINGS, extra))
+    group = properties.make_group(schema.SCENE)
+    assert "example_width" in group.__annotations__
+    assert "example_width" in {s.name for s in schema.preset_settings()}
+    args = cli.build_parser().parse_args(["--example-width", "3"])
+    assert args.example_width == 3.0
+    assert any(m.glsl == "example_width" for m in schema._param_block())
