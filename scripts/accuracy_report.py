@@ -22,7 +22,7 @@ os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwi
 from tests.support import accuracy  # noqa: E402
 from tests.support import scenes  # noqa: E402
 import solidwire_addon  # noqa: E402
-import test_render_reference as cases  # noqa: E402
+from tests import test_render_reference as cases  # noqa: E402
 
 
 def main(argv=None) -> int:

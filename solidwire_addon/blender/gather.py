@@ -64,7 +64,8 @@ def fingerprint(mesh):
     return content, (positions, corner_vert)
 
 
-def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None):
+def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
+           should_stop=None):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -75,7 +76,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     With ``view`` (a core.view.View), a mesh the cache does not hold yet is not
     extracted at all while every instance of it lies outside the view
     frustum (its evaluated bound box against the clip planes); those
-    instances count as culled."""
+    instances count as culled. ``should_stop()`` (a render's Esc) is asked
+    before each object's work; when it says True, gathering ends there."""
     mode = depsgraph.mode
     if trust_updates is None:
         trust_updates = mode == "VIEWPORT"
@@ -97,6 +99,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
         obj = instance.object
         if obj.type != "MESH":
             continue
+        if should_stop is not None and should_stop():
+            break
         is_instance = instance.is_instance
         if not is_instance and not instance.show_self:
             continue
