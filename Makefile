@@ -18,7 +18,7 @@ BLENDER_TAGS = $(VENV_PYTHON) -c "import importlib.util, os; \
 	print(os.path.join(importlib.util.find_spec('bpy').submodule_search_locations[0], \
 	'5.0', 'scripts', 'modules', '_bpy_internal', 'extensions', 'tags.py'))"
 
-.PHONY: demo test venv zip check-system clean bench bench-scale fetch-meshes test-slow soak fuzz compat
+.PHONY: demo test test-newest venv venv-newest zip check-system clean bench bench-scale fetch-meshes test-slow soak fuzz compat
 
 venv: $(VENV_STAMP)
 
@@ -40,8 +40,26 @@ check-system:
 demo: $(VENV_STAMP) check-system
 	$(VENV_PYTHON) scripts/render.py --demo -o $(DEMO_IMAGE)
 
+# -X faulthandler: a crash inside the GPU driver names the test and the line.
 test: $(VENV_STAMP) check-system
-	$(VENV_PYTHON) -m pytest tests
+	$(VENV_PYTHON) -X faulthandler -m pytest tests
+
+# The newest Blender on the package index (bpy 5.3.0, Python 3.13) in its own
+# venv: CI runs the whole suite on it too. Python 3.13 from PATH, or pyenv's.
+NEWEST_VENV := .venv-newest
+NEWEST_STAMP := $(NEWEST_VENV)/.solidwire-requirements-installed
+$(NEWEST_STAMP): requirements-newest.txt
+	@py=$$(command -v python3.13 2>/dev/null); \
+	{ [ -n "$$py" ] && $$py -c 'import sys' 2>/dev/null; } || py=$$(ls -d $$(pyenv root 2>/dev/null)/versions/3.13*/bin/python3.13 2>/dev/null | tail -n 1); \
+	test -n "$$py" || { echo "error: Python 3.13 not found (bpy 5.3 needs it)" >&2; exit 1; }; \
+	$$py -m venv $(NEWEST_VENV)
+	$(NEWEST_VENV)/bin/python -m pip install --disable-pip-version-check -r requirements-newest.txt
+	touch $(NEWEST_STAMP)
+
+venv-newest: $(NEWEST_STAMP)
+
+test-newest: $(NEWEST_STAMP) check-system
+	$(NEWEST_VENV)/bin/python -X faulthandler -m pytest tests
 
 # The installable extension zip, validated and built by Blender's own tool.
 zip: $(VENV_STAMP)

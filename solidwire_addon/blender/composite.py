@@ -33,6 +33,7 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import sys
 import shutil
 import tempfile
 from dataclasses import dataclass
@@ -192,13 +193,37 @@ def _exr_output(scene, multilayer: bool) -> None:
     scene.render.use_file_extension = False
 
 
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Blender's own lines for the temporary layer files (``Saved: '...'``,
+    ``Fra:`` progress) go nowhere: the user asked for the composite only,
+    and the command line reports that one. Errors (stderr) still show. C
+    code writes to file descriptor 1 directly, so the descriptor itself is
+    redirected (Blender flushes its stdout after each of these lines)."""
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:  # no real stdout (embedded consoles): nothing to hide
+        yield
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
+
+
 def _render_to(scene, engine: str, path: Path, layer: str) -> dict:
     import bpy
 
     scene.render.engine = engine
     scene.render.filepath = str(path)
     try:
-        bpy.ops.render.render(write_still=True, scene=scene.name, layer=layer)
+        with _quiet_stdout():
+            bpy.ops.render.render(write_still=True, scene=scene.name, layer=layer)
     except RuntimeError as exc:
         raise CompositeError(f"{engine} render failed: {' '.join(str(exc).split())}") from None
     if not path.is_file():
