@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Scale benchmark (issue 5): what SolidWire costs as scenes grow.
+"""Scale benchmark: what SolidWire costs as scenes grow.
 
 Measured in one run, each against the path it replaces:
 

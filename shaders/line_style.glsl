@@ -1,12 +1,12 @@
 /* SolidWire line style, shared by every fragment stage (the exact path, the
- * silhouette fins and the benchmark's method variants): the SPEC 1.4
+ * silhouette fins and the benchmark's method variants): the image model (docs/image_model.md §4)
  * intensity profile, the thickness modes, depth fade and the dash mask. */
 
 #ifndef THICKNESS_MODE
 #  define THICKNESS_MODE 0 /* constant pixels (the method variants) */
 #endif
 
-/* SPEC 1.4 profile: 1 inside the core, 2^(-2 x^2) falloff over two softness
+/* Profile (docs/image_model.md §4.1): 1 inside the core, 2^(-2 x^2) falloff over two softness
  * widths, cut to 0 beyond (the step there is 2^-8, one 8-bit level). */
 float line_profile(float d, float half_thickness)
 {
@@ -15,7 +15,7 @@ float line_profile(float d, float half_thickness)
 }
 
 /* Half the core width at a point of view depth `depth` whose clip w is
- * 1 / inv_clip_w (THICKNESS_MODE, issue 7):
+ * 1 / inv_clip_w (THICKNESS_MODE, docs/image_model.md §4.2):
  *   0 constant in pixels;
  *   1 a width in scene units: pixels per unit there, exact for perspective
  *     and orthographic views;
@@ -35,7 +35,7 @@ float half_thickness_at(float depth, float inv_clip_w)
 #endif
 }
 
-/* SPEC 1.4 depth fade at view depth `depth` (a hard cut at fade_start when
+/* Depth fade (docs/image_model.md §4.5) at view depth `depth` (a hard cut at fade_start when
  * the range is empty). */
 float depth_fade(float depth)
 {

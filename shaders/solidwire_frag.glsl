@@ -98,7 +98,7 @@ void main()
   float intensity = line_profile(d_real, half_thickness);
 
 #ifdef HIDDEN_PASS
-  /* Hidden-line style (issue 7): this face is behind the visible surface;
+  /* Hidden-line style (docs/image_model.md §5.4): this face is behind the visible surface;
    * its real edges are drawn dimmed and dashed along the nearest edge, from
    * that edge's lower-id end. No diagonals, no fill. */
   float along_real = dot(vec2(-real_line.y, real_line.x), p);

@@ -9,7 +9,7 @@ For every method x scene at 1280 x 720 (``--size``), this measures
   background load affects them alike. The mesh scenes turn around a vertical axis
   like the papers' benchmarks; the stress scenes stand still.
 - the error of one frame against the float64 reference of the image model
-  (tests/support/reference.py, SPEC 1.5): mean, 99.9th percentile and max |dI| and
+  (tests/support/reference.py, docs/image_model.md §7): mean, 99.9th percentile and max |dI| and
   the count of pixels with |dI| > 2/255, silhouette samples excluded. The
   reference is slow numpy, so it is evaluated on sampled window rows (every
   ``--ref-row-step``-th row, same camera as the full-size frame); the output
@@ -31,7 +31,7 @@ Run scripts/fetch_meshes.py first for the teapot and bunny (optional: their
 scenes are skipped when the meshes are missing).
 
 Line settings: thickness 0, softness 1 px (the papers' prefiltered profile
-I(d) = 2^(-2 d^2), SPEC 1.4), diagonals SOLID (every
+I(d) = 2^(-2 d^2), docs/image_model.md §4), diagonals SOLID (every
 triangle edge drawn): the published methods draw every triangle edge, so with
 SOLID all methods are asked for the same lines and differ only in how they
 compute the distance to them.

@@ -4,7 +4,7 @@ switch, never user-facing.
 The add-on always draws with the "exact" method (shaders/solidwire_*.glsl).
 scripts/bench/ and tests/test_stress.py compare it with faithful variants of
 the methods in the seed documents, all fed the same inputs (position and
-triangle tables, per-corner edge flags, vertex pulling) and the same SPEC 1.4
+triangle tables, per-corner edge flags, vertex pulling) and the same docs/image_model.md §4
 intensity profile, so the comparison is about the distance computation:
 
 - ``nvidia2007``: NVIDIA "Solid Wireframe" whitepaper (2007): window-space
