@@ -13,8 +13,9 @@ window-space distances to the near-clipped projection of each face's edges.
 
 Method:
 - Visibility: every triangle is clipped to the near plane only to bound the
-  pixels it may cover; for those pixels a float64 ray (from the near to the
-  far clip plane through the sample) is intersected with the triangle
+  pixels it may cover; for those pixels a float64 ray through the sample
+  (from the camera centre, or for orthographic cameras from the near plane
+  along the view direction) is intersected with the triangle
   (Moller-Trumbore). The nearest hit between clip start and end wins.
   Zero-area and edge-on triangles never hit.
 - Silhouette flag: the visible face is also found for four samples 0.01 px
@@ -233,16 +234,37 @@ def _triangle_pixel_bounds(proj, tri_view, width, height):
     return x0, x1, y0, y1
 
 
-def _rays(inv_proj, px, py, width, height):
-    """Float64 rays through window points: origin on the near plane, and the
-    vector to the far plane point (t in [0, 1] spans clip start..end)."""
+def _clip_depths(proj):
+    """View depths (positive) of the near and far clip planes of ``proj``:
+    where NDC z is -1 and +1. The far one is inf when the far plane is at
+    infinity (a huge clip end rounds the float32 camera matrix to that)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        near = (proj[3, 3] + proj[2, 3]) / (proj[2, 2] + proj[3, 2])
+        far = (proj[2, 3] - proj[3, 3]) / (proj[2, 2] - proj[3, 2])
+    return float(near), (float(far) if np.isfinite(far) and far > near else np.inf)
+
+
+def _rays(inv_proj, proj, px, py, width, height):
+    """Float64 rays through window points: (origin, direction, t_near, t_far).
+
+    Perspective: from the camera centre through the sample's point on the
+    near plane; orthographic: from that near-plane point along the view
+    direction. Hits are kept for t in [t_near, t_far] (clip start..end).
+    Nothing is unprojected from the far plane: with a huge clip end its
+    point has w ~ 0 (or exactly 0) and the ray would turn NaN."""
     x = px / width * 2.0 - 1.0
     y = py / height * 2.0 - 1.0
-    near = np.stack([x, y, -np.ones_like(x), np.ones_like(x)], axis=-1) @ inv_proj.T
-    far = np.stack([x, y, np.ones_like(x), np.ones_like(x)], axis=-1) @ inv_proj.T
-    near = near[..., :3] / near[..., 3:4]
-    far = far[..., :3] / far[..., 3:4]
-    return near, far - near
+    near_h = np.stack([x, y, -np.ones_like(x), np.ones_like(x)], axis=-1) @ inv_proj.T
+    near_pt = near_h[..., :3] / near_h[..., 3:4]
+    near_depth, far_depth = _clip_depths(proj)
+    if proj[3, 2] != 0.0:  # perspective: camera centre at the view origin
+        origin = np.zeros_like(near_pt)
+        direction = near_pt  # t = 1 on the near plane, t = depth / near beyond
+        return origin, direction, 1.0, far_depth / near_depth
+    origin = near_pt  # orthographic: parallel rays down -z from the near plane
+    direction = np.zeros_like(near_pt)
+    direction[..., 2] = -1.0
+    return origin, direction, 0.0, far_depth - near_depth
 
 
 def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None):
@@ -291,7 +313,7 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None)
         e2 = geo.tri_view[pair_tri, 2] - v0
         scale = np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
         for s, (ox, oy) in enumerate(OFFSETS):
-            origin, direction = _rays(inv_proj, px + 0.5 + ox, py + 0.5 + oy, width, height)
+            origin, direction, t_near, t_far = _rays(inv_proj, proj, px + 0.5 + ox, py + 0.5 + oy, width, height)
             pvec = np.cross(direction, e2)
             det = np.einsum("ij,ij->i", e1, pvec)
             ok = np.abs(det) > 1e-13 * scale * np.linalg.norm(direction, axis=1)
@@ -304,7 +326,7 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None)
                 qvec = np.cross(tvec, e1)
                 v = np.einsum("ij,ij->i", direction, qvec) * inv_det
                 t = np.einsum("ij,ij->i", e2, qvec) * inv_det
-            hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
+            hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= t_near) & (t <= t_far)
             depth = -(origin[:, 2] + t * direction[:, 2])
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
             if s == 0 and all_hits is not None:
