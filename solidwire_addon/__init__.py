@@ -16,7 +16,7 @@ import atexit
 import bpy
 
 from .blender import cli, engine, ops, ops_composite, overlay, properties, runtime, ui
-from .core import log, shaders, silhouettes, targets
+from .core import log, silhouettes, targets
 
 _classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
 _registered = False
@@ -65,11 +65,12 @@ def _at_exit() -> None:
 
 
 def release_gpu() -> None:
-    """Free every GPU object the add-on holds (targets, meshes, shaders)."""
+    """Free the GPU objects the add-on holds (targets, meshes, fin batches).
+    Compiled shader programs are the exception: they live until interpreter
+    exit (core/shaders.py says why)."""
     targets.release()
     runtime.release()
     silhouettes.release()
-    shaders.clear()
 
 
 def stats() -> dict:

@@ -3,13 +3,14 @@
 The interface (samplers, push constants, the parameter block and the flat
 varyings) is declared here once; the GLSL bodies live in files so they can be
 read, diffed and linted as GLSL. Variants are compiled on first use and kept
-for the life of the process (or until :func:`clear` at unregister), keyed by
+for the life of the process (see _cache for why), keyed by
 the feature flags that change the generated code, so a feature that is off
 costs nothing at run time.
 """
 
 from __future__ import annotations
 
+import atexit
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -51,7 +52,30 @@ class ShaderVariant:
     instanced: bool = False
 
 
+# Compiled programs live for the whole process :
+# they are reused across unregister/register and freed only at interpreter
+# exit. Why: a render (bpy.ops.render.render) draws in the render engine's own
+# GL context, everything else in the script/window context, and the programs
+# are shared by both. Deleting a program from one context after the other has
+# drawn with it crashed Mesa's llvmpipe later, inside an unrelated draw (a
+# segfault in swrast_dri during batch.draw, reproducible with a fixed test
+# order: unregister -> register -> overlay draw after an engine render).
+# Keeping the programs removed the crash; textures, batches and framebuffers
+# freed across contexts did not cause it and are still released at
+# unregister. A program is a few KiB of driver memory.
 _cache: dict[ShaderVariant, object] = {}
+_exit_hook_installed = False
+
+
+def _keep(cache: dict, key, shader):
+    """Store a compiled program; the first one installs the exit hook that
+    frees them all while Blender's GPU context still exists."""
+    global _exit_hook_installed
+    cache[key] = shader
+    if not _exit_hook_installed:
+        atexit.register(release_at_exit)
+        _exit_hook_installed = True
+    return shader
 
 
 def read_source(name: str, directory: Path = SHADER_DIR) -> str:
@@ -152,12 +176,12 @@ def get(variant: ShaderVariant):
     """The compiled shader for ``variant`` (compiled once, then cached)."""
     shader = _cache.get(variant)
     if shader is None:
-        shader = gpu.shader.create_from_info(_create_info(variant))
-        _cache[variant] = shader
+        shader = _keep(_cache, variant, gpu.shader.create_from_info(_create_info(variant)))
     return shader
 
 
-def clear() -> None:
+def release_at_exit() -> None:
+    """Free every compiled program (interpreter exit only; see _cache)."""
     _cache.clear()
     _silhouette_cache.clear()
 
@@ -197,6 +221,5 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         common = read_source("common.glsl") + read_source("edge_geometry.glsl")
         info.vertex_source(common + read_source("silhouette_vert.glsl"))
         info.fragment_source(common + read_source("line_style.glsl") + read_source("silhouette_frag.glsl"))
-        shader = gpu.shader.create_from_info(info)
-        _silhouette_cache[key] = shader
+        shader = _keep(_silhouette_cache, key, gpu.shader.create_from_info(info))
     return shader
