@@ -18,7 +18,7 @@ from ..core import passes
 from ..core.ids import ENGINE_ID
 from . import gather, runtime
 from .gpu_context import ensure_gpu, is_init_scene
-from ..core.view import View
+from ..core.view import DrawStats, View
 from .views import NoCameraError, camera_view, render_size
 
 
@@ -53,36 +53,73 @@ def region_of(scene, width: int, height: int) -> tuple[int, int, int, int]:
     return x0, y0, x1 - x0, y1 - y0
 
 
-def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None):
-    """Render ``depsgraph``'s scene from its camera: (rgba premultiplied over
-    the film, view depth), or None when ``should_stop()`` said so. Shared by
-    the engine and the command line.
+# Frames larger than this many pixels a side are drawn and handed to Blender
+# tile by tile (RenderEngine.begin_result on a sub-rectangle), so SolidWire's
+# own float targets and readback stay at one tile (~0.2 GiB at 2048^2) however
+# big the frame: peak memory is Blender's result plus one tile.
+TILE_SIZE = 2048
 
-    ``region`` (x0, y0, w, h) in pixels of the full frame draws that window
-    only, pixel for pixel as in the full render. ``report(text, fraction)``
-    hears about the stages."""
-    ensure_gpu()  # uploads start in gather(), before anything is drawn
-    scene = depsgraph.scene
-    view = camera_view(scene, depsgraph, size)
-    if region is not None:
-        view = sub_view(view, region)
-    settings = scene.solidwire.snapshot()
+
+def tiles_of(region, tile_size: int | None = None):
+    """(x0, y0, w, h) tiles covering ``region`` (frame pixels), rows from the bottom."""
+    x0, y0, w, h = region
+    size = tile_size or TILE_SIZE
+    for ty in range(y0, y0 + h, size):
+        for tx in range(x0, x0 + w, size):
+            yield tx, ty, min(size, x0 + w - tx), min(size, y0 + h - ty)
+
+
+class PreparedFrame:
+    """What every tile of one frame shares: the full-frame view, the settings
+    snapshot and the gathered draw items (extracted and uploaded once)."""
+
+    def __init__(self, depsgraph, size, *, should_stop=None):
+        ensure_gpu()  # uploads start in gather(), before anything is drawn
+        self.scene = depsgraph.scene
+        self.view = camera_view(self.scene, depsgraph, size)
+        self.settings = self.scene.solidwire.snapshot()
+        # Reuse: unchanged meshes are recognised by their content fingerprint
+        # (runtime.py says why), so a multi-frame render re-extracts only what
+        # changed on each frame.
+        self.frame = runtime.begin_frame(reuse=True)
+        # The view lets gather skip extracting meshes that are wholly off-screen.
+        self.items, self.seen, self.ms_extract = gather.gather(
+            depsgraph, runtime.mesh_cache, view=self.view, should_stop=should_stop
+        )
+        self.draw_stats = None
+        self.ms_draw = 0.0
+
+    def draw(self, region):
+        """(rgba premultiplied over the film, view depth) of ``region``
+        (x0, y0, w, h in frame pixels), pixel for pixel as in the whole frame."""
+        width, height = self.view.width, self.view.height
+        view = self.view if tuple(region) == (0, 0, width, height) else sub_view(self.view, region)
+        start = time.perf_counter()
+        rgba, depth, stats = passes.render(self.items, view, self.settings)
+        self.ms_draw += (time.perf_counter() - start) * 1000.0
+        if self.draw_stats is None:
+            self.draw_stats = stats
+        return composite_film(rgba, self.scene), depth
+
+    def finish(self) -> None:
+        runtime.end_frame(self.frame, self.draw_stats or DrawStats(), self.ms_extract, self.ms_draw, self.seen)
+
+
+def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None):
+    """Render ``depsgraph``'s scene from its camera in one piece: (rgba
+    premultiplied over the film, view depth), or None when ``should_stop()``
+    said so. ``region`` (x0, y0, w, h) in pixels of the full frame draws that
+    window only. ``report(text, fraction)`` hears about the stages."""
     report = report or (lambda _text, _fraction: None)
     report("extracting meshes", 0.0)
-    # Reuse: unchanged meshes are recognised by their content fingerprint
-    # (runtime.py says why), so a multi-frame render re-extracts only what
-    # changed on each frame.
-    frame = runtime.begin_frame(reuse=True)
-    # The view lets gather skip extracting meshes that are wholly off-screen.
-    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, view=view, should_stop=should_stop)
+    frame = PreparedFrame(depsgraph, size, should_stop=should_stop)
     if should_stop is not None and should_stop():
         return None
-    report(f"drawing {len(items)} objects", 0.5)
-    start = time.perf_counter()
-    rgba, depth, draw_stats = passes.render(items, view, settings)
-    runtime.end_frame(frame, draw_stats, ms_extract, (time.perf_counter() - start) * 1000.0, seen)
+    report(f"drawing {len(frame.items)} objects", 0.5)
+    rendered = frame.draw(region or (0, 0, frame.view.width, frame.view.height))
+    frame.finish()
     report("writing the result", 0.9)
-    return composite_film(rgba, scene), depth
+    return rendered
 
 
 def sub_view(view, region):
@@ -118,26 +155,33 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         width, height = render_size(scene)
         region = region_of(scene, width, height)
         layer_name = depsgraph.view_layer.name
-
-        def report(text, fraction):
-            self.update_stats("SolidWire", f"{layer_name} | {text}")
-            self.update_progress(fraction)
-
         try:
-            rendered = render_scene(depsgraph, (width, height), region=region, should_stop=self.test_break,
-                                    report=report)
+            self.update_stats("SolidWire", f"{layer_name} | extracting meshes")
+            frame = PreparedFrame(depsgraph, (width, height), should_stop=self.test_break)
+            tiles = list(tiles_of(region))
+            for number, tile in enumerate(tiles, start=1):
+                if self.test_break():
+                    return  # cancelled (Esc): Blender keeps what it had
+                self.update_stats("SolidWire", f"{layer_name} | drawing {len(frame.items)} objects"
+                                  + (f", tile {number} of {len(tiles)}" if len(tiles) > 1 else ""))
+                self.update_progress(0.1 + 0.9 * (number - 1) / len(tiles))
+                rgba, depth = frame.draw(tile)
+                self._write(tile, region, layer_name, rgba, depth)
+            frame.finish()
         except NoCameraError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
-            return
         except Exception as exc:  # never take the render (or Blender) down
             self.report({"ERROR"}, f"SolidWire render failed: {type(exc).__name__}: {exc}")
-            return
-        if rendered is None:
-            return  # cancelled (Esc): Blender keeps what it had
-        rgba, depth = rendered
-        # Each view layer into its own result layer; the region's size (with
-        # or without Crop to Render Region, Blender places it in the frame).
-        result = self.begin_result(0, 0, region[2], region[3], layer=layer_name)
+        else:
+            self.update_progress(1.0)
+
+    def _write(self, tile, region, layer_name, rgba, depth) -> None:
+        """One tile into this view layer's result layer. Result coordinates
+        are relative to the region (Blender places the region in the frame,
+        with or without Crop to Render Region). The result is ended whatever
+        happens."""
+        x0, y0, w, h = tile
+        result = self.begin_result(x0 - region[0], y0 - region[1], w, h, layer=layer_name)
         cancel = True
         try:
             layer = result.layers[0]
@@ -146,11 +190,10 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
             if depth_pass != -1:
                 write_pass(layer.passes[depth_pass], depth)
             cancel = False
-        except Exception as exc:  # the result must be ended whatever happens
-            self.report({"ERROR"}, f"SolidWire could not write the result: {type(exc).__name__}: {exc}")
+        except Exception as exc:
+            raise RuntimeError(f"could not write the result: {type(exc).__name__}: {exc}") from None
         finally:
             self.end_result(result, cancel=cancel)
-        self.update_progress(1.0)
 
     def update_render_passes(self, scene=None, renderlayer=None):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
