@@ -31,6 +31,14 @@ void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float bes
 
 void main()
 {
+#ifdef LINEAR_DEPTH
+  /* The render's own float depth buffer holds view depth / clip end: a float
+   * keeps the same relative precision (2^-24) at every depth, so which of two
+   * surfaces is nearer never depends on the clip range (docs/image_model.md
+   * §2). The GL mapping 0.5 * z/w + 0.5 crowds every far depth into the last
+   * few float steps below 1. */
+  gl_FragDepth = view_depth * params.inv_clip_end;
+#endif
   /* Window position relative to the viewport centre (edge_geometry.glsl). */
   vec2 p = gl_FragCoord.xy - viewport_centre();
   /* Squared distances to the five candidate edges. */

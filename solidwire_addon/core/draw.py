@@ -20,7 +20,8 @@ from .settings import pack_params
 from .view import DrawStats, View, outside_frustum_many, translation
 
 
-def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0) -> shaders.ShaderVariant:
+def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0,
+                   linear_depth: bool = False) -> shaders.ShaderVariant:
     """The compiled-code features ``settings`` ask for."""
     diagonals = {
         "HIDDEN": shaders.DIAGONALS_HIDDEN,
@@ -32,6 +33,7 @@ def shader_variant(settings, write_view_depth: bool = False, depth_bias: float =
         use_fade=bool(settings.use_fade),
         write_view_depth=write_view_depth,
         depth_bias=depth_bias,
+        linear_depth=linear_depth,
         thickness_mode={"WORLD": shaders.THICKNESS_WORLD, "DEPTH": shaders.THICKNESS_DEPTH}.get(
             settings.thickness_mode, shaders.THICKNESS_PIXELS
         ),
@@ -109,6 +111,7 @@ def draw(
     depth_test: str = "LESS_EQUAL",
     depth_write: bool = True,
     hidden_pass: bool = False,
+    linear_depth: bool = False,
     program=EXACT,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
@@ -118,7 +121,7 @@ def draw(
     stats = DrawStats()
     if not items:
         return stats
-    variant = shader_variant(settings, write_view_depth, depth_bias)
+    variant = shader_variant(settings, write_view_depth, depth_bias, linear_depth)
     if hidden_pass:
         variant = replace(variant, hidden_pass=True, write_view_depth=False)
     ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))

@@ -69,7 +69,7 @@ def render(items, view: View, settings, *, cull: bool = True):
     with framebuffer.bind():
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, width, height)
-        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull)
+        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull, linear_depth=True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     blended = [step for step in steps[1:] if step.kind in (HIDDEN, WIRE)]
@@ -82,9 +82,9 @@ def render(items, view: View, settings, *, cull: bool = True):
             try:
                 for step in blended:
                     if step.kind == HIDDEN:
-                        draw_mod.draw_hidden_lines(items, view, step.settings, cull=cull)
+                        draw_mod.draw_hidden_lines(items, view, step.settings, cull=cull, linear_depth=True)
                     else:
-                        draw_mod.draw(items, view, step.settings, depth_write=False, cull=cull)
+                        draw_mod.draw(items, view, step.settings, depth_write=False, cull=cull, linear_depth=True)
             finally:
                 gpu.state.blend_set("NONE")
                 gpu.state.depth_test_set("NONE")
@@ -102,7 +102,7 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
     with framebuffer.bind():
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, view.width, view.height)
-        silhouettes.draw_silhouettes(items, view, settings, targets.depth)
+        silhouettes.draw_silhouettes(items, view, settings, targets.depth, linear_depth=True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     outer = read_texture(targets.outer, 1)[..., 0:1]

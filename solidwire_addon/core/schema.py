@@ -351,6 +351,7 @@ CLI_RANGES = (
 VIEW_PARAMS = (
     ("viewport", "vec4"),  # x0, y0, width, height of the target, px
     ("world_half_thickness_px", "float"),  # world_thickness / 2 in px at clip w = 1
+    ("inv_clip_end", "float"),  # 1 / the view's clip end (linear depth of the render)
 )
 
 

@@ -46,6 +46,10 @@ class ShaderVariant:
     # The mesh has n-gons: the fragment stage walks their outlines and
     # diagonals (USE_NGONS); tri/quad meshes get a variant without that code.
     ngons: bool = False
+    # The render's offscreen passes write view depth / clip end as depth
+    # (LINEAR_DEPTH, see solidwire_frag.glsl); the viewport overlay keeps
+    # Blender's depth mapping, whose buffer it shares.
+    linear_depth: bool = False
     # Many instances of one mesh in one draw_instanced call,
     # each reading its matrices from a float texture by gl_InstanceID (see
     # shaders/instancing.glsl and draw.py).
@@ -147,6 +151,9 @@ def _create_info(variant: ShaderVariant):
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
+    if variant.linear_depth:
+        info.define("LINEAR_DEPTH", "1")
+        compat.depth_write(info, "ANY")
     if variant.ngons:
         info.define("USE_NGONS", "1")
     if variant.depth_bias:
@@ -194,7 +201,8 @@ _silhouette_cache: dict[ShaderVariant, object] = {}
 def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
     """The fin shader; ``overlay_bias`` > 0 gives the viewport-overlay form
     (colour output, fixed-function occlusion; see silhouette_frag.glsl)."""
-    key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias)
+    key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
+                        linear_depth=variant.linear_depth and not overlay_bias)
     shader = _silhouette_cache.get(key)
     if shader is None:
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
@@ -216,6 +224,8 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
             info.fragment_out(0, "FLOAT", "frag_intensity")
         compat.depth_write(info, "ANY")
         info.define("THICKNESS_MODE", str(key.thickness_mode))
+        if key.linear_depth:
+            info.define("LINEAR_DEPTH", "1")
         if key.use_fade:
             info.define("USE_FADE", "1")
         common = read_source("common.glsl") + read_source("edge_geometry.glsl")
