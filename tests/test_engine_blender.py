@@ -163,3 +163,21 @@ def test_tiled_frames_equal_the_frame_drawn_in_one_piece(tmp_path, region_scene,
     tiled = scenes.render_to_file(region_scene, tmp_path / "tiled.png")
     assert tiled.shape == whole.shape and whole[..., 3].max() > 0.5
     assert np.abs(tiled - whole).max() <= 1.5 / 65535
+
+
+def test_a_render_after_the_window_context_drew_is_right(tmp_path):
+    """F12 draws in the render engine's own GL context, the overlay and
+    scripts in the window context. A program drawn with in both gave a wrong
+    F12 image (most of the surface missing); each context now has its own
+    programs (core/shaders.py, gl_context)."""
+    scene = _two_layer_scene()
+    _multilayer_render(scene, tmp_path / "layers.exr")  # the engine context draws these variants
+    scene = scenes.empty_scene(80, 60)
+    scenes.monkey(scene)
+    scenes.add_camera(scene, location=(2.5, -4.0, 1.8), target=(0.0, 0.0, 0.0))
+    window_rgba, _depth = engine.render_scene(bpy.context.evaluated_depsgraph_get(), (80, 60))  # window context
+    scene = scenes.empty_scene(80, 60)  # a new file: new meshes, same variants
+    scenes.monkey(scene)
+    scenes.add_camera(scene, location=(2.5, -4.0, 1.8), target=(0.0, 0.0, 0.0))
+    f12 = scenes.render_to_file(scene, tmp_path / "f12.png")
+    assert np.abs(f12[..., 3] - window_rgba[..., 3]).max() <= 1.5 / 65535

@@ -14,7 +14,7 @@ import time
 import bpy
 import numpy as np
 
-from ..core import passes
+from ..core import passes, shaders
 from ..core.ids import ENGINE_ID
 from . import gather, runtime
 from .gpu_context import ensure_gpu, is_init_scene
@@ -156,24 +156,29 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         region = region_of(scene, width, height)
         layer_name = depsgraph.view_layer.name
         try:
-            self.update_stats("SolidWire", f"{layer_name} | extracting meshes")
-            frame = PreparedFrame(depsgraph, (width, height), should_stop=self.test_break)
-            tiles = list(tiles_of(region))
-            for number, tile in enumerate(tiles, start=1):
-                if self.test_break():
-                    return  # cancelled (Esc): Blender keeps what it had
-                self.update_stats("SolidWire", f"{layer_name} | drawing {len(frame.items)} objects"
-                                  + (f", tile {number} of {len(tiles)}" if len(tiles) > 1 else ""))
-                self.update_progress(0.1 + 0.9 * (number - 1) / len(tiles))
-                rgba, depth = frame.draw(tile)
-                self._write(tile, region, layer_name, rgba, depth)
-            frame.finish()
+            with shaders.gl_context("render-engine"):
+                self._render_frame(depsgraph, (width, height), region, layer_name)
         except NoCameraError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
         except Exception as exc:  # never take the render (or Blender) down
             self.report({"ERROR"}, f"SolidWire render failed: {type(exc).__name__}: {exc}")
         else:
             self.update_progress(1.0)
+
+    def _render_frame(self, depsgraph, size, region, layer_name) -> None:
+        """Extract once, then draw and hand over the region tile by tile."""
+        self.update_stats("SolidWire", f"{layer_name} | extracting meshes")
+        frame = PreparedFrame(depsgraph, size, should_stop=self.test_break)
+        tiles = list(tiles_of(region))
+        for number, tile in enumerate(tiles, start=1):
+            if self.test_break():
+                return  # cancelled (Esc): Blender keeps what it had
+            self.update_stats("SolidWire", f"{layer_name} | drawing {len(frame.items)} objects"
+                              + (f", tile {number} of {len(tiles)}" if len(tiles) > 1 else ""))
+            self.update_progress(0.1 + 0.9 * (number - 1) / len(tiles))
+            rgba, depth = frame.draw(tile)
+            self._write(tile, region, layer_name, rgba, depth)
+        frame.finish()
 
     def _write(self, tile, region, layer_name, rgba, depth) -> None:
         """One tile into this view layer's result layer. Result coordinates

@@ -67,6 +67,13 @@ def render(items, view: View, settings, *, cull: bool = True):
     stats = None
     framebuffer = targets.framebuffer()
     with framebuffer.bind():
+        # A clear honours the depth write mask, and GPU state lives per GL
+        # context: a previous frame drawn in this context may have left depth
+        # writes off, which left the old depth in place (wrong occlusion in
+        # the next render drawn in that context).
+        gpu.state.depth_mask_set(True)
+        gpu.state.color_mask_set(True, True, True, True)
+        gpu.state.blend_set("NONE")
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, width, height)
         stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull, linear_depth=True)
@@ -100,6 +107,7 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
     with the wire colour ("over", premultiplied)."""
     framebuffer = targets.silhouette_framebuffer()
     with framebuffer.bind():
+        gpu.state.depth_mask_set(True)  # see render(): the clear honours the mask
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, view.width, view.height)
         silhouettes.draw_silhouettes(items, view, settings, targets.depth, linear_depth=True)

@@ -11,6 +11,7 @@ costs nothing at run time.
 from __future__ import annotations
 
 import atexit
+import contextlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -56,18 +57,31 @@ class ShaderVariant:
     instanced: bool = False
 
 
-# Compiled programs live for the whole process :
-# they are reused across unregister/register and freed only at interpreter
-# exit. Why: a render (bpy.ops.render.render) draws in the render engine's own
-# GL context, everything else in the script/window context, and the programs
-# are shared by both. Deleting a program from one context after the other has
-# drawn with it crashed Mesa's llvmpipe later, inside an unrelated draw (a
-# segfault in swrast_dri during batch.draw, reproducible with a fixed test
-# order: unregister -> register -> overlay draw after an engine render).
-# Keeping the programs removed the crash; textures, batches and framebuffers
-# freed across contexts did not cause it and are still released at
-# unregister. A program is a few KiB of driver memory.
-_cache: dict[ShaderVariant, object] = {}
+# Two GL contexts draw SolidWire: a render (bpy.ops.render.render, F12) draws
+# in the render engine's own context, everything else (viewport overlay,
+# scripts) in the window/script context. Compiled programs are kept apart per
+# context (``gl_context``): a program compiled and drawn with in one context
+# and then drawn with in the other gave wrong images there (part of the
+# surface missing after the window context had drawn the same variant), and
+# deleting a program from one context after the other had drawn with it
+# crashed llvmpipe later inside an unrelated draw (segfault in swrast_dri
+# during batch.draw). Programs also live for the whole process: reused across
+# unregister/register and freed only at interpreter exit, while Blender's GPU
+# context still exists. A program is a few KiB of driver memory.
+_cache: dict[tuple, object] = {}
+_context = "window"
+
+
+@contextlib.contextmanager
+def gl_context(name: str):
+    """Draw calls inside use the programs of GL context ``name`` (the render
+    engine says "render-engine"; everything else is "window")."""
+    global _context
+    previous, _context = _context, name
+    try:
+        yield
+    finally:
+        _context = previous
 _exit_hook_installed = False
 
 
@@ -181,9 +195,10 @@ _INSTANCE_SLOT_FRAG = "#define SW_INSTANCE_SLOT instance_slot\n"
 
 def get(variant: ShaderVariant):
     """The compiled shader for ``variant`` (compiled once, then cached)."""
-    shader = _cache.get(variant)
+    key = (_context, variant)
+    shader = _cache.get(key)
     if shader is None:
-        shader = _keep(_cache, variant, gpu.shader.create_from_info(_create_info(variant)))
+        shader = _keep(_cache, key, gpu.shader.create_from_info(_create_info(variant)))
     return shader
 
 
@@ -195,7 +210,7 @@ def release_at_exit() -> None:
 
 # Full-width silhouettes (image model §5.5): the fin pass of silhouettes.py. Shares
 # the parameter block, vertex pulling and edge geometry with the exact path.
-_silhouette_cache: dict[ShaderVariant, object] = {}
+_silhouette_cache: dict[tuple, object] = {}
 
 
 def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
@@ -203,7 +218,7 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
     (colour output, fixed-function occlusion; see silhouette_frag.glsl)."""
     key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
                         linear_depth=variant.linear_depth and not overlay_bias)
-    shader = _silhouette_cache.get(key)
+    shader = _silhouette_cache.get((_context, key))
     if shader is None:
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
         iface.flat("VEC4", "fin_a")
@@ -231,5 +246,5 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         common = read_source("common.glsl") + read_source("edge_geometry.glsl")
         info.vertex_source(common + read_source("silhouette_vert.glsl"))
         info.fragment_source(common + read_source("line_style.glsl") + read_source("silhouette_frag.glsl"))
-        shader = _keep(_silhouette_cache, key, gpu.shader.create_from_info(info))
+        shader = _keep(_silhouette_cache, (_context, key), gpu.shader.create_from_info(info))
     return shader
