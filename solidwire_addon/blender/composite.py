@@ -270,14 +270,33 @@ def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = 
     render; ``depth`` also returns both Depth passes; ``keep_exr`` (a path
     stem) keeps the two float layers as ``STEM.beauty.exr`` and
     ``STEM.wire.exr``."""
+    _check_compositable(scene, depth)
+    engine = resolve_engine(scene, engine)
+    layer = _view_layer(scene, view_layer)
+    tmp = Path(tempfile.mkdtemp(prefix="solidwire-over-"))
+    try:
+        beauty_exr, wire_exr = _render_both(scene, engine, layer, tmp, samples=samples, depth=depth)
+        result = _composite(beauty_exr, wire_exr, layer.name, engine, depth)
+        if keep_exr is not None:
+            _keep_layers(tmp, Path(keep_exr).absolute())
+        return result
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _check_compositable(scene, depth: bool) -> None:
+    """What the two renders cannot line up (CompositeError, one line)."""
     if scene.camera is None:
         raise CompositeError(f"scene '{scene.name}' has no camera")
     if scene.render.use_multiview:
         raise CompositeError("stereo / multi-view renders are not supported (switch Stereoscopy off)")
     if depth and scene.render.pixel_aspect_x != scene.render.pixel_aspect_y:
         raise CompositeError("Blender cannot write Depth passes with non-square pixels (pixel aspect)")
-    engine = resolve_engine(scene, engine)
-    layer = _view_layer(scene, view_layer)
+
+
+def _render_both(scene, engine: str, layer, tmp: Path, *, samples, depth: bool) -> tuple[dict, dict]:
+    """The beauty and the wire rendered into ``tmp`` as float EXR layers,
+    read back; every setting changed for them is restored afterwards."""
     settings = scene.solidwire
     render = scene.render
     restores = [
@@ -289,44 +308,45 @@ def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = 
     if samples is not None:
         restores += [(scene.cycles, ("samples",))] if hasattr(scene, "cycles") else []
         restores += [(scene.eevee, ("taa_render_samples",))]
-    tmp = Path(tempfile.mkdtemp(prefix="solidwire-over-"))
-    try:
-        with preserved(*restores):
-            _exr_output(scene, multilayer=depth)
-            render.use_motion_blur = False
-            render.use_border = False
-            render.use_sequencer = False
-            if depth:
-                layer.use_pass_z = True
-            if samples is not None:
-                if hasattr(scene, "cycles"):
-                    scene.cycles.samples = samples
-                scene.eevee.taa_render_samples = samples
-
-            beauty_exr = _render_to(scene, engine, tmp / "beauty.exr", layer.name)
-
-            render.film_transparent = True
-            render.use_compositing = False
-            settings.use_fill = False
-            wire_exr = _render_to(scene, ENGINE_ID, tmp / "wire.exr", layer.name)
-
-        beauty = _combined(beauty_exr, layer.name, engine)
-        wire = _combined(wire_exr, layer.name, ENGINE_ID)
-        if beauty.shape != wire.shape:
-            raise CompositeError(f"the beauty ({beauty.shape[1]}x{beauty.shape[0]}) and the wire "
-                                 f"({wire.shape[1]}x{wire.shape[0]}) differ in size")
-        result = Layers(beauty, wire, alpha_over(wire, beauty), engine)
+    with preserved(*restores):
+        _exr_output(scene, multilayer=depth)
+        render.use_motion_blur = False
+        render.use_border = False
+        render.use_sequencer = False
         if depth:
-            result.beauty_depth = _depth(beauty_exr, layer.name)
-            result.wire_depth = _depth(wire_exr, layer.name)
-        if keep_exr is not None:
-            keep_exr = Path(keep_exr).absolute()
-            keep_exr.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(tmp / "beauty.exr", keep_exr.with_name(keep_exr.name + ".beauty.exr"))
-            shutil.copyfile(tmp / "wire.exr", keep_exr.with_name(keep_exr.name + ".wire.exr"))
-        return result
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+            layer.use_pass_z = True
+        if samples is not None:
+            if hasattr(scene, "cycles"):
+                scene.cycles.samples = samples
+            scene.eevee.taa_render_samples = samples
+
+        beauty_exr = _render_to(scene, engine, tmp / "beauty.exr", layer.name)
+
+        render.film_transparent = True
+        render.use_compositing = False
+        settings.use_fill = False
+        wire_exr = _render_to(scene, ENGINE_ID, tmp / "wire.exr", layer.name)
+    return beauty_exr, wire_exr
+
+
+def _composite(beauty_exr: dict, wire_exr: dict, layer_name: str, engine: str, depth: bool) -> Layers:
+    beauty = _combined(beauty_exr, layer_name, engine)
+    wire = _combined(wire_exr, layer_name, ENGINE_ID)
+    if beauty.shape != wire.shape:
+        raise CompositeError(f"the beauty ({beauty.shape[1]}x{beauty.shape[0]}) and the wire "
+                             f"({wire.shape[1]}x{wire.shape[0]}) differ in size")
+    result = Layers(beauty, wire, alpha_over(wire, beauty), engine)
+    if depth:
+        result.beauty_depth = _depth(beauty_exr, layer_name)
+        result.wire_depth = _depth(wire_exr, layer_name)
+    return result
+
+
+def _keep_layers(tmp: Path, stem: Path) -> None:
+    """Copy the two float layers next to the output as STEM.beauty.exr / STEM.wire.exr."""
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(tmp / "beauty.exr", stem.with_name(stem.name + ".beauty.exr"))
+    shutil.copyfile(tmp / "wire.exr", stem.with_name(stem.name + ".wire.exr"))
 
 
 def _combined(channels: dict, layer: str, engine: str) -> np.ndarray:
