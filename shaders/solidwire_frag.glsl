@@ -6,6 +6,7 @@
  *   USE_FADE           depth fade
  *   DIAGONALS          0 hidden, 1 solid, 2 patterned (dotted/dashed)
  *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
+ *   USE_CLIP_PLANES    viewport clipping region: discard outside its planes
  */
 
 /* Squared distance from window point p to the segment stored as (line,
@@ -31,6 +32,15 @@ void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float bes
 
 void main()
 {
+#ifdef USE_CLIP_PLANES
+  /* Outside the viewport's clipping region: nothing of this face exists
+   * here (docs/image_model.md §5.6). */
+  if (min(min(min(clip_distance_a.x, clip_distance_a.y), min(clip_distance_a.z, clip_distance_a.w)),
+          min(clip_distance_b.x, clip_distance_b.y)) < 0.0)
+  {
+    discard;
+  }
+#endif
   /* Window position relative to the viewport centre (edge_geometry.glsl). */
   vec2 p = gl_FragCoord.xy - viewport_centre();
   /* Squared distances to the five candidate edges. */

@@ -366,6 +366,9 @@ def test_draw_handler_never_raises(monkeypatch, capsys):
             self.region = object()
             self.region_data = object()
             self.view_layer = bpy.context.view_layer
+            self.screen = None
+            self.area = None
+            self.preferences = bpy.context.preferences
 
         def evaluated_depsgraph_get(self):
             return bpy.context.evaluated_depsgraph_get()
