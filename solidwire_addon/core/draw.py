@@ -163,6 +163,12 @@ def clip_space_planes(planes, view: View) -> list:
     return rows.astype(np.float32).ravel().tolist()
 
 
+def _set_clip_planes(shader, rows: list) -> None:
+    # An array uniform: uniform_float takes at most 16 floats.
+    buffer = gpu.types.Buffer("FLOAT", len(rows), rows)
+    shader.uniform_vector_float(shader.uniform_from_name("clip_planes"), buffer, 4, shaders.CLIP_PLANES)
+
+
 def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats, clip_rows=None) -> None:
     """Draw (mesh, world, object_to_view, object_to_clip) groups with one
     shader variant: per object, or instanced for meshes with many instances."""
@@ -171,7 +177,7 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
     shader.bind()
     shader.uniform_block("params", ubo)
     if clip_rows is not None:
-        shader.uniform_float("clip_planes", clip_rows)
+        _set_clip_planes(shader, clip_rows)
     instanced = []  # (mesh, object_to_view, object_to_clip, mirrored) drawn with draw_instanced
     for mesh, world, object_to_view_all, object_to_clip_all in groups:
         mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
@@ -208,7 +214,7 @@ def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, clip_rows=
     shader.bind()
     shader.uniform_block("params", ubo)
     if clip_rows is not None:
-        shader.uniform_float("clip_planes", clip_rows)
+        _set_clip_planes(shader, clip_rows)
     shader.uniform_sampler("instance_table", table)
     base = 0
     for mesh, _o2v, object_to_clip, mirrored in groups:
