@@ -330,3 +330,24 @@ def test_hidden_and_excluded_collections_are_not_drawn():
     for obj in (back, extra_hidden, extra_excluded):
         bpy.data.objects.remove(obj)
     assert_matches_reference(scene, alpha, ViewportState())
+
+
+def test_handler_reads_this_viewports_own_switch():
+    """The handler asks the 3D View being drawn, not the scene: a viewport
+    switched on draws while the scene default is off, and the other 3D View
+    of the same screen does not."""
+    scene = scenes.empty_scene(show_overlay=False)
+    screen = bpy.data.screens["Animation"]
+    first, second = [area for area in screen.areas if area.type == "VIEW_3D"][:2]
+    overlay.set_viewport_shows(screen, first, True)
+    region_3d = SimpleNamespace(use_clip_planes=False)
+
+    def state(area):
+        context = SimpleNamespace(
+            scene=scene, space_data=None, region=object(), region_data=region_3d,
+            screen=screen, area=area, preferences=bpy.context.preferences,
+        )
+        return overlay_state.plan_overlay(overlay.viewport_state(context))
+
+    assert state(first) is not None
+    assert state(second) is None
