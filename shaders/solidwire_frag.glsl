@@ -6,6 +6,7 @@
  *   USE_FADE           depth fade
  *   DIAGONALS          0 hidden, 1 solid, 2 patterned (dotted/dashed)
  *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
+ *   USE_CLIP_PLANES    viewport clipping region: discard outside its planes
  */
 
 /* Squared distance from window point p to the segment stored as (line,
@@ -38,6 +39,15 @@ void main()
    * §2). The GL mapping 0.5 * z/w + 0.5 crowds every far depth into the last
    * few float steps below 1. */
   gl_FragDepth = view_depth * params.inv_clip_end;
+#endif
+#ifdef USE_CLIP_PLANES
+  /* Outside the viewport's clipping region: nothing of this face exists
+   * here (docs/image_model.md §5.6). */
+  if (min(min(min(clip_distance_a.x, clip_distance_a.y), min(clip_distance_a.z, clip_distance_a.w)),
+          min(clip_distance_b.x, clip_distance_b.y)) < 0.0)
+  {
+    discard;
+  }
 #endif
   /* Window position relative to the viewport centre (edge_geometry.glsl). */
   vec2 p = gl_FragCoord.xy - viewport_centre();

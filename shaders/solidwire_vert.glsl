@@ -82,6 +82,17 @@ void main()
   vec3 local = fetch_texel(vertex_positions,
                            int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
+#ifdef USE_CLIP_PLANES
+  /* Viewport clipping region: signed distances to the clip-space planes
+   * (draw.py, clip_space_planes), linear in clip space so the interpolated
+   * value is exact; the fragment stage discards where one is negative.
+   * Taken before the depth bias, which moves only z. */
+  clip_distance_a = vec4(dot(clip_planes[0], position),
+                         dot(clip_planes[1], position),
+                         dot(clip_planes[2], position),
+                         dot(clip_planes[3], position));
+  clip_distance_b = vec2(dot(clip_planes[4], position), dot(clip_planes[5], position));
+#endif
 #ifdef DEPTH_BIAS
   /* Viewport overlay only: Blender's own Solid shading has already written
    * (nearly) the same depth for the same surface, but from its own float32

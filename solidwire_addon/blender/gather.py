@@ -53,13 +53,15 @@ def fingerprint(mesh):
     read with the same bulk reads extraction needs, which then reuses them."""
     positions = extract.read_positions(mesh)
     corner_vert = extract.read_corner_verts(mesh)
+    # Topology first, the positions' checksum last (MeshCache.get_validated
+    # re-uploads positions alone when only the last element differs).
     content = (
         len(positions),
         len(mesh.edges),
         len(corner_vert),
         len(mesh.polygons),
-        zlib.crc32(memoryview(positions).cast("B")),
         zlib.crc32(memoryview(corner_vert).cast("B")),
+        zlib.crc32(memoryview(positions).cast("B")),
     )
     return content, (positions, corner_vert)
 
@@ -248,8 +250,14 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions):
             )
         return arrays
 
+    def reposition(entry, context):
+        positions, corner_vert = context
+        return extract.reposition(entry, positions, corner_vert, extract.read_face_offsets(get_source()))
+
     try:
-        mesh, _extracted = cache.get_validated(key, fast, lambda: fingerprint(get_source()), make_arrays)
+        mesh, _extracted = cache.get_validated(
+            key, fast, lambda: fingerprint(get_source()), make_arrays, reposition
+        )
     finally:
         if in_edit_mode and source:
             obj.to_mesh_clear()

@@ -10,7 +10,7 @@ import bpy
 import numpy as np
 from bpy.props import StringProperty
 
-from . import presets
+from . import overlay, presets
 from .overlay import viewport_object_filter
 from .properties import redraw_viewports
 
@@ -32,12 +32,33 @@ def _solidwire(context):
     return context.scene.solidwire
 
 
+def current_viewport(context):
+    """(screen, area) of the 3D View the operator or panel acts on, or None."""
+    area = getattr(context, "area", None)
+    screen = getattr(context, "screen", None)
+    if area is None or screen is None or area.type != "VIEW_3D":
+        return None
+    return screen, area
+
+
+def overlay_shown(context) -> bool:
+    """Whether SolidWire is on in the current 3D View (the scene default
+    outside a 3D View)."""
+    props = _solidwire(context)
+    viewport = current_viewport(context)
+    if viewport is None:
+        return bool(props.show_overlay)
+    return overlay.viewport_shows(*viewport, props)
+
+
 class SOLIDWIRE_OT_toggle_overlay(bpy.types.Operator):
-    """Show or hide the SolidWire overlay in 3D viewports"""
+    """Show or hide the SolidWire overlay in this 3D View (outside a 3D View: the default for viewports)"""
 
     bl_idname = "solidwire.toggle_overlay"
     bl_label = "Toggle SolidWire Overlay"
-    bl_options = {"REGISTER", "UNDO"}
+    # No UNDO: the toggle is view state kept on the screen, like Blender's own
+    # overlay options; undoing a modelling step must not flip it.
+    bl_options = {"REGISTER"}
 
     @classmethod
     def poll(cls, context):
@@ -45,7 +66,12 @@ class SOLIDWIRE_OT_toggle_overlay(bpy.types.Operator):
 
     def execute(self, context):
         props = _solidwire(context)
-        props.show_overlay = not props.show_overlay
+        viewport = current_viewport(context)
+        if viewport is None:
+            props.show_overlay = not props.show_overlay
+        else:
+            overlay.set_viewport_shows(*viewport, not overlay.viewport_shows(*viewport, props))
+            viewport[1].tag_redraw()
         return {"FINISHED"}
 
 
@@ -101,7 +127,9 @@ class SOLIDWIRE_OT_fade_from_visible(bpy.types.Operator):
         else:
             self.report({"ERROR"}, "SolidWire: no 3D viewport or scene camera to measure depth from")
             return {"CANCELLED"}
-        keep = viewport_object_filter(context.view_layer, space, only_selected=props.only_selected)
+        keep = viewport_object_filter(
+            context.view_layer, space, only_selected=props.only_selected, draw_edit_mode=props.overlay_edit_mode
+        )
         extent = visible_depth_extent(context.evaluated_depsgraph_get(), view_matrix, keep)
         if extent is None:
             self.report({"WARNING"}, "SolidWire: no visible mesh in front of the view")

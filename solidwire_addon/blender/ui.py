@@ -81,7 +81,7 @@ class VIEW3D_PT_solidwire(bpy.types.Panel):
         return getattr(context.scene, "solidwire", None) is not None
 
     def draw_header(self, context):
-        self.layout.prop(context.scene.solidwire, "show_overlay", text="")
+        draw_toggle(self.layout, context, text="")
 
     def draw_header_preset(self, context):
         draw_presets_header(self.layout)
@@ -93,8 +93,9 @@ class VIEW3D_PT_solidwire(bpy.types.Panel):
 
         layout.separator()
         col = layout.column(heading="Overlay")
-        col.active = props.show_overlay
+        col.active = ops.overlay_shown(context)
         col.prop(props, "only_selected")
+        col.prop(props, "overlay_edit_mode")
         obj = context.object
         row = col.row()
         if obj is not None:
@@ -135,7 +136,20 @@ def draw_overlay_popover(self, context) -> None:
     layout = self.layout
     layout.separator()
     row = layout.row(heading="SolidWire")
-    row.prop(props, "show_overlay", text="Solid Wireframe")
+    draw_toggle(row, context, text="Solid Wireframe")
+
+
+def draw_toggle(layout, context, text: str) -> None:
+    """This viewport's SolidWire checkbox. The toggle lives on the screen
+    and an entry is created on first use, which a draw function may not do,
+    so the checkbox is the toggle operator drawn as one (no undo step)."""
+    shown = ops.overlay_shown(context)
+    layout.operator(
+        ops.SOLIDWIRE_OT_toggle_overlay.bl_idname,
+        text=text,
+        icon="CHECKBOX_HLT" if shown else "CHECKBOX_DEHLT",
+        emboss=False,
+    )
 
 
 def draw_object_visibility(self, context) -> None:

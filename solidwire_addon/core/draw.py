@@ -112,18 +112,25 @@ def draw(
     depth_write: bool = True,
     hidden_pass: bool = False,
     linear_depth: bool = False,
+    clip_planes=None,
     program=EXACT,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
 
     Every fragment of a face writes depth (nothing is discarded), so a wire is
-    only ever seen on the face that is the visible surface there."""
+    only ever seen on the face that is the visible surface there. The one
+    exception is ``clip_planes`` ((6, 4) world-space planes of a viewport's
+    clipping region): fragments outside them are discarded."""
     stats = DrawStats()
     if not items:
         return stats
     variant = shader_variant(settings, write_view_depth, depth_bias, linear_depth)
     if hidden_pass:
         variant = replace(variant, hidden_pass=True, write_view_depth=False)
+    clip_rows = None
+    if clip_planes is not None:
+        variant = replace(variant, clip_planes=True)
+        clip_rows = clip_space_planes(clip_planes, view)
     ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
     gpu.state.depth_test_set(depth_test)
     gpu.state.depth_mask_set(depth_write)
@@ -138,19 +145,42 @@ def draw(
         for with_ngons in (False, True):
             batch = [g for g in groups if (program.supports_ngons and g[0].has_ngons) == with_ngons]
             if batch:
-                _draw_groups(batch, replace(variant, ngons=with_ngons), ubo, settings, program, flip, stats)
+                _draw_groups(batch, replace(variant, ngons=with_ngons), ubo, settings, program, flip, stats, clip_rows)
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
 
 
-def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats) -> None:
+def clip_space_planes(planes, view: View) -> list:
+    """World-space planes (kept where dot(plane, (x, 1)) >= 0, Blender's
+    convention) as clip-space planes, flattened for the shader: with
+    clip = P V world, dot(plane, world) = dot(plane P V^-1, clip), the same
+    for every object, and linear in clip space, so the interpolated distance
+    is exact across a triangle."""
+    world = np.asarray(planes, dtype=np.float64).reshape(-1, 4)
+    rows = np.zeros((shaders.CLIP_PLANES, 4))
+    rows[: len(world)] = world[: shaders.CLIP_PLANES] @ np.linalg.inv(view.projection @ view.view_matrix)
+    # Scale each plane so float32 keeps its precision (the sign is what counts).
+    norms = np.abs(rows).max(axis=1, keepdims=True)
+    rows = np.where(norms > 0.0, rows / np.where(norms > 0.0, norms, 1.0), 0.0)
+    return rows.astype(np.float32).ravel().tolist()
+
+
+def _set_clip_planes(shader, rows: list) -> None:
+    # An array uniform: uniform_float takes at most 16 floats.
+    buffer = gpu.types.Buffer("FLOAT", len(rows), rows)
+    shader.uniform_vector_float(shader.uniform_from_name("clip_planes"), buffer, 4, shaders.CLIP_PLANES)
+
+
+def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats, clip_rows=None) -> None:
     """Draw (mesh, world, object_to_view, object_to_clip) groups with one
     shader variant: per object, or instanced for meshes with many instances."""
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
     shader.bind()
     shader.uniform_block("params", ubo)
+    if clip_rows is not None:
+        _set_clip_planes(shader, clip_rows)
     instanced = []  # (mesh, object_to_view, object_to_clip, mirrored) drawn with draw_instanced
     for mesh, world, object_to_view_all, object_to_clip_all in groups:
         mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
@@ -176,16 +206,18 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
-        _draw_instanced(instanced, variant, ubo, settings, stats)
+        _draw_instanced(instanced, variant, ubo, settings, stats, clip_rows)
 
 
-def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats) -> None:
+def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, clip_rows=None) -> None:
     """One draw_instanced call per (mesh, facing) group; every instance's
     matrices in one float texture for the whole frame."""
     shader = shaders.get(replace(variant, instanced=True))
     table = table_texture(np.concatenate([_instance_rows(o2v, o2c) for _mesh, o2v, o2c, _side in groups]))
     shader.bind()
     shader.uniform_block("params", ubo)
+    if clip_rows is not None:
+        _set_clip_planes(shader, clip_rows)
     shader.uniform_sampler("instance_table", table)
     base = 0
     for mesh, _o2v, object_to_clip, mirrored in groups:

@@ -128,10 +128,17 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
 OVERLAY_DEPTH_BIAS = 2.0**-18
 
 
-def draw_over_viewport(items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS):
+def draw_over_viewport(
+    items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS, scene_depth: bool = True, clip_planes=None
+):
     """Draw ``items`` over a bound framebuffer that already holds the scene's
     colour and depth (a 3D viewport after its own drawing). Returns the
     DrawStats of the surface pass.
+
+    ``scene_depth`` False (X-ray: Blender's depth is no surface there) clears
+    the bound depth first, so only our own surfaces occlude. ``clip_planes``
+    ((6, 4) world-space planes, the viewport's clipping region) discards
+    everything outside them in every pass (docs/image_model.md §5.6).
 
     A depth-only pre-pass comes first, so only the nearest of our own
     surfaces passes the colour passes (no back edges show through where the
@@ -142,10 +149,14 @@ def draw_over_viewport(items, view: View, settings, *, depth_bias: float = OVERL
     saved_depth_test = gpu.state.depth_test_get()
     saved_depth_mask = gpu.state.depth_mask_get()
     stats = None
+    clip = {} if clip_planes is None else {"clip_planes": clip_planes}
     try:
+        if not scene_depth:
+            gpu.state.depth_mask_set(True)
+            gpu.state.active_framebuffer_get().clear(depth=1.0)
         gpu.state.blend_set("NONE")
         gpu.state.color_mask_set(False, False, False, False)
-        draw_mod.draw(items, view, settings, depth_bias=depth_bias)
+        draw_mod.draw(items, view, settings, depth_bias=depth_bias, **clip)
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set("ALPHA_PREMULT")
         for step in plan(settings):
@@ -153,12 +164,12 @@ def draw_over_viewport(items, view: View, settings, *, depth_bias: float = OVERL
                 # With hidden lines the surface pass only carries the fill.
                 if settings.use_hidden_lines and not settings.use_fill:
                     continue
-                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias)
+                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **clip)
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
-                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias)
+                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias, **clip)
             elif step.kind == WIRE:
-                stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias)
+                stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **clip)
             elif step.kind == SILHOUETTES:
                 silhouettes.draw_silhouettes(items, view, step.settings, overlay_bias=depth_bias)
     finally:

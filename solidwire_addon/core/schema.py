@@ -138,7 +138,7 @@ DEFAULT_DUTY = {"DOTTED": 0.25, "DASHED": 0.5}
 SETTINGS: tuple[Setting, ...] = (
     Setting(
         "show_overlay", BOOL, False, "SolidWire Overlay",
-        "Draw the solid wireframe over meshes in 3D viewports",
+        "Default for 3D viewports without their own SolidWire toggle (each viewport has its own)",
         cli=NO_FLAG, in_snapshot=False, in_preset=False,
     ),
     # -- line ----------------------------------------------------------------
@@ -301,6 +301,11 @@ SETTINGS: tuple[Setting, ...] = (
     Setting(
         "only_selected", BOOL, False, "Only Selected",
         "Draw the viewport overlay on selected objects only",
+        cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "overlay_edit_mode", BOOL, False, "Draw in Edit Mode",
+        "Also draw the viewport overlay on objects in Edit Mode (over Blender's own edit wire)",
         cli=NO_FLAG, in_snapshot=False, in_preset=False,
     ),
 )

@@ -28,6 +28,8 @@ EDGE_COUNT = 5  # three triangle edges + two edges to a quad's 4th corner
 
 DIAGONALS_HIDDEN, DIAGONALS_SOLID, DIAGONALS_PATTERN = 0, 1, 2
 
+CLIP_PLANES = 6  # as many as Blender's clipping region (RegionView3D.clip_planes)
+
 
 @dataclass(frozen=True)
 class ShaderVariant:
@@ -55,6 +57,9 @@ class ShaderVariant:
     # each reading its matrices from a float texture by gl_InstanceID (see
     # shaders/instancing.glsl and draw.py).
     instanced: bool = False
+    # Viewport clipping region (Alt+B): fragments outside CLIP_PLANES
+    # clip-space planes are discarded (USE_CLIP_PLANES; image model §5.6).
+    clip_planes: bool = False
 
 
 # Two GL contexts draw SolidWire: a render (bpy.ops.render.render, F12) draws
@@ -157,6 +162,11 @@ def _create_info(variant: ShaderVariant):
         info.push_constant("INT", "instance_base")
         info.sampler(3, "FLOAT_2D", "instance_table")
         iface.flat("INT", "instance_slot")
+    if variant.clip_planes:
+        info.push_constant("VEC4", "clip_planes", CLIP_PLANES)
+        iface.smooth("VEC4", "clip_distance_a")
+        iface.smooth("VEC2", "clip_distance_b")
+        info.define("USE_CLIP_PLANES", "1")
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     info.sampler(2, "FLOAT_2D", "ngon_corners")
     info.vertex_in(0, "INT", "edge_flags")
