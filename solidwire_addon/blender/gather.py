@@ -26,8 +26,39 @@ import numpy as np
 from ..core import extract
 from ..core.cache import MeshCache
 from ..core.log import warn_once
-from ..core.view import DrawItem, outside_frustum_many
+from ..core.view import DrawItem, Style, outside_frustum_many
 from . import runtime
+
+# Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
+SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
+
+
+class ObjectSettings:
+    """The per-object settings (``object.solidwire``) of one frame, read once
+    per original object: whether it is shown in this target and its style
+    override. ``show`` is SHOW_IN_RENDER or SHOW_IN_VIEWPORT; for the
+    viewport the older ``solidwire_exclude`` property still opts out."""
+
+    def __init__(self, show: str):
+        self.show = show
+        self._known: dict[int, tuple] = {}
+
+    def lookup(self, obj_orig) -> tuple:
+        """(shown, Style or None) of an original object."""
+        uid = obj_orig.session_uid
+        known = self._known.get(uid)
+        if known is None:
+            props = getattr(obj_orig, "solidwire", None)
+            shown, style = True, None
+            if props is not None:
+                shown = bool(getattr(props, self.show))
+                if props.use_override:
+                    style = Style(tuple(float(c) for c in props.wire_color), float(props.thickness),
+                                  tuple(float(c) for c in props.fill_color))
+            if self.show == SHOW_IN_VIEWPORT and getattr(obj_orig, "solidwire_exclude", False):
+                shown = False
+            known = self._known[uid] = (shown, style)
+        return known
 
 
 class SeenKeys(set):
@@ -65,7 +96,7 @@ def fingerprint(mesh):
 
 
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None):
+           should_stop=None, object_settings: ObjectSettings | None = None):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -77,7 +108,12 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     extracted at all while every instance of it lies outside the view
     frustum (its evaluated bound box against the clip planes); those
     instances count as culled. ``should_stop()`` (a render's Esc) is asked
-    before each object's work; when it says True, gathering ends there."""
+    before each object's work; when it says True, gathering ends there.
+
+    ``object_settings`` applies the per-object settings: an object drawn
+    itself follows its own; an instance is drawn only if both its instancer
+    and the object it instances are shown, and takes the style override of
+    the object it instances (docs/image_model.md §5.9)."""
     mode = depsgraph.mode
     if trust_updates is None:
         trust_updates = mode == "VIEWPORT"
@@ -110,6 +146,11 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
         owner = parent if parent is not None else obj
         if object_filter is not None and not object_filter(owner.original):
             continue
+        style = None
+        if object_settings is not None:
+            shown, style = object_settings.lookup(obj.original)
+            if not shown or (parent is not None and not object_settings.lookup(parent.original)[0]):
+                continue
         data = obj.data
         pointer = data.as_pointer()
         if pointer in deferred:
@@ -156,7 +197,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                 )
             by_pointer[pointer] = mesh
         if mesh is not None:
-            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64)))
+            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), style))
     for _key, _uids, _box, culled in deferred.values():
         cache.culled += culled  # never extracted: every instance outside the view
     return items, seen, ms_extract

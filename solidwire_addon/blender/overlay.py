@@ -37,10 +37,14 @@ def viewport_object_filter(view_layer, space_view3d=None, *, only_selected: bool
 
     ``visible_get`` covers hide states (eye icon, ``hide_viewport``),
     collection visibility, and local view when ``space_view3d`` is given.
-    The per-object opt-out and "only selected" come on top."""
+    The per-object switch (``show_in_viewport``, or the older
+    ``solidwire_exclude``) and "only selected" come on top."""
 
     def keep(obj) -> bool:
         if getattr(obj, "solidwire_exclude", False):
+            return False
+        props = getattr(obj, "solidwire", None)
+        if props is not None and not props.show_in_viewport:
             return False
         try:
             visible = obj.visible_get(view_layer=view_layer, viewport=space_view3d)
@@ -63,7 +67,8 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None) -
     # Meshes are reused across redraws: the viewport depsgraph reports every
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
-    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter)
+    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
+                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT))
     start = time.perf_counter()
     stats = passes.draw_over_viewport(items, view, settings)
     ms_draw = (time.perf_counter() - start) * 1000.0

@@ -63,15 +63,31 @@ EXACT = ExactProgram()
 INSTANCING_MIN = 16
 
 
+def styled(settings, style, show_wire: bool = True):
+    """``settings`` with an object's style override applied
+    (docs/image_model.md §5.9); ``show_wire=False`` keeps the wire out of the
+    pass whatever the override's colour (the fill-only surface pass under
+    hidden lines)."""
+    if style is not None:
+        settings = replace(settings, wire_color=style.wire_color, thickness=style.thickness,
+                           fill_color=style.fill_color)
+    if not show_wire and settings.wire_color[3] != 0.0:
+        settings = replace(settings, wire_color=(*settings.wire_color[:3], 0.0))
+    return settings
+
+
 def _groups(items, view: View, cull: bool, stats: DrawStats):
-    """Items grouped by GPU mesh with their float64-composed matrices, culled
-    (vectorised over each group). Yields (mesh, world (N,4,4), object_to_view,
-    object_to_clip) with only the visible instances."""
-    by_mesh: dict[int, list] = {}
+    """Items grouped by GPU mesh and style with their float64-composed
+    matrices, culled (vectorised over each group). Yields (mesh, style,
+    world (N,4,4), object_to_view, object_to_clip) with only the visible
+    instances."""
+    by_mesh: dict = {}
     for item in items:
-        by_mesh.setdefault(id(item.mesh), []).append(item)
+        # Plain items key by mesh alone: no tuple per item on the common path.
+        key = id(item.mesh) if item.style is None else (id(item.mesh), item.style)
+        by_mesh.setdefault(key, []).append(item)
     for group in by_mesh.values():
-        mesh = group[0].mesh
+        mesh, style = group[0].mesh, group[0].style
         world = np.stack([item.matrix for item in group]) if len(group) > 1 else group[0].matrix[None]
         # float64 all the way to here: the mesh centre and any large world
         # translation cancel against the view before rounding to float32.
@@ -84,7 +100,7 @@ def _groups(items, view: View, cull: bool, stats: DrawStats):
                 keep = ~outside
                 world, object_to_view, object_to_clip = world[keep], object_to_view[keep], object_to_clip[keep]
         if len(world):
-            yield mesh, world, object_to_view, object_to_clip
+            yield mesh, style, world, object_to_view, object_to_clip
 
 
 def _instance_rows(object_to_view: np.ndarray, object_to_clip: np.ndarray) -> np.ndarray:
@@ -109,19 +125,31 @@ def draw(
     depth_test: str = "LESS_EQUAL",
     depth_write: bool = True,
     hidden_pass: bool = False,
+    show_wire: bool = True,
     program=EXACT,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
 
     Every fragment of a face writes depth (nothing is discarded), so a wire is
-    only ever seen on the face that is the visible surface there."""
+    only ever seen on the face that is the visible surface there. Items with
+    a style override draw with their own parameter block (one per distinct
+    style); the variant does not depend on the style."""
     stats = DrawStats()
     if not items:
         return stats
+    settings = styled(settings, None, show_wire)
     variant = shader_variant(settings, write_view_depth, depth_bias)
     if hidden_pass:
         variant = replace(variant, hidden_pass=True, write_view_depth=False)
-    ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
+    blocks = {None: gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))}
+
+    def ubo(style):
+        block = blocks.get(style)
+        if block is None:
+            block = blocks[style] = gpu.types.GPUUniformBuf(
+                pack_params(styled(settings, style, show_wire), view.viewport, view.projection))
+        return block
+
     gpu.state.depth_test_set(depth_test)
     gpu.state.depth_mask_set(depth_write)
     # Window-space winding flips with a mirroring view or a projection that
@@ -142,23 +170,28 @@ def draw(
 
 
 def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats) -> None:
-    """Draw (mesh, world, object_to_view, object_to_clip) groups with one
-    shader variant: per object, or instanced for meshes with many instances."""
+    """Draw (mesh, style, world, object_to_view, object_to_clip) groups with
+    one shader variant: per object, or instanced for meshes with many
+    instances. ``ubo(style)`` is the parameter block of a style."""
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
     shader.bind()
-    shader.uniform_block("params", ubo)
-    instanced = []  # (mesh, object_to_view, object_to_clip, mirrored) drawn with draw_instanced
-    for mesh, world, object_to_view_all, object_to_clip_all in groups:
+    bound = None
+    shader.uniform_block("params", ubo(bound))
+    instanced = []  # (mesh, style, object_to_view, object_to_clip, mirrored) drawn with draw_instanced
+    for mesh, style, world, object_to_view_all, object_to_clip_all in groups:
         mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
         if program.supports_instancing and len(world) >= INSTANCING_MIN:
             if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
                 for side in (False, True):
                     pick = mirrored_all == side
-                    instanced.append((mesh, object_to_view_all[pick], object_to_clip_all[pick], side))
+                    instanced.append((mesh, style, object_to_view_all[pick], object_to_clip_all[pick], side))
             else:
-                instanced.append((mesh, object_to_view_all, object_to_clip_all, bool(mirrored_all[0])))
+                instanced.append((mesh, style, object_to_view_all, object_to_clip_all, bool(mirrored_all[0])))
             continue
+        if style is not bound:
+            bound = style
+            shader.uniform_block("params", ubo(style))
         for object_to_view, object_to_clip, mirrored in zip(object_to_view_all, object_to_clip_all, mirrored_all):
             if settings.use_backface_culling:
                 gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
@@ -177,16 +210,20 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
 
 
 def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats) -> None:
-    """One draw_instanced call per (mesh, facing) group; every instance's
-    matrices in one float texture for the whole frame."""
+    """One draw_instanced call per (mesh, style, facing) group; every
+    instance's matrices in one float texture for the whole frame."""
     shader = shaders.get(replace(variant, instanced=True))
-    table = table_texture(np.concatenate([_instance_rows(o2v, o2c) for _mesh, o2v, o2c, _side in groups]))
+    table = table_texture(np.concatenate([_instance_rows(o2v, o2c) for _mesh, _style, o2v, o2c, _side in groups]))
     shader.bind()
-    shader.uniform_block("params", ubo)
+    bound = None
+    shader.uniform_block("params", ubo(bound))
     shader.uniform_sampler("instance_table", table)
     base = 0
-    for mesh, _o2v, object_to_clip, mirrored in groups:
+    for mesh, style, _o2v, object_to_clip, mirrored in groups:
         count = len(object_to_clip)
+        if style is not bound:
+            bound = style
+            shader.uniform_block("params", ubo(style))
         if settings.use_backface_culling:
             gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
         shader.uniform_int("instance_base", base)

@@ -33,6 +33,7 @@ SURFACE, HIDDEN, WIRE, SILHOUETTES = "surface", "hidden", "wire", "silhouettes"
 class Pass:
     kind: str
     settings: object  # the DrawSettings this pass draws with
+    show_wire: bool = True  # False: the pass draws no wire, whatever an object's override says
 
 
 def plan(settings) -> tuple[Pass, ...]:
@@ -44,7 +45,7 @@ def plan(settings) -> tuple[Pass, ...]:
         # then the wire on its own.
         wire_only = replace(settings, use_fill=False)
         passes = [
-            Pass(SURFACE, replace(settings, wire_color=(*settings.wire_color[:3], 0.0))),
+            Pass(SURFACE, replace(settings, wire_color=(*settings.wire_color[:3], 0.0)), show_wire=False),
             Pass(HIDDEN, wire_only),
             Pass(WIRE, wire_only),
         ]
@@ -69,7 +70,8 @@ def render(items, view: View, settings, *, cull: bool = True):
     with framebuffer.bind():
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, width, height)
-        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull)
+        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull,
+                              show_wire=steps[0].show_wire)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     blended = [step for step in steps[1:] if step.kind in (HIDDEN, WIRE)]
@@ -145,7 +147,8 @@ def draw_over_viewport(items, view: View, settings, *, depth_bias: float = OVERL
                 # With hidden lines the surface pass only carries the fill.
                 if settings.use_hidden_lines and not settings.use_fill:
                     continue
-                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias)
+                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias,
+                                              show_wire=step.show_wire)
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
                 draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias)
