@@ -281,3 +281,16 @@ def test_fade_range_from_visible_objects():
     props = scene.solidwire
     assert props.use_fade
     assert (props.fade_start, props.fade_end) == pytest.approx((5.0, 17.0), abs=1e-4)
+
+
+def test_view_layer_passes_panel(context):
+    view_layer = context.scene.view_layers[0]
+    ctx = SimpleNamespace(scene=context.scene, engine="SOLIDWIRE", view_layer=view_layer)
+    assert ui.VIEWLAYER_PT_solidwire_passes.poll(ctx)
+    assert not ui.VIEWLAYER_PT_solidwire_passes.poll(SimpleNamespace(engine="CYCLES", view_layer=view_layer))
+    drawn = draw_with(ui.VIEWLAYER_PT_solidwire_passes.draw, ctx).greyed_props()
+    assert set(drawn) == {"use_pass_z", "use_pass_normal", "use_pass_object_index",
+                          "use_pass_wire", "use_pass_hidden_wire", "use_pass_edge_distance"}
+    # Switching a pass asks Blender for the engine's passes again (no error headless).
+    view_layer.solidwire.use_pass_wire = True
+    view_layer.solidwire.use_pass_wire = False

@@ -53,10 +53,12 @@ def region_of(scene, width: int, height: int) -> tuple[int, int, int, int]:
     return x0, y0, x1 - x0, y1 - y0
 
 
-def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None):
+def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None, extra_passes=(),
+                 extra_out=None):
     """Render ``depsgraph``'s scene from its camera: (rgba premultiplied over
     the film, view depth), or None when ``should_stop()`` said so. Shared by
-    the engine and the command line.
+    the engine and the command line. The render passes named in
+    ``extra_passes`` (core.passes.EXTRA_PASSES) go into the dict ``extra_out``.
 
     ``region`` (x0, y0, w, h) in pixels of the full frame draws that window
     only, pixel for pixel as in the full render. ``report(text, fraction)``
@@ -80,7 +82,9 @@ def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=
         return None
     report(f"drawing {len(items)} objects", 0.5)
     start = time.perf_counter()
-    rgba, depth, draw_stats = passes.render(items, view, settings)
+    rgba, depth, draw_stats, extra = passes.render_passes(items, view, settings, extra_passes=extra_passes)
+    if extra_out is not None:
+        extra_out.update(extra)
     runtime.end_frame(frame, draw_stats, ms_extract, (time.perf_counter() - start) * 1000.0, seen)
     report("writing the result", 0.9)
     return composite_film(rgba, scene), depth
@@ -96,6 +100,34 @@ def sub_view(view, region):
     window[0, 0], window[0, 3] = width / w, (width - 2.0 * x0 - w) / w
     window[1, 1], window[1, 3] = height / h, (height - 2.0 * y0 - h) / h
     return View(view.view_matrix, window @ view.projection, (0, 0, w, h))
+
+
+def extra_passes_of(view_layer) -> tuple:
+    """The render passes beyond Combined and Depth that ``view_layer`` asks
+    for: Blender's own switches and SolidWire's (``view_layer.solidwire``)."""
+    names = []
+    if view_layer.use_pass_normal:
+        names.append(passes.NORMAL_PASS)
+    if view_layer.use_pass_object_index:
+        names.append(passes.OBJECT_INDEX_PASS)
+    props = getattr(view_layer, "solidwire", None)
+    if props is not None:
+        for enabled, name in ((props.use_pass_wire, passes.WIRE_PASS),
+                              (props.use_pass_hidden_wire, passes.HIDDEN_WIRE_PASS),
+                              (props.use_pass_edge_distance, passes.EDGE_DISTANCE_PASS)):
+            if enabled:
+                names.append(name)
+    return tuple(names)
+
+
+# (channels, channel ids, type) of each extra pass as Blender registers it.
+PASS_LAYOUT = {
+    passes.NORMAL_PASS: (3, "XYZ", "VECTOR"),
+    passes.OBJECT_INDEX_PASS: (1, "X", "VALUE"),
+    passes.WIRE_PASS: (1, "X", "VALUE"),
+    passes.HIDDEN_WIRE_PASS: (1, "X", "VALUE"),
+    passes.EDGE_DISTANCE_PASS: (1, "X", "VALUE"),
+}
 
 
 def write_pass(render_pass, array: np.ndarray) -> None:
@@ -119,6 +151,8 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         width, height = render_size(scene)
         region = region_of(scene, width, height)
         layer_name = depsgraph.view_layer.name
+        wanted = extra_passes_of(depsgraph.view_layer)
+        extra = {}
 
         def report(text, fraction):
             self.update_stats("SolidWire", f"{layer_name} | {text}")
@@ -126,7 +160,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
 
         try:
             rendered = render_scene(depsgraph, (width, height), region=region, should_stop=self.test_break,
-                                    report=report)
+                                    report=report, extra_passes=wanted, extra_out=extra)
         except NoCameraError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
             return
@@ -146,6 +180,10 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
             depth_pass = layer.passes.find("Depth")
             if depth_pass != -1:
                 write_pass(layer.passes[depth_pass], depth)
+            for name, values in extra.items():
+                index = layer.passes.find(name)
+                if index != -1:
+                    write_pass(layer.passes[index], values)
             cancel = False
         except Exception as exc:  # the result must be ended whatever happens
             self.report({"ERROR"}, f"SolidWire could not write the result: {type(exc).__name__}: {exc}")
@@ -157,6 +195,9 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
         if renderlayer.use_pass_z:
             self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
+        for name in extra_passes_of(renderlayer):
+            channels, channel_ids, kind = PASS_LAYOUT[name]
+            self.register_pass(scene, renderlayer, name, channels, channel_ids, kind)
 
 
 # Blender's own panels marked for any engine carry the pseudo-engine

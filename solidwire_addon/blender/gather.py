@@ -44,7 +44,7 @@ class ObjectSettings:
         self._known: dict[int, tuple] = {}
 
     def lookup(self, obj_orig) -> tuple:
-        """(shown, Style or None) of an original object."""
+        """(shown, Style or None, pass index) of an original object."""
         uid = obj_orig.session_uid
         known = self._known.get(uid)
         if known is None:
@@ -57,7 +57,7 @@ class ObjectSettings:
                                   tuple(float(c) for c in props.fill_color))
             if self.show == SHOW_IN_VIEWPORT and getattr(obj_orig, "solidwire_exclude", False):
                 shown = False
-            known = self._known[uid] = (shown, style)
+            known = self._known[uid] = (shown, style, int(getattr(obj_orig, "pass_index", 0)))
         return known
 
 
@@ -146,9 +146,9 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
         owner = parent if parent is not None else obj
         if object_filter is not None and not object_filter(owner.original):
             continue
-        style = None
+        style, pass_index = None, 0
         if object_settings is not None:
-            shown, style = object_settings.lookup(obj.original)
+            shown, style, pass_index = object_settings.lookup(obj.original)
             if not shown or (parent is not None and not object_settings.lookup(parent.original)[0]):
                 continue
         data = obj.data
@@ -197,7 +197,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                 )
             by_pointer[pointer] = mesh
         if mesh is not None:
-            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), style))
+            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), style, pass_index))
     for _key, _uids, _box, culled in deferred.values():
         cache.culled += culled  # never extracted: every instance outside the view
     return items, seen, ms_extract

@@ -182,7 +182,42 @@ class OBJECT_PT_solidwire(bpy.types.Panel):
         draw_object_settings(self.layout, context.object)
 
 
-classes = (SOLIDWIRE_MT_presets, VIEW3D_PT_solidwire, RENDER_PT_solidwire, OBJECT_PT_solidwire)
+# Blender's own pass switches the engine writes (docs/image_model.md §6).
+BLENDER_PASSES = ("use_pass_z", "use_pass_normal", "use_pass_object_index")
+
+
+class VIEWLAYER_PT_solidwire_passes(bpy.types.Panel):
+    """View Layer Properties > Passes while SolidWire is the engine: the
+    passes it writes, Blender's and its own (``view_layer.solidwire``)."""
+
+    bl_idname = "VIEWLAYER_PT_solidwire_passes"
+    bl_label = "Passes"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "view_layer"
+    COMPAT_ENGINES = {ENGINE_ID}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES and getattr(context, "view_layer", None) is not None
+
+    def draw(self, context):
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        view_layer = context.view_layer
+        col = layout.column(heading="Data", align=True)
+        for name in BLENDER_PASSES:
+            col.prop(view_layer, name)
+        props = getattr(view_layer, "solidwire", None)
+        if props is not None:
+            col = layout.column(heading="SolidWire", align=True)
+            for setting in schema.settings_in(schema.VIEW_LAYER):
+                col.prop(props, setting.name)
+
+
+classes = (SOLIDWIRE_MT_presets, VIEW3D_PT_solidwire, RENDER_PT_solidwire, OBJECT_PT_solidwire,
+           VIEWLAYER_PT_solidwire_passes)
 
 # (Blender panel, our draw function): appended at register, removed at unregister.
 _APPENDS = (

@@ -76,11 +76,11 @@ def styled(settings, style, show_wire: bool = True):
     return settings
 
 
-def _groups(items, view: View, cull: bool, stats: DrawStats):
+def _groups(items, view: View, cull: bool, stats: DrawStats, pass_indices: bool = False):
     """Items grouped by GPU mesh and style with their float64-composed
     matrices, culled (vectorised over each group). Yields (mesh, style,
-    world (N,4,4), object_to_view, object_to_clip) with only the visible
-    instances."""
+    world (N,4,4), object_to_view, object_to_clip, pass indices (N,) or
+    None) with only the visible instances."""
     by_mesh: dict = {}
     for item in items:
         # Plain items key by mesh alone: no tuple per item on the common path.
@@ -93,14 +93,16 @@ def _groups(items, view: View, cull: bool, stats: DrawStats):
         # translation cancel against the view before rounding to float32.
         object_to_view = view.view_matrix @ world @ translation(mesh.centre)
         object_to_clip = view.projection @ object_to_view
+        indices = np.array([item.pass_index for item in group], dtype=np.float64) if pass_indices else None
         if cull:
             outside = outside_frustum_many(object_to_clip, mesh.bounds_min, mesh.bounds_max)
             if outside.any():
                 stats.objects_culled += int(outside.sum())
                 keep = ~outside
                 world, object_to_view, object_to_clip = world[keep], object_to_view[keep], object_to_clip[keep]
+                indices = None if indices is None else indices[keep]
         if len(world):
-            yield mesh, style, world, object_to_view, object_to_clip
+            yield mesh, style, world, object_to_view, object_to_clip, indices
 
 
 def _instance_rows(object_to_view: np.ndarray, object_to_clip: np.ndarray) -> np.ndarray:
@@ -126,6 +128,7 @@ def draw(
     depth_write: bool = True,
     hidden_pass: bool = False,
     show_wire: bool = True,
+    write_aovs: bool = False,
     program=EXACT,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
@@ -141,6 +144,8 @@ def draw(
     variant = shader_variant(settings, write_view_depth, depth_bias)
     if hidden_pass:
         variant = replace(variant, hidden_pass=True, write_view_depth=False)
+    if write_aovs:
+        variant = replace(variant, write_aovs=True)
     blocks = {None: gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))}
 
     def ubo(style):
@@ -155,7 +160,7 @@ def draw(
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
-    groups = list(_groups(items, view, cull, stats))
+    groups = list(_groups(items, view, cull, stats, pass_indices=write_aovs))
     try:
         # Meshes with n-gons need the fragment stage's outline walk; the rest
         # use a variant without it (llvmpipe pays for a loop even when it runs
@@ -179,9 +184,12 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
     bound = None
     shader.uniform_block("params", ubo(bound))
     instanced = []  # (mesh, style, object_to_view, object_to_clip, mirrored) drawn with draw_instanced
-    for mesh, style, world, object_to_view_all, object_to_clip_all in groups:
+    object_block = None  # the render passes' per-object block (write_aovs only)
+    for mesh, style, world, object_to_view_all, object_to_clip_all, indices in groups:
         mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
-        if program.supports_instancing and len(world) >= INSTANCING_MIN:
+        # (The instanced variant has no per-object pass values: with passes
+        # every object is drawn on its own.)
+        if program.supports_instancing and len(world) >= INSTANCING_MIN and not variant.write_aovs:
             if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
                 for side in (False, True):
                     pick = mirrored_all == side
@@ -192,9 +200,12 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
         if style is not bound:
             bound = style
             shader.uniform_block("params", ubo(style))
-        for object_to_view, object_to_clip, mirrored in zip(object_to_view_all, object_to_clip_all, mirrored_all):
+        for k, (object_to_view, object_to_clip, mirrored) in enumerate(
+                zip(object_to_view_all, object_to_clip_all, mirrored_all)):
             if settings.use_backface_culling:
                 gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
+            if variant.write_aovs:
+                object_block = _set_object_block(shader, object_block, world[k], bool(mirrored), float(indices[k]))
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             if uses_view_depth:
                 shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
@@ -207,6 +218,29 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
         _draw_instanced(instanced, variant, ubo, settings, stats)
+
+
+def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_index: float):
+    """Bind the render passes' per-object values (shaders.OBJECT_BLOCK_GLSL):
+    the normal matrix (inverse transpose of the object's 3x3), negated for a
+    mirrored object so that gl_FrontFacing says which side the camera sees,
+    and the object's pass index. One block, updated per object."""
+    try:
+        normal_matrix = np.linalg.inv(world[:3, :3]).T
+    except np.linalg.LinAlgError:
+        normal_matrix = np.zeros((3, 3))
+    if mirrored:
+        normal_matrix = -normal_matrix
+    values = np.zeros((3, 4), dtype=np.float32)
+    values[:, :3] = normal_matrix.T  # columns
+    values[0, 3] = pass_index
+    data = values.tobytes()
+    if block is None:
+        block = gpu.types.GPUUniformBuf(data)
+        shader.uniform_block("object_params", block)
+    else:
+        block.update(data)
+    return block
 
 
 def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats) -> None:

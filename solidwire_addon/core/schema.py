@@ -349,7 +349,27 @@ OBJECT_SETTINGS: tuple[Setting, ...] = (
 OVERRIDE_FIELDS = ("wire_color", "thickness", "fill_color")
 
 # -- per view layer (view_layer.solidwire; docs/image_model.md §6) --------------
-VIEW_LAYER_SETTINGS: tuple[Setting, ...] = ()
+# Render passes of SolidWire's own, switched on per view layer (the engine
+# registers and writes them; View Layer Properties > Passes shows them).
+VIEW_LAYER_SETTINGS: tuple[Setting, ...] = (
+    Setting(
+        "use_pass_wire", BOOL, False, "Wire",
+        "Render pass 'Wire': the line intensity of the visible wire, 0 to 1, without colour or opacity",
+        scope=VIEW_LAYER, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "use_pass_hidden_wire", BOOL, False, "Hidden Wire",
+        "Render pass 'Hidden Wire': the coverage of the dimmed, dashed hidden edges (Hidden Lines style), "
+        "whether or not Hidden Lines is on",
+        scope=VIEW_LAYER, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "use_pass_edge_distance", BOOL, False, "Edge Distance",
+        "Render pass 'Edge Distance': window-pixel distance to the nearest edge of the visible face "
+        "(1e10 where nothing is drawn), to restyle lines in the compositor",
+        scope=VIEW_LAYER, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+)
 
 SETTINGS = (*SETTINGS, *OBJECT_SETTINGS, *VIEW_LAYER_SETTINGS)
 

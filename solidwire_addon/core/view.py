@@ -49,6 +49,7 @@ class DrawItem:
     mesh: object  # core.cache.GPUMesh
     matrix: np.ndarray  # (4, 4) float64
     style: Style | None = None
+    pass_index: int = 0  # the IndexOB pass value (object.pass_index)
 
 
 @dataclass

@@ -55,6 +55,8 @@ class ReferenceResult:
     d_real: np.ndarray = None
     face_object: np.ndarray = None
     objects: list = None  # names of the objects whose settings style each face
+    object_face_offsets: list = None  # first face id of each entry of objects
+    hidden: np.ndarray = None  # (H, W) H of image model §5.4 (hidden lines on only)
 
 
 @dataclass
@@ -73,6 +75,7 @@ class _Geometry:
     face_thickness: np.ndarray = None  # (F,) override thickness per face (NaN: the scene's)
     face_object: np.ndarray = None  # (F,) index into objects
     objects: list = None
+    offsets: list = None  # first face id of each object
 
 
 # ---------------------------------------------------------------- scene input
@@ -94,7 +97,7 @@ def _camera(scene, depsgraph, width, height):
 def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
     tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
     sil_edges, sil_third = [], []
-    face_thickness, face_object, objects = [], [], []
+    face_thickness, face_object, objects, offsets = [], [], [], []
     face_offset = 0
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -114,6 +117,7 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
         face_thickness.append(np.full(npoly, override, np.float64))
         face_object.append(np.full(npoly, len(objects), np.int64))
         objects.append(source.name)
+        offsets.append(face_offset)
         co = np.empty(nv * 3, np.float32)
         mesh.vertices.foreach_get("co", co)
         co = co.reshape(-1, 3).astype(np.float64)
@@ -205,6 +209,7 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
         cat(face_thickness, (0,), np.float64),
         cat(face_object, (0,), np.int64),
         objects,
+        offsets,
     )
 
 
@@ -606,6 +611,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
     on_silhouette = (faces[1:] != face[None, :]).any(axis=0)
 
     intensity = np.zeros(len(face))
+    hidden_all = np.zeros(len(face))
     d_real_all = np.full(len(face), np.inf)
     covered = np.nonzero(face >= 0)[0]
     if len(covered):
@@ -630,6 +636,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         if hidden_lines:
             wire_alpha = float(s.wire_color[3])
             hidden = _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha)
+            hidden_all = hidden
             # The visible wire over the hidden lines ("over" with one colour),
             # expressed as an intensity relative to the wire alpha.
             a_vis = value * wire_alpha
@@ -652,6 +659,8 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         d_real_all.reshape(shape),
         np.where(face >= 0, geo.face_object[np.maximum(face, 0)] if len(geo.face_object) else -1, -1).reshape(shape),
         geo.objects,
+        geo.offsets,
+        hidden_all.reshape(shape),
     )
 
 
