@@ -7,7 +7,7 @@
  *   DIAGONALS          0 hidden, 1 solid, 2 patterned (dotted/dashed)
  *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
  *   WRITE_AOVS         third and fourth targets: (d_real, I_vis, object
- *                      index, 0) and the camera-facing world normal (render
+ *                      index, material index) and the camera-facing world normal (render
  *                      passes, docs/image_model.md §6)
  */
 
@@ -152,7 +152,7 @@ void main()
   frag_view_depth = view_depth;
 #endif
 #ifdef WRITE_AOVS
-  frag_aov = vec4(d_real, intensity, object_params.normal_matrix0.w, 0.0);
+  frag_aov = vec4(d_real, intensity, object_params.normal_matrix0.w, material_pass_index);
   frag_normal = vec4(gl_FrontFacing ? face_normal : -face_normal, 0.0);
 #endif
 }

@@ -90,6 +90,8 @@ void main()
   vec3 n = object_to_world_normal * cross(p1 - p0, p2 - p0);
   float n_length = length(n);
   face_normal = n_length > 0.0 ? n / n_length : vec3(0.0);
+  /* IndexMA: the pass_index of this triangle's material (draw.py). */
+  material_pass_index = fetch_texel(triangle_material, triangle).x;
 #endif
   vec4 position = (corner == 0) ? c0 : ((corner == 1) ? c1 : c2);
   vec3 local = fetch_texel(vertex_positions,

@@ -1,4 +1,4 @@
-"""Render passes (docs/image_model.md §6): Blender's Normal and IndexOB and
+"""Render passes (docs/image_model.md §6): Blender's Normal, IndexOB, IndexMA and
 SolidWire's Wire, Hidden Wire and Edge Distance, each against its
 definition, in a multilayer EXR with two view layers."""
 
@@ -16,13 +16,14 @@ from tests.support import reference, scenes
 from tests.test_engine_blender import _multilayer_render, _two_layer_scene
 
 P999, MAX = 2.0 / 255.0, 0.1
-ALL_PASSES = ("Normal", "IndexOB", "Wire", "Hidden Wire", "Edge Distance")
+ALL_PASSES = ("Normal", "IndexOB", "IndexMA", "Wire", "Hidden Wire", "Edge Distance")
 
 
 def _enable_all(view_layer) -> None:
     view_layer.use_pass_z = True
     view_layer.use_pass_normal = True
     view_layer.use_pass_object_index = True
+    view_layer.use_pass_material_index = True
     props = view_layer.solidwire
     props.use_pass_wire = props.use_pass_hidden_wire = props.use_pass_edge_distance = True
 
@@ -97,6 +98,19 @@ def _check_layer(scene, view_layer, channels, name: str, pass_indices: dict) -> 
         expected[ref.face_object == k] = pass_indices[object_name]
     assert (index[off] == expected[off]).all(), name
 
+    material = channel("IndexMA", "X")[..., 0]
+    expected = np.zeros(ref.face.shape)
+    for k, object_name in enumerate(ref.objects):
+        obj = bpy.data.objects[object_name]
+        passes_of_slots = [slot.material.pass_index for slot in obj.material_slots]
+        here = ref.face_object == k
+        for face in np.unique(ref.face[here]):
+            polygon = obj.data.polygons[int(face) - ref.object_face_offsets[k]]
+            if passes_of_slots:
+                expected[ref.face == face] = passes_of_slots[min(polygon.material_index, len(passes_of_slots) - 1)]
+    assert (material[off] == expected[off]).all(), name
+    assert name != "Left" or set(np.unique(material[off])) == {0.0, 2.0, 9.0}
+
     normal = channel("Normal", "XYZ")
     assert np.abs(normal - _expected_normals(scene, ref))[off].max() <= 1e-4, name
 
@@ -106,6 +120,12 @@ def test_every_pass_of_two_view_layers_in_one_multilayer_exr(tmp_path):
     left_cube, right_sphere = bpy.data.objects["LeftCube"], bpy.data.objects["RightSphere"]
     left_cube.pass_index, right_sphere.pass_index = 3, 11
     left_cube.rotation_euler = (0.4, 0.3, 0.2)
+    for pass_index in (2, 9):
+        material = bpy.data.materials.new(f"Pass{pass_index}")
+        material.pass_index = pass_index
+        left_cube.data.materials.append(material)
+    for polygon in left_cube.data.polygons:
+        polygon.material_index = 1 if polygon.normal.y < -0.5 else 0  # the face towards the camera
     for view_layer in scene.view_layers:
         _enable_all(view_layer)
     channels = _multilayer_render(scene, tmp_path / "passes.exr")

@@ -289,7 +289,7 @@ def test_view_layer_passes_panel(context):
     assert ui.VIEWLAYER_PT_solidwire_passes.poll(ctx)
     assert not ui.VIEWLAYER_PT_solidwire_passes.poll(SimpleNamespace(engine="CYCLES", view_layer=view_layer))
     drawn = draw_with(ui.VIEWLAYER_PT_solidwire_passes.draw, ctx).greyed_props()
-    assert set(drawn) == {"use_pass_z", "use_pass_normal", "use_pass_object_index",
+    assert set(drawn) == {"use_pass_z", "use_pass_normal", "use_pass_object_index", "use_pass_material_index",
                           "use_pass_wire", "use_pass_hidden_wire", "use_pass_edge_distance"}
     # Switching a pass asks Blender for the engine's passes again (no error headless).
     view_layer.solidwire.use_pass_wire = True

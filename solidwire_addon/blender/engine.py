@@ -77,7 +77,8 @@ def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=
     frame = runtime.begin_frame(reuse=True)
     # The view lets gather skip extracting meshes that are wholly off-screen.
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, view=view, should_stop=should_stop,
-                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_RENDER))
+                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_RENDER),
+                                            materials=passes.MATERIAL_INDEX_PASS in extra_passes)
     if should_stop is not None and should_stop():
         return None
     report(f"drawing {len(items)} objects", 0.5)
@@ -110,6 +111,8 @@ def extra_passes_of(view_layer) -> tuple:
         names.append(passes.NORMAL_PASS)
     if view_layer.use_pass_object_index:
         names.append(passes.OBJECT_INDEX_PASS)
+    if view_layer.use_pass_material_index:
+        names.append(passes.MATERIAL_INDEX_PASS)
     props = getattr(view_layer, "solidwire", None)
     if props is not None:
         for enabled, name in ((props.use_pass_wire, passes.WIRE_PASS),
@@ -124,6 +127,7 @@ def extra_passes_of(view_layer) -> tuple:
 PASS_LAYOUT = {
     passes.NORMAL_PASS: (3, "XYZ", "VECTOR"),
     passes.OBJECT_INDEX_PASS: (1, "X", "VALUE"),
+    passes.MATERIAL_INDEX_PASS: (1, "X", "VALUE"),
     passes.WIRE_PASS: (1, "X", "VALUE"),
     passes.HIDDEN_WIRE_PASS: (1, "X", "VALUE"),
     passes.EDGE_DISTANCE_PASS: (1, "X", "VALUE"),

@@ -96,7 +96,7 @@ def fingerprint(mesh):
 
 
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None, object_settings: ObjectSettings | None = None):
+           should_stop=None, object_settings: ObjectSettings | None = None, materials: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -113,7 +113,9 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     ``object_settings`` applies the per-object settings: an object drawn
     itself follows its own; an instance is drawn only if both its instancer
     and the object it instances are shown, and takes the style override of
-    the object it instances (docs/image_model.md §5.9)."""
+    the object it instances (docs/image_model.md §5.9). ``materials`` (the
+    IndexMA pass) gives each item its faces' material slots and the slots'
+    material pass indices."""
     mode = depsgraph.mode
     if trust_updates is None:
         trust_updates = mode == "VIEWPORT"
@@ -130,6 +132,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     instancer_meshes: dict[int, int] = {}  # geometry-nodes parent uid -> distinct meshes so far
     view_projection = None if view is None else view.projection @ view.view_matrix
     deferred: dict[int, tuple] = {}  # culled, never-extracted mesh -> (key, uids, bound box, instances culled)
+    face_slots: dict[int, np.ndarray] = {}  # evaluated mesh -> material slot per face (materials only)
 
     for instance in depsgraph.object_instances:
         obj = instance.object
@@ -197,10 +200,26 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                 )
             by_pointer[pointer] = mesh
         if mesh is not None:
-            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), style, pass_index))
+            item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), style, pass_index)
+            if materials:
+                item.materials = _materials_of(obj, data, pointer, face_slots)
+            items.append(item)
     for _key, _uids, _box, culled in deferred.values():
         cache.culled += culled  # never extracted: every instance outside the view
     return items, seen, ms_extract
+
+
+def _materials_of(obj, data, pointer, face_slots) -> tuple | None:
+    """(material slot per face, pass_index per slot) of an evaluated object."""
+    try:
+        slots = face_slots.get(pointer)
+        if slots is None:
+            slots = face_slots[pointer] = extract.read_material_indices(data)
+        passes = tuple(float(s.material.pass_index) if s.material is not None else 0.0 for s in obj.material_slots)
+    except (AttributeError, RuntimeError, ValueError) as exc:
+        warn_once(("materials", obj.name), f"SolidWire: no material indices for '{obj.name}': {exc}")
+        return None
+    return slots, passes
 
 
 def _bound_box(obj):

@@ -94,15 +94,18 @@ def _groups(items, view: View, cull: bool, stats: DrawStats, pass_indices: bool 
         object_to_view = view.view_matrix @ world @ translation(mesh.centre)
         object_to_clip = view.projection @ object_to_view
         indices = np.array([item.pass_index for item in group], dtype=np.float64) if pass_indices else None
+        materials = [item.materials for item in group] if pass_indices else None
         if cull:
             outside = outside_frustum_many(object_to_clip, mesh.bounds_min, mesh.bounds_max)
             if outside.any():
                 stats.objects_culled += int(outside.sum())
                 keep = ~outside
                 world, object_to_view, object_to_clip = world[keep], object_to_view[keep], object_to_clip[keep]
-                indices = None if indices is None else indices[keep]
+                if indices is not None:
+                    indices = indices[keep]
+                    materials = [m for m, k in zip(materials, keep) if k]
         if len(world):
-            yield mesh, style, world, object_to_view, object_to_clip, indices
+            yield mesh, style, world, object_to_view, object_to_clip, (indices, materials)
 
 
 def _instance_rows(object_to_view: np.ndarray, object_to_clip: np.ndarray) -> np.ndarray:
@@ -185,7 +188,8 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
     shader.uniform_block("params", ubo(bound))
     instanced = []  # (mesh, style, object_to_view, object_to_clip, mirrored) drawn with draw_instanced
     object_block = None  # the render passes' per-object block (write_aovs only)
-    for mesh, style, world, object_to_view_all, object_to_clip_all, indices in groups:
+    material_tables: dict = {}  # (mesh, materials) -> triangle -> material pass index texture
+    for mesh, style, world, object_to_view_all, object_to_clip_all, (indices, materials) in groups:
         mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
         # (The instanced variant has no per-object pass values: with passes
         # every object is drawn on its own.)
@@ -206,6 +210,7 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
                 gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
             if variant.write_aovs:
                 object_block = _set_object_block(shader, object_block, world[k], bool(mirrored), float(indices[k]))
+                shader.uniform_sampler("triangle_material", _material_table(mesh, materials[k], material_tables))
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             if uses_view_depth:
                 shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
@@ -218,6 +223,26 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
         _draw_instanced(instanced, variant, ubo, settings, stats)
+
+
+def _material_table(mesh, materials, tables: dict):
+    """Texture of the IndexMA value of each triangle of ``mesh`` for one
+    object's materials (face material index -> slot -> the material's
+    pass_index; an index past the last slot uses the last, as Blender does).
+    Shared by the instances with the same materials in one draw."""
+    key = (id(mesh), None if materials is None else (id(materials[0]), materials[1]))
+    table = tables.get(key)
+    if table is None:
+        values = np.zeros((mesh.triangle_count, 4), dtype=np.float32)
+        if materials is not None and len(materials[1]):
+            face_slot, slot_pass = materials
+            slots = np.asarray(slot_pass, dtype=np.float32)
+            face = np.asarray(mesh.triangle_polygons_cpu)
+            face_ok = face < len(face_slot)
+            slot = np.clip(face_slot[np.where(face_ok, face, 0)], 0, len(slots) - 1)
+            values[:, 0] = np.where(face_ok, slots[slot], 0.0)
+        table = tables[key] = table_texture(values)
+    return table
 
 
 def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_index: float):

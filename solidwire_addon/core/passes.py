@@ -31,10 +31,10 @@ SURFACE, HIDDEN, WIRE, SILHOUETTES = "surface", "hidden", "wire", "silhouettes"
 # Render passes beyond Combined and Depth (docs/image_model.md §6), by the
 # name they have in Blender's render result.
 WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS = "Wire", "Hidden Wire", "Edge Distance"
-NORMAL_PASS, OBJECT_INDEX_PASS = "Normal", "IndexOB"
-EXTRA_PASSES = (WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS)
+NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS = "Normal", "IndexOB", "IndexMA"
+EXTRA_PASSES = (WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS)
 # Written by the surface pass's extra outputs (the rest has its own pass).
-_SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS))
+_SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
 
 
 @dataclass(frozen=True)
@@ -120,6 +120,7 @@ def render_passes(items, view: View, settings, *, cull: bool = True, extra_passe
         extra[WIRE_PASS] = aov[..., 1:2]
         extra[EDGE_DISTANCE_PASS] = np.where(covered, aov[..., 0], BACKGROUND_DEPTH)[..., None]
         extra[OBJECT_INDEX_PASS] = aov[..., 2:3]
+        extra[MATERIAL_INDEX_PASS] = aov[..., 3:4]
         extra[NORMAL_PASS] = read_texture(targets.normal, 4)[..., :3]
     if any(step.kind == SILHOUETTES for step in steps):
         rgba = _composite_silhouettes(rgba, targets, items, view, settings)

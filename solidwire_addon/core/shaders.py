@@ -136,6 +136,8 @@ def _create_info(variant: ShaderVariant):
         # object when passes are written).
         info.typedef_source(schema.param_block_glsl() + OBJECT_BLOCK_GLSL)
         info.uniform_buf(1, "SolidWireObject", "object_params")
+        info.sampler(4, "FLOAT_2D", "triangle_material")
+        iface.flat("FLOAT", "material_pass_index")
         info.fragment_out(2, "VEC4", "frag_aov")
         info.fragment_out(3, "VEC4", "frag_normal")
         info.define("WRITE_AOVS", "1")

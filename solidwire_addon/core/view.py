@@ -50,6 +50,9 @@ class DrawItem:
     matrix: np.ndarray  # (4, 4) float64
     style: Style | None = None
     pass_index: int = 0  # the IndexOB pass value (object.pass_index)
+    # For the IndexMA pass only: (material slot index per face (F,) int32,
+    # the pass_index of each material slot). None: every face 0.
+    materials: tuple | None = None
 
 
 @dataclass
