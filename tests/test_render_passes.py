@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-import pytest
 from mathutils import Vector
 
 from solidwire_addon.blender import engine

@@ -77,7 +77,9 @@ def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=
     frame = runtime.begin_frame(reuse=True)
     # The view lets gather skip extracting meshes that are wholly off-screen.
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, view=view, should_stop=should_stop,
-                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_RENDER),
+                                            object_settings=gather.ObjectSettings(
+                                                gather.SHOW_IN_RENDER, bpy.data.objects,
+                                                pass_index=passes.OBJECT_INDEX_PASS in extra_passes),
                                             materials=passes.MATERIAL_INDEX_PASS in extra_passes)
     if should_stop is not None and should_stop():
         return None

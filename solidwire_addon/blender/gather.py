@@ -39,12 +39,25 @@ class ObjectSettings:
     override. ``show`` is SHOW_IN_RENDER or SHOW_IN_VIEWPORT; for the
     viewport the older ``solidwire_exclude`` property still opts out."""
 
-    def __init__(self, show: str):
+    def __init__(self, show: str, objects=(), *, pass_index: bool = False):
+        """``objects`` (``bpy.data.objects``) are scanned once: when none has
+        a setting off its default and no pass index is wanted, gather()
+        skips the per-instance look-up altogether (``active`` is False), so
+        scenes that do not use these settings pay one scan per frame."""
         self.show = show
         self._known: dict[int, tuple] = {}
+        self.active = pass_index or any(self._non_default(obj) for obj in objects)
 
-    def lookup(self, obj_orig) -> tuple:
-        """(shown, Style or None, pass index) of an original object."""
+    def _non_default(self, obj) -> bool:
+        props = getattr(obj, "solidwire", None)
+        if props is not None and (props.use_override or not getattr(props, self.show)):
+            return True
+        return self.show == SHOW_IN_VIEWPORT and bool(getattr(obj, "solidwire_exclude", False))
+
+    def lookup(self, obj) -> tuple:
+        """(shown, Style or None, pass index) of an evaluated object's
+        original, read once per original and frame."""
+        obj_orig = obj.original
         uid = obj_orig.session_uid
         known = self._known.get(uid)
         if known is None:
@@ -150,9 +163,9 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
         if object_filter is not None and not object_filter(owner.original):
             continue
         style, pass_index = None, 0
-        if object_settings is not None:
-            shown, style, pass_index = object_settings.lookup(obj.original)
-            if not shown or (parent is not None and not object_settings.lookup(parent.original)[0]):
+        if object_settings is not None and object_settings.active:
+            shown, style, pass_index = object_settings.lookup(obj)
+            if not shown or (parent is not None and not object_settings.lookup(parent)[0]):
                 continue
         data = obj.data
         pointer = data.as_pointer()

@@ -68,7 +68,7 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None) -
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
-                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT))
+                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects))
     start = time.perf_counter()
     stats = passes.draw_over_viewport(items, view, settings)
     ms_draw = (time.perf_counter() - start) * 1000.0
