@@ -7,6 +7,9 @@
  *   DIAGONALS          0 hidden, 1 solid, 2 patterned (dotted/dashed)
  *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
  *   USE_CLIP_PLANES    viewport clipping region: discard outside its planes
+ *   WRITE_AOVS         third and fourth targets: (d_real, I_vis, object
+ *                      index, material index) and the camera-facing world normal (render
+ *                      passes, docs/image_model.md §6)
  */
 
 /* Squared distance from window point p to the segment stored as (line,
@@ -165,5 +168,9 @@ void main()
 #endif
 #if defined(WRITE_VIEW_DEPTH) && !defined(HIDDEN_PASS)
   frag_view_depth = view_depth;
+#endif
+#ifdef WRITE_AOVS
+  frag_aov = vec4(d_real, intensity, object_params.normal_matrix0.w, material_pass_index);
+  frag_normal = vec4(gl_FrontFacing ? face_normal : -face_normal, 0.0);
 #endif
 }

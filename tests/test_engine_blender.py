@@ -141,7 +141,8 @@ def test_blenders_generic_panels_offer_solidwire():
     # Engine-specific panels (not marked for any engine) stay hidden, apart
     # from the film's transparency switch.
     specific = {name for name in solidwire if "BLENDER_RENDER" not in getattr(bpy.types, name).COMPAT_ENGINES}
-    assert specific <= {"CYCLES_RENDER_PT_film_transparency", "RENDER_PT_eevee_film", "RENDER_PT_solidwire"}, sorted(specific)
+    assert specific <= {"CYCLES_RENDER_PT_film_transparency", "RENDER_PT_eevee_film", "RENDER_PT_solidwire",
+                        "VIEWLAYER_PT_solidwire_passes"}, sorted(specific)
     print(f"panels in {sorted(TABS)}: SOLIDWIRE {len(solidwire)}, BLENDER_WORKBENCH {len(workbench)}")
 
 

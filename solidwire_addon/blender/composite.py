@@ -41,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core import compat
+from ..core import compat, output
 from ..core.exr import ExrError, exr_pass, read_exr
 from ..core.ids import ENGINE_ID
 
@@ -261,6 +261,18 @@ class Layers:
     wire_depth: np.ndarray | None = None
 
 
+def check_inputs(scene, engine=None, *, depth: bool = False) -> str:
+    """Everything about the scene a wire-over render needs, checked before
+    rendering; returns the beauty's engine identifier."""
+    if scene.camera is None:
+        raise CompositeError(f"scene '{scene.name}' has no camera")
+    if scene.render.use_multiview:
+        raise CompositeError("stereo / multi-view renders are not supported (switch Stereoscopy off)")
+    if depth and scene.render.pixel_aspect_x != scene.render.pixel_aspect_y:
+        raise CompositeError("Blender cannot write Depth passes with non-square pixels (pixel aspect)")
+    return resolve_engine(scene, engine)
+
+
 def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = None, depth: bool = False,
                   keep_exr: Path | None = None) -> Layers:
     """Render the beauty with ``engine`` (default: the scene's) and the wire
@@ -270,8 +282,7 @@ def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = 
     render; ``depth`` also returns both Depth passes; ``keep_exr`` (a path
     stem) keeps the two float layers as ``STEM.beauty.exr`` and
     ``STEM.wire.exr``."""
-    _check_compositable(scene, depth)
-    engine = resolve_engine(scene, engine)
+    engine = check_inputs(scene, engine, depth=depth)
     layer = _view_layer(scene, view_layer)
     tmp = Path(tempfile.mkdtemp(prefix="solidwire-over-"))
     try:
@@ -282,16 +293,6 @@ def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = 
         return result
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-
-
-def _check_compositable(scene, depth: bool) -> None:
-    """What the two renders cannot line up (CompositeError, one line)."""
-    if scene.camera is None:
-        raise CompositeError(f"scene '{scene.name}' has no camera")
-    if scene.render.use_multiview:
-        raise CompositeError("stereo / multi-view renders are not supported (switch Stereoscopy off)")
-    if depth and scene.render.pixel_aspect_x != scene.render.pixel_aspect_y:
-        raise CompositeError("Blender cannot write Depth passes with non-square pixels (pixel aspect)")
 
 
 def _render_both(scene, engine: str, layer, tmp: Path, *, samples, depth: bool) -> tuple[dict, dict]:
@@ -373,7 +374,14 @@ def render_wire_over(scene, filepath, engine=None, *, keep_layers: bool = False,
     ``filepath`` in the scene's output format (plus ``NAME.beauty.exr`` and
     ``NAME.wire.exr`` beside it with ``keep_layers``). Returns the layers."""
     path = Path(os.fspath(filepath)).absolute()
-    check_output_format(scene)  # before the (slow) renders
+    # Before the (slow) renders: bad input or a path that cannot be written
+    # costs nothing.
+    check_inputs(scene, engine)
+    check_output_format(scene)
+    try:
+        output.check_output(path)
+    except output.OutputError as exc:
+        raise CompositeError(str(exc)) from None
     keep = path.with_name(path.stem) if keep_layers else None
     layers = render_layers(scene, engine, keep_exr=keep, **kwargs)
     save_image(scene, layers.composite, path)

@@ -80,7 +80,10 @@ def object_state(obj, view_layer, space_view3d=None) -> overlay_state.ObjectStat
     """Read one object's plain state for this viewport.
 
     ``visible_get`` covers hide states (eye icon, ``hide_viewport``),
-    collection visibility, and local view when ``space_view3d`` is given."""
+    collection visibility, and local view when ``space_view3d`` is given.
+    The per-object switch (``object.solidwire.show_in_viewport``, or the
+    older ``solidwire_exclude``) makes the object excluded."""
+    props = getattr(obj, "solidwire", None)
     try:
         visible = obj.visible_get(view_layer=view_layer, viewport=space_view3d)
     except (TypeError, RuntimeError):
@@ -94,7 +97,8 @@ def object_state(obj, view_layer, space_view3d=None) -> overlay_state.ObjectStat
     return overlay_state.ObjectState(
         visible=bool(visible),
         selected=bool(selected),
-        excluded=bool(getattr(obj, "solidwire_exclude", False)),
+        excluded=bool(getattr(obj, "solidwire_exclude", False))
+        or (props is not None and not getattr(props, "show_in_viewport", True)),
         in_edit_mode=getattr(obj, "mode", "OBJECT") == "EDIT",
     )
 
@@ -161,7 +165,8 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     # Meshes are reused across redraws: the viewport depsgraph reports every
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
-    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter)
+    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
+                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects))
     start = time.perf_counter()
     stats = passes.draw_over_viewport(
         items,

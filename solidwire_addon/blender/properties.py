@@ -43,8 +43,23 @@ def _diagonal_mode_changed(self, _context) -> None:
     redraw_viewports()
 
 
+def _passes_changed(self, _context) -> None:
+    """A pass switched on or off: Blender asks the engine for its passes
+    again (the compositor's Render Layers node shows them at once)."""
+    scene = self.id_data
+    for view_layer in getattr(scene, "view_layers", ()):
+        if view_layer.solidwire == self:
+            try:
+                view_layer.update_render_passes()
+            except (AttributeError, RuntimeError):
+                pass  # the passes are asked for again at the next render anyway
+
+
 # Settings whose change does more than redraw.
-_UPDATES = {"diagonal_mode": _diagonal_mode_changed}
+_UPDATES = {
+    "diagonal_mode": _diagonal_mode_changed,
+    **{s.name: _passes_changed for s in schema.settings_in(schema.VIEW_LAYER) if s.name.startswith("use_pass_")},
+}
 
 
 def make_property(setting: schema.Setting):

@@ -54,6 +54,8 @@ class GPUMesh:
         # Kept (no copy) so the silhouette pass can derive its edge table on
         # first use without re-extracting; see silhouettes.py.
         self.triangles_cpu = arrays.triangles
+        # The IndexMA pass maps triangles to their faces' materials (draw.py).
+        self.triangle_polygons_cpu = arrays.triangle_polygons
         self.edge_flags_cpu = arrays.edge_flags
         self.silhouette_edges = None  # (texture, count), built lazily
         # What reposition() needs to tell a move of vertices from a new shape.

@@ -106,6 +106,13 @@ def _read_attribute(mesh, name: str, prop: str, count: int, dtype, width: int = 
     return out if width == 1 else out.reshape(count, width)
 
 
+def read_material_indices(mesh) -> np.ndarray:
+    """(F,) int32 material slot index of each face (0 without the attribute)."""
+    count = len(mesh.polygons)
+    values = _read_attribute(mesh, "material_index", "value", count, np.int32)
+    return np.zeros(count, dtype=np.int32) if values is None else values
+
+
 def read_positions(mesh) -> np.ndarray:
     """(V, 3) float32 vertex positions."""
     count = len(mesh.vertices)

@@ -61,7 +61,7 @@ class ObjectState:
 
     visible: bool = True  # visible_get(view_layer, viewport): hide, collections, local view
     selected: bool = False
-    excluded: bool = False  # object.solidwire_exclude
+    excluded: bool = False  # object.solidwire.show_in_viewport off (or the older solidwire_exclude)
     in_edit_mode: bool = False
 
 

@@ -23,16 +23,25 @@ import numpy as np
 
 from . import draw as draw_mod
 from . import silhouettes
-from .targets import read_texture, targets_for
+from .targets import BACKGROUND_DEPTH, read_texture, targets_for
 from .view import View
 
 SURFACE, HIDDEN, WIRE, SILHOUETTES = "surface", "hidden", "wire", "silhouettes"
+
+# Render passes beyond Combined and Depth (docs/image_model.md §6), by the
+# name they have in Blender's render result.
+WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS = "Wire", "Hidden Wire", "Edge Distance"
+NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS = "Normal", "IndexOB", "IndexMA"
+EXTRA_PASSES = (WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS)
+# Written by the surface pass's extra outputs (the rest has its own pass).
+_SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
 
 
 @dataclass(frozen=True)
 class Pass:
     kind: str
     settings: object  # the DrawSettings this pass draws with
+    show_wire: bool = True  # False: the pass draws no wire, whatever an object's override says
 
 
 def plan(settings) -> tuple[Pass, ...]:
@@ -44,7 +53,7 @@ def plan(settings) -> tuple[Pass, ...]:
         # then the wire on its own.
         wire_only = replace(settings, use_fill=False)
         passes = [
-            Pass(SURFACE, replace(settings, wire_color=(*settings.wire_color[:3], 0.0))),
+            Pass(SURFACE, replace(settings, wire_color=(*settings.wire_color[:3], 0.0)), show_wire=False),
             Pass(HIDDEN, wire_only),
             Pass(WIRE, wire_only),
         ]
@@ -61,11 +70,23 @@ def render(items, view: View, settings, *, cull: bool = True):
     ``rgba`` is (H, W, 4) float32, premultiplied, bottom row first, over a
     transparent background; ``view_depth`` is (H, W) with BACKGROUND_DEPTH
     where nothing was drawn. The caller makes sure the GPU is usable."""
+    rgba, depth, stats, _extra = render_passes(items, view, settings, cull=cull)
+    return rgba, depth, stats
+
+
+def render_passes(items, view: View, settings, *, cull: bool = True, extra_passes=()):
+    """:func:`render` plus the render passes named in ``extra_passes`` (of
+    EXTRA_PASSES): (rgba, view_depth, stats, {name: (H, W, channels)}).
+    A pass that is not asked for costs nothing: the surface pass gets its
+    extra outputs only when one of them is wanted, Hidden Wire its own pass
+    only when asked for."""
+    extra_passes = frozenset(extra_passes)
+    aovs = bool(extra_passes & _SURFACE_AOVS)
     width, height = view.width, view.height
     targets = targets_for(width, height)
     steps = plan(settings)
     stats = None
-    framebuffer = targets.framebuffer()
+    framebuffer = targets.framebuffer(aovs=aovs)
     with framebuffer.bind():
         # A clear honours the depth write mask, and GPU state lives per GL
         # context: a previous frame drawn in this context may have left depth
@@ -76,7 +97,8 @@ def render(items, view: View, settings, *, cull: bool = True):
         gpu.state.blend_set("NONE")
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, width, height)
-        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull, linear_depth=True)
+        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull,
+                              show_wire=steps[0].show_wire, write_aovs=aovs, linear_depth=True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     blended = [step for step in steps[1:] if step.kind in (HIDDEN, WIRE)]
@@ -95,10 +117,40 @@ def render(items, view: View, settings, *, cull: bool = True):
             finally:
                 gpu.state.blend_set("NONE")
                 gpu.state.depth_test_set("NONE")
+    extra = {}
+    if HIDDEN_WIRE_PASS in extra_passes:
+        extra[HIDDEN_WIRE_PASS] = _hidden_wire(targets, items, view, settings, cull)
     rgba, depth = targets.read()
+    if aovs:
+        covered = depth < BACKGROUND_DEPTH
+        aov = read_texture(targets.aov, 4)
+        extra[WIRE_PASS] = aov[..., 1:2]
+        extra[EDGE_DISTANCE_PASS] = np.where(covered, aov[..., 0], BACKGROUND_DEPTH)[..., None]
+        extra[OBJECT_INDEX_PASS] = aov[..., 2:3]
+        extra[MATERIAL_INDEX_PASS] = aov[..., 3:4]
+        extra[NORMAL_PASS] = read_texture(targets.normal, 4)[..., :3]
     if any(step.kind == SILHOUETTES for step in steps):
         rgba = _composite_silhouettes(rgba, targets, items, view, settings)
-    return rgba, depth, stats
+    return rgba, depth, stats, {name: value for name, value in extra.items() if name in extra_passes}
+
+
+def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:
+    """The Hidden Wire pass: H of image model §5.4 (coverage of the hidden
+    layers, wire alpha included), whether or not Hidden Lines is on in the
+    image. The hidden-line pass again, into a target of its own over the
+    surface depth: "over" blending of the a_k on 0 leaves 1 - prod(1 - a_k)
+    in alpha."""
+    framebuffer = targets.hidden_framebuffer()
+    with framebuffer.bind():
+        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0))  # the surface depth stays
+        gpu.state.viewport_set(0, 0, view.width, view.height)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        try:
+            draw_mod.draw_hidden_lines(items, view, replace(settings, use_fill=False), cull=cull, linear_depth=True)
+        finally:
+            gpu.state.blend_set("NONE")
+            gpu.state.depth_test_set("NONE")
+    return read_texture(targets.hidden, 4)[..., 3:4]
 
 
 def _composite_silhouettes(rgba, targets, items, view, settings):
@@ -164,7 +216,8 @@ def draw_over_viewport(
                 # With hidden lines the surface pass only carries the fill.
                 if settings.use_hidden_lines and not settings.use_fill:
                     continue
-                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **clip)
+                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias,
+                                              show_wire=step.show_wire, **clip)
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
                 draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias, **clip)

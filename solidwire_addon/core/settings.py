@@ -17,7 +17,7 @@ import numpy as np
 from . import schema
 from .log import warn_once
 
-_SNAPSHOT = tuple(s for s in schema.SETTINGS if s.in_snapshot)
+_SNAPSHOT = tuple(s for s in schema.SETTINGS if s.in_snapshot and s.scope == schema.SCENE)
 
 
 def _post_init(self) -> None:

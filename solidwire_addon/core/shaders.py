@@ -53,6 +53,11 @@ class ShaderVariant:
     # (LINEAR_DEPTH, see solidwire_frag.glsl); the viewport overlay keeps
     # Blender's depth mapping, whose buffer it shares.
     linear_depth: bool = False
+    # Render passes beyond Combined and Depth (image model §6): a third and
+    # fourth colour output with d_real, I_vis and the object index, and the
+    # world-space face normal. Only the render's surface pass of a view
+    # layer that asks for them compiles this.
+    write_aovs: bool = False
     # Many instances of one mesh in one draw_instanced call,
     # each reading its matrices from a float texture by gl_InstanceID (see
     # shaders/instancing.glsl and draw.py).
@@ -180,6 +185,18 @@ def _create_info(variant: ShaderVariant):
         compat.depth_write(info, "ANY")
     if variant.ngons:
         info.define("USE_NGONS", "1")
+    if variant.write_aovs:
+        # Per-object values in a block of their own (push constants are full);
+        # the instanced variant does not have them (draw.py draws object by
+        # object when passes are written).
+        info.typedef_source(schema.param_block_glsl() + OBJECT_BLOCK_GLSL)
+        info.uniform_buf(1, "SolidWireObject", "object_params")
+        info.sampler(4, "FLOAT_2D", "triangle_material")
+        iface.flat("FLOAT", "material_pass_index")
+        info.fragment_out(2, "VEC4", "frag_aov")
+        info.fragment_out(3, "VEC4", "frag_normal")
+        info.define("WRITE_AOVS", "1")
+        iface.flat("VEC3", "face_normal")
     if variant.depth_bias:
         info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
 
@@ -194,6 +211,16 @@ def _create_info(variant: ShaderVariant):
         info.fragment_source(common + style + read_source("solidwire_frag.glsl"))
     return info
 
+
+# Per-object values of the render passes (std140): the columns of the normal
+# matrix, the object's pass index in the first column's w.
+OBJECT_BLOCK_GLSL = """struct SolidWireObject {
+  vec4 normal_matrix0;
+  vec4 normal_matrix1;
+  vec4 normal_matrix2;
+};
+"""
+OBJECT_BLOCK_FLOATS = 12
 
 # Instanced variant of the exact path: shaders/instancing.glsl is prepended
 # to the unchanged stage sources (it turns the two push constants into reads

@@ -10,6 +10,14 @@ window-space distances to the near-clipped projection of each face's edges.
     result.on_silhouette   # (H, W) samples within 0.01 px of a face change
     result.face            # (H, W) visible face id, -1 for background
     result.depth           # (H, W) view depth of the visible point (inf: none)
+    result.d_real          # (H, W) distance to the visible face's real edges (inf: none)
+    result.face_object     # (H, W) index into result.objects of the visible
+                           # face's style object (-1: background)
+
+Per-object settings (object.solidwire, docs/image_model.md §5.9): an instance
+is drawn when its instancer and the object it instances both have
+``show_in_render``; the style override (thickness here; colours are composed
+by the tests from ``face_object``) is the instanced object's.
 
 Method:
 - Visibility: every triangle is clipped to the near plane only to bound the
@@ -45,6 +53,11 @@ class ReferenceResult:
     face: np.ndarray
     depth: np.ndarray
     rows: np.ndarray  # window rows (j, bottom = 0) that the arrays hold
+    d_real: np.ndarray = None
+    face_object: np.ndarray = None
+    objects: list = None  # names of the objects whose settings style each face
+    object_face_offsets: list = None  # first face id of each entry of objects
+    hidden: np.ndarray = None  # (H, W) H of image model §5.4 (hidden lines on only)
 
 
 @dataclass
@@ -60,6 +73,10 @@ class _Geometry:
     # Silhouette candidates (issue 7): real edges with one or two faces.
     sil_edges: np.ndarray = None  # (S, 2, 3) view-space endpoints
     sil_third: np.ndarray = None  # (S, 2, 3) third vertex of the face on each side (NaN: none)
+    face_thickness: np.ndarray = None  # (F,) override thickness per face (NaN: the scene's)
+    face_object: np.ndarray = None  # (F,) index into objects
+    objects: list = None
+    offsets: list = None  # first face id of each object
 
 
 # ---------------------------------------------------------------- scene input
@@ -81,6 +98,7 @@ def _camera(scene, depsgraph, width, height):
 def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
     tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
     sil_edges, sil_third = [], []
+    face_thickness, face_object, objects, offsets = [], [], [], []
     face_offset = 0
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -88,13 +106,19 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
             continue
         if not inst.is_instance and not inst.show_self:
             continue
-        exclude = getattr(obj.original, "solidwire_exclude", False)
-        if exclude:
+        source = obj.original
+        instancer = inst.parent.original if inst.is_instance and inst.parent is not None else source
+        if not (source.solidwire.show_in_render and instancer.solidwire.show_in_render):
             continue
         mesh = obj.data
         nv, nl, npoly = len(mesh.vertices), len(mesh.loops), len(mesh.polygons)
         if npoly == 0:
             continue
+        override = source.solidwire.thickness if source.solidwire.use_override else np.nan
+        face_thickness.append(np.full(npoly, override, np.float64))
+        face_object.append(np.full(npoly, len(objects), np.int64))
+        objects.append(source.name)
+        offsets.append(face_offset)
         co = np.empty(nv * 3, np.float32)
         mesh.vertices.foreach_get("co", co)
         co = co.reshape(-1, 3).astype(np.float64)
@@ -183,6 +207,10 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
         cat(edge_origin, (0,), bool),
         cat(sil_edges, (0, 2, 3), np.float64),
         cat(sil_third, (0, 2, 3), np.float64),
+        cat(face_thickness, (0,), np.float64),
+        cat(face_object, (0,), np.int64),
+        objects,
+        offsets,
     )
 
 
@@ -430,9 +458,14 @@ def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_a
     return best, best_along
 
 
-def _thickness_at(s, z, proj, height):
-    """Core width T at view depth z for the thickness mode (issue 7)."""
+def _thickness_at(s, z, proj, height, override=None):
+    """Core width T at view depth z for the thickness mode (image model
+    §4.2). ``override`` (same shape as z, NaN: none) is the object's own
+    Thickness, used in place of the scene's (PIXELS and DEPTH's near width)."""
     mode = getattr(s, "thickness_mode", "PIXELS")
+    near = float(s.thickness)
+    if override is not None:
+        near = np.where(np.isnan(override), near, override)
     if mode == "WORLD":
         clip_w = proj[3, 2] * (-z) + proj[3, 3]  # z for perspective, 1 for orthographic
         return float(s.world_thickness) * 0.5 * height * abs(proj[1, 1]) / clip_w
@@ -442,8 +475,8 @@ def _thickness_at(s, z, proj, height):
             t = np.clip((z - start) / (end - start), 0.0, 1.0)
         else:
             t = (z > start).astype(np.float64)
-        return float(s.thickness) + t * (float(s.thickness_far) - float(s.thickness))
-    return np.full_like(z, float(s.thickness))
+        return near + t * (float(s.thickness_far) - near)
+    return np.broadcast_to(near, np.shape(z)).astype(np.float64)
 
 
 def _eye(proj):
@@ -563,7 +596,7 @@ def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, va
         return coverage
     xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
     d, along = _min_distance_per_pixel(f, xy, geo, wa, wb, valid, geo.edge_real, want_along=True)
-    a = profile(d, _thickness_at(s, z, proj, height), float(s.softness))
+    a = profile(d, _thickness_at(s, z, proj, height, geo.face_thickness[f]), float(s.softness))
     a *= float(s.hidden_alpha) * pattern_mask(np.abs(along), float(s.hidden_period), float(s.hidden_duty))
     a *= _fade(s, z) * wire_alpha
     transmit = np.ones(len(face))
@@ -600,14 +633,17 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
     on_silhouette = (faces[1:] != face[None, :]).any(axis=0)
 
     intensity = np.zeros(len(face))
+    hidden_all = np.zeros(len(face))
+    d_real_all = np.full(len(face), np.inf)
     covered = np.nonzero(face >= 0)[0]
     if len(covered):
         pix_xy = np.stack([covered % width + 0.5, rows[covered // width] + 0.5], axis=1).astype(np.float64)
         pix_face = face[covered]
         wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
         softness = float(s.softness)
-        thickness = _thickness_at(s, depth[covered], proj, height)
+        thickness = _thickness_at(s, depth[covered], proj, height, geo.face_thickness[pix_face])
         d_real, _ = _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, geo.edge_real)
+        d_real_all[covered] = d_real
         value = profile(d_real, thickness, softness)
         mode = s.diagonal_mode
         if mode != "HIDDEN":
@@ -622,6 +658,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         if hidden_lines:
             wire_alpha = float(s.wire_color[3])
             hidden = _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha)
+            hidden_all = hidden
             # The visible wire over the hidden lines ("over" with one colour),
             # expressed as an intensity relative to the wire alpha.
             a_vis = value * wire_alpha
@@ -641,6 +678,11 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         face.reshape(shape),
         depth.reshape(shape),
         rows,
+        d_real_all.reshape(shape),
+        np.where(face >= 0, geo.face_object[np.maximum(face, 0)] if len(geo.face_object) else -1, -1).reshape(shape),
+        geo.objects,
+        geo.offsets,
+        hidden_all.reshape(shape),
     )
 
 
