@@ -13,6 +13,7 @@ Blender has one, else this repository's package, registered for the run.
 from __future__ import annotations
 
 import importlib
+import os
 import runpy
 import sys
 from pathlib import Path
@@ -74,8 +75,19 @@ def main(argv: list[str]) -> int:
             addon.unregister()
 
 
+# The bpy 4.2 module crashes at interpreter exit once any property with an
+# update callback was registered (an upstream bug, fixed in 4.5; reproduced
+# without SolidWire): the image is written and the exit code decided, so the
+# wrapper leaves without Python's finalisation there.
+_EXIT_CRASHES = not bpy.app.binary_path and bpy.app.version < (4, 5, 0)
+
+
 if __name__ == "__main__":
     code = main(sys.argv)
+    if _EXIT_CRASHES:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
     # Inside Blender a script that returns lets Blender exit 0, so a failure
     # must leave through SystemExit; with the bpy module the same is harmless.
     if code:
