@@ -25,7 +25,7 @@ RESOLUTION = (960, 540)
 # Colours are linear (scene-referred); the Standard view transform shows them
 # as written.
 WORLD_COLOR = (0.30, 0.36, 0.45)
-FILL_COLOR = (0.93, 0.91, 0.86, 1.0)
+FILL_COLOR = (0.93, 0.91, 0.86)
 WIRE_COLOR = (0.045, 0.05, 0.07, 1.0)
 
 

@@ -6,6 +6,8 @@
  *   USE_FADE           depth fade
  *   DIAGONALS          0 hidden, 1 solid, 2 patterned (dotted/dashed)
  *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
+ *   SHADING, ITEM_COLORS, MATERIAL_COLORS   fill shading and colour sources
+ *                      (fill_shading.glsl)
  */
 
 /* Squared distance from window point p to the segment stored as (line,
@@ -139,11 +141,21 @@ void main()
 #endif
 
   float wire_weight = intensity * params.wire_color.a;
+#ifdef ITEM_COLORS
+  vec3 wire_rgb = item_wire; /* colour sources (fill_shading.glsl) */
+#else
+  vec3 wire_rgb = params.wire_color.rgb;
+#endif
 #if defined(USE_FILL) && !defined(HIDDEN_PASS)
-  frag_color = vec4(mix(params.fill_color.rgb, params.wire_color.rgb, wire_weight), 1.0);
+#  ifdef ITEM_COLORS
+  vec3 fill_rgb = item_fill;
+#  else
+  vec3 fill_rgb = params.fill_color.rgb;
+#  endif
+  frag_color = vec4(mix(shaded_fill(fill_rgb), wire_rgb, wire_weight), 1.0);
 #else
   /* Premultiplied: what the render pass expects and what blending needs. */
-  frag_color = vec4(params.wire_color.rgb * wire_weight, wire_weight);
+  frag_color = vec4(wire_rgb * wire_weight, wire_weight);
 #endif
 #if defined(WRITE_VIEW_DEPTH) && !defined(HIDDEN_PASS)
   frag_view_depth = view_depth;

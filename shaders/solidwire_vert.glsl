@@ -82,6 +82,25 @@ void main()
   vec3 local = fetch_texel(vertex_positions,
                            int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
+#ifdef USE_CORNERS
+  /* This corner's normal and its face's material (one texel per triangle
+   * corner, in draw order; extract.corner_table). */
+  vec4 corner_data = fetch_texel(corner_table, gl_VertexID);
+  shading_normal = mat3(normal_to_view) * corner_data.xyz;
+#endif
+#ifdef ITEM_COLORS
+  /* The object's block of the frame's colour table (core/colors.py). */
+  int item_base = int(item_info.x);
+  vec4 item_head = fetch_texel(item_colors, item_base);
+  item_wire = item_head.rgb;
+  item_fill = fetch_texel(item_colors, item_base + 1).rgb;
+#  ifdef MATERIAL_COLORS
+  int material_count = int(item_head.w);
+  if (material_count > 0) {
+    item_fill = fetch_texel(item_colors, item_base + 2 + clamp(int(corner_data.w), 0, material_count - 1)).rgb;
+  }
+#  endif
+#endif
 #ifdef DEPTH_BIAS
   /* Viewport overlay only: Blender's own Solid shading has already written
    * (nearly) the same depth for the same surface, but from its own float32

@@ -161,7 +161,7 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
              "--fill-color", "0.1,0.2,0.3", "--diagonals", "SOLID", "--opaque",
              "--width", "120", "--height", "80", "--percentage", "50"),
             dict(thickness=3.0, softness=0.6, wire_color=(1.0, 0.2, 0.1, 1.0), use_fill=True,
-                 fill_color=(0.1, 0.2, 0.3, 1.0), diagonal_mode="SOLID"),
+                 fill_color=(0.1, 0.2, 0.3), diagonal_mode="SOLID"),
             dict(film_transparent=False, resolution_x=120, resolution_y=80, resolution_percentage=50),
             id="options",
         ),

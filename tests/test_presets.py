@@ -109,7 +109,7 @@ def test_user_preset_round_trips(user_dir):
     props = scene.solidwire
     props.thickness, props.softness = 2.75, 0.5
     props.wire_color = (0.1, 0.2, 0.3, 0.8)
-    props.use_fill, props.fill_color = True, (0.9, 0.8, 0.7, 1.0)
+    props.use_fill, props.fill_color = True, (0.9, 0.8, 0.7)
     props.diagonal_mode = "DASHED"
     props.pattern_period, props.pattern_duty = 12.0, 0.4
     props.use_fade, props.fade_start, props.fade_end = True, 3.0, 7.5

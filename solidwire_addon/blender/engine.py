@@ -74,7 +74,8 @@ def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=
     # changed on each frame.
     frame = runtime.begin_frame(reuse=True)
     # The view lets gather skip extracting meshes that are wholly off-screen.
-    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, view=view, should_stop=should_stop)
+    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, view=view, should_stop=should_stop,
+                                            **passes.gather_options(settings))
     if should_stop is not None and should_stop():
         return None
     report(f"drawing {len(items)} objects", 0.5)

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..core import extract
 from ..core.cache import MeshCache
+from ..core.colors import ItemSource
 from ..core.log import warn_once
 from ..core.view import DrawItem, outside_frustum_many
 from . import runtime
@@ -46,11 +47,14 @@ def _is_plain(obj_orig) -> bool:
     )
 
 
-def fingerprint(mesh):
-    """(fingerprint, (positions, corner_vert)) of a mesh's drawn geometry.
+def fingerprint(mesh, corners: bool = False):
+    """(fingerprint, (positions, corner_vert, corner inputs)) of a mesh's
+    drawn geometry.
 
     Counts plus CRC32 of the vertex positions and corner vertices (~4 GB/s),
-    read with the same bulk reads extraction needs, which then reuses them."""
+    read with the same bulk reads extraction needs, which then reuses them.
+    With ``corners`` (shaded fill), the corner normals and material indices
+    too: sharp edges or materials can change without moving a vertex."""
     positions = extract.read_positions(mesh)
     corner_vert = extract.read_corner_verts(mesh)
     content = (
@@ -61,11 +65,25 @@ def fingerprint(mesh):
         zlib.crc32(memoryview(positions).cast("B")),
         zlib.crc32(memoryview(corner_vert).cast("B")),
     )
-    return content, (positions, corner_vert)
+    corner_inputs = None
+    if corners:
+        corner_inputs = extract.read_corner_inputs(mesh)
+        content += tuple(zlib.crc32(memoryview(np.ascontiguousarray(a)).cast("B")) for a in corner_inputs)
+    return content, (positions, corner_vert, corner_inputs)
+
+
+def item_source(obj) -> ItemSource:
+    """What the colour sources read from an evaluated object (core/colors.py):
+    its name, its viewport colour and its material slots' viewport colours."""
+    materials = []
+    for slot in obj.material_slots:
+        material = slot.material
+        materials.append(None if material is None else tuple(float(c) for c in material.diffuse_color[:3]))
+    return ItemSource(obj.name, tuple(float(c) for c in obj.color[:3]), tuple(materials))
 
 
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None):
+           should_stop=None, corners: bool = False, colors: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -77,7 +95,10 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     extracted at all while every instance of it lies outside the view
     frustum (its evaluated bound box against the clip planes); those
     instances count as culled. ``should_stop()`` (a render's Esc) is asked
-    before each object's work; when it says True, gathering ends there."""
+    before each object's work; when it says True, gathering ends there.
+    ``corners``: meshes carry their corner table (shaded fill, material
+    colours; a separate cache entry, so FLAT draws never pay for it).
+    ``colors``: each item carries its object's :class:`ItemSource`."""
     mode = depsgraph.mode
     if trust_updates is None:
         trust_updates = mode == "VIEWPORT"
@@ -94,6 +115,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     instancer_meshes: dict[int, int] = {}  # geometry-nodes parent uid -> distinct meshes so far
     view_projection = None if view is None else view.projection @ view.view_matrix
     deferred: dict[int, tuple] = {}  # culled, never-extracted mesh -> (key, uids, bound box, instances culled)
+    sources: dict[int, ItemSource] = {}  # evaluated object -> its colour-source inputs this frame
 
     for instance in depsgraph.object_instances:
         obj = instance.object
@@ -124,7 +146,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
             seen.add(key)
             mesh = None
             try:
-                mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions)
+                mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions,
+                                    corners)
                 ms_extract += ms
             except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
                 warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
@@ -138,13 +161,16 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
             if len(data.polygons) or obj.original.mode == "EDIT":
                 try:
                     key, uids = _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes)
+                    if corners:
+                        key = (*key, "corners")
                     if view_projection is not None and key not in cache:
                         box = _bound_box(obj)
                         if box is not None and _outside(view_projection, instance, box):
                             deferred[pointer] = (key, uids, box, 1)
                             continue
                     seen.add(key)
-                    mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions)
+                    mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions,
+                                        corners)
                     ms_extract += ms
                 except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
                     warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
@@ -156,7 +182,12 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                 )
             by_pointer[pointer] = mesh
         if mesh is not None:
-            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64)))
+            source = None
+            if colors:
+                source = sources.get(obj.as_pointer())
+                if source is None:
+                    source = sources[obj.as_pointer()] = item_source(obj)
+            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), source))
     for _key, _uids, _box, culled in deferred.values():
         cache.culled += culled  # never extracted: every instance outside the view
     return items, seen, ms_extract
@@ -179,9 +210,9 @@ def _outside(view_projection, instance, box) -> bool:
     return bool(outside_frustum_many(object_to_clip[None], *box)[0])
 
 
-def _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions):
+def _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions, corners=False):
     trust = (depsgraph_id, epoch) if trust_updates else None
-    return _mesh_for(obj, data, pointer, key, uids, cache, trust, versions)
+    return _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners)
 
 
 def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
@@ -208,7 +239,7 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
     return key, uids
 
 
-def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions):
+def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
     obj_orig = obj.original
     fast = None
@@ -228,9 +259,10 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions):
         return source[0]
 
     def make_arrays(context):
-        positions, corner_vert = context
+        positions, corner_vert, corner_inputs = context
         try:
-            arrays = extract.extract_mesh(get_source(), positions=positions, corner_vert=corner_vert)
+            arrays = extract.extract_mesh(get_source(), positions=positions, corner_vert=corner_vert,
+                                          corners=corner_inputs if corners else None)
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
             return None
@@ -249,7 +281,8 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions):
         return arrays
 
     try:
-        mesh, _extracted = cache.get_validated(key, fast, lambda: fingerprint(get_source()), make_arrays)
+        mesh, _extracted = cache.get_validated(key, fast, (lambda: fingerprint(get_source(), True)) if corners else (lambda: fingerprint(get_source())),
+                                                  make_arrays)
     finally:
         if in_edit_mode and source:
             obj.to_mesh_clear()

@@ -63,7 +63,8 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None) -
     # Meshes are reused across redraws: the viewport depsgraph reports every
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
-    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter)
+    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
+                                            **passes.gather_options(settings))
     start = time.perf_counter()
     stats = passes.draw_over_viewport(items, view, settings)
     ms_draw = (time.perf_counter() - start) * 1000.0

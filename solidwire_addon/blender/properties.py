@@ -56,7 +56,7 @@ def make_property(setting: schema.Setting):
         if value is not None and abs(value) != float("inf"):
             limits[key] = value
     if setting.kind == schema.COLOR:
-        return FloatVectorProperty(default=setting.default, size=4, subtype="COLOR", **limits, **common)
+        return FloatVectorProperty(default=setting.default, size=setting.size, subtype="COLOR", **limits, **common)
     return FloatProperty(default=setting.default, subtype=setting.subtype, **limits, **common)
 
 

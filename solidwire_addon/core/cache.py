@@ -51,6 +51,9 @@ class GPUMesh:
         ngon[: len(arrays.ngon_corners), 0] = arrays.ngon_corners
         self.ngon_corners = table_texture(ngon)
         self.has_ngons = len(arrays.ngon_corners) > 0
+        # Corner normals and material indices, one texel per triangle corner
+        # (read by gl_VertexID); only for a shaded or per-material fill.
+        self.corners = None if arrays.corners is None else table_texture(arrays.corners)
         # Kept (no copy) so the silhouette pass can derive its edge table on
         # first use without re-extracting; see silhouettes.py.
         self.triangles_cpu = arrays.triangles
@@ -67,6 +70,7 @@ class GPUMesh:
             + self.triangles.width * self.triangles.height * 16
             + 3 * self.triangle_count * 4
             + self.ngon_corners.width * self.ngon_corners.height * 16
+            + (0 if self.corners is None else self.corners.width * self.corners.height * 16)
         )
 
 

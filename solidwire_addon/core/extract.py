@@ -54,6 +54,10 @@ class MeshArrays:
     # Triangles that use one vertex twice (a corrupt face such as (0, 1, 1, 2)):
     # zero area, so never rasterised; counted for the user message only.
     degenerate_triangles: int = 0
+    # Shading only (see corner_table): (3T, 4) float32, per triangle corner in
+    # the order of ``triangles``: Blender's corner normal xyz and the face's
+    # material index. None when the fill is not shaded by normals/materials.
+    corners: np.ndarray = None
 
     @property
     def triangle_count(self) -> int:
@@ -600,20 +604,70 @@ def read_mesh_fast(mesh) -> dict:
     }
 
 
-def extract_mesh(mesh, *, positions=None, corner_vert=None) -> MeshArrays:
+def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> MeshArrays:
     """Evaluated Blender mesh -> :class:`MeshArrays` (fast path).
 
     ``positions`` / ``corner_vert`` may be passed when the caller has just
-    read them (the GPU cache reads them for its change fingerprint)."""
+    read them (the GPU cache reads them for its change fingerprint).
+    ``corners``: also build the corner table (shaded fill, material colours);
+    True, or the (normals, materials) of :func:`read_corner_inputs` when the
+    caller has them already."""
     data = read_mesh_fast(mesh) if positions is None else {
         "positions": positions,
         "corner_vert": corner_vert if corner_vert is not None else read_corner_verts(mesh),
         "face_offsets": read_face_offsets(mesh),
         "blender_tris": blender_triangles(mesh),
     }
-    return build_arrays_fast(**data)
+    arrays = build_arrays_fast(**data)
+    if corners:
+        normals, materials = read_corner_inputs(mesh) if corners is True else corners
+        arrays.corners = corner_table(arrays, data["corner_vert"], data["face_offsets"], normals, materials)
+    return arrays
 
 
 def extract_mesh_naive(mesh) -> MeshArrays:
     """The reference path: Blender's ``loop_triangles`` for every face."""
     return build_arrays(**read_mesh(mesh))
+
+
+def read_corner_inputs(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """(corner normals (L, 3) float32, material index per face (P,) int32):
+    what :func:`corner_table` needs. The normals are Blender's own
+    (``Mesh.corner_normals``: smooth, flat, sharp edges and custom normals as
+    the mesh defines them), so the fill is shaded as Blender shades it."""
+    normals = _read(mesh.corner_normals, "vector", len(mesh.loops), np.float32, 3)
+    materials = _read_attribute(mesh, "material_index", "value", len(mesh.polygons), np.int32)
+    if materials is None:
+        materials = np.zeros(len(mesh.polygons), dtype=np.int32)
+    return normals, materials
+
+
+def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray,
+                 normals: np.ndarray, materials: np.ndarray) -> np.ndarray:
+    """(3T, 4) float32: for each corner of each drawn triangle (the order of
+    ``arrays.triangles``, which the vertex stage reads by gl_VertexID) the
+    corner normal of that polygon corner and the polygon's material index.
+
+    A triangle row holds vertex ids, not corners: the corner is found as the
+    one of the triangle's polygon with that vertex (unique in any polygon
+    that is not degenerate; a face that uses a vertex twice has zero-area
+    triangles that never draw)."""
+    count = arrays.triangle_count
+    table = np.zeros((3 * count, 4), dtype=np.float32)
+    if count == 0:
+        return table
+    vertex_count = np.int64(max(arrays.vertex_count, 1))
+    sizes = np.diff(face_offsets).astype(np.int64)
+    corner_face = np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
+    keys = corner_face * vertex_count + corner_vert.astype(np.int64)
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    polygons = arrays.triangle_polygons.astype(np.int64)
+    wanted = (polygons[:, None] * vertex_count + arrays.triangles[:, :3].astype(np.int64)).reshape(-1)
+    at = np.minimum(np.searchsorted(sorted_keys, wanted), len(sorted_keys) - 1)
+    corner = order[at]
+    found = sorted_keys[at] == wanted
+    table[:, :3] = np.where(found[:, None], normals[corner], 0.0)
+    material = materials[polygons] if len(materials) else np.zeros(count, np.int32)
+    table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
+    return table

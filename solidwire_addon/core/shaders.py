@@ -26,6 +26,9 @@ EDGE_COUNT = 5  # three triangle edges + two edges to a quad's 4th corner
 
 DIAGONALS_HIDDEN, DIAGONALS_SOLID, DIAGONALS_PATTERN = 0, 1, 2
 
+# Fill shading (docs/image_model.md §5.8); FLAT is §5.2's flat fill.
+SHADING_FLAT, SHADING_STUDIO, SHADING_MATCAP = 0, 1, 2
+
 
 @dataclass(frozen=True)
 class ShaderVariant:
@@ -49,6 +52,22 @@ class ShaderVariant:
     # each reading its matrices from a float texture by gl_InstanceID (see
     # shaders/instancing.glsl and draw.py).
     instanced: bool = False
+    # Shaded fill (SHADING_*): the vertex stage pulls corner normals.
+    shading: int = SHADING_FLAT
+    # Per-object wire/fill colours from the frame's colour table
+    # (core/colors.py); with material_colors, the fill per face material.
+    item_colors: bool = False
+    material_colors: bool = False
+
+    @property
+    def uses_corners(self) -> bool:
+        """The corner table (normals, material indices) is read."""
+        return self.shading != SHADING_FLAT or self.material_colors
+
+    @property
+    def per_item(self) -> bool:
+        """The per-object normal matrix and item info are read."""
+        return self.uses_corners or self.item_colors
 
 
 _cache: dict[ShaderVariant, object] = {}
@@ -117,6 +136,25 @@ def _create_info(variant: ShaderVariant):
         iface.flat("INT", "instance_slot")
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     info.sampler(2, "FLOAT_2D", "ngon_corners")
+    if variant.per_item:
+        if not variant.instanced:
+            info.push_constant("MAT4", "normal_to_view")
+            info.push_constant("VEC4", "item_info")
+        info.define("PER_ITEM", "1")
+    if variant.uses_corners:
+        info.sampler(4, "FLOAT_2D", "corner_table")
+        info.define("USE_CORNERS", "1")
+        iface.smooth("VEC3", "shading_normal")
+    info.define("SHADING", str(variant.shading))
+    if variant.shading == SHADING_MATCAP:
+        info.sampler(6, "FLOAT_2D", "matcap_image")
+    if variant.item_colors:
+        info.sampler(5, "FLOAT_2D", "item_colors")
+        info.define("ITEM_COLORS", "1")
+        iface.flat("VEC3", "item_wire")
+        iface.flat("VEC3", "item_fill")
+    if variant.material_colors:
+        info.define("MATERIAL_COLORS", "1")
     info.vertex_in(0, "INT", "edge_flags")
     info.vertex_out(iface)
     output_and_feature_defines(info, variant)
@@ -130,21 +168,22 @@ def _create_info(variant: ShaderVariant):
 
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
     style = read_source("line_style.glsl")
+    fill = read_source("fill_shading.glsl")
     if variant.instanced:
         instancing = read_source("instancing.glsl")
         info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + style + read_source("solidwire_frag.glsl"))
+        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + style + fill + read_source("solidwire_frag.glsl"))
     else:
         info.vertex_source(common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(common + style + read_source("solidwire_frag.glsl"))
+        info.fragment_source(common + style + fill + read_source("solidwire_frag.glsl"))
     return info
 
 
 # Instanced variant of the exact path: shaders/instancing.glsl is prepended
 # to the unchanged stage sources (it turns the two push constants into reads
 # from `instance_table`); each stage says where its instance's texels start.
-INSTANCE_TEXELS = 5
-_INSTANCE_SLOT_VERT = "#define SW_INSTANCE_SLOT (instance_slot = instance_base + 5 * gl_InstanceID)\n"
+INSTANCE_TEXELS = 9
+_INSTANCE_SLOT_VERT = f"#define SW_INSTANCE_SLOT (instance_slot = instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
 _INSTANCE_SLOT_FRAG = "#define SW_INSTANCE_SLOT instance_slot\n"
 
 

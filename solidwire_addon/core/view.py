@@ -36,6 +36,7 @@ class DrawItem:
 
     mesh: object  # core.cache.GPUMesh
     matrix: np.ndarray  # (4, 4) float64
+    source: object = None  # core.colors.ItemSource: inputs of the colour sources (when asked for)
 
 
 @dataclass
