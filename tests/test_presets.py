@@ -71,7 +71,7 @@ def test_field_ranges_match_the_settings():
         elif field.kind == "ENUM":
             assert set(field.choices) == {item.identifier for item in prop.enum_items}, key
         elif field.kind == "COLOR":
-            assert (prop.array_length, prop.hard_min, prop.hard_max) == (4, 0.0, 1.0), key
+            assert (prop.array_length, prop.hard_min, prop.hard_max) == (field.size, 0.0, 1.0), key
         else:
             assert prop.type == "BOOLEAN", key
 

@@ -92,13 +92,14 @@ class Setting:
         if self.kind == COLOR:
             what = "RGBA" if self.size == 4 else "RGB"
             # An RGB colour also takes RGBA (older presets, '#RRGGBBAA'): the
-            # alpha is dropped; an RGBA colour takes RGB with alpha 1.
-            if not (isinstance(value, (list, tuple)) and len(value) in (3, 4) and all(_is_number(c) for c in value)):
+            # alpha is dropped. An RGBA colour needs all four.
+            sizes = (3, 4) if self.size == 3 else (4,)
+            if not (isinstance(value, (list, tuple)) and len(value) in sizes and all(_is_number(c) for c in value)):
                 raise ValueError(f"'{self.name}' must be a list of {self.size} numbers ({what}, linear), not {value!r}")
             if not all(0.0 <= c <= 1.0 for c in value):
                 raise ValueError(f"'{self.name}' components must lie in 0..1, got {list(value)}")
             value = tuple(float(c) for c in value)
-            return value[:3] if self.size == 3 else (value if len(value) == 4 else (*value, 1.0))
+            return value[: self.size]
         if not _is_number(value):
             raise ValueError(f"'{self.name}' must be a number, not {value!r}")
         if not math.isfinite(value):
