@@ -186,6 +186,14 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
             {},
             id="world-thickness",
         ),
+        pytest.param(
+            ("--fill", "--shading", "matcap", "--matcap", "clay_brown", "--fill-source", "random",
+             "--wire-source", "OBJECT"),
+            dict(use_fill=True, fill_shading="MATCAP", matcap="clay_brown", fill_color_source="RANDOM",
+                 wire_color_source="OBJECT"),
+            {},
+            id="shading-and-colour-sources",
+        ),
     ],
 )
 def test_cli_renders_the_same_image_as_the_engine(tmp_path, cli_options, settings, render_settings):
