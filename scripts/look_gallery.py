@@ -1,6 +1,7 @@
 """Render the fill shadings (FLAT, STUDIO, MATCAP) and the colour sources
-(object, material, random) on one small scene and write a labelled sheet
-for the README (docs/looks.png).
+(object, material, random) on one small scene and write a sheet for the
+README (docs/looks.png): top row Flat, Studio, MatCap; bottom row fill from
+Object colour, from Material colour, Random per object (wire too).
 
     .venv/bin/python -m scripts.look_gallery [-o docs/looks.png]
 
@@ -23,7 +24,7 @@ import solidwire_addon  # noqa: E402
 from solidwire_addon.blender import engine  # noqa: E402
 from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
 
-CELL = preset_gallery.CELL
+CELL = (360, 270)
 LOOK = dict(use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0),
             thickness=1.2, softness=1.0, fill_color_source="SINGLE", wire_color_source="SINGLE")
 CELLS = (
@@ -80,7 +81,8 @@ def main(argv=None) -> int:
     try:
         scene = build_scene()
         cells = render_cells(scene)
-        preset_gallery.write(preset_gallery.compose(cells, columns=3), cells, args.output, columns=3)
+        preset_gallery.write(preset_gallery.compose(cells, columns=3, cell=CELL), cells, args.output, columns=3,
+                             cell=CELL)
     finally:
         solidwire_addon.unregister()
     print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")

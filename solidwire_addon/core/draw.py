@@ -219,12 +219,11 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
     extras = extras or {}
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
-    uses_normals = variant.per_item and shaders.uses_uniform(shader, "normal_to_view")
-    uses_info = variant.per_item and shaders.uses_uniform(shader, "item_info")
     shader.bind()
     shader.uniform_block("params", ubo)
     _bind_extras(shader, variant, extras)
     instanced = []  # (mesh, object_to_view, object_to_clip, info, mirrored) drawn with draw_instanced
+    single = []  # (mesh, object_to_view, object_to_clip, info, mirrored) drawn one by one
     for mesh, world, object_to_view_all, object_to_clip_all, indices in groups:
         mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
         info_all = np.zeros((len(world), 4))
@@ -239,18 +238,24 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             else:
                 instanced.append((mesh, object_to_view_all, object_to_clip_all, info_all, bool(mirrored_all[0])))
             continue
-        for object_to_view, object_to_clip, info, mirrored in zip(
-            object_to_view_all, object_to_clip_all, info_all, mirrored_all
-        ):
+        single.extend(zip([mesh] * len(world), object_to_view_all, object_to_clip_all, info_all, mirrored_all))
+    if single and variant.per_item:
+        # Normal matrices and item info of every object in one texture
+        # (item_table.glsl); each draw says its slot.
+        rows = np.zeros((len(single), shaders.ITEM_TEXELS, 4), dtype=np.float32)
+        rows[:, :3, :] = np.swapaxes(normal_to_view(np.stack([o2v for _m, o2v, _c, _i, _s in single])), 1, 2)[:, :3, :]
+        rows[:, 3, :] = np.stack([info for _m, _v, _c, info, _s in single])
+        item_table = table_texture(rows.reshape(-1, 4))  # kept alive until the draws are done
+        shader.uniform_sampler("item_table", item_table)
+    if single:
+        for slot, (mesh, object_to_view, object_to_clip, _info, mirrored) in enumerate(single):
             if settings.use_backface_culling:
                 gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             if uses_view_depth:
                 shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
-            if uses_normals:
-                shader.uniform_float("normal_to_view", normal_to_view(object_to_view).T.astype(np.float32).ravel().tolist())
-            if uses_info:
-                shader.uniform_float("item_info", info.astype(np.float32).tolist())
+            if variant.per_item:
+                shader.uniform_int("item_slot", slot)
             _bind_mesh(shader, variant, mesh)
             program.batch(mesh).draw(shader)
             stats.objects_drawn += 1

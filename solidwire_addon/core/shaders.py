@@ -138,8 +138,9 @@ def _create_info(variant: ShaderVariant):
     info.sampler(2, "FLOAT_2D", "ngon_corners")
     if variant.per_item:
         if not variant.instanced:
-            info.push_constant("MAT4", "normal_to_view")
-            info.push_constant("VEC4", "item_info")
+            # normal_to_view / item_info come from item_table (item_table.glsl).
+            info.push_constant("INT", "item_slot")
+            info.sampler(3, "FLOAT_2D", "item_table")
         info.define("PER_ITEM", "1")
     if variant.uses_corners:
         info.sampler(4, "FLOAT_2D", "corner_table")
@@ -174,8 +175,9 @@ def _create_info(variant: ShaderVariant):
         info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + read_source("solidwire_vert.glsl"))
         info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + style + fill + read_source("solidwire_frag.glsl"))
     else:
-        info.vertex_source(common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(common + style + fill + read_source("solidwire_frag.glsl"))
+        items = read_source("item_table.glsl") if variant.per_item else ""
+        info.vertex_source(items + common + read_source("solidwire_vert.glsl"))
+        info.fragment_source(items + common + style + fill + read_source("solidwire_frag.glsl"))
     return info
 
 
@@ -183,6 +185,7 @@ def _create_info(variant: ShaderVariant):
 # to the unchanged stage sources (it turns the two push constants into reads
 # from `instance_table`); each stage says where its instance's texels start.
 INSTANCE_TEXELS = 9
+ITEM_TEXELS = 4  # per object of the non-instanced path (item_table.glsl)
 _INSTANCE_SLOT_VERT = f"#define SW_INSTANCE_SLOT (instance_slot = instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
 _INSTANCE_SLOT_FRAG = "#define SW_INSTANCE_SLOT instance_slot\n"
 
