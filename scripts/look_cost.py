@@ -24,7 +24,7 @@ from solidwire_addon.blender.gpu_context import ensure_gpu
 
 SIZE = (1920, 1080)
 BASE = dict(use_fill=True, fill_shading="FLAT", fill_color_source="SINGLE", wire_color_source="SINGLE",
-            fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0))
+            fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0), edge_angle=0.0)
 OPTIONS = (
     ("Flat fill (baseline)", {}),
     ("STUDIO shading", dict(fill_shading="STUDIO")),
@@ -32,7 +32,8 @@ OPTIONS = (
     ("Fill source OBJECT", dict(fill_color_source="OBJECT")),
     ("Fill source MATERIAL", dict(fill_color_source="MATERIAL")),
     ("Fill + wire source RANDOM", dict(fill_color_source="RANDOM", wire_color_source="RANDOM")),
-    ("STUDIO + MATERIAL (everything)", dict(fill_shading="STUDIO", fill_color_source="MATERIAL")),
+    ("STUDIO + MATERIAL", dict(fill_shading="STUDIO", fill_color_source="MATERIAL")),
+    ("Edge angle 10°", dict(edge_angle=0.1745)),
 )
 
 

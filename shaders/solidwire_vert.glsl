@@ -61,6 +61,10 @@ void main()
     else {
       simple = !is_ngon;
     }
+    /* An edge that is not drawn (edge angle) moves to the diagonals: then a
+     * line distance is no longer a segment distance for every sample. */
+    int drawn_mask = is_quad ? (EDGE0_REAL | EDGE1_REAL) : (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
+    simple = simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0;
   }
   else {
     /* Some corner is behind the near plane: clip each edge (edge_setup). */

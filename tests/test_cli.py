@@ -188,9 +188,9 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
         ),
         pytest.param(
             ("--fill", "--shading", "matcap", "--matcap", "clay_brown", "--fill-source", "random",
-             "--wire-source", "OBJECT"),
+             "--wire-source", "OBJECT", "--edge-angle", "0.2"),
             dict(use_fill=True, fill_shading="MATCAP", matcap="clay_brown", fill_color_source="RANDOM",
-                 wire_color_source="OBJECT"),
+                 wire_color_source="OBJECT", edge_angle=0.2),
             {},
             id="shading-and-colour-sources",
         ),

@@ -83,7 +83,7 @@ def item_source(obj) -> ItemSource:
 
 
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None, corners: bool = False, colors: bool = False):
+           should_stop=None, corners: bool = False, colors: bool = False, edge_angle: float = 0.0):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -98,7 +98,9 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     before each object's work; when it says True, gathering ends there.
     ``corners``: meshes carry their corner table (shaded fill, material
     colours; a separate cache entry, so FLAT draws never pay for it).
-    ``colors``: each item carries its object's :class:`ItemSource`."""
+    ``colors``: each item carries its object's :class:`ItemSource`.
+    ``edge_angle`` (radians, > 0): flat edges are not drawn (extraction
+    clears their flags; a separate cache entry per angle)."""
     mode = depsgraph.mode
     if trust_updates is None:
         trust_updates = mode == "VIEWPORT"
@@ -147,7 +149,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
             mesh = None
             try:
                 mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions,
-                                    corners)
+                                    corners, edge_angle)
                 ms_extract += ms
             except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
                 warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
@@ -163,6 +165,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                     key, uids = _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes)
                     if corners:
                         key = (*key, "corners")
+                    if edge_angle > 0.0:
+                        key = (*key, "angle", float(edge_angle))
                     if view_projection is not None and key not in cache:
                         box = _bound_box(obj)
                         if box is not None and _outside(view_projection, instance, box):
@@ -170,7 +174,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                             continue
                     seen.add(key)
                     mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions,
-                                        corners)
+                                        corners, edge_angle)
                     ms_extract += ms
                 except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
                     warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
@@ -210,9 +214,10 @@ def _outside(view_projection, instance, box) -> bool:
     return bool(outside_frustum_many(object_to_clip[None], *box)[0])
 
 
-def _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions, corners=False):
+def _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions, corners=False,
+             edge_angle=0.0):
     trust = (depsgraph_id, epoch) if trust_updates else None
-    return _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners)
+    return _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners, edge_angle)
 
 
 def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
@@ -239,7 +244,7 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
     return key, uids
 
 
-def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False):
+def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False, edge_angle=0.0):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
     obj_orig = obj.original
     fast = None
@@ -262,7 +267,7 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
         positions, corner_vert, corner_inputs = context
         try:
             arrays = extract.extract_mesh(get_source(), positions=positions, corner_vert=corner_vert,
-                                          corners=corner_inputs if corners else None)
+                                          corners=corner_inputs if corners else None, edge_angle=edge_angle)
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
             return None

@@ -49,6 +49,8 @@ class GPUMesh:
         self.triangles = table_texture(arrays.triangles.astype(np.float32))
         ngon = np.zeros((max(len(arrays.ngon_corners), 1), 4), dtype=np.float32)
         ngon[: len(arrays.ngon_corners), 0] = arrays.ngon_corners
+        if arrays.ngon_hidden is not None:
+            ngon[: len(arrays.ngon_hidden), 1] = arrays.ngon_hidden  # outline edge not drawn (edge angle)
         self.ngon_corners = table_texture(ngon)
         self.has_ngons = len(arrays.ngon_corners) > 0
         # Corner normals and material indices, one texel per triangle corner

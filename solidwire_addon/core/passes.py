@@ -60,7 +60,8 @@ def gather_options(settings) -> dict:
     """What the draw items of a frame with ``settings`` must carry (keyword
     arguments of blender/gather.gather): corner tables for a shaded fill or
     material colours, colour-source inputs for per-object colours."""
-    return {"corners": draw_mod.needs_corners(settings), "colors": colors.needs_item_colors(settings)}
+    return {"corners": draw_mod.needs_corners(settings), "colors": colors.needs_item_colors(settings),
+            "edge_angle": float(settings.edge_angle)}
 
 
 def render(items, view: View, settings, *, cull: bool = True):

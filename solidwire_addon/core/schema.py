@@ -227,6 +227,13 @@ SETTINGS: tuple[Setting, ...] = (
         "interior edges (renders; hidden by nearer surfaces)",
         section="line", cli="--silhouettes",
     ),
+    # -- edges ---------------------------------------------------------------
+    Setting(
+        "edge_angle", FLOAT, 0.0, "Edge Angle",
+        "Edges between two faces that meet at less than this angle are not drawn (treated like diagonals); "
+        "boundary and non-manifold edges always are",
+        minimum=0.0, maximum=math.pi, subtype="ANGLE", section="line",
+    ),
     # -- fill ----------------------------------------------------------------
     Setting(
         "use_fill", BOOL, True, "Fill",

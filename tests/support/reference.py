@@ -116,6 +116,26 @@ def _object_colors(obj, s, npoly, material_index):
     return faces, wire
 
 
+def _flat_edges(mesh, loop_poly, real_a, real_b, angle) -> set:
+    """{(lo, hi)} vertex pairs of the edges that the edge angle hides."""
+    if not angle > 0.0:
+        return set()
+    normals = np.empty(len(mesh.polygons) * 3, np.float32)
+    mesh.polygon_normals.foreach_get("vector", normals)
+    normals = normals.reshape(-1, 3).astype(np.float64)
+    faces: dict = {}
+    for f, a, b in zip(loop_poly.tolist(), real_a.tolist(), real_b.tolist()):
+        faces.setdefault((min(a, b), max(a, b)), []).append(f)
+    hidden = set()
+    for key, fs in faces.items():
+        if len(fs) == 2 and fs[0] != fs[1]:
+            n1, n2 = normals[fs[0]], normals[fs[1]]
+            c = np.dot(n1, n2) / max(np.linalg.norm(n1) * np.linalg.norm(n2), 1e-300)
+            if np.arccos(np.clip(c, -1.0, 1.0)) < angle:
+                hidden.add(key)
+    return hidden
+
+
 def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
     tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
     sil_edges, sil_third = [], []
@@ -176,7 +196,11 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
 
         # A face with a non-finite (NaN/Inf) corner is not drawn at all.
         finite = np.isfinite(vco).all(axis=1)
-        sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2]
+        # Edge angle (image model §3.4): an edge of exactly two distinct
+        # faces whose face normals differ by less than the angle is not
+        # drawn; it then counts as a diagonal of each face.
+        not_drawn = _flat_edges(mesh, loop_poly, real_a, real_b, float(getattr(s, "edge_angle", 0.0) or 0.0))
+        sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2 and (a, b) not in not_drawn]
         if sil:
             sa = np.array([e[0] for e in sil])
             sb = np.array([e[1] for e in sil])
@@ -219,7 +243,9 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         ok = poly_ok[loop_poly]
         edges.append(np.stack([vco[ra[ok]], vco[rb[ok]]], axis=1))
         edge_faces.append(face_offset + loop_poly[ok])
-        edge_real.append(np.ones(ok.sum(), bool))
+        drawn = np.array([(min(x, y), max(x, y)) not in not_drawn for x, y in zip(ra[ok].tolist(), rb[ok].tolist())],
+                         dtype=bool).reshape(-1)
+        edge_real.append(drawn)
         edge_origin.append(ra[ok] < rb[ok])
         if len(diag):
             da, db = diag[:, 1], diag[:, 2]
