@@ -158,3 +158,29 @@ def test_fill_colour_has_no_alpha():
     assert setting.check([0.1, 0.2, 0.3, 0.5]) == (0.1, 0.2, 0.3)
     with pytest.raises(ValueError):
         setting.check([0.1, 0.2])
+
+
+def test_matcap_decoding_leaves_nothing_in_the_file():
+    from solidwire_addon.blender import matcap_files
+
+    before = (len(bpy.data.scenes), len(bpy.data.node_groups), len(bpy.data.images))
+    diffuse, specular = matcap_files.decode_pixels("metal_carpaint")
+    assert diffuse.shape == (512, 512, 4) and specular is not None and specular.max() > 0.0
+    assert (len(bpy.data.scenes), len(bpy.data.node_groups), len(bpy.data.images)) == before
+    assert matcap_files.decode_pixels("no_such_matcap") is None
+
+
+def test_pending_matcap_draws_flat_until_decoded():
+    """A loader that cannot decode yet (Blender's interface) gets asked
+    again: nothing is cached until real pixels come."""
+    from solidwire_addon.core import matcaps
+    from solidwire_addon.blender import matcap_files
+
+    answers = [matcaps.PENDING, (np.ones((4, 4, 4), np.float32), None)]
+    matcaps.set_loader(lambda _name: answers.pop(0))
+    try:
+        assert matcaps.texture("clay_studio") is None
+        assert matcaps.texture("clay_studio") is not None
+        assert answers == []
+    finally:
+        matcaps.set_loader(matcap_files.load_pixels)

@@ -7,14 +7,23 @@ pass is therefore taken through Blender's compositor: a tiny scratch scene
 renders the Image node's pass into an uncompressed float EXR that
 core/exr.py reads. Everything made for it (scene, node group, image, file)
 is removed again; nothing stays in the user's file.
+
+A render cannot be started from a render or from drawing, so in Blender's
+interface a matcap is decoded ahead of use, in the main thread from a timer:
+when Shading or MatCap changes in the panel, and when a file whose scenes use
+a matcap is loaded. Until then a draw gets ``matcaps.PENDING`` (a flat fill,
+one message). Without an interface (the bpy module, ``blender -b``) a render
+runs in the main thread and decodes on first use.
 """
 
 from __future__ import annotations
 
 import os
 import tempfile
+import threading
 
 import bpy
+from bpy.app.handlers import persistent
 import numpy as np
 
 from ..core import exr, matcaps
@@ -80,7 +89,60 @@ def _multilayer_size(image) -> tuple[int, int]:
     return x1 - x0 + 1, y1 - y0 + 1
 
 
+_decoded: dict[str, object] = {}
+
+
 def load_pixels(name: str):
+    """The loader of core/matcaps.py: decoded pixels, None (no such file) or
+    matcaps.PENDING (asked for; decoded soon in the main thread)."""
+    if name in _decoded:
+        return _decoded[name]
+    main_thread = threading.current_thread() is threading.main_thread()
+    if bpy.app.background and main_thread:
+        return _decode_once(name)
+    if main_thread:
+        request(name)
+    return matcaps.PENDING
+
+
+def request(name: str) -> None:
+    """Decode matcap ``name`` soon, in the main thread, outside any draw."""
+    if name in _decoded or name in _requested:
+        return
+    _requested.add(name)
+
+    def decode():
+        _requested.discard(name)
+        try:
+            _decode_once(name)
+        except Exception as exc:  # noqa: BLE001 - a timer must not raise
+            print(f"SolidWire: matcap '{name}' could not be read ({exc})")
+            _decoded[name] = None
+        matcaps.forget(name)
+        properties_redraw()
+        return None
+
+    bpy.app.timers.register(decode, first_interval=0.0)
+
+
+_requested: set[str] = set()
+
+
+def properties_redraw() -> None:
+    wm = getattr(bpy.context, "window_manager", None)
+    for window in getattr(wm, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                area.tag_redraw()
+
+
+def _decode_once(name: str):
+    if name not in _decoded:
+        _decoded[name] = decode_pixels(name)
+    return _decoded[name]
+
+
+def decode_pixels(name: str):
     """(diffuse, specular or None), each (H, W, 4) float32 bottom row first,
     or None when the file is missing."""
     path = matcap_path(name)
@@ -99,9 +161,25 @@ def load_pixels(name: str):
         bpy.data.images.remove(image)
 
 
+def request_for_scenes(*_args) -> None:
+    """Decode the matcaps that the open file's scenes use (after a load)."""
+    for scene in bpy.data.scenes:
+        props = getattr(scene, "solidwire", None)
+        if props is not None and props.use_fill and props.fill_shading == "MATCAP":
+            request(props.matcap)
+
+
+_on_load = persistent(request_for_scenes)
+
+
 def register() -> None:
     matcaps.set_loader(load_pixels)
+    if not bpy.app.background:
+        bpy.app.handlers.load_post.append(_on_load)
 
 
 def unregister() -> None:
     matcaps.set_loader(None)
+    if _on_load in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(_on_load)
+    _requested.clear()

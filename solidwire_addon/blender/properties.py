@@ -13,6 +13,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
 
 from ..core import schema
 from ..core.settings import DrawSettings
+from . import matcap_files
 
 # Where each scope's PropertyGroup is attached.
 _OWNERS = {schema.SCENE: "Scene", schema.OBJECT: "Object", schema.VIEW_LAYER: "ViewLayer"}
@@ -35,8 +36,15 @@ def _diagonal_mode_changed(self, _context) -> None:
     redraw_viewports()
 
 
+def _matcap_changed(self, _context) -> None:
+    """Decode the chosen matcap now, in the main thread (matcap_files.py)."""
+    if self.fill_shading == "MATCAP":
+        matcap_files.request(self.matcap)
+    redraw_viewports()
+
+
 # Settings whose change does more than redraw.
-_UPDATES = {"diagonal_mode": _diagonal_mode_changed}
+_UPDATES = {"diagonal_mode": _diagonal_mode_changed, "fill_shading": _matcap_changed, "matcap": _matcap_changed}
 
 
 def make_property(setting: schema.Setting):

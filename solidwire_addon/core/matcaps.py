@@ -21,6 +21,10 @@ from .log import warn_once
 _loader: Callable | None = None
 _textures: dict[str, object] = {}
 
+# What a loader returns when it cannot decode now but will later (Blender's
+# interface: see blender/matcap_files.py); the fill is flat until then.
+PENDING = "pending"
+
 
 def set_loader(loader: Callable | None) -> None:
     global _loader
@@ -40,6 +44,9 @@ def texture(name: str):
         except Exception as exc:  # noqa: BLE001 - a bad file must not break the frame
             warn_once(("matcap", name), f"SolidWire: matcap '{name}' could not be read ({exc}); drawing a flat fill")
             pixels = None
+    if pixels is PENDING:
+        warn_once(("matcap pending", name), f"SolidWire: matcap '{name}' is still loading; the fill is flat until then")
+        return None
     if pixels is None:
         warn_once(("matcap", name), f"SolidWire: matcap '{name}' is not available; drawing a flat fill")
         _textures[name] = None
@@ -53,6 +60,11 @@ def texture(name: str):
     np.asarray(buf)[:] = pixels.reshape(-1)
     _textures[name] = gpu.types.GPUTexture((width, height), format="RGBA32F", data=buf)
     return _textures[name]
+
+
+def forget(name: str) -> None:
+    """Ask the loader again for ``name`` on next use."""
+    _textures.pop(name, None)
 
 
 def clear() -> None:
