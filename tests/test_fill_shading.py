@@ -184,3 +184,25 @@ def test_pending_matcap_draws_flat_until_decoded():
         assert answers == []
     finally:
         matcaps.set_loader(matcap_files.load_pixels)
+
+
+def test_defaults_make_a_readable_picture_of_the_default_scene(output_dir):
+    """A plain F12 of Blender's startup scene (cube, camera, light, 0.05 grey
+    world) with the add-on's defaults: a lit light fill under a dark wire."""
+    bpy.ops.wm.read_factory_settings(use_empty=False)
+    scene = bpy.context.scene
+    scene.render.engine = "SOLIDWIRE"
+    scene.render.resolution_percentage = 25
+    rgba = scenes.render_to_file(scene, output_dir / "defaults_startup_scene.png", depth16=False)
+    grey = rgba[..., :3].mean(axis=-1)
+    world = np.median(grey[:10, :10])
+    fill = grey > world + 0.25  # the lit fill is far brighter than the world
+    assert fill.mean() > 0.05
+    # Three faces of the cube in three clearly different shades (lit, not flat).
+    levels = np.unique(np.round(grey[fill], 2))
+    shades = [v for v in levels if np.count_nonzero(np.round(grey[fill], 2) == v) > 200]
+    assert len(shades) >= 3 and shades[-1] - shades[0] > 0.05, shades
+    # The wire is darker than the world, and there is plenty of it.
+    rows, cols = np.nonzero(fill)
+    box = grey[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1]
+    assert np.count_nonzero(box < world - 0.05) > 100
