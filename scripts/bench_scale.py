@@ -16,7 +16,10 @@ Measured in one run, each against the path it replaces:
    process so earlier parts do not count);
 6. the frame time of a 250-frame animation render (Blender's own
    ``render(animation=True)``, the ``-a`` path) with one deforming object
-   among 100 static ones, with reuse vs without.
+   among 100 static ones, with reuse vs without;
+7. the viewport overlay's redraw cost after one edit (``--part
+   interactive`` runs only this): a vertex moved in Edit Mode on Suzanne
+   level 5, one of 1000 objects moved, one vertex of one of them moved.
 
 Frame times are the wall time of ``bpy.ops.render.render`` (Blender's
 depsgraph evaluation included) and SolidWire's own share (stats
@@ -296,6 +299,133 @@ def bench_animation(static: int, frame_end: int) -> dict:
 # --------------------------------------------------------------------------
 
 
+# --------------------------------------------------------------------------
+# 7: interactive cost of the viewport overlay (edits between redraws)
+
+
+class _Viewport:
+    """An offscreen stand-in for a 3D viewport's overlay framebuffer."""
+
+    def __init__(self, width: int, height: int):
+        import gpu
+
+        self.size = (width, height)
+        self.color = gpu.types.GPUTexture(self.size, format="SRGB8_A8")
+        self.depth = gpu.types.GPUTexture(self.size, format="DEPTH32F_STENCIL8")
+        self.framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.color,))
+
+    def redraw(self, scene, plan) -> dict:
+        """One overlay redraw as the draw handler does it (depsgraph
+        evaluation, gather, draw), waited for; ms of each part."""
+        import gpu
+
+        from solidwire_addon.blender import overlay
+        from solidwire_addon.blender.views import camera_view
+
+        start = time.perf_counter()
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        ms_depsgraph = (time.perf_counter() - start) * 1000.0
+        view = camera_view(scene, depsgraph, self.size)
+        with self.framebuffer.bind():
+            self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+            gpu.state.viewport_set(0, 0, *self.size)
+            stats = overlay.draw_scene_overlay(
+                depsgraph, view, scene.solidwire.snapshot(),
+                object_filter=overlay.object_filter(plan, bpy.context.view_layer), plan=plan,
+            )
+            self.framebuffer.read_color(0, 0, 1, 1, 4, 0, "UBYTE")  # wait for the GPU
+        stats["ms_redraw"] = (time.perf_counter() - start) * 1000.0
+        stats["ms_depsgraph"] = ms_depsgraph
+        return stats
+
+
+def _median_stats(samples: list) -> dict:
+    keys = ("ms_redraw", "ms_depsgraph", "ms_extract", "ms_upload", "ms_draw", "meshes_extracted",
+            "meshes_repositioned", "triangles_drawn")
+    return {key: statistics.median(s[key] for s in samples) for key in keys}
+
+
+def bench_interactive(level: int, objects: int, edits: int) -> dict:
+    """Redraw cost after one edit: a vertex moved in Edit Mode on a 1M-triangle
+    mesh, one of ``objects`` objects moved, one of them edited. Each against
+    a redraw with nothing changed."""
+    import bmesh
+
+    from solidwire_addon.core import overlay_state
+
+    plan = overlay_state.plan_overlay(overlay_state.ViewportState(draw_edit_mode=True))
+    viewport = _Viewport(640, 360)
+    out = {}
+
+    scene = scenes.empty_scene(640, 360)
+    scenes.add_camera(scene, location=(0.0, -4.0, 0.5), target=(0.0, 0.0, 0.0))
+    obj = scenes.monkey(scene, subdivisions=level)
+    runtime.mesh_cache.clear()
+    viewport.redraw(scene, plan)
+    out["big_steady"] = _median_stats([viewport.redraw(scene, plan) for _ in range(edits)])
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.object.mode_set(mode="EDIT")
+    viewport.redraw(scene, plan)
+    bm = bmesh.from_edit_mesh(obj.data)
+    bm.verts.ensure_lookup_table()
+    for name, allow in (("big_edit_vertex", True), ("big_edit_vertex_full", False)):
+        runtime.mesh_cache.allow_reposition = allow
+        samples = []
+        for i in range(edits):
+            bm.verts[i].co.z += 0.01
+            bmesh.update_edit_mesh(obj.data)
+            samples.append(viewport.redraw(scene, plan))
+        out[name] = _median_stats(samples)
+    runtime.mesh_cache.allow_reposition = True
+    bpy.ops.object.mode_set(mode="OBJECT")
+
+    scene = many_objects_scene(objects)
+    runtime.mesh_cache.clear()
+    viewport.redraw(scene, plan)
+    out["objects_steady"] = _median_stats([viewport.redraw(scene, plan) for _ in range(edits)])
+    moved = bpy.data.objects["Obj0"]
+    samples = []
+    for _ in range(edits):
+        moved.location.z += 0.1
+        samples.append(viewport.redraw(scene, plan))
+    out["objects_move_one"] = _median_stats(samples)
+    for name, allow in (("objects_edit_one", True), ("objects_edit_one_full", False)):
+        runtime.mesh_cache.allow_reposition = allow
+        samples = []
+        for i in range(edits):
+            moved.data.vertices[i].co.z += 0.01
+            moved.data.update()
+            samples.append(viewport.redraw(scene, plan))
+        out[name] = _median_stats(samples)
+    runtime.mesh_cache.allow_reposition = True
+    out["big_triangles"] = out["big_steady"]["triangles_drawn"]
+    return out
+
+
+def interactive_table(r: dict, args) -> str:
+    def row(name, s):
+        return (
+            f"| {name} | {s['ms_redraw']:.0f} | {s['ms_depsgraph']:.0f} | {s['ms_extract']:.0f} | "
+            f"{s['ms_upload']:.1f} | {s['ms_draw']:.0f} | {s['meshes_extracted']:.0f} | {s['meshes_repositioned']:.0f} |"
+        )
+
+    big = f"Suzanne L{args.level} ({r['big_triangles']:,.0f} tris) in Edit Mode"
+    lines = [
+        "| overlay redraw, 640 x 360 (median) | total ms | depsgraph ms | extract ms | upload ms | draw ms "
+        "| meshes re-extracted | positions re-uploaded |",
+        "|---|---|---|---|---|---|---|---|",
+        row(f"{big}: nothing changed", r["big_steady"]),
+        row(f"{big}: one vertex moved", r["big_edit_vertex"]),
+        row(f"{big}: one vertex moved, full re-extraction (baseline)", r["big_edit_vertex_full"]),
+        row(f"{args.objects} objects: nothing changed", r["objects_steady"]),
+        row(f"{args.objects} objects: one object moved", r["objects_move_one"]),
+        row(f"{args.objects} objects: one vertex of one object moved", r["objects_edit_one"]),
+        row(f"{args.objects} objects: one vertex moved, full re-extraction (baseline)", r["objects_edit_one_full"]),
+    ]
+    return "\n".join(lines) + "\n"
+
+
 def table(results: dict, args) -> str:
     e = results["extraction"]
     o = results["objects"]
@@ -350,7 +480,8 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="small sizes (a minute or so)")
     parser.add_argument("--out", default=str(ROOT / "out" / "bench_scale.md"))
-    parser.add_argument("--part", choices=["memory"], help=argparse.SUPPRESS)
+    parser.add_argument("--part", choices=["memory", "interactive"],
+                        help="run one part only (interactive: overlay redraw cost after an edit)")
     args = parser.parse_args(argv)
     args.level = 4 if args.quick else 5
     args.repeat = 3 if args.quick else 5
@@ -358,6 +489,7 @@ def main(argv=None) -> int:
     args.instances = 2000 if args.quick else 10000
     args.frames = 4 if args.quick else 6
     args.static = 100
+    args.edits = 3 if args.quick else 5
     args.anim_frames = 20 if args.quick else 250
     args.memory_objects, args.memory_level = (2, 5) if args.quick else (10, 5)
 
@@ -368,6 +500,16 @@ def main(argv=None) -> int:
 
     ensure_gpu()
     results = {"renderer": renderer()}
+    if args.part == "interactive":
+        results["interactive"] = bench_interactive(args.level, args.objects, args.edits)
+        text = f"Renderer {results['renderer']}; bpy {bpy.app.version_string}.\n\n" + interactive_table(
+            results["interactive"], args
+        )
+        print(text, flush=True)
+        out = Path(args.out).with_name("bench_interactive.md")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(text, encoding="utf-8")
+        os._exit(0)
     print("extraction ...", file=sys.stderr)
     results["extraction"] = bench_extraction(args.level, args.repeat)
     print(f"{args.objects} objects ...", file=sys.stderr)
@@ -386,8 +528,10 @@ def main(argv=None) -> int:
     if not lines:
         raise RuntimeError(f"memory part failed ({child.returncode}): {child.stderr[-2000:]}")
     results["memory"] = json.loads(lines[-1])
+    print("interactive ...", file=sys.stderr)
+    results["interactive"] = bench_interactive(args.level, args.objects, args.edits)
 
-    text = table(results, args)
+    text = table(results, args) + "\n" + interactive_table(results["interactive"], args)
     print(text)
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -19,8 +19,12 @@ void main()
    * (perspective-correct), then q's depth in NDC and view space. */
   float u = s * fin_a.w / (s * fin_a.w + (1.0 - s) * fin_b.w);
   vec4 q = mix(fin_a, fin_b, u);
-  float q_depth = 0.5 * (q.z / q.w) + 0.5;
   float q_view_depth = mix(fin_view_depth.x, fin_view_depth.y, u);
+#ifdef LINEAR_DEPTH
+  float q_depth = q_view_depth * params.inv_clip_end; /* the main pass's encoding */
+#else
+  float q_depth = 0.5 * (q.z / q.w) + 0.5;
+#endif
 #ifndef OVERLAY_FINS
   float scene = texelFetch(scene_depth, ivec2(p), 0).r;
   if (scene < q_depth) {

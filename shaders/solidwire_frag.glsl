@@ -8,6 +8,10 @@
  *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
  *   SHADING, ITEM_COLORS, MATERIAL_COLORS   fill shading and colour sources
  *                      (fill_shading.glsl)
+ *   USE_CLIP_PLANES    viewport clipping region: discard outside its planes
+ *   WRITE_AOVS         third and fourth targets: (d_real, I_vis, object
+ *                      index, material index) and the camera-facing world normal (render
+ *                      passes, docs/image_model.md §6)
  */
 
 /* Squared distance from window point p to the segment stored as (line,
@@ -33,6 +37,23 @@ void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float bes
 
 void main()
 {
+#ifdef LINEAR_DEPTH
+  /* The render's own float depth buffer holds view depth / clip end: a float
+   * keeps the same relative precision (2^-24) at every depth, so which of two
+   * surfaces is nearer never depends on the clip range (docs/image_model.md
+   * §2). The GL mapping 0.5 * z/w + 0.5 crowds every far depth into the last
+   * few float steps below 1. */
+  gl_FragDepth = view_depth * params.inv_clip_end;
+#endif
+#ifdef USE_CLIP_PLANES
+  /* Outside the viewport's clipping region: nothing of this face exists
+   * here (docs/image_model.md §5.6). */
+  if (min(min(min(clip_distance_a.x, clip_distance_a.y), min(clip_distance_a.z, clip_distance_a.w)),
+          min(clip_distance_b.x, clip_distance_b.y)) < 0.0)
+  {
+    discard;
+  }
+#endif
   /* Window position relative to the viewport centre (edge_geometry.glsl). */
   vec2 p = gl_FragCoord.xy - viewport_centre();
   /* Squared distances to the five candidate edges. */
@@ -178,5 +199,9 @@ void main()
 #endif
 #if defined(WRITE_VIEW_DEPTH) && !defined(HIDDEN_PASS)
   frag_view_depth = view_depth;
+#endif
+#ifdef WRITE_AOVS
+  frag_aov = vec4(d_real, intensity, object_params.normal_matrix0.w, material_pass_index);
+  frag_normal = vec4(gl_FrontFacing ? face_normal : -face_normal, 0.0);
 #endif
 }

@@ -82,6 +82,21 @@ void main()
   }
   triangle_flags = edge_flags | (simple ? SIMPLE_TRIANGLE : 0);
 
+#ifdef WRITE_AOVS
+  /* Normal pass: the triangle's world-space normal (loop order, through the
+   * normal matrix); the fragment stage turns it towards the camera. The
+   * matrix's sign folds in mirroring, so gl_FrontFacing picks the side. */
+  vec3 p0 = fetch_texel(vertex_positions, int(ids.x)).xyz;
+  vec3 p1 = fetch_texel(vertex_positions, int(ids.y)).xyz;
+  vec3 p2 = fetch_texel(vertex_positions, int(ids.z)).xyz;
+  mat3 object_to_world_normal = mat3(object_params.normal_matrix0.xyz, object_params.normal_matrix1.xyz,
+                                     object_params.normal_matrix2.xyz);
+  vec3 n = object_to_world_normal * cross(p1 - p0, p2 - p0);
+  float n_length = length(n);
+  face_normal = n_length > 0.0 ? n / n_length : vec3(0.0);
+  /* IndexMA: the pass_index of this triangle's material (draw.py). */
+  material_pass_index = fetch_texel(triangle_material, triangle).x;
+#endif
   vec4 position = (corner == 0) ? c0 : ((corner == 1) ? c1 : c2);
   vec3 local = fetch_texel(vertex_positions,
                            int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
@@ -104,6 +119,17 @@ void main()
     item_fill = fetch_texel(item_colors, item_base + 2 + clamp(int(corner_data.w), 0, material_count - 1)).rgb;
   }
 #  endif
+#endif
+#ifdef USE_CLIP_PLANES
+  /* Viewport clipping region: signed distances to the clip-space planes
+   * (draw.py, clip_space_planes), linear in clip space so the interpolated
+   * value is exact; the fragment stage discards where one is negative.
+   * Taken before the depth bias, which moves only z. */
+  clip_distance_a = vec4(dot(clip_params.planes[0], position),
+                         dot(clip_params.planes[1], position),
+                         dot(clip_params.planes[2], position),
+                         dot(clip_params.planes[3], position));
+  clip_distance_b = vec2(dot(clip_params.planes[4], position), dot(clip_params.planes[5], position));
 #endif
 #ifdef DEPTH_BIAS
   /* Viewport overlay only: Blender's own Solid shading has already written

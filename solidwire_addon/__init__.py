@@ -16,7 +16,7 @@ import atexit
 import bpy
 
 from .blender import cli, engine, matcap_files, ops, ops_composite, overlay, properties, runtime, ui
-from .core import log, matcaps, shaders, silhouettes, targets
+from .core import log, matcaps, silhouettes, targets
 
 _classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
 _registered = False
@@ -67,12 +67,13 @@ def _at_exit() -> None:
 
 
 def release_gpu() -> None:
-    """Free every GPU object the add-on holds (targets, meshes, shaders)."""
+    """Free the GPU objects the add-on holds (targets, meshes, fin batches).
+    Compiled shader programs are the exception: they live until interpreter
+    exit (core/shaders.py says why)."""
     targets.release()
     runtime.release()
     silhouettes.release()
     matcaps.clear()
-    shaders.clear()
 
 
 def stats() -> dict:

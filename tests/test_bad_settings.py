@@ -223,7 +223,7 @@ def test_engine_failure_is_reported_not_a_silent_black_frame(tmp_path, monkeypat
     scene = scenes.empty_scene(32, 24)
     scenes.cube(scene)
     scenes.add_camera(scene)
-    monkeypatch.setattr(offscreen, "render", broken)
+    monkeypatch.setattr(offscreen, "render_passes", broken)
     path = tmp_path / "frame.png"
     with pytest.raises(RuntimeError, match="SolidWire render failed: MemoryError"):
         scenes.render_to_file(scene, path)

@@ -321,7 +321,7 @@ def test_a_failing_render_exits_1_with_a_clear_line(tmp_path):
         def broken_render(*args, **kwargs):
             raise ValueError("simulated failure")
 
-        engine.render_scene = broken_render
+        engine.PreparedFrame = broken_render
         sys.argv = ["render.py", {str(blend)!r}, "-o", "out.png"]
         try:
             runpy.run_path({str(RENDER_SCRIPT)!r}, run_name="__main__")

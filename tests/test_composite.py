@@ -17,6 +17,7 @@ import bpy
 import numpy as np
 import pytest
 
+from solidwire_addon.core import compat
 from tests.support import scenes
 from solidwire_addon.blender import composite
 
@@ -66,7 +67,7 @@ def plain_render(scene, engine: str, path: Path, *, transparent: bool | None = N
     if transparent is not None:
         render.film_transparent = transparent
     image = render.image_settings
-    image.media_type = "MULTI_LAYER_IMAGE"
+    compat.set_media_type(image, "MULTI_LAYER_IMAGE")  # Blender 5 (no-op on 4.x)
     image.file_format = "OPEN_EXR_MULTILAYER"
     image.color_depth = "32"
     image.exr_codec = "NONE"
@@ -85,7 +86,7 @@ def rgba_of(channels: dict) -> np.ndarray:
 
 def exr_output(scene):
     image = scene.render.image_settings
-    image.media_type = "IMAGE"
+    compat.set_media_type(image, "IMAGE")
     image.file_format = "OPEN_EXR"
     image.color_mode = "RGBA"
     image.color_depth = "32"
@@ -240,7 +241,7 @@ def _state(scene):
         "engine": r.engine, "filepath": r.filepath, "ext": r.use_file_extension,
         "motion": r.use_motion_blur, "border": r.use_border, "film": r.film_transparent,
         "comp": r.use_compositing, "seq": r.use_sequencer,
-        "media": im.media_type, "format": im.file_format, "mode": im.color_mode,
+        "media": getattr(im, "media_type", None), "format": im.file_format, "mode": im.color_mode,
         "depth": im.color_depth, "codec": im.exr_codec,
         "z": scene.view_layers[0].use_pass_z, "fill": scene.solidwire.use_fill,
         "samples": scene.cycles.samples,
@@ -365,7 +366,8 @@ def test_unknown_engine_fails_before_rendering(tmp_path):
 
 def test_video_output_format_is_refused(tmp_path):
     scene = occlusion_scene()
-    scene.render.image_settings.media_type = "VIDEO"
+    if not compat.set_media_type(scene.render.image_settings, "VIDEO"):
+        scene.render.image_settings.file_format = "FFMPEG"  # Blender 4.x: the format is the family
     with pytest.raises(composite.CompositeError, match="video"):
         composite.render_wire_over(scene, tmp_path / "x.mp4", "WORKBENCH")
 

@@ -141,5 +141,44 @@ def test_blenders_generic_panels_offer_solidwire():
     # Engine-specific panels (not marked for any engine) stay hidden, apart
     # from the film's transparency switch.
     specific = {name for name in solidwire if "BLENDER_RENDER" not in getattr(bpy.types, name).COMPAT_ENGINES}
-    assert specific <= {"CYCLES_RENDER_PT_film_transparency", "RENDER_PT_eevee_film", "RENDER_PT_solidwire"}, sorted(specific)
+    assert specific <= {"CYCLES_RENDER_PT_film_transparency", "RENDER_PT_eevee_film", "RENDER_PT_solidwire",
+                        "VIEWLAYER_PT_solidwire_passes"}, sorted(specific)
     print(f"panels in {sorted(TABS)}: SOLIDWIRE {len(solidwire)}, BLENDER_WORKBENCH {len(workbench)}")
+
+
+@pytest.mark.parametrize("use_region", [False, True])
+def test_tiled_frames_equal_the_frame_drawn_in_one_piece(tmp_path, region_scene, monkeypatch, use_region):
+    """Big frames are drawn tile by tile (engine.TILE_SIZE); with tiny tiles
+    the image equals the one-piece render (each tile is an exact window of
+    the frame's projection)."""
+    region_scene.solidwire.use_silhouettes = True  # the fin pass is tiled too
+    region_scene.solidwire.diagonal_mode = "DASHED"
+    if use_region:
+        render = region_scene.render
+        render.use_border, render.use_crop_to_border = True, True
+        render.border_min_x, render.border_max_x, render.border_min_y, render.border_max_y = 0.1, 0.9, 0.2, 0.95
+    whole = scenes.render_to_file(region_scene, tmp_path / "whole.png")
+    monkeypatch.setattr(engine, "TILE_SIZE", 17)
+    tiles = list(engine.tiles_of(engine.region_of(region_scene, 80, 60)))
+    assert len(tiles) > 6 and len({(w, h) for _x, _y, w, h in tiles}) > 1  # uneven edge tiles too
+    tiled = scenes.render_to_file(region_scene, tmp_path / "tiled.png")
+    assert tiled.shape == whole.shape and whole[..., 3].max() > 0.5
+    assert np.abs(tiled - whole).max() <= 1.5 / 65535
+
+
+def test_a_render_after_the_window_context_drew_is_right(tmp_path):
+    """F12 draws in the render engine's own GL context, the overlay and
+    scripts in the window context. A program drawn with in both gave a wrong
+    F12 image (most of the surface missing); each context now has its own
+    programs (core/shaders.py, gl_context)."""
+    scene = _two_layer_scene()
+    _multilayer_render(scene, tmp_path / "layers.exr")  # the engine context draws these variants
+    scene = scenes.empty_scene(80, 60)
+    scenes.monkey(scene)
+    scenes.add_camera(scene, location=(2.5, -4.0, 1.8), target=(0.0, 0.0, 0.0))
+    window_rgba, _depth = engine.render_scene(bpy.context.evaluated_depsgraph_get(), (80, 60))  # window context
+    scene = scenes.empty_scene(80, 60)  # a new file: new meshes, same variants
+    scenes.monkey(scene)
+    scenes.add_camera(scene, location=(2.5, -4.0, 1.8), target=(0.0, 0.0, 0.0))
+    f12 = scenes.render_to_file(scene, tmp_path / "f12.png")
+    assert np.abs(f12[..., 3] - window_rgba[..., 3]).max() <= 1.5 / 65535

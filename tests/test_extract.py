@@ -141,3 +141,60 @@ def test_flipped_quad_without_blender():
     reference = extract.build_arrays(positions, np.arange(4), [0], [4], [[0, 1, 3], [1, 2, 3]], [0, 0])
     assert_same_arrays(fast, reference)
     np.testing.assert_array_equal(fast.triangles, [[3, 0, 1, 2], [1, 2, 3, 0]])
+
+
+def _quad_grid(n: int = 12, seed: int = 1):
+    rng = np.random.default_rng(seed)
+    xs, ys = np.meshgrid(np.arange(n + 1, dtype=np.float32), np.arange(n + 1, dtype=np.float32))
+    positions = np.stack([xs.ravel(), ys.ravel(), rng.uniform(-0.05, 0.05, (n + 1) ** 2)], axis=1).astype(np.float32)
+    faces = [(j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i)
+             for j in range(n) for i in range(n)]
+    corner_vert = np.array(faces, dtype=np.int32).ravel()
+    offsets = np.arange(0, len(corner_vert) + 1, 4, dtype=np.int32)
+    return positions, corner_vert, offsets
+
+
+def test_reposition_is_a_full_extraction_of_the_moved_mesh():
+    """Positions-only re-upload: same triangles, and the same world positions
+    as extracting the moved mesh from scratch (bounds may only grow)."""
+    positions, corner_vert, offsets = _quad_grid()
+    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
+    moved = positions.copy()
+    moved[17] += (0.02, -0.01, 0.3)
+    moved[40, 2] -= 0.2
+    result = extract.reposition(arrays, moved, corner_vert, offsets)
+    assert result is not None
+    local, centre, bounds_min, bounds_max, source = result
+    full = extract.build_arrays_fast(moved, corner_vert, offsets)
+    np.testing.assert_array_equal(full.triangles, arrays.triangles)
+    np.testing.assert_array_equal(full.edge_flags, arrays.edge_flags)
+    np.testing.assert_allclose(local + centre, full.positions + full.centre, atol=1e-5)
+    assert (bounds_min <= full.bounds_min).all() and (bounds_max >= full.bounds_max).all()
+    assert np.shares_memory(source, moved)  # kept as read, no copy
+
+
+def test_reposition_refuses_what_changes_the_triangles():
+    positions, corner_vert, offsets = _quad_grid()
+    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
+    # Corner 1 of the first quad pulled over the diagonal 0-2, next to corner 3:
+    # the quad now splits along 1-3.
+    q = arrays.quads[0]
+    folded = positions.copy()
+    folded[q[1]] = 0.9 * positions[q[3]] + 0.1 * positions[q[0]]
+    assert extract.reposition(arrays, folded, corner_vert, offsets) is None
+    assert not np.array_equal(extract.build_arrays_fast(folded, corner_vert, offsets).triangles, arrays.triangles)
+    # A non-finite vertex, other face sizes, or n-gons: full extraction.
+    broken = positions.copy()
+    broken[3, 0] = np.nan
+    assert extract.reposition(arrays, broken, corner_vert, offsets) is None
+    regrouped = offsets.copy()
+    regrouped[1] -= 1
+    regrouped[2] += 0
+    assert extract.reposition(arrays, positions, corner_vert, regrouped) is None
+    hexagon = np.array([(np.cos(a), np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]], dtype=np.float32)
+    ngon = extract.build_arrays_fast(
+        hexagon, np.arange(6, dtype=np.int32), np.array([0, 6], dtype=np.int32),
+        blender_tris=lambda rows: np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]])[rows],
+    )
+    assert ngon.quads is None
+    assert extract.reposition(ngon, hexagon * 1.1, np.arange(6, dtype=np.int32), np.array([0, 6])) is None

@@ -366,6 +366,9 @@ def test_draw_handler_never_raises(monkeypatch, capsys):
             self.region = object()
             self.region_data = object()
             self.view_layer = bpy.context.view_layer
+            self.screen = None
+            self.area = None
+            self.preferences = bpy.context.preferences
 
         def evaluated_depsgraph_get(self):
             return bpy.context.evaluated_depsgraph_get()
@@ -417,8 +420,14 @@ def test_redraws_reuse_meshes_and_see_edits():
     front.data.vertices[0].co.z += 0.7
     front.data.update()
     third, alpha_third = redraw()
-    assert third["meshes_extracted"] == 1
+    # Only a vertex moved: the position table alone is uploaded again ...
+    assert third["meshes_extracted"] == 0 and third["meshes_repositioned"] == 1
     assert not np.array_equal(alpha_second, alpha_third)
+    # ... and draws exactly what a full extraction draws.
+    runtime.mesh_cache.clear()
+    fourth, alpha_fourth = redraw()
+    assert fourth["meshes_extracted"] == 2
+    assert np.array_equal(alpha_third, alpha_fourth)
 
 
 @pytest.mark.parametrize(

@@ -113,3 +113,34 @@ def test_exact_path_on_dense_mesh():
     measured = _method_intensity(scene, "exact")[ref.rows]
     report = reference.error_report(measured, ref)
     accuracy.assert_accurate(report)
+
+
+@pytest.mark.parametrize("ortho", [False, True], ids=["perspective", "orthographic"])
+def test_huge_clip_end(ortho, output_dir):
+    """Clip end 1e9: the reference stays finite (its rays start at the camera
+    or, orthographic, on the near plane, never at a far plane with w ~ 0),
+    it is the reference of the same view with an ordinary clip end (only
+    depth changes with the clip end), and the engine meets the thresholds."""
+    scene = scenes.empty_scene(320, 180, diagonal_mode="SOLID")
+    scenes.monkey(scene)
+    scenes.cube(scene, "Cube", size=1.0, location=(1.5, 1.0, -0.5))
+    camera = scenes.add_camera(scene, location=(4.0, -4.0, 3.0), clip=(0.1, 1.0e9), ortho_scale=5.0 if ortho else None)
+    bpy.context.view_layer.update()
+    ref = reference.render_reference(scene)
+    assert np.isfinite(ref.intensity).all()
+    assert (ref.face >= 0).sum() > 0.1 * ref.face.size  # the objects are seen ...
+    assert np.isfinite(ref.depth[ref.face >= 0]).all()
+    assert ref.intensity.max() > 0.9  # ... with their wire
+    if not ortho:
+        # Orthographic depth over a 1e9 clip range is below float32 resolution
+        # (objects z-fight in any depth buffer), so the engine is compared in
+        # perspective only; the reference itself is checked for both.
+        rgba = scenes.render_to_file(scene, output_dir / "stress_clip_end_1e9.png")
+        report = reference.error_report(rgba[..., 3], ref)
+        report["name"] = "clip_end_1e9"
+        accuracy.assert_accurate(report)
+    camera.data.clip_end = 100.0
+    bpy.context.view_layer.update()
+    ordinary = reference.render_reference(scene)
+    np.testing.assert_array_equal(ref.face, ordinary.face)
+    np.testing.assert_allclose(ref.intensity, ordinary.intensity, rtol=0.0, atol=1e-9)

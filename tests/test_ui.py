@@ -90,8 +90,12 @@ class FakeLayout:
         rna = getattr(getattr(bpy.ops, category), name).get_rna_type()
         assert property in rna.properties, f"{idname} has no property {property!r}"
 
-    def greyed_props(self) -> dict:
-        return {name: greyed for _data, name, greyed in self.props}
+    def greyed_props(self, data=None) -> dict:
+        """{name: greyed} of the rows drawn for ``data`` (default: every row
+        except an object's own settings, which share names with the scene's)."""
+        if data is not None:
+            return {name: greyed for d, name, greyed in self.props if d == data}
+        return {name: greyed for d, name, greyed in self.props if type(d).__name__ != "SolidWireObjectSettings"}
 
 
 def draw_with(function, context, owner=None):
@@ -174,7 +178,7 @@ def test_panels_menu_and_popover_are_registered():
     assert bpy.types.VIEW3D_PT_solidwire.bl_region_type == "UI"
     assert bpy.types.VIEW3D_PT_solidwire.bl_category == "SolidWire"
     assert ui.appended_draw_functions("VIEW3D_PT_overlay") == [ui.draw_overlay_popover]
-    assert ui.appended_draw_functions("OBJECT_PT_visibility") == [ui.draw_object_visibility]
+    assert bpy.types.OBJECT_PT_solidwire.bl_context == "object"
 
 
 @pytest.fixture
@@ -187,12 +191,17 @@ def context():
 def test_sidebar_panel_draws_every_setting(context):
     layout = draw_with(ui.VIEW3D_PT_solidwire.draw, context)
     drawn = layout.greyed_props()
-    for name in (*SPEC_PROPERTIES, "only_selected", "solidwire_exclude"):
+    for name in (*SPEC_PROPERTIES, "only_selected", "overlay_edit_mode"):
         assert name in drawn, name
+    # The active object's own settings, the override's values greyed while it is off.
+    assert layout.greyed_props(context.object.solidwire) == {
+        "show_in_viewport": False, "show_in_render": False, "use_override": False,
+        "wire_color": True, "thickness": True, "fill_color": True,
+    }
     assert "solidwire.fade_from_visible" in layout.operators
 
     header = draw_with(ui.VIEW3D_PT_solidwire.draw_header, context)
-    assert header.greyed_props() == {"show_overlay": False}
+    assert header.operators == ["solidwire.toggle_overlay"]
     preset_header = draw_with(ui.VIEW3D_PT_solidwire.draw_header_preset, context)
     assert preset_header.menus == ["SOLIDWIRE_MT_presets"]
     assert preset_header.operators == ["solidwire.preset_add", "solidwire.preset_remove"]
@@ -247,9 +256,16 @@ def test_presets_menu_lists_builtin_and_user_presets(context):
 
 def test_overlay_popover_and_object_entries(context):
     layout = draw_with(ui.draw_overlay_popover, context)
-    assert layout.greyed_props() == {"show_overlay": False}
-    layout = draw_with(ui.draw_object_visibility, context)
-    assert layout.greyed_props() == {"solidwire_exclude": False}
+    assert layout.operators == ["solidwire.toggle_overlay"]
+    obj = context.object
+    assert ui.OBJECT_PT_solidwire.poll(context)
+    layout = draw_with(ui.OBJECT_PT_solidwire.draw, context)
+    assert "solidwire_exclude" not in layout.greyed_props()
+    obj.solidwire.use_override = True
+    assert not any(draw_with(ui.OBJECT_PT_solidwire.draw, context).greyed_props(obj.solidwire).values())
+    # An older file's opt-out shows while it is set, so it can be cleared.
+    obj.solidwire_exclude = True
+    assert draw_with(ui.OBJECT_PT_solidwire.draw, context).greyed_props()["solidwire_exclude"] is False
 
 
 def test_fade_range_from_visible_objects():
@@ -266,3 +282,74 @@ def test_fade_range_from_visible_objects():
     props = scene.solidwire
     assert props.use_fade
     assert (props.fade_start, props.fade_end) == pytest.approx((5.0, 17.0), abs=1e-4)
+
+
+def _two_viewports():
+    """A screen of the factory file with two 3D Views (Animation workspace)."""
+    screen = bpy.data.screens["Animation"]
+    views = [area for area in screen.areas if area.type == "VIEW_3D"]
+    assert len(views) >= 2
+    return screen, views[0], views[1]
+
+
+def test_each_viewport_has_its_own_toggle(tmp_path):
+    from solidwire_addon.blender import overlay
+
+    scene = scenes.empty_scene()
+    props = scene.solidwire
+    screen, first, second = _two_viewports()
+    assert not overlay.viewport_shows(screen, first, props) and not overlay.viewport_shows(screen, second, props)
+    with bpy.context.temp_override(screen=screen, area=first):
+        assert ops.overlay_shown(bpy.context) is False
+        assert bpy.ops.solidwire.toggle_overlay() == {"FINISHED"}
+        assert ops.overlay_shown(bpy.context) is True
+        # The checkbox drawn in this viewport shows its own state.
+        layout = draw_with(ui.draw_overlay_popover, bpy.context)
+    assert overlay.viewport_shows(screen, first, props)
+    assert not overlay.viewport_shows(screen, second, props)
+    assert props.show_overlay is False, "the scene default is not touched"
+
+    # The scene setting is the default of viewports that never had a toggle.
+    props.show_overlay = True
+    assert overlay.viewport_shows(screen, second, props)
+    with bpy.context.temp_override(screen=screen, area=first):
+        bpy.ops.solidwire.toggle_overlay()
+    assert not overlay.viewport_shows(screen, first, props)
+    assert overlay.viewport_shows(screen, second, props)
+    props.show_overlay = False
+    with bpy.context.temp_override(screen=screen, area=first):
+        bpy.ops.solidwire.toggle_overlay()
+
+    # The choice is saved with the file's UI and comes back on reopening.
+    path = tmp_path / "viewport_toggle.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=True)
+    screen, first, second = _two_viewports()
+    props = bpy.context.scene.solidwire
+    assert overlay.viewport_shows(screen, first, props)
+    assert not overlay.viewport_shows(screen, second, props)
+    assert layout.operators == ["solidwire.toggle_overlay"]
+
+
+def test_toggle_adds_no_undo_step():
+    """View state, like Blender's own overlay options: no UNDO in the
+    operator, and the toggle lives on a Screen, an ID type Blender's undo
+    leaves out (ID_CHECK_UNDO), so a button on it pushes no undo step either."""
+    from solidwire_addon.blender import properties
+
+    assert "UNDO" not in ops.SOLIDWIRE_OT_toggle_overlay.bl_options
+    toggles = bpy.types.Screen.bl_rna.properties[properties.VIEWPORTS_ATTRIBUTE]
+    assert toggles.fixed_type.identifier == properties.SolidWireViewportToggle.__name__
+
+
+def test_view_layer_passes_panel(context):
+    view_layer = context.scene.view_layers[0]
+    ctx = SimpleNamespace(scene=context.scene, engine="SOLIDWIRE", view_layer=view_layer)
+    assert ui.VIEWLAYER_PT_solidwire_passes.poll(ctx)
+    assert not ui.VIEWLAYER_PT_solidwire_passes.poll(SimpleNamespace(engine="CYCLES", view_layer=view_layer))
+    drawn = draw_with(ui.VIEWLAYER_PT_solidwire_passes.draw, ctx).greyed_props()
+    assert set(drawn) == {"use_pass_z", "use_pass_normal", "use_pass_object_index", "use_pass_material_index",
+                          "use_pass_wire", "use_pass_hidden_wire", "use_pass_edge_distance"}
+    # Switching a pass asks Blender for the engine's passes again (no error headless).
+    view_layer.solidwire.use_pass_wire = True
+    view_layer.solidwire.use_pass_wire = False

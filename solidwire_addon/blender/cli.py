@@ -27,17 +27,15 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import re
 import sys
-import tempfile
 import time
 import traceback
 from pathlib import Path
 
 import bpy
 
-from ..core import compat, schema
+from ..core import compat, output, schema
 from ..core.ids import ENGINE_ID, EXTENSION_ID
 from . import composite, presets, runtime
 
@@ -424,31 +422,18 @@ def scene_frame_path(scene, frame: int) -> Path:
 
 def check_output_folder(directory: Path) -> None:
     """Create the folder if needed (as Blender does) and prove it writable."""
-    existing = directory
-    while not existing.exists() and existing != existing.parent:
-        existing = existing.parent
-    if not existing.is_dir():
-        raise UsageError(f"cannot write to '{directory}': '{existing}' is a file, not a folder")
     try:
-        directory.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UsageError(f"cannot create output folder '{directory}': {exc.strerror}") from None
-    try:
-        # A real write, not os.access: also right for read-only mounts and root.
-        with tempfile.NamedTemporaryFile(dir=directory, prefix=".solidwire-write-test-"):
-            pass
-    except OSError as exc:
-        raise UsageError(f"cannot write to '{directory}': {exc.strerror}") from None
+        output.check_output_folder(directory)
+    except output.OutputError as exc:
+        raise UsageError(str(exc)) from None
 
 
 def check_output(path: Path) -> None:
     """Fail before rendering if the image cannot be written there."""
-    if path.is_dir():
-        raise UsageError(f"output '{path}' is a directory")
-    check_output_folder(path.parent)
-    if path.exists() and not os.access(path, os.W_OK):
-        raise UsageError(f"cannot overwrite '{path}': permission denied")
-
+    try:
+        output.check_output(path)
+    except output.OutputError as exc:
+        raise UsageError(str(exc)) from None
 
 
 def file_format_of(path: Path, color_depth: str | None) -> str:

@@ -41,7 +41,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core import compat
+from ..core import compat, output
 from ..core.exr import ExrError, exr_pass, read_exr
 from ..core.ids import ENGINE_ID
 
@@ -261,6 +261,18 @@ class Layers:
     wire_depth: np.ndarray | None = None
 
 
+def check_inputs(scene, engine=None, *, depth: bool = False) -> str:
+    """Everything about the scene a wire-over render needs, checked before
+    rendering; returns the beauty's engine identifier."""
+    if scene.camera is None:
+        raise CompositeError(f"scene '{scene.name}' has no camera")
+    if scene.render.use_multiview:
+        raise CompositeError("stereo / multi-view renders are not supported (switch Stereoscopy off)")
+    if depth and scene.render.pixel_aspect_x != scene.render.pixel_aspect_y:
+        raise CompositeError("Blender cannot write Depth passes with non-square pixels (pixel aspect)")
+    return resolve_engine(scene, engine)
+
+
 def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = None, depth: bool = False,
                   keep_exr: Path | None = None) -> Layers:
     """Render the beauty with ``engine`` (default: the scene's) and the wire
@@ -270,14 +282,22 @@ def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = 
     render; ``depth`` also returns both Depth passes; ``keep_exr`` (a path
     stem) keeps the two float layers as ``STEM.beauty.exr`` and
     ``STEM.wire.exr``."""
-    if scene.camera is None:
-        raise CompositeError(f"scene '{scene.name}' has no camera")
-    if scene.render.use_multiview:
-        raise CompositeError("stereo / multi-view renders are not supported (switch Stereoscopy off)")
-    if depth and scene.render.pixel_aspect_x != scene.render.pixel_aspect_y:
-        raise CompositeError("Blender cannot write Depth passes with non-square pixels (pixel aspect)")
-    engine = resolve_engine(scene, engine)
+    engine = check_inputs(scene, engine, depth=depth)
     layer = _view_layer(scene, view_layer)
+    tmp = Path(tempfile.mkdtemp(prefix="solidwire-over-"))
+    try:
+        beauty_exr, wire_exr = _render_both(scene, engine, layer, tmp, samples=samples, depth=depth)
+        result = _composite(beauty_exr, wire_exr, layer.name, engine, depth)
+        if keep_exr is not None:
+            _keep_layers(tmp, Path(keep_exr).absolute())
+        return result
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _render_both(scene, engine: str, layer, tmp: Path, *, samples, depth: bool) -> tuple[dict, dict]:
+    """The beauty and the wire rendered into ``tmp`` as float EXR layers,
+    read back; every setting changed for them is restored afterwards."""
     settings = scene.solidwire
     render = scene.render
     restores = [
@@ -289,44 +309,45 @@ def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = 
     if samples is not None:
         restores += [(scene.cycles, ("samples",))] if hasattr(scene, "cycles") else []
         restores += [(scene.eevee, ("taa_render_samples",))]
-    tmp = Path(tempfile.mkdtemp(prefix="solidwire-over-"))
-    try:
-        with preserved(*restores):
-            _exr_output(scene, multilayer=depth)
-            render.use_motion_blur = False
-            render.use_border = False
-            render.use_sequencer = False
-            if depth:
-                layer.use_pass_z = True
-            if samples is not None:
-                if hasattr(scene, "cycles"):
-                    scene.cycles.samples = samples
-                scene.eevee.taa_render_samples = samples
-
-            beauty_exr = _render_to(scene, engine, tmp / "beauty.exr", layer.name)
-
-            render.film_transparent = True
-            render.use_compositing = False
-            settings.use_fill = False
-            wire_exr = _render_to(scene, ENGINE_ID, tmp / "wire.exr", layer.name)
-
-        beauty = _combined(beauty_exr, layer.name, engine)
-        wire = _combined(wire_exr, layer.name, ENGINE_ID)
-        if beauty.shape != wire.shape:
-            raise CompositeError(f"the beauty ({beauty.shape[1]}x{beauty.shape[0]}) and the wire "
-                                 f"({wire.shape[1]}x{wire.shape[0]}) differ in size")
-        result = Layers(beauty, wire, alpha_over(wire, beauty), engine)
+    with preserved(*restores):
+        _exr_output(scene, multilayer=depth)
+        render.use_motion_blur = False
+        render.use_border = False
+        render.use_sequencer = False
         if depth:
-            result.beauty_depth = _depth(beauty_exr, layer.name)
-            result.wire_depth = _depth(wire_exr, layer.name)
-        if keep_exr is not None:
-            keep_exr = Path(keep_exr).absolute()
-            keep_exr.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(tmp / "beauty.exr", keep_exr.with_name(keep_exr.name + ".beauty.exr"))
-            shutil.copyfile(tmp / "wire.exr", keep_exr.with_name(keep_exr.name + ".wire.exr"))
-        return result
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+            layer.use_pass_z = True
+        if samples is not None:
+            if hasattr(scene, "cycles"):
+                scene.cycles.samples = samples
+            scene.eevee.taa_render_samples = samples
+
+        beauty_exr = _render_to(scene, engine, tmp / "beauty.exr", layer.name)
+
+        render.film_transparent = True
+        render.use_compositing = False
+        settings.use_fill = False
+        wire_exr = _render_to(scene, ENGINE_ID, tmp / "wire.exr", layer.name)
+    return beauty_exr, wire_exr
+
+
+def _composite(beauty_exr: dict, wire_exr: dict, layer_name: str, engine: str, depth: bool) -> Layers:
+    beauty = _combined(beauty_exr, layer_name, engine)
+    wire = _combined(wire_exr, layer_name, ENGINE_ID)
+    if beauty.shape != wire.shape:
+        raise CompositeError(f"the beauty ({beauty.shape[1]}x{beauty.shape[0]}) and the wire "
+                             f"({wire.shape[1]}x{wire.shape[0]}) differ in size")
+    result = Layers(beauty, wire, alpha_over(wire, beauty), engine)
+    if depth:
+        result.beauty_depth = _depth(beauty_exr, layer_name)
+        result.wire_depth = _depth(wire_exr, layer_name)
+    return result
+
+
+def _keep_layers(tmp: Path, stem: Path) -> None:
+    """Copy the two float layers next to the output as STEM.beauty.exr / STEM.wire.exr."""
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(tmp / "beauty.exr", stem.with_name(stem.name + ".beauty.exr"))
+    shutil.copyfile(tmp / "wire.exr", stem.with_name(stem.name + ".wire.exr"))
 
 
 def _combined(channels: dict, layer: str, engine: str) -> np.ndarray:
@@ -353,7 +374,14 @@ def render_wire_over(scene, filepath, engine=None, *, keep_layers: bool = False,
     ``filepath`` in the scene's output format (plus ``NAME.beauty.exr`` and
     ``NAME.wire.exr`` beside it with ``keep_layers``). Returns the layers."""
     path = Path(os.fspath(filepath)).absolute()
-    check_output_format(scene)  # before the (slow) renders
+    # Before the (slow) renders: bad input or a path that cannot be written
+    # costs nothing.
+    check_inputs(scene, engine)
+    check_output_format(scene)
+    try:
+        output.check_output(path)
+    except output.OutputError as exc:
+        raise CompositeError(str(exc)) from None
     keep = path.with_name(path.stem) if keep_layers else None
     layers = render_layers(scene, engine, keep_exr=keep, **kwargs)
     save_image(scene, layers.composite, path)

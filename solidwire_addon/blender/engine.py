@@ -14,11 +14,11 @@ import time
 import bpy
 import numpy as np
 
-from ..core import passes
+from ..core import passes, shaders
 from ..core.ids import ENGINE_ID
 from . import gather, runtime
 from .gpu_context import ensure_gpu, is_init_scene
-from ..core.view import View
+from ..core.view import DrawStats, View
 from .views import NoCameraError, camera_view, render_size
 
 
@@ -53,37 +53,86 @@ def region_of(scene, width: int, height: int) -> tuple[int, int, int, int]:
     return x0, y0, x1 - x0, y1 - y0
 
 
-def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None):
-    """Render ``depsgraph``'s scene from its camera: (rgba premultiplied over
-    the film, view depth), or None when ``should_stop()`` said so. Shared by
-    the engine and the command line.
+# Frames larger than this many pixels a side are drawn and handed to Blender
+# tile by tile (RenderEngine.begin_result on a sub-rectangle), so SolidWire's
+# own float targets and readback stay at one tile (~0.2 GiB at 2048^2) however
+# big the frame: peak memory is Blender's result plus one tile.
+TILE_SIZE = 2048
 
-    ``region`` (x0, y0, w, h) in pixels of the full frame draws that window
-    only, pixel for pixel as in the full render. ``report(text, fraction)``
-    hears about the stages."""
-    ensure_gpu()  # uploads start in gather(), before anything is drawn
-    scene = depsgraph.scene
-    view = camera_view(scene, depsgraph, size)
-    if region is not None:
-        view = sub_view(view, region)
-    settings = scene.solidwire.snapshot()
+
+def tiles_of(region, tile_size: int | None = None):
+    """(x0, y0, w, h) tiles covering ``region`` (frame pixels), rows from the bottom."""
+    x0, y0, w, h = region
+    size = tile_size or TILE_SIZE
+    for ty in range(y0, y0 + h, size):
+        for tx in range(x0, x0 + w, size):
+            yield tx, ty, min(size, x0 + w - tx), min(size, y0 + h - ty)
+
+
+class PreparedFrame:
+    """What every tile of one frame shares: the full-frame view, the settings
+    snapshot and the gathered draw items (extracted and uploaded once).
+    ``extra_passes`` (core.passes.EXTRA_PASSES) are drawn with each tile."""
+
+    def __init__(self, depsgraph, size, *, should_stop=None, extra_passes=()):
+        ensure_gpu()  # uploads start in gather(), before anything is drawn
+        self.scene = depsgraph.scene
+        self.view = camera_view(self.scene, depsgraph, size)
+        self.settings = self.scene.solidwire.snapshot()
+        # Reuse: unchanged meshes are recognised by their content fingerprint
+        # (runtime.py says why), so a multi-frame render re-extracts only what
+        # changed on each frame.
+        self.frame = runtime.begin_frame(reuse=True)
+        # The view lets gather skip extracting meshes that are wholly off-screen.
+        self.extra_passes = tuple(extra_passes)
+        self.items, self.seen, self.ms_extract = gather.gather(
+            depsgraph, runtime.mesh_cache, view=self.view, should_stop=should_stop,
+            object_settings=gather.ObjectSettings(
+                gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes),
+            materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
+            **passes.gather_options(self.settings),
+        )
+        self.draw_stats = None
+        self.ms_draw = 0.0
+
+    def draw(self, region):
+        """(rgba premultiplied over the film, view depth, {extra pass: values})
+        of ``region`` (x0, y0, w, h in frame pixels), pixel for pixel as in
+        the whole frame."""
+        width, height = self.view.width, self.view.height
+        view = self.view if tuple(region) == (0, 0, width, height) else sub_view(self.view, region)
+        start = time.perf_counter()
+        rgba, depth, stats, extra = passes.render_passes(self.items, view, self.settings,
+                                                         extra_passes=self.extra_passes)
+        self.ms_draw += (time.perf_counter() - start) * 1000.0
+        if self.draw_stats is None:
+            self.draw_stats = stats
+        return composite_film(rgba, self.scene), depth, extra
+
+    def finish(self) -> None:
+        runtime.end_frame(self.frame, self.draw_stats or DrawStats(), self.ms_extract, self.ms_draw, self.seen)
+
+
+def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None, extra_passes=(),
+                 extra_out=None):
+    """Render ``depsgraph``'s scene from its camera in one piece: (rgba
+    premultiplied over the film, view depth), or None when ``should_stop()``
+    said so. ``region`` (x0, y0, w, h) in pixels of the full frame draws that
+    window only. ``report(text, fraction)`` hears about the stages. The render
+    passes named in ``extra_passes`` (core.passes.EXTRA_PASSES) go into the
+    dict ``extra_out``."""
     report = report or (lambda _text, _fraction: None)
     report("extracting meshes", 0.0)
-    # Reuse: unchanged meshes are recognised by their content fingerprint
-    # (runtime.py says why), so a multi-frame render re-extracts only what
-    # changed on each frame.
-    frame = runtime.begin_frame(reuse=True)
-    # The view lets gather skip extracting meshes that are wholly off-screen.
-    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, view=view, should_stop=should_stop,
-                                            **passes.gather_options(settings))
+    frame = PreparedFrame(depsgraph, size, should_stop=should_stop, extra_passes=extra_passes)
     if should_stop is not None and should_stop():
         return None
-    report(f"drawing {len(items)} objects", 0.5)
-    start = time.perf_counter()
-    rgba, depth, draw_stats = passes.render(items, view, settings)
-    runtime.end_frame(frame, draw_stats, ms_extract, (time.perf_counter() - start) * 1000.0, seen)
+    report(f"drawing {len(frame.items)} objects", 0.5)
+    rgba, depth, extra = frame.draw(region or (0, 0, frame.view.width, frame.view.height))
+    if extra_out is not None:
+        extra_out.update(extra)
+    frame.finish()
     report("writing the result", 0.9)
-    return composite_film(rgba, scene), depth
+    return rgba, depth
 
 
 def sub_view(view, region):
@@ -96,6 +145,37 @@ def sub_view(view, region):
     window[0, 0], window[0, 3] = width / w, (width - 2.0 * x0 - w) / w
     window[1, 1], window[1, 3] = height / h, (height - 2.0 * y0 - h) / h
     return View(view.view_matrix, window @ view.projection, (0, 0, w, h))
+
+
+def extra_passes_of(view_layer) -> tuple:
+    """The render passes beyond Combined and Depth that ``view_layer`` asks
+    for: Blender's own switches and SolidWire's (``view_layer.solidwire``)."""
+    names = []
+    if view_layer.use_pass_normal:
+        names.append(passes.NORMAL_PASS)
+    if view_layer.use_pass_object_index:
+        names.append(passes.OBJECT_INDEX_PASS)
+    if view_layer.use_pass_material_index:
+        names.append(passes.MATERIAL_INDEX_PASS)
+    props = getattr(view_layer, "solidwire", None)
+    if props is not None:
+        for enabled, name in ((props.use_pass_wire, passes.WIRE_PASS),
+                              (props.use_pass_hidden_wire, passes.HIDDEN_WIRE_PASS),
+                              (props.use_pass_edge_distance, passes.EDGE_DISTANCE_PASS)):
+            if enabled:
+                names.append(name)
+    return tuple(names)
+
+
+# (channels, channel ids, type) of each extra pass as Blender registers it.
+PASS_LAYOUT = {
+    passes.NORMAL_PASS: (3, "XYZ", "VECTOR"),
+    passes.OBJECT_INDEX_PASS: (1, "X", "VALUE"),
+    passes.MATERIAL_INDEX_PASS: (1, "X", "VALUE"),
+    passes.WIRE_PASS: (1, "X", "VALUE"),
+    passes.HIDDEN_WIRE_PASS: (1, "X", "VALUE"),
+    passes.EDGE_DISTANCE_PASS: (1, "X", "VALUE"),
+}
 
 
 def write_pass(render_pass, array: np.ndarray) -> None:
@@ -119,26 +199,39 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         width, height = render_size(scene)
         region = region_of(scene, width, height)
         layer_name = depsgraph.view_layer.name
-
-        def report(text, fraction):
-            self.update_stats("SolidWire", f"{layer_name} | {text}")
-            self.update_progress(fraction)
-
         try:
-            rendered = render_scene(depsgraph, (width, height), region=region, should_stop=self.test_break,
-                                    report=report)
+            with shaders.gl_context("render-engine"):
+                self._render_frame(depsgraph, (width, height), region, layer_name)
         except NoCameraError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
-            return
         except Exception as exc:  # never take the render (or Blender) down
             self.report({"ERROR"}, f"SolidWire render failed: {type(exc).__name__}: {exc}")
-            return
-        if rendered is None:
-            return  # cancelled (Esc): Blender keeps what it had
-        rgba, depth = rendered
-        # Each view layer into its own result layer; the region's size (with
-        # or without Crop to Render Region, Blender places it in the frame).
-        result = self.begin_result(0, 0, region[2], region[3], layer=layer_name)
+        else:
+            self.update_progress(1.0)
+
+    def _render_frame(self, depsgraph, size, region, layer_name) -> None:
+        """Extract once, then draw and hand over the region tile by tile."""
+        self.update_stats("SolidWire", f"{layer_name} | extracting meshes")
+        frame = PreparedFrame(depsgraph, size, should_stop=self.test_break,
+                              extra_passes=extra_passes_of(depsgraph.view_layer))
+        tiles = list(tiles_of(region))
+        for number, tile in enumerate(tiles, start=1):
+            if self.test_break():
+                return  # cancelled (Esc): Blender keeps what it had
+            self.update_stats("SolidWire", f"{layer_name} | drawing {len(frame.items)} objects"
+                              + (f", tile {number} of {len(tiles)}" if len(tiles) > 1 else ""))
+            self.update_progress(0.1 + 0.9 * (number - 1) / len(tiles))
+            rgba, depth, extra = frame.draw(tile)
+            self._write(tile, region, layer_name, rgba, depth, extra)
+        frame.finish()
+
+    def _write(self, tile, region, layer_name, rgba, depth, extra) -> None:
+        """One tile into this view layer's result layer. Result coordinates
+        are relative to the region (Blender places the region in the frame,
+        with or without Crop to Render Region). The result is ended whatever
+        happens."""
+        x0, y0, w, h = tile
+        result = self.begin_result(x0 - region[0], y0 - region[1], w, h, layer=layer_name)
         cancel = True
         try:
             layer = result.layers[0]
@@ -146,17 +239,23 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
             depth_pass = layer.passes.find("Depth")
             if depth_pass != -1:
                 write_pass(layer.passes[depth_pass], depth)
+            for name, values in extra.items():
+                index = layer.passes.find(name)
+                if index != -1:
+                    write_pass(layer.passes[index], values)
             cancel = False
-        except Exception as exc:  # the result must be ended whatever happens
-            self.report({"ERROR"}, f"SolidWire could not write the result: {type(exc).__name__}: {exc}")
+        except Exception as exc:
+            raise RuntimeError(f"could not write the result: {type(exc).__name__}: {exc}") from None
         finally:
             self.end_result(result, cancel=cancel)
-        self.update_progress(1.0)
 
     def update_render_passes(self, scene=None, renderlayer=None):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
         if renderlayer.use_pass_z:
             self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
+        for name in extra_passes_of(renderlayer):
+            channels, channel_ids, kind = PASS_LAYOUT[name]
+            self.register_pass(scene, renderlayer, name, channels, channel_ids, kind)
 
 
 # Blender's own panels marked for any engine carry the pseudo-engine

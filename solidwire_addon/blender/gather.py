@@ -27,8 +27,52 @@ from ..core import extract
 from ..core.cache import MeshCache
 from ..core.colors import ItemSource
 from ..core.log import warn_once
-from ..core.view import DrawItem, outside_frustum_many
+from ..core.view import DrawItem, Style, outside_frustum_many
 from . import runtime
+
+# Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
+SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
+
+
+class ObjectSettings:
+    """The per-object settings (``object.solidwire``) of one frame, read once
+    per original object: whether it is shown in this target and its style
+    override. ``show`` is SHOW_IN_RENDER or SHOW_IN_VIEWPORT; for the
+    viewport the older ``solidwire_exclude`` property still opts out."""
+
+    def __init__(self, show: str, objects=(), *, pass_index: bool = False):
+        """``objects`` (``bpy.data.objects``) are scanned once: when none has
+        a setting off its default and no pass index is wanted, gather()
+        skips the per-instance look-up altogether (``active`` is False), so
+        scenes that do not use these settings pay one scan per frame."""
+        self.show = show
+        self._known: dict[int, tuple] = {}
+        self.active = pass_index or any(self._non_default(obj) for obj in objects)
+
+    def _non_default(self, obj) -> bool:
+        props = getattr(obj, "solidwire", None)
+        if props is not None and (props.use_override or not getattr(props, self.show)):
+            return True
+        return self.show == SHOW_IN_VIEWPORT and bool(getattr(obj, "solidwire_exclude", False))
+
+    def lookup(self, obj) -> tuple:
+        """(shown, Style or None, pass index) of an evaluated object's
+        original, read once per original and frame."""
+        obj_orig = obj.original
+        uid = obj_orig.session_uid
+        known = self._known.get(uid)
+        if known is None:
+            props = getattr(obj_orig, "solidwire", None)
+            shown, style = True, None
+            if props is not None:
+                shown = bool(getattr(props, self.show))
+                if props.use_override:
+                    style = Style(tuple(float(c) for c in props.wire_color), float(props.thickness),
+                                  tuple(float(c) for c in props.fill_color))
+            if self.show == SHOW_IN_VIEWPORT and getattr(obj_orig, "solidwire_exclude", False):
+                shown = False
+            known = self._known[uid] = (shown, style, int(getattr(obj_orig, "pass_index", 0)))
+        return known
 
 
 class SeenKeys(set):
@@ -57,13 +101,15 @@ def fingerprint(mesh, corners: bool = False):
     too: sharp edges or materials can change without moving a vertex."""
     positions = extract.read_positions(mesh)
     corner_vert = extract.read_corner_verts(mesh)
+    # Topology first, the positions' checksum last (MeshCache.get_validated
+    # re-uploads positions alone when only the last element differs).
     content = (
         len(positions),
         len(mesh.edges),
         len(corner_vert),
         len(mesh.polygons),
-        zlib.crc32(memoryview(positions).cast("B")),
         zlib.crc32(memoryview(corner_vert).cast("B")),
+        zlib.crc32(memoryview(positions).cast("B")),
     )
     corner_inputs = None
     if corners:
@@ -83,7 +129,8 @@ def item_source(obj) -> ItemSource:
 
 
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None, corners: bool = False, colors: bool = False, edge_angle: float = 0.0):
+           should_stop=None, corners: bool = False, colors: bool = False, edge_angle: float = 0.0,
+           object_settings: ObjectSettings | None = None, materials: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -100,7 +147,14 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     colours; a separate cache entry, so FLAT draws never pay for it).
     ``colors``: each item carries its object's :class:`ItemSource`.
     ``edge_angle`` (radians, > 0): flat edges are not drawn (extraction
-    clears their flags; a separate cache entry per angle)."""
+    clears their flags; a separate cache entry per angle).
+
+    ``object_settings`` applies the per-object settings: an object drawn
+    itself follows its own; an instance is drawn only if both its instancer
+    and the object it instances are shown, and takes the style override of
+    the object it instances (docs/image_model.md §5.9). ``materials`` (the
+    IndexMA pass) gives each item its faces' material slots and the slots'
+    material pass indices."""
     mode = depsgraph.mode
     if trust_updates is None:
         trust_updates = mode == "VIEWPORT"
@@ -118,6 +172,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     view_projection = None if view is None else view.projection @ view.view_matrix
     deferred: dict[int, tuple] = {}  # culled, never-extracted mesh -> (key, uids, bound box, instances culled)
     sources: dict[int, ItemSource] = {}  # evaluated object -> its colour-source inputs this frame
+    face_slots: dict[int, np.ndarray] = {}  # evaluated mesh -> material slot per face (materials only)
 
     for instance in depsgraph.object_instances:
         obj = instance.object
@@ -134,6 +189,11 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
         owner = parent if parent is not None else obj
         if object_filter is not None and not object_filter(owner.original):
             continue
+        style, pass_index = None, 0
+        if object_settings is not None and object_settings.active:
+            shown, style, pass_index = object_settings.lookup(obj)
+            if not shown or (parent is not None and not object_settings.lookup(parent)[0]):
+                continue
         data = obj.data
         pointer = data.as_pointer()
         if pointer in deferred:
@@ -191,10 +251,26 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                 source = sources.get(obj.as_pointer())
                 if source is None:
                     source = sources[obj.as_pointer()] = item_source(obj)
-            items.append(DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), source))
+            item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), source, style, pass_index)
+            if materials:
+                item.materials = _materials_of(obj, data, pointer, face_slots)
+            items.append(item)
     for _key, _uids, _box, culled in deferred.values():
         cache.culled += culled  # never extracted: every instance outside the view
     return items, seen, ms_extract
+
+
+def _materials_of(obj, data, pointer, face_slots) -> tuple | None:
+    """(material slot per face, pass_index per slot) of an evaluated object."""
+    try:
+        slots = face_slots.get(pointer)
+        if slots is None:
+            slots = face_slots[pointer] = extract.read_material_indices(data)
+        passes = tuple(float(s.material.pass_index) if s.material is not None else 0.0 for s in obj.material_slots)
+    except (AttributeError, RuntimeError, ValueError) as exc:
+        warn_once(("materials", obj.name), f"SolidWire: no material indices for '{obj.name}': {exc}")
+        return None
+    return slots, passes
 
 
 def _bound_box(obj):
@@ -285,9 +361,19 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
             )
         return arrays
 
+    def reposition(entry, context):
+        positions, corner_vert = context[:2]
+        return extract.reposition(entry, positions, corner_vert, extract.read_face_offsets(get_source()))
+
     try:
-        mesh, _extracted = cache.get_validated(key, fast, (lambda: fingerprint(get_source(), True)) if corners else (lambda: fingerprint(get_source())),
-                                                  make_arrays)
+        # Positions-only re-upload (reposition) only for meshes without a
+        # corner table or edge angle: corner normals and which edges are flat
+        # follow the positions, so those meshes are extracted again.
+        simple = not corners and edge_angle <= 0.0
+        mesh, _extracted = cache.get_validated(
+            key, fast, (lambda: fingerprint(get_source(), True)) if corners else (lambda: fingerprint(get_source())),
+            make_arrays, reposition if simple else None
+        )
     finally:
         if in_edit_mode and source:
             obj.to_mesh_clear()

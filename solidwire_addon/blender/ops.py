@@ -6,11 +6,13 @@ the overlay handler, reacting to the settings' update callbacks.
 
 from __future__ import annotations
 
+import functools
+
 import bpy
 import numpy as np
 from bpy.props import StringProperty
 
-from . import presets
+from . import overlay, presets
 from .overlay import viewport_object_filter
 from .properties import redraw_viewports
 
@@ -32,20 +34,72 @@ def _solidwire(context):
     return context.scene.solidwire
 
 
+def current_viewport(context):
+    """(screen, area) of the 3D View the operator or panel acts on, or None."""
+    area = getattr(context, "area", None)
+    screen = getattr(context, "screen", None)
+    if area is None or screen is None or area.type != "VIEW_3D":
+        return None
+    return screen, area
+
+
+def overlay_shown(context) -> bool:
+    """Whether SolidWire is on in the current 3D View (the scene default
+    outside a 3D View)."""
+    props = _solidwire(context)
+    viewport = current_viewport(context)
+    if viewport is None:
+        return bool(props.show_overlay)
+    return overlay.viewport_shows(*viewport, props)
+
+
+def one_line_errors(method):
+    """Wrap an operator's ``execute`` / ``invoke``: an unexpected exception is
+    reported as one line (``bpy.ops`` raises RuntimeError with it) and the
+    operator is cancelled, instead of Blender printing a traceback. Expected
+    problems are checked and reported by the operators themselves."""
+
+    def run(self, *args):
+        try:
+            return method(self, *args)
+        except Exception as exc:  # noqa: BLE001 - no traceback from an operator
+            message = " ".join(str(exc).split()) or type(exc).__name__
+            self.report({"ERROR"}, f"SolidWire: {self.bl_label} failed: {type(exc).__name__}: {message}")
+            return {"CANCELLED"}
+
+    # Blender checks the argument count of execute (self, context) and
+    # invoke (self, context, event), so the wrapper keeps it.
+    if method.__code__.co_argcount == 3:
+        def guarded(self, context, event):
+            return run(self, context, event)
+    else:
+        def guarded(self, context):
+            return run(self, context)
+    return functools.wraps(method)(guarded)
+
+
 class SOLIDWIRE_OT_toggle_overlay(bpy.types.Operator):
-    """Show or hide the SolidWire overlay in 3D viewports"""
+    """Show or hide the SolidWire overlay in this 3D View (outside a 3D View: the default for viewports)"""
 
     bl_idname = "solidwire.toggle_overlay"
     bl_label = "Toggle SolidWire Overlay"
-    bl_options = {"REGISTER", "UNDO"}
+    # No UNDO: the toggle is view state kept on the screen, like Blender's own
+    # overlay options; undoing a modelling step must not flip it.
+    bl_options = {"REGISTER"}
 
     @classmethod
     def poll(cls, context):
         return getattr(context.scene, "solidwire", None) is not None
 
+    @one_line_errors
     def execute(self, context):
         props = _solidwire(context)
-        props.show_overlay = not props.show_overlay
+        viewport = current_viewport(context)
+        if viewport is None:
+            props.show_overlay = not props.show_overlay
+        else:
+            overlay.set_viewport_shows(*viewport, not overlay.viewport_shows(*viewport, props))
+            viewport[1].tag_redraw()
         return {"FINISHED"}
 
 
@@ -71,6 +125,9 @@ def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
     if not depths:
         return None
     depths = np.concatenate(depths)
+    depths = depths[np.isfinite(depths)]  # an object with a broken transform says nothing
+    if not len(depths):
+        return None
     near, far = max(float(depths.min()), 0.0), float(depths.max())
     if far <= 0.0:
         return None
@@ -88,6 +145,7 @@ class SOLIDWIRE_OT_fade_from_visible(bpy.types.Operator):
     def poll(cls, context):
         return getattr(context.scene, "solidwire", None) is not None
 
+    @one_line_errors
     def execute(self, context):
         props = _solidwire(context)
         space = context.space_data if getattr(context, "space_data", None) and context.space_data.type == "VIEW_3D" else None
@@ -101,7 +159,9 @@ class SOLIDWIRE_OT_fade_from_visible(bpy.types.Operator):
         else:
             self.report({"ERROR"}, "SolidWire: no 3D viewport or scene camera to measure depth from")
             return {"CANCELLED"}
-        keep = viewport_object_filter(context.view_layer, space, only_selected=props.only_selected)
+        keep = viewport_object_filter(
+            context.view_layer, space, only_selected=props.only_selected, draw_edit_mode=props.overlay_edit_mode
+        )
         extent = visible_depth_extent(context.evaluated_depsgraph_get(), view_matrix, keep)
         if extent is None:
             self.report({"WARNING"}, "SolidWire: no visible mesh in front of the view")
@@ -121,6 +181,7 @@ class SOLIDWIRE_OT_preset_apply(bpy.types.Operator):
 
     name: StringProperty(name="Preset", description="Name of the preset to apply")
 
+    @one_line_errors
     def execute(self, context):
         global active_preset_name
         try:
@@ -143,9 +204,11 @@ class SOLIDWIRE_OT_preset_add(bpy.types.Operator):
 
     name: StringProperty(name="Name", description="Name of the new preset", default="My Preset", maxlen=64)
 
+    @one_line_errors
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self)
 
+    @one_line_errors
     def execute(self, context):
         global active_preset_name
         try:
@@ -171,11 +234,13 @@ class SOLIDWIRE_OT_preset_remove(bpy.types.Operator):
     def poll(cls, context):
         return bool(active_preset_name)
 
+    @one_line_errors
     def invoke(self, context, event):
         if not self.name:
             self.name = active_preset_name
         return context.window_manager.invoke_confirm(self, event)
 
+    @one_line_errors
     def execute(self, context):
         global active_preset_name
         name = self.name or active_preset_name

@@ -10,6 +10,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, StringProperty
 
 from . import composite
+from .ops import one_line_errors
 
 ENGINE_ITEMS = (
     ("SCENE", "Scene Engine", "The scene's render engine (when that is not SolidWire)"),
@@ -62,6 +63,7 @@ class SOLIDWIRE_OT_render_wire_over(bpy.types.Operator):
         scene = getattr(context, "scene", None)
         return scene is not None and getattr(scene, "solidwire", None) is not None
 
+    @one_line_errors
     def execute(self, context):
         scene = context.scene
         path = Path(bpy.path.abspath(self.filepath)) if self.filepath else default_output_path(scene)

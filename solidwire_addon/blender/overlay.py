@@ -23,75 +23,179 @@ import time
 
 import bpy
 
-from ..core import passes
+from ..core import overlay_state, passes
 from ..core.log import warn_once
 from ..core.view import View
-from . import gather, runtime
+from . import gather, properties, runtime
 from .views import region_view
 
 _handle = None
 
 
-def viewport_object_filter(view_layer, space_view3d=None, *, only_selected: bool = False):
-    """``object_filter`` for gather(): what this viewport shows.
+# -- the per-viewport toggle (stored on the screen; see properties.py) ----------
+
+
+def _area_index(screen, area) -> int | None:
+    for index, candidate in enumerate(getattr(screen, "areas", ())):
+        if candidate == area:
+            return index
+    return None
+
+
+def viewport_toggle(screen, area):
+    """This 3D View's toggle entry, or None when it never had one."""
+    index = _area_index(screen, area)
+    if index is None:
+        return None
+    for entry in getattr(screen, properties.VIEWPORTS_ATTRIBUTE, ()):
+        if entry.area_index == index:
+            return entry
+    return None
+
+
+def viewport_shows(screen, area, scene_props) -> bool:
+    """Whether SolidWire is on in this 3D View: its own toggle, or the
+    scene's default for a viewport that never had one."""
+    entry = viewport_toggle(screen, area)
+    if entry is not None:
+        return bool(entry.show)
+    return bool(getattr(scene_props, "show_overlay", False))
+
+
+def set_viewport_shows(screen, area, show: bool) -> None:
+    entry = viewport_toggle(screen, area)
+    if entry is None:
+        index = _area_index(screen, area)
+        if index is None:
+            raise ValueError("the area is not part of the screen")
+        entry = getattr(screen, properties.VIEWPORTS_ATTRIBUTE).add()
+        entry.area_index = index
+    entry.show = bool(show)
+
+
+# -- what the overlay draws ------------------------------------------------------
+
+
+def object_state(obj, view_layer, space_view3d=None) -> overlay_state.ObjectState:
+    """Read one object's plain state for this viewport.
 
     ``visible_get`` covers hide states (eye icon, ``hide_viewport``),
     collection visibility, and local view when ``space_view3d`` is given.
-    The per-object opt-out and "only selected" come on top."""
+    The per-object switch (``object.solidwire.show_in_viewport``, or the
+    older ``solidwire_exclude``) makes the object excluded."""
+    props = getattr(obj, "solidwire", None)
+    try:
+        visible = obj.visible_get(view_layer=view_layer, viewport=space_view3d)
+    except (TypeError, RuntimeError):
+        # Not in this view layer (e.g. an instancer from a linked scene):
+        # the depsgraph already decided it is drawn.
+        visible = True
+    try:
+        selected = obj.select_get(view_layer=view_layer)
+    except (TypeError, RuntimeError):
+        selected = False
+    return overlay_state.ObjectState(
+        visible=bool(visible),
+        selected=bool(selected),
+        excluded=bool(getattr(obj, "solidwire_exclude", False))
+        or (props is not None and not getattr(props, "show_in_viewport", True)),
+        in_edit_mode=getattr(obj, "mode", "OBJECT") == "EDIT",
+    )
+
+
+def object_filter(plan, view_layer, space_view3d=None):
+    """``object_filter`` for gather(): the plan's rule on each object's state."""
 
     def keep(obj) -> bool:
-        if getattr(obj, "solidwire_exclude", False):
-            return False
-        try:
-            visible = obj.visible_get(view_layer=view_layer, viewport=space_view3d)
-        except (TypeError, RuntimeError):
-            # Not in this view layer (e.g. an instancer from a linked scene):
-            # the depsgraph already decided it is drawn.
-            visible = True
-        if not visible:
-            return False
-        if only_selected and not obj.select_get(view_layer=view_layer):
-            return False
-        return True
+        return overlay_state.keep_object(plan, object_state(obj, view_layer, space_view3d))
 
     return keep
 
 
-def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None) -> dict:
+def viewport_object_filter(view_layer, space_view3d=None, *, only_selected: bool = False, draw_edit_mode: bool = True):
+    """``object_filter`` for gather() outside a draw (operators, tests):
+    visibility, opt-out and "only selected"; Edit Mode objects kept unless
+    ``draw_edit_mode`` is False."""
+    plan = overlay_state.plan_overlay(
+        overlay_state.ViewportState(only_selected=only_selected, draw_edit_mode=draw_edit_mode)
+    )
+    return object_filter(plan, view_layer, space_view3d)
+
+
+def viewport_state(context) -> overlay_state.ViewportState | None:
+    """Read the plain state of the viewport being drawn (None: not a 3D View
+    region or no SolidWire settings)."""
+    props = getattr(context.scene, "solidwire", None)
+    if props is None:
+        return None
+    space = context.space_data
+    region_3d = context.region_data
+    if context.region is None or region_3d is None:
+        return None
+    shading = getattr(space, "shading", None)
+    shading_type = getattr(shading, "type", overlay_state.SOLID)
+    if shading_type == overlay_state.WIREFRAME:
+        xray, alpha = getattr(shading, "show_xray_wireframe", False), getattr(shading, "xray_alpha_wireframe", 1.0)
+    else:
+        xray, alpha = getattr(shading, "show_xray", False), getattr(shading, "xray_alpha", 1.0)
+    clip_planes = None
+    if getattr(region_3d, "use_clip_planes", False):
+        clip_planes = tuple(tuple(plane) for plane in region_3d.clip_planes)
+    overlay = getattr(space, "overlay", None)
+    return overlay_state.ViewportState(
+        show=viewport_shows(context.screen, context.area, props),
+        show_overlays=bool(getattr(overlay, "show_overlays", True)),
+        shading=shading_type,
+        xray=bool(xray),
+        xray_alpha=float(alpha),
+        clip_planes=clip_planes,
+        pixel_size=float(context.preferences.system.pixel_size),
+        only_selected=bool(props.only_selected),
+        draw_edit_mode=bool(props.overlay_edit_mode),
+    )
+
+
+def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, plan=None) -> dict:
     """Draw the overlay of ``depsgraph``'s scene into the bound framebuffer,
-    which already holds the scene's colour and depth. Returns the frame stats."""
+    which already holds the scene's colour and depth. ``plan`` (an
+    ``overlay_state.OverlayPlan``) carries the viewport state: depth source,
+    clipping planes and UI scale. Returns the frame stats."""
+    if plan is None:
+        plan = overlay_state.plan_overlay(overlay_state.ViewportState())
     # Meshes are reused across redraws: the viewport depsgraph reports every
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
+                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
                                             **passes.gather_options(settings))
     start = time.perf_counter()
-    stats = passes.draw_over_viewport(items, view, settings)
+    stats = passes.draw_over_viewport(
+        items,
+        view,
+        overlay_state.draw_settings(plan, settings),
+        scene_depth=plan.scene_depth,
+        clip_planes=plan.clip_planes,
+    )
     ms_draw = (time.perf_counter() - start) * 1000.0
     return runtime.end_frame(frame, stats, ms_extract, ms_draw, seen)
 
 
 def _draw_callback() -> None:
-    """The POST_VIEW handler. Never raises: a failure is reported once and the
+    """The POST_VIEW handler: reads the context into plain state, the rest is
+    core/overlay_state.py. Never raises: a failure is reported once and the
     next redraw tries again."""
     try:
         context = bpy.context
-        props = getattr(context.scene, "solidwire", None)
-        if props is None or not props.show_overlay:
+        state = viewport_state(context)
+        plan = overlay_state.plan_overlay(state) if state is not None else None
+        if plan is None:
             return
-        space = context.space_data
-        region, region_3d = context.region, context.region_data
-        if region is None or region_3d is None:
-            return
-        overlay = getattr(space, "overlay", None)
-        if overlay is not None and not overlay.show_overlays:
-            return  # the viewport's own Overlays toggle hides ours too
-        view_layer = context.view_layer
         draw_scene_overlay(
             context.evaluated_depsgraph_get(),
-            region_view(region, region_3d),
-            props.snapshot(),
-            object_filter=viewport_object_filter(view_layer, space, only_selected=props.only_selected),
+            region_view(context.region, context.region_data),
+            context.scene.solidwire.snapshot(),
+            object_filter=object_filter(plan, context.view_layer, context.space_data),
+            plan=plan,
         )
     except Exception as exc:  # noqa: BLE001 - a draw handler must never raise
         warn_once(("overlay", type(exc).__name__, str(exc)), f"SolidWire overlay: {type(exc).__name__}: {exc}")

@@ -9,7 +9,15 @@ changes.
 from __future__ import annotations
 
 import bpy
-from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, PointerProperty
+from bpy.props import (
+    BoolProperty,
+    CollectionProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    PointerProperty,
+)
 
 from ..core import schema
 from ..core.settings import DrawSettings
@@ -43,8 +51,25 @@ def _matcap_changed(self, _context) -> None:
     redraw_viewports()
 
 
+def _passes_changed(self, _context) -> None:
+    """A pass switched on or off: Blender asks the engine for its passes
+    again (the compositor's Render Layers node shows them at once)."""
+    scene = self.id_data
+    for view_layer in getattr(scene, "view_layers", ()):
+        if view_layer.solidwire == self:
+            try:
+                view_layer.update_render_passes()
+            except (AttributeError, RuntimeError):
+                pass  # the passes are asked for again at the next render anyway
+
+
 # Settings whose change does more than redraw.
-_UPDATES = {"diagonal_mode": _diagonal_mode_changed, "fill_shading": _matcap_changed, "matcap": _matcap_changed}
+_UPDATES = {
+    "diagonal_mode": _diagonal_mode_changed,
+    "fill_shading": _matcap_changed,
+    "matcap": _matcap_changed,
+    **{s.name: _passes_changed for s in schema.settings_in(schema.VIEW_LAYER) if s.name.startswith("use_pass_")},
+}
 
 
 def make_property(setting: schema.Setting):
@@ -81,12 +106,36 @@ def make_group(scope: str):
 GROUPS = {scope: make_group(scope) for scope in _OWNERS if schema.settings_in(scope)}
 SolidWireSettings = GROUPS[schema.SCENE]
 
-classes = tuple(GROUPS.values())
+
+class SolidWireViewportToggle(bpy.types.PropertyGroup):
+    """One 3D View's own SolidWire toggle, kept on its screen.
+
+    Blender lets add-ons register properties on ID types only (not on Area,
+    SpaceView3D or View3DOverlay), so the toggle lives in a collection on the
+    Screen, keyed by the area's index in ``screen.areas``. Screens are UI
+    data: a change adds no undo step (Blender's ID_CHECK_UNDO leaves screens
+    out) and is saved with the file's UI. Indices are stable while areas are
+    split (new areas go last); joining areas can move a toggle to the
+    neighbouring 3D View, and a maximised area (its own temporary screen)
+    starts from the scene default."""
+
+    area_index: IntProperty(name="Area", description="Index of the 3D View in screen.areas", min=0)
+    show: BoolProperty(
+        name="SolidWire Overlay",
+        description="Draw the solid wireframe over meshes in this 3D View",
+        default=False,
+        update=redraw_viewports,
+    )
+
+
+classes = (*GROUPS.values(), SolidWireViewportToggle)
+VIEWPORTS_ATTRIBUTE = "solidwire_viewports"
 
 
 def register_properties() -> None:
     for scope, group in GROUPS.items():
         setattr(getattr(bpy.types, _OWNERS[scope]), ATTRIBUTE, PointerProperty(type=group))
+    setattr(bpy.types.Screen, VIEWPORTS_ATTRIBUTE, CollectionProperty(type=SolidWireViewportToggle))
     # Per-object opt-out of the viewport overlay.
     bpy.types.Object.solidwire_exclude = BoolProperty(
         name="Exclude from SolidWire Overlay",
@@ -101,5 +150,7 @@ def unregister_properties() -> None:
         owner = getattr(bpy.types, _OWNERS[scope])
         if hasattr(owner, ATTRIBUTE):
             delattr(owner, ATTRIBUTE)
+    if hasattr(bpy.types.Screen, VIEWPORTS_ATTRIBUTE):
+        delattr(bpy.types.Screen, VIEWPORTS_ATTRIBUTE)
     if hasattr(bpy.types.Object, "solidwire_exclude"):
         del bpy.types.Object.solidwire_exclude

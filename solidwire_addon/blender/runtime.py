@@ -116,6 +116,7 @@ def end_frame(start: float, draw_stats, ms_extract: float, ms_draw: float, seen_
         triangles_drawn=draw_stats.triangles_drawn,
         meshes_extracted=mesh_cache.extracted,
         meshes_reused=mesh_cache.reused,
+        meshes_repositioned=mesh_cache.repositioned,
         meshes_cached=len(mesh_cache),
         gpu_bytes=mesh_cache.gpu_bytes,
         ms_extract=ms_extract,

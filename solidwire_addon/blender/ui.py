@@ -37,6 +37,26 @@ def draw_look_settings(layout, props) -> None:
             col.operator(idname, icon=icon)
 
 
+def draw_object_settings(layout, obj) -> None:
+    """An object's own settings (``object.solidwire``), rows in schema order;
+    the override's values are greyed while the override is off. An older
+    file's ``solidwire_exclude`` shows only while it is set, so it can be
+    cleared."""
+    props = getattr(obj, "solidwire", None)
+    if props is None:
+        return
+    layout.use_property_split = True
+    layout.use_property_decorate = False
+    col = layout.column(align=True)
+    for setting in schema.settings_in(schema.OBJECT):
+        row = col.row()
+        if setting.active_if is not None:
+            row.active = bool(setting.active_if(props))
+        row.prop(props, setting.name)
+    if getattr(obj, "solidwire_exclude", False):
+        col.prop(obj, "solidwire_exclude", text="Overlay Off (older file)")
+
+
 def draw_presets_header(layout) -> None:
     """Presets menu with + and -, as in Blender's own preset menus."""
     row = layout.row(align=True)
@@ -81,7 +101,7 @@ class VIEW3D_PT_solidwire(bpy.types.Panel):
         return getattr(context.scene, "solidwire", None) is not None
 
     def draw_header(self, context):
-        self.layout.prop(context.scene.solidwire, "show_overlay", text="")
+        draw_toggle(self.layout, context, text="")
 
     def draw_header_preset(self, context):
         draw_presets_header(self.layout)
@@ -93,13 +113,18 @@ class VIEW3D_PT_solidwire(bpy.types.Panel):
 
         layout.separator()
         col = layout.column(heading="Overlay")
-        col.active = props.show_overlay
+        col.active = ops.overlay_shown(context)
         col.prop(props, "only_selected")
+        col.prop(props, "overlay_edit_mode")
+
+        # The active object's own settings (also in Object Properties).
+        layout.separator()
         obj = context.object
-        row = col.row()
-        if obj is not None:
-            row.prop(obj, "solidwire_exclude", text=f"Exclude '{obj.name}'")
+        if obj is not None and getattr(obj, "solidwire", None) is not None:
+            layout.label(text=f"Object '{obj.name}'", icon="OBJECT_DATA")
+            draw_object_settings(layout, obj)
         else:
+            row = layout.row()
             row.enabled = False
             row.label(text="No active object")
 
@@ -135,24 +160,82 @@ def draw_overlay_popover(self, context) -> None:
     layout = self.layout
     layout.separator()
     row = layout.row(heading="SolidWire")
-    row.prop(props, "show_overlay", text="Solid Wireframe")
+    draw_toggle(row, context, text="Solid Wireframe")
 
 
-def draw_object_visibility(self, context) -> None:
-    """Appended to Object Properties > Visibility: the per-object opt-out."""
-    obj = context.object
-    if obj is not None and obj.type == "MESH" and hasattr(obj, "solidwire_exclude"):
+def draw_toggle(layout, context, text: str) -> None:
+    """This viewport's SolidWire checkbox. The toggle lives on the screen
+    and an entry is created on first use, which a draw function may not do,
+    so the checkbox is the toggle operator drawn as one (no undo step)."""
+    shown = ops.overlay_shown(context)
+    layout.operator(
+        ops.SOLIDWIRE_OT_toggle_overlay.bl_idname,
+        text=text,
+        icon="CHECKBOX_HLT" if shown else "CHECKBOX_DEHLT",
+        emboss=False,
+    )
+
+
+class OBJECT_PT_solidwire(bpy.types.Panel):
+    """Object Properties > SolidWire: the object's own settings, for every
+    engine (the viewport overlay draws over any engine)."""
+
+    bl_idname = "OBJECT_PT_solidwire"
+    bl_label = "SolidWire"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "object"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        obj = getattr(context, "object", None)
+        return obj is not None and getattr(obj, "solidwire", None) is not None
+
+    def draw(self, context):
+        draw_object_settings(self.layout, context.object)
+
+
+# Blender's own pass switches the engine writes (docs/image_model.md §6).
+BLENDER_PASSES = ("use_pass_z", "use_pass_normal", "use_pass_object_index", "use_pass_material_index")
+
+
+class VIEWLAYER_PT_solidwire_passes(bpy.types.Panel):
+    """View Layer Properties > Passes while SolidWire is the engine: the
+    passes it writes, Blender's and its own (``view_layer.solidwire``)."""
+
+    bl_idname = "VIEWLAYER_PT_solidwire_passes"
+    bl_label = "Passes"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "view_layer"
+    COMPAT_ENGINES = {ENGINE_ID}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES and getattr(context, "view_layer", None) is not None
+
+    def draw(self, context):
         layout = self.layout
         layout.use_property_split = True
-        layout.prop(obj, "solidwire_exclude", text="SolidWire Overlay Off")
+        layout.use_property_decorate = False
+        view_layer = context.view_layer
+        col = layout.column(heading="Data", align=True)
+        for name in BLENDER_PASSES:
+            col.prop(view_layer, name)
+        props = getattr(view_layer, "solidwire", None)
+        if props is not None:
+            col = layout.column(heading="SolidWire", align=True)
+            for setting in schema.settings_in(schema.VIEW_LAYER):
+                col.prop(props, setting.name)
 
 
-classes = (SOLIDWIRE_MT_presets, VIEW3D_PT_solidwire, RENDER_PT_solidwire)
+classes = (SOLIDWIRE_MT_presets, VIEW3D_PT_solidwire, RENDER_PT_solidwire, OBJECT_PT_solidwire,
+           VIEWLAYER_PT_solidwire_passes)
 
 # (Blender panel, our draw function): appended at register, removed at unregister.
 _APPENDS = (
     ("VIEW3D_PT_overlay", draw_overlay_popover),
-    ("OBJECT_PT_visibility", draw_object_visibility),
 )
 
 

@@ -59,8 +59,17 @@ class GPUMesh:
         # Kept (no copy) so the silhouette pass can derive its edge table on
         # first use without re-extracting; see silhouettes.py.
         self.triangles_cpu = arrays.triangles
+        # The IndexMA pass maps triangles to their faces' materials (draw.py).
+        self.triangle_polygons_cpu = arrays.triangle_polygons
         self.edge_flags_cpu = arrays.edge_flags
         self.silhouette_edges = None  # (texture, count), built lazily
+        # What reposition() needs to tell a move of vertices from a new shape.
+        self.vertex_count = arrays.vertex_count
+        self.quads = arrays.quads
+        self.quad_flip = arrays.quad_flip
+        self.face_offsets_crc = arrays.face_offsets_crc
+        self.source_positions = arrays.source_positions
+        self.mesh_bounds = (arrays.bounds_min, arrays.bounds_max)  # mesh space
 
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
@@ -74,6 +83,20 @@ class GPUMesh:
             + self.ngon_corners.width * self.ngon_corners.height * 16
             + (0 if self.corners is None else self.corners.width * self.corners.height * 16)
         )
+
+
+    def replace_positions(self, local: np.ndarray, centre, bounds_min, bounds_max, source_positions=None) -> None:
+        """New vertex positions, same faces and triangles: only the position
+        table is uploaded again (the triangle table, the edge-flag batch and
+        the silhouette edges depend on the faces alone)."""
+        positions = np.zeros((len(local), 4), dtype=np.float32)
+        positions[:, :3] = local
+        self.positions = table_texture(positions)
+        self.centre = centre
+        self.bounds_min = bounds_min - centre
+        self.bounds_max = bounds_max - centre
+        self.mesh_bounds = (bounds_min, bounds_max)
+        self.source_positions = source_positions
 
 
 class MeshCache:
@@ -97,6 +120,10 @@ class MeshCache:
         self._tokens: dict[object, tuple] = {}  # key -> (fast, fingerprint)
         self.extracted = 0
         self.reused = 0
+        self.repositioned = 0  # meshes whose positions alone were uploaded again
+        # Benchmark switch (scripts/bench_scale.py): False re-extracts every
+        # changed mesh in full, the behaviour before positions-only uploads.
+        self.allow_reposition = True
         self.culled = 0  # instances culled before their mesh was ever extracted
         self.ms_upload = 0.0
 
@@ -106,13 +133,18 @@ class MeshCache:
     def __contains__(self, key) -> bool:
         return key in self._entries
 
-    def get_validated(self, key, fast, fingerprint, make_arrays):
+    def get_validated(self, key, fast, fingerprint, make_arrays, reposition=None):
         """The GPU mesh for ``key`` if it is still valid, else a rebuilt one.
 
         ``fast`` is a token or None; ``fingerprint()`` computes the content
         fingerprint (called only when the fast token does not match) and
-        returns ``(fingerprint, context)``; ``make_arrays(context)`` extracts
-        (``context`` lets it reuse what the fingerprint already read).
+        returns ``(fingerprint, context)``; the fingerprint is a tuple whose
+        last element is the positions' checksum and the rest the topology.
+        ``make_arrays(context)`` extracts (``context`` lets it reuse what the
+        fingerprint already read). When only the positions changed,
+        ``reposition(entry, context)`` may return the new (local positions,
+        centre, bounds_min, bounds_max, source positions) and only the position table is
+        uploaded; None sends it through a full extraction.
         Returns ``(GPUMesh or None, extracted: bool)``."""
         entry = self._entries.get(key)
         tokens = self._tokens.get(key)
@@ -124,6 +156,21 @@ class MeshCache:
             self._tokens[key] = (fast, content)
             self.reused += 1
             return entry, False
+        if (
+            entry is not None
+            and tokens is not None
+            and reposition is not None
+            and self.allow_reposition
+            and tokens[1][:-1] == content[:-1]
+        ):
+            moved = reposition(entry, context)
+            if moved is not None:
+                start = time.perf_counter()
+                entry.replace_positions(*moved)
+                self.ms_upload += (time.perf_counter() - start) * 1000.0
+                self._tokens[key] = (fast, content)
+                self.repositioned += 1
+                return entry, True
         self._entries.pop(key, None)  # free the old upload before making the new one
         mesh = self._build(key, make_arrays(context), (fast, content))
         return mesh, True
@@ -163,6 +210,7 @@ class MeshCache:
     def reset_counters(self) -> None:
         self.extracted = 0
         self.reused = 0
+        self.repositioned = 0
         self.culled = 0
         self.ms_upload = 0.0
 

@@ -3,7 +3,7 @@ fill and the wire, and the per-frame colour table the shaders read them from.
 
 Each draw item gets a block of texels in one table: texel 0 = (wire RGB,
 material count), texel 1 = (fill RGB, 0), then one texel per material slot.
-The vertex stage finds its block from the item's base index (a push constant,
+The vertex stage finds its block from the item's base index (the item table,
 or the instance table for instanced draws).
 """
 
@@ -64,17 +64,22 @@ def item_colors(source: ItemSource | None, settings) -> tuple[tuple, tuple, tupl
     return wire, fill, materials
 
 
-def color_table(items, settings) -> tuple[np.ndarray, np.ndarray]:
+def color_table(items, settings, styled=None) -> tuple[np.ndarray, np.ndarray]:
     """((K, 4) float32 table, (len(items),) base texel of each item).
-    Items with the same source share one block."""
+    Items with the same source (and style override) share one block.
+    ``styled(style)``: the settings of an item with an object's style
+    override (core/draw.styled; its wire and fill colours replace the
+    scene's before the colour sources apply)."""
     rows: list = []
     bases = np.empty(len(items), dtype=np.int64)
     blocks: dict = {}
     for index, item in enumerate(items):
-        key = item.source
+        style = getattr(item, "style", None)
+        key = (item.source, style)
         base = blocks.get(key)
         if base is None:
-            wire, fill, materials = item_colors(key, settings)
+            item_settings = settings if style is None or styled is None else styled(style)
+            wire, fill, materials = item_colors(item.source, item_settings)
             base = len(rows)
             rows.append((*wire, float(len(materials))))
             rows.append((*fill, 0.0))

@@ -21,7 +21,8 @@ from .settings import pack_params
 from .view import DrawStats, View, outside_frustum_many, translation
 
 
-def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0) -> shaders.ShaderVariant:
+def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0,
+                   linear_depth: bool = False) -> shaders.ShaderVariant:
     """The compiled-code features ``settings`` ask for."""
     diagonals = {
         "HIDDEN": shaders.DIAGONALS_HIDDEN,
@@ -33,6 +34,7 @@ def shader_variant(settings, write_view_depth: bool = False, depth_bias: float =
         use_fade=bool(settings.use_fade),
         write_view_depth=write_view_depth,
         depth_bias=depth_bias,
+        linear_depth=linear_depth,
         thickness_mode={"WORLD": shaders.THICKNESS_WORLD, "DEPTH": shaders.THICKNESS_DEPTH}.get(
             settings.thickness_mode, shaders.THICKNESS_PIXELS
         ),
@@ -82,21 +84,40 @@ EXACT = ExactProgram()
 INSTANCING_MIN = 16
 
 
-def _groups(items, view: View, cull: bool, stats: DrawStats):
-    """Items grouped by GPU mesh with their float64-composed matrices, culled
-    (vectorised over each group). Yields (mesh, world (N,4,4), object_to_view,
-    object_to_clip, item indices (N,)) with only the visible instances."""
-    by_mesh: dict[int, list] = {}
+def styled(settings, style, show_wire: bool = True):
+    """``settings`` with an object's style override applied
+    (docs/image_model.md §5.9); ``show_wire=False`` keeps the wire out of the
+    pass whatever the override's colour (the fill-only surface pass under
+    hidden lines)."""
+    if style is not None:
+        settings = replace(settings, wire_color=style.wire_color, thickness=style.thickness,
+                           fill_color=style.fill_color)
+    if not show_wire and settings.wire_color[3] != 0.0:
+        settings = replace(settings, wire_color=(*settings.wire_color[:3], 0.0))
+    return settings
+
+
+def _groups(items, view: View, cull: bool, stats: DrawStats, pass_indices: bool = False):
+    """Items grouped by GPU mesh and style with their float64-composed
+    matrices, culled (vectorised over each group). Yields (mesh, style,
+    world (N,4,4), object_to_view, object_to_clip, item indices (N,),
+    (pass indices (N,), materials) or (None, None)) with only the visible
+    instances."""
+    by_mesh: dict = {}
     for index, item in enumerate(items):
-        by_mesh.setdefault(id(item.mesh), []).append(index)
+        # Plain items key by mesh alone: no tuple per item on the common path.
+        key = id(item.mesh) if item.style is None else (id(item.mesh), item.style)
+        by_mesh.setdefault(key, []).append(index)
     for group in by_mesh.values():
-        mesh = items[group[0]].mesh
+        mesh, style = items[group[0]].mesh, items[group[0]].style
         indices = np.asarray(group, dtype=np.int64)
         world = np.stack([items[i].matrix for i in group]) if len(group) > 1 else items[group[0]].matrix[None]
         # float64 all the way to here: the mesh centre and any large world
         # translation cancel against the view before rounding to float32.
         object_to_view = view.view_matrix @ world @ translation(mesh.centre)
         object_to_clip = view.projection @ object_to_view
+        pass_index = np.array([items[i].pass_index for i in group], dtype=np.float64) if pass_indices else None
+        materials = [items[i].materials for i in group] if pass_indices else None
         if cull:
             outside = outside_frustum_many(object_to_clip, mesh.bounds_min, mesh.bounds_max)
             if outside.any():
@@ -104,8 +125,11 @@ def _groups(items, view: View, cull: bool, stats: DrawStats):
                 keep = ~outside
                 world, object_to_view, object_to_clip = world[keep], object_to_view[keep], object_to_clip[keep]
                 indices = indices[keep]
+                if pass_index is not None:
+                    pass_index = pass_index[keep]
+                    materials = [m for m, k in zip(materials, keep) if k]
         if len(world):
-            yield mesh, world, object_to_view, object_to_clip, indices
+            yield mesh, style, world, object_to_view, object_to_clip, indices, (pass_index, materials)
 
 
 def normal_to_view(object_to_view: np.ndarray) -> np.ndarray:
@@ -145,20 +169,37 @@ def draw(
     depth_test: str = "LESS_EQUAL",
     depth_write: bool = True,
     hidden_pass: bool = False,
+    show_wire: bool = True,
+    write_aovs: bool = False,
+    linear_depth: bool = False,
+    clip_planes=None,
     program=EXACT,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
 
     Every fragment of a face writes depth (nothing is discarded), so a wire is
-    only ever seen on the face that is the visible surface there."""
+    only ever seen on the face that is the visible surface there. Items with
+    a style override draw with their own parameter block (one per distinct
+    style); the variant does not depend on the style. ``clip_planes``
+    ((6, 4) world-space planes of a viewport's clipping region): fragments
+    outside them are discarded."""
     stats = DrawStats()
     if not items:
         return stats
-    variant = shader_variant(settings, write_view_depth, depth_bias)
+    settings = styled(settings, None, show_wire)
+    variant = shader_variant(settings, write_view_depth, depth_bias, linear_depth)
     if hidden_pass:
         variant = replace(variant, hidden_pass=True, write_view_depth=False, shading=shaders.SHADING_FLAT,
                           material_colors=False)
+    if write_aovs:
+        variant = replace(variant, write_aovs=True)
+    clip_rows = None
+    if clip_planes is not None:
+        variant = replace(variant, clip_planes=True)
+        clip_rows = clip_space_planes(clip_planes, view)
     extras = {}
+    if clip_rows is not None:
+        extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
     if variant.shading == shaders.SHADING_MATCAP:
         extras["matcap_image"] = matcaps.texture(settings.matcap)
         if extras["matcap_image"] is None:
@@ -169,17 +210,35 @@ def draw(
             # not ask for it): draw flat rather than read a missing table.
             warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
             variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
+    # Two per-object mechanisms side by side (merge of issue11 and issue12):
+    # an object's style override (wire colour, thickness, fill colour) is a
+    # parameter block per distinct style (``ubo(style)``), since thickness
+    # and the wire's alpha live there; per-item colours of the colour sources
+    # and the fill shading's normal matrix come from the frame's item table
+    # (colors.color_table, item_table.glsl), whose colours are computed from
+    # each item's styled settings, so an override also holds for the colour
+    # sources' SINGLE values. The render passes' world normal and pass index
+    # keep their own object block (_set_object_block).
     bases = np.zeros(len(items), dtype=np.int64)
     if variant.item_colors:
-        table, bases = colors.color_table(items, settings)
+        table, bases = colors.color_table(items, settings,
+                                          lambda style: styled(settings, style, show_wire))
         extras["item_colors"] = table_texture(table)
-    ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
+    blocks = {None: gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))}
+
+    def ubo(style):
+        block = blocks.get(style)
+        if block is None:
+            block = blocks[style] = gpu.types.GPUUniformBuf(
+                pack_params(styled(settings, style, show_wire), view.viewport, view.projection))
+        return block
+
     gpu.state.depth_test_set(depth_test)
     gpu.state.depth_mask_set(depth_write)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
-    groups = list(_groups(items, view, cull, stats))
+    groups = list(_groups(items, view, cull, stats, pass_indices=write_aovs))
     try:
         # Meshes with n-gons need the fragment stage's outline walk; the rest
         # use a variant without it (llvmpipe pays for a loop even when it runs
@@ -194,12 +253,36 @@ def draw(
     return stats
 
 
+def clip_space_planes(planes, view: View) -> list:
+    """World-space planes (kept where dot(plane, (x, 1)) >= 0, Blender's
+    convention) as clip-space planes, flattened for the shader: with
+    clip = P V world, dot(plane, world) = dot(plane P V^-1, clip), the same
+    for every object, and linear in clip space, so the interpolated distance
+    is exact across a triangle."""
+    world = np.asarray(planes, dtype=np.float64).reshape(-1, 4)
+    rows = np.zeros((shaders.CLIP_PLANES, 4))
+    rows[: len(world)] = world[: shaders.CLIP_PLANES] @ np.linalg.inv(view.projection @ view.view_matrix)
+    # Scale each plane so float32 keeps its precision (the sign is what counts).
+    norms = np.abs(rows).max(axis=1, keepdims=True)
+    rows = np.where(norms > 0.0, rows / np.where(norms > 0.0, norms, 1.0), 0.0)
+    return rows.astype(np.float32).ravel().tolist()
+
+
+def _set_clip_planes(shader, block) -> None:
+    # A uniform block (shaders.CLIP_BLOCK_GLSL), not push constants: those
+    # stay within 128 bytes.
+    shader.uniform_block("clip_params", block)
+
+
 def _bind_extras(shader, variant, extras) -> None:
-    """Samplers of the shaded fill and the colour sources."""
+    """Samplers of the shaded fill and the colour sources, and the clipping
+    region's block."""
     if variant.shading == shaders.SHADING_MATCAP:
         shader.uniform_sampler("matcap_image", extras["matcap_image"])
     if variant.item_colors:
         shader.uniform_sampler("item_colors", extras["item_colors"])
+    if variant.clip_planes:
+        _set_clip_planes(shader, extras["clip_block"])
 
 
 def _bind_mesh(shader, variant, mesh) -> None:
@@ -213,44 +296,63 @@ def _bind_mesh(shader, variant, mesh) -> None:
 
 def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats, extras=None,
                  bases=None) -> None:
-    """Draw (mesh, world, object_to_view, object_to_clip, item indices)
-    groups with one shader variant: per object, or instanced for meshes with
-    many instances."""
+    """Draw (mesh, style, world, object_to_view, object_to_clip, item
+    indices, pass data) groups with one shader variant: per object, or
+    instanced for meshes with many instances. ``ubo(style)`` is the
+    parameter block of a style."""
     extras = extras or {}
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
     shader.bind()
-    shader.uniform_block("params", ubo)
+    bound = None
+    shader.uniform_block("params", ubo(bound))
     _bind_extras(shader, variant, extras)
-    instanced = []  # (mesh, object_to_view, object_to_clip, info, mirrored) drawn with draw_instanced
-    single = []  # (mesh, object_to_view, object_to_clip, info, mirrored) drawn one by one
-    for mesh, world, object_to_view_all, object_to_clip_all, indices in groups:
+    instanced = []  # (mesh, style, object_to_view, object_to_clip, info, mirrored) drawn with draw_instanced
+    # (mesh, style, world, object_to_view, object_to_clip, info, mirrored, pass index, materials) drawn one by one
+    single = []
+    for mesh, style, world, object_to_view_all, object_to_clip_all, indices, (pass_index, materials) in groups:
         mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
         info_all = np.zeros((len(world), 4))
         if bases is not None and len(bases):
             info_all[:, 0] = bases[indices]
         info_all[:, 1] = mirrored_all
-        if program.supports_instancing and len(world) >= INSTANCING_MIN:
+        # (The instanced variant has no per-object pass values: with passes
+        # every object is drawn on its own.)
+        if program.supports_instancing and len(world) >= INSTANCING_MIN and not variant.write_aovs:
             if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
                 for side in (False, True):
                     pick = mirrored_all == side
-                    instanced.append((mesh, object_to_view_all[pick], object_to_clip_all[pick], info_all[pick], side))
+                    instanced.append((mesh, style, object_to_view_all[pick], object_to_clip_all[pick], info_all[pick],
+                                      side))
             else:
-                instanced.append((mesh, object_to_view_all, object_to_clip_all, info_all, bool(mirrored_all[0])))
+                instanced.append((mesh, style, object_to_view_all, object_to_clip_all, info_all,
+                                  bool(mirrored_all[0])))
             continue
-        single.extend(zip([mesh] * len(world), object_to_view_all, object_to_clip_all, info_all, mirrored_all))
+        for k in range(len(world)):
+            single.append((mesh, style, world[k], object_to_view_all[k], object_to_clip_all[k], info_all[k],
+                           bool(mirrored_all[k]), None if pass_index is None else float(pass_index[k]),
+                           None if materials is None else materials[k]))
     if single and variant.per_item:
         # Normal matrices and item info of every object in one texture
         # (item_table.glsl); each draw says its slot.
         rows = np.zeros((len(single), shaders.ITEM_TEXELS, 4), dtype=np.float32)
-        rows[:, :3, :] = np.swapaxes(normal_to_view(np.stack([o2v for _m, o2v, _c, _i, _s in single])), 1, 2)[:, :3, :]
-        rows[:, 3, :] = np.stack([info for _m, _v, _c, info, _s in single])
+        rows[:, :3, :] = np.swapaxes(normal_to_view(np.stack([entry[3] for entry in single])), 1, 2)[:, :3, :]
+        rows[:, 3, :] = np.stack([entry[5] for entry in single])
         item_table = table_texture(rows.reshape(-1, 4))  # kept alive until the draws are done
         shader.uniform_sampler("item_table", item_table)
+    object_block = None  # the render passes' per-object block (write_aovs only)
+    material_tables: dict = {}  # (mesh, materials) -> triangle -> material pass index texture
     if single:
-        for slot, (mesh, object_to_view, object_to_clip, _info, mirrored) in enumerate(single):
+        for slot, (mesh, style, world, object_to_view, object_to_clip, _info, mirrored, pass_index,
+                   materials) in enumerate(single):
+            if style is not bound:
+                bound = style
+                shader.uniform_block("params", ubo(style))
             if settings.use_backface_culling:
                 gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
+            if variant.write_aovs:
+                object_block = _set_object_block(shader, object_block, world, bool(mirrored), pass_index)
+                shader.uniform_sampler("triangle_material", _material_table(mesh, materials, material_tables))
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             if uses_view_depth:
                 shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
@@ -264,18 +366,66 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
         _draw_instanced(instanced, variant, ubo, settings, stats, extras)
 
 
+def _material_table(mesh, materials, tables: dict):
+    """Texture of the IndexMA value of each triangle of ``mesh`` for one
+    object's materials (face material index -> slot -> the material's
+    pass_index; an index past the last slot uses the last, as Blender does).
+    Shared by the instances with the same materials in one draw."""
+    key = (id(mesh), None if materials is None else (id(materials[0]), materials[1]))
+    table = tables.get(key)
+    if table is None:
+        values = np.zeros((mesh.triangle_count, 4), dtype=np.float32)
+        if materials is not None and len(materials[1]):
+            face_slot, slot_pass = materials
+            slots = np.asarray(slot_pass, dtype=np.float32)
+            face = np.asarray(mesh.triangle_polygons_cpu)
+            face_ok = face < len(face_slot)
+            slot = np.clip(face_slot[np.where(face_ok, face, 0)], 0, len(slots) - 1)
+            values[:, 0] = np.where(face_ok, slots[slot], 0.0)
+        table = tables[key] = table_texture(values)
+    return table
+
+
+def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_index: float):
+    """Bind the render passes' per-object values (shaders.OBJECT_BLOCK_GLSL):
+    the normal matrix (inverse transpose of the object's 3x3), negated for a
+    mirrored object so that gl_FrontFacing says which side the camera sees,
+    and the object's pass index. One block, updated per object."""
+    try:
+        normal_matrix = np.linalg.inv(world[:3, :3]).T
+    except np.linalg.LinAlgError:
+        normal_matrix = np.zeros((3, 3))
+    if mirrored:
+        normal_matrix = -normal_matrix
+    values = np.zeros((3, 4), dtype=np.float32)
+    values[:, :3] = normal_matrix.T  # columns
+    values[0, 3] = pass_index
+    data = values.tobytes()
+    if block is None:
+        block = gpu.types.GPUUniformBuf(data)
+        shader.uniform_block("object_params", block)
+    else:
+        block.update(data)
+    return block
+
+
 def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras=None) -> None:
-    """One draw_instanced call per (mesh, facing) group; every instance's
-    matrices in one float texture for the whole frame."""
+    """One draw_instanced call per (mesh, style, facing) group; every
+    instance's matrices in one float texture for the whole frame."""
     shader = shaders.get(replace(variant, instanced=True))
-    table = table_texture(np.concatenate([_instance_rows(o2v, o2c, info) for _mesh, o2v, o2c, info, _side in groups]))
+    table = table_texture(np.concatenate([_instance_rows(o2v, o2c, info)
+                                         for _mesh, _style, o2v, o2c, info, _side in groups]))
     shader.bind()
-    shader.uniform_block("params", ubo)
+    bound = None
+    shader.uniform_block("params", ubo(bound))
     shader.uniform_sampler("instance_table", table)
     _bind_extras(shader, variant, extras or {})
     base = 0
-    for mesh, _o2v, object_to_clip, _info, mirrored in groups:
+    for mesh, style, _o2v, object_to_clip, _info, mirrored in groups:
         count = len(object_to_clip)
+        if style is not bound:
+            bound = style
+            shader.uniform_block("params", ubo(style))
         if settings.use_backface_culling:
             gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
         shader.uniform_int("instance_base", base)

@@ -19,6 +19,7 @@ its 4th corner joins p2 and p0.
 
 from __future__ import annotations
 
+import zlib
 from dataclasses import dataclass
 from typing import Callable
 
@@ -63,6 +64,19 @@ class MeshArrays:
     # Edge angle (see hide_flat_edges): per entry of ngon_corners, 1 where
     # that outline slot starts an edge that is not drawn. None: all drawn.
     ngon_hidden: np.ndarray = None
+    # Set when positions alone decide nothing but the quad diagonals (tris and
+    # quads only, every vertex finite): the quads' vertex ids, their split
+    # and a checksum of the face sizes, so that an edit that only moves
+    # vertices can be re-uploaded as positions (see reposition()).
+    quads: np.ndarray | None = None
+    quad_flip: np.ndarray | None = None
+    face_offsets_crc: int | None = None
+    source_positions: np.ndarray | None = None  # (V, 3) float32 as read, to find moved vertices
+
+    @property
+    def mesh_bounds(self) -> tuple:
+        """(bounds_min, bounds_max) in mesh space, as GPUMesh keeps them too."""
+        return self.bounds_min, self.bounds_max
 
     @property
     def triangle_count(self) -> int:
@@ -99,6 +113,13 @@ def _read_attribute(mesh, name: str, prop: str, count: int, dtype, width: int = 
     if count:
         attribute.data.foreach_get(prop, out)
     return out if width == 1 else out.reshape(count, width)
+
+
+def read_material_indices(mesh) -> np.ndarray:
+    """(F,) int32 material slot index of each face (0 without the attribute)."""
+    count = len(mesh.polygons)
+    values = _read_attribute(mesh, "material_index", "value", count, np.int32)
+    return np.zeros(count, dtype=np.int32) if values is None else values
 
 
 def read_positions(mesh) -> np.ndarray:
@@ -566,9 +587,63 @@ def build_arrays_fast(
     # vertex set as build_arrays' triangles[:, :3], read from fewer entries.
     face_vertex = _face_vertices(len(positions), corner_vert)
     local, centre, bounds_min, bounds_max = _recentre(positions, None, columns, face_vertex)
-    return MeshArrays(
+    arrays = MeshArrays(
         local, centre, triangles, flags, tri_polygons, bounds_min, bounds_max, 0, ngon_corners, degenerate_triangles=_degenerate_count(triangles)
     )
+    if not len(ngon_corners):
+        arrays.quads, arrays.quad_flip, arrays.source_positions = quads, flip, positions
+        arrays.face_offsets_crc = zlib.crc32(memoryview(np.ascontiguousarray(offsets)).cast("B"))
+    return arrays
+
+
+def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_offsets: np.ndarray):
+    """(local positions, centre, bounds_min, bounds_max, source positions)
+    for new vertex positions of a mesh whose faces are unchanged, or None when the new
+    positions change more than positions: a quad split differently (or too
+    close to call), a non-finite vertex, n-gons (their triangulation follows
+    the positions), other face sizes.
+
+    ``previous`` is what the last extraction kept (``quads``, ``quad_flip``,
+    ``face_offsets_crc``, ``source_positions``, ``centre`` and
+    ``mesh_bounds``); the caller has checked that the
+    vertex, corner and face counts and the corner vertices are the same."""
+    quads, flip = getattr(previous, "quads", None), getattr(previous, "quad_flip", None)
+    if quads is None or flip is None or previous.face_offsets_crc is None:
+        return None
+    positions = np.asarray(positions, dtype=np.float32).reshape(-1, 3)
+    if len(positions) != previous.vertex_count or _finite_vertices(positions) is not None:
+        return None
+    offsets = np.ascontiguousarray(face_offsets, dtype=np.int32)
+    if zlib.crc32(memoryview(offsets).cast("B")) != previous.face_offsets_crc:
+        return None
+    old = getattr(previous, "source_positions", None)
+    if old is None or old.shape != positions.shape:
+        return None
+    # Flat index arithmetic instead of reductions over the short axis of
+    # (N, 3) / (Q, 4) arrays, which numpy does slowly.
+    moved_ids = np.unique(np.flatnonzero(positions.ravel() != old.ravel()) // 3)
+    moved = np.zeros(len(positions), dtype=bool)
+    moved[moved_ids] = True
+    if len(quads) and len(moved_ids):
+        # Only quads with a moved corner can split differently.
+        touched = np.unique(np.flatnonzero(moved[quads.ravel()]) // 4)
+        if len(touched):
+            ids, corners = np.unique(quads[touched], return_inverse=True)
+            new_flip, undecided = quad_flip(positions[ids], corners.reshape(-1, 4).astype(np.int32))
+            if undecided.any() or not np.array_equal(new_flip, flip[touched]):
+                return None
+    # The centre stays where it was (any nearby centre keeps float32
+    # precision); the bounds grow to take in the moved vertices, never
+    # shrink (culling only needs them to enclose the mesh).
+    centre = previous.centre
+    bounds_min, bounds_max = previous.mesh_bounds
+    if len(moved_ids):
+        moved_positions = positions[moved_ids].astype(np.float64)
+        bounds_min = np.minimum(bounds_min, moved_positions.min(axis=0))
+        bounds_max = np.maximum(bounds_max, moved_positions.max(axis=0))
+    local = np.empty_like(positions)
+    np.subtract(positions, centre, out=local, dtype=np.float64, casting="unsafe")
+    return local, centre, bounds_min, bounds_max, positions
 
 
 def _ngon_tri_rows(tri_start, sizes, ngon_faces) -> np.ndarray:

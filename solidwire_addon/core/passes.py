@@ -24,16 +24,25 @@ import numpy as np
 from . import colors
 from . import draw as draw_mod
 from . import silhouettes
-from .targets import read_texture, targets_for
+from .targets import BACKGROUND_DEPTH, read_texture, targets_for
 from .view import View
 
 SURFACE, HIDDEN, WIRE, SILHOUETTES = "surface", "hidden", "wire", "silhouettes"
+
+# Render passes beyond Combined and Depth (docs/image_model.md §6), by the
+# name they have in Blender's render result.
+WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS = "Wire", "Hidden Wire", "Edge Distance"
+NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS = "Normal", "IndexOB", "IndexMA"
+EXTRA_PASSES = (WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS)
+# Written by the surface pass's extra outputs (the rest has its own pass).
+_SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
 
 
 @dataclass(frozen=True)
 class Pass:
     kind: str
     settings: object  # the DrawSettings this pass draws with
+    show_wire: bool = True  # False: the pass draws no wire, whatever an object's override says
 
 
 def plan(settings) -> tuple[Pass, ...]:
@@ -45,7 +54,7 @@ def plan(settings) -> tuple[Pass, ...]:
         # then the wire on its own.
         wire_only = replace(settings, use_fill=False)
         passes = [
-            Pass(SURFACE, replace(settings, wire_color=(*settings.wire_color[:3], 0.0))),
+            Pass(SURFACE, replace(settings, wire_color=(*settings.wire_color[:3], 0.0)), show_wire=False),
             Pass(HIDDEN, wire_only),
             Pass(WIRE, wire_only),
         ]
@@ -70,15 +79,35 @@ def render(items, view: View, settings, *, cull: bool = True):
     ``rgba`` is (H, W, 4) float32, premultiplied, bottom row first, over a
     transparent background; ``view_depth`` is (H, W) with BACKGROUND_DEPTH
     where nothing was drawn. The caller makes sure the GPU is usable."""
+    rgba, depth, stats, _extra = render_passes(items, view, settings, cull=cull)
+    return rgba, depth, stats
+
+
+def render_passes(items, view: View, settings, *, cull: bool = True, extra_passes=()):
+    """:func:`render` plus the render passes named in ``extra_passes`` (of
+    EXTRA_PASSES): (rgba, view_depth, stats, {name: (H, W, channels)}).
+    A pass that is not asked for costs nothing: the surface pass gets its
+    extra outputs only when one of them is wanted, Hidden Wire its own pass
+    only when asked for."""
+    extra_passes = frozenset(extra_passes)
+    aovs = bool(extra_passes & _SURFACE_AOVS)
     width, height = view.width, view.height
     targets = targets_for(width, height)
     steps = plan(settings)
     stats = None
-    framebuffer = targets.framebuffer()
+    framebuffer = targets.framebuffer(aovs=aovs)
     with framebuffer.bind():
+        # A clear honours the depth write mask, and GPU state lives per GL
+        # context: a previous frame drawn in this context may have left depth
+        # writes off, which left the old depth in place (wrong occlusion in
+        # the next render drawn in that context).
+        gpu.state.depth_mask_set(True)
+        gpu.state.color_mask_set(True, True, True, True)
+        gpu.state.blend_set("NONE")
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, width, height)
-        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull)
+        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull,
+                              show_wire=steps[0].show_wire, write_aovs=aovs, linear_depth=True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     blended = [step for step in steps[1:] if step.kind in (HIDDEN, WIRE)]
@@ -91,16 +120,46 @@ def render(items, view: View, settings, *, cull: bool = True):
             try:
                 for step in blended:
                     if step.kind == HIDDEN:
-                        draw_mod.draw_hidden_lines(items, view, step.settings, cull=cull)
+                        draw_mod.draw_hidden_lines(items, view, step.settings, cull=cull, linear_depth=True)
                     else:
-                        draw_mod.draw(items, view, step.settings, depth_write=False, cull=cull)
+                        draw_mod.draw(items, view, step.settings, depth_write=False, cull=cull, linear_depth=True)
             finally:
                 gpu.state.blend_set("NONE")
                 gpu.state.depth_test_set("NONE")
+    extra = {}
+    if HIDDEN_WIRE_PASS in extra_passes:
+        extra[HIDDEN_WIRE_PASS] = _hidden_wire(targets, items, view, settings, cull)
     rgba, depth = targets.read()
+    if aovs:
+        covered = depth < BACKGROUND_DEPTH
+        aov = read_texture(targets.aov, 4)
+        extra[WIRE_PASS] = aov[..., 1:2]
+        extra[EDGE_DISTANCE_PASS] = np.where(covered, aov[..., 0], BACKGROUND_DEPTH)[..., None]
+        extra[OBJECT_INDEX_PASS] = aov[..., 2:3]
+        extra[MATERIAL_INDEX_PASS] = aov[..., 3:4]
+        extra[NORMAL_PASS] = read_texture(targets.normal, 4)[..., :3]
     if any(step.kind == SILHOUETTES for step in steps):
         rgba = _composite_silhouettes(rgba, targets, items, view, settings)
-    return rgba, depth, stats
+    return rgba, depth, stats, {name: value for name, value in extra.items() if name in extra_passes}
+
+
+def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:
+    """The Hidden Wire pass: H of image model §5.4 (coverage of the hidden
+    layers, wire alpha included), whether or not Hidden Lines is on in the
+    image. The hidden-line pass again, into a target of its own over the
+    surface depth: "over" blending of the a_k on 0 leaves 1 - prod(1 - a_k)
+    in alpha."""
+    framebuffer = targets.hidden_framebuffer()
+    with framebuffer.bind():
+        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0))  # the surface depth stays
+        gpu.state.viewport_set(0, 0, view.width, view.height)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        try:
+            draw_mod.draw_hidden_lines(items, view, replace(settings, use_fill=False), cull=cull, linear_depth=True)
+        finally:
+            gpu.state.blend_set("NONE")
+            gpu.state.depth_test_set("NONE")
+    return read_texture(targets.hidden, 4)[..., 3:4]
 
 
 def _composite_silhouettes(rgba, targets, items, view, settings):
@@ -109,9 +168,10 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
     with the wire colour ("over", premultiplied)."""
     framebuffer = targets.silhouette_framebuffer()
     with framebuffer.bind():
+        gpu.state.depth_mask_set(True)  # see render(): the clear honours the mask
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         gpu.state.viewport_set(0, 0, view.width, view.height)
-        silhouettes.draw_silhouettes(items, view, settings, targets.depth)
+        silhouettes.draw_silhouettes(items, view, settings, targets.depth, linear_depth=True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     outer = read_texture(targets.outer, 1)[..., 0:1]
@@ -129,10 +189,17 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
 OVERLAY_DEPTH_BIAS = 2.0**-18
 
 
-def draw_over_viewport(items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS):
+def draw_over_viewport(
+    items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS, scene_depth: bool = True, clip_planes=None
+):
     """Draw ``items`` over a bound framebuffer that already holds the scene's
     colour and depth (a 3D viewport after its own drawing). Returns the
     DrawStats of the surface pass.
+
+    ``scene_depth`` False (X-ray: Blender's depth is no surface there) clears
+    the bound depth first, so only our own surfaces occlude. ``clip_planes``
+    ((6, 4) world-space planes, the viewport's clipping region) discards
+    everything outside them in every pass (docs/image_model.md §5.6).
 
     A depth-only pre-pass comes first, so only the nearest of our own
     surfaces passes the colour passes (no back edges show through where the
@@ -143,10 +210,14 @@ def draw_over_viewport(items, view: View, settings, *, depth_bias: float = OVERL
     saved_depth_test = gpu.state.depth_test_get()
     saved_depth_mask = gpu.state.depth_mask_get()
     stats = None
+    clip = {} if clip_planes is None else {"clip_planes": clip_planes}
     try:
+        if not scene_depth:
+            gpu.state.depth_mask_set(True)
+            gpu.state.active_framebuffer_get().clear(depth=1.0)
         gpu.state.blend_set("NONE")
         gpu.state.color_mask_set(False, False, False, False)
-        draw_mod.draw(items, view, settings, depth_bias=depth_bias)
+        draw_mod.draw(items, view, settings, depth_bias=depth_bias, **clip)
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set("ALPHA_PREMULT")
         for step in plan(settings):
@@ -154,12 +225,13 @@ def draw_over_viewport(items, view: View, settings, *, depth_bias: float = OVERL
                 # With hidden lines the surface pass only carries the fill.
                 if settings.use_hidden_lines and not settings.use_fill:
                     continue
-                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias)
+                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias,
+                                              show_wire=step.show_wire, **clip)
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
-                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias)
+                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias, **clip)
             elif step.kind == WIRE:
-                stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias)
+                stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **clip)
             elif step.kind == SILHOUETTES:
                 silhouettes.draw_silhouettes(items, view, step.settings, overlay_bias=depth_bias)
     finally:

@@ -160,7 +160,7 @@ DEFAULT_DUTY = {"DOTTED": 0.25, "DASHED": 0.5}
 SETTINGS: tuple[Setting, ...] = (
     Setting(
         "show_overlay", BOOL, False, "SolidWire Overlay",
-        "Draw the solid wireframe over meshes in 3D viewports",
+        "Default for 3D viewports without their own SolidWire toggle (each viewport has its own)",
         cli=NO_FLAG, in_snapshot=False, in_preset=False,
     ),
     # -- line ----------------------------------------------------------------
@@ -370,9 +370,86 @@ SETTINGS: tuple[Setting, ...] = (
         "Draw the viewport overlay on selected objects only",
         cli=NO_FLAG, in_snapshot=False, in_preset=False,
     ),
+    Setting(
+        "overlay_edit_mode", BOOL, False, "Draw in Edit Mode",
+        "Also draw the viewport overlay on objects in Edit Mode (over Blender's own edit wire)",
+        cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
 )
 
-BY_NAME: dict[str, Setting] = {s.name: s for s in SETTINGS}
+# -- per object (object.solidwire; docs/image_model.md §5.9) ---------------------
+# Not part of the scene's snapshot, presets or command line: gather() reads
+# them per drawn instance. The override's three values share their names with
+# the scene settings they replace (scope tells them apart).
+_OVERRIDE_ACTIVE = lambda p: p.use_override  # noqa: E731
+OBJECT_SETTINGS: tuple[Setting, ...] = (
+    Setting(
+        "show_in_viewport", BOOL, True, "Show in Viewport",
+        "Draw the SolidWire overlay on this object in 3D viewports",
+        scope=OBJECT, section="object", cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "show_in_render", BOOL, True, "Show in Render",
+        "Draw this object in SolidWire renders (it neither draws nor hides anything when off)",
+        scope=OBJECT, section="object", cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "use_override", BOOL, False, "Override Style",
+        "Give this object (and its instances) its own wire colour, thickness and fill colour",
+        scope=OBJECT, section="object", cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "wire_color", COLOR, (0.0, 0.0, 0.0, 1.0), "Wire Color",
+        "This object's wire colour and opacity",
+        scope=OBJECT, minimum=0.0, maximum=1.0, subtype="COLOR", section="object",
+        active_if=_OVERRIDE_ACTIVE, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "thickness", FLOAT, 1.5, "Thickness",
+        "This object's line width in pixels (Pixels and Depth Cue modes: the near width)",
+        scope=OBJECT, minimum=0.0, maximum=1000.0, soft_max=20.0, subtype="PIXEL", section="object",
+        active_if=_OVERRIDE_ACTIVE, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "fill_color", COLOR, (1.0, 1.0, 1.0), "Fill Color",
+        "This object's fill colour (when Fill is on; RGB like the scene's, always opaque)",
+        scope=OBJECT, minimum=0.0, maximum=1.0, subtype="COLOR", size=3, section="object",
+        active_if=_OVERRIDE_ACTIVE, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+)
+# The style values an object's override replaces (same names as the scene's).
+OVERRIDE_FIELDS = ("wire_color", "thickness", "fill_color")
+
+# -- per view layer (view_layer.solidwire; docs/image_model.md §6) --------------
+# Render passes of SolidWire's own, switched on per view layer (the engine
+# registers and writes them; View Layer Properties > Passes shows them).
+VIEW_LAYER_SETTINGS: tuple[Setting, ...] = (
+    Setting(
+        "use_pass_wire", BOOL, False, "Wire",
+        "Render pass 'Wire': the line intensity of the visible wire, 0 to 1, without colour or opacity",
+        scope=VIEW_LAYER, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "use_pass_hidden_wire", BOOL, False, "Hidden Wire",
+        "Render pass 'Hidden Wire': the coverage of the dimmed, dashed hidden edges (Hidden Lines style), "
+        "whether or not Hidden Lines is on",
+        scope=VIEW_LAYER, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+    Setting(
+        "use_pass_edge_distance", BOOL, False, "Edge Distance",
+        "Render pass 'Edge Distance': window-pixel distance to the nearest edge of the visible face "
+        "(1e10 where nothing is drawn), to restyle lines in the compositor",
+        scope=VIEW_LAYER, cli=NO_FLAG, in_snapshot=False, in_preset=False,
+    ),
+)
+
+SETTINGS = (*SETTINGS, *OBJECT_SETTINGS, *VIEW_LAYER_SETTINGS)
+
+# (scope, name) -> setting: a name may exist in several scopes.
+BY_SCOPE: dict[tuple[str, str], Setting] = {(s.scope, s.name): s for s in SETTINGS}
+assert len(BY_SCOPE) == len(SETTINGS), "a setting is defined twice in one scope"
+# The scene's settings by name.
+BY_NAME: dict[str, Setting] = {s.name: s for s in SETTINGS if s.scope == SCENE}
 
 
 def settings_in(scope: str) -> tuple[Setting, ...]:
@@ -418,6 +495,7 @@ CLI_RANGES = (
 VIEW_PARAMS = (
     ("viewport", "vec4"),  # x0, y0, width, height of the target, px
     ("world_half_thickness_px", "float"),  # world_thickness / 2 in px at clip w = 1
+    ("inv_clip_end", "float"),  # 1 / the view's clip end (linear depth of the render)
 )
 
 
@@ -431,7 +509,8 @@ class BlockMember:
 def _param_block() -> tuple[BlockMember, ...]:
     """The std140 layout: every vec4 first, then floats, padded to whole vec4s
     (so no member needs alignment padding of its own)."""
-    members = [BlockMember(s.param.glsl, "vec4" if s.kind == COLOR else "float", s) for s in SETTINGS if s.param]
+    members = [BlockMember(s.param.glsl, "vec4" if s.kind == COLOR else "float", s)
+               for s in SETTINGS if s.param and s.scope == SCENE]
     members += [BlockMember(name, kind, None) for name, kind in VIEW_PARAMS]
     vec4s = [m for m in members if m.glsl_type == "vec4"]
     floats = [m for m in members if m.glsl_type == "float"]

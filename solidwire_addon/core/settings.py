@@ -17,7 +17,7 @@ import numpy as np
 from . import schema
 from .log import warn_once
 
-_SNAPSHOT = tuple(s for s in schema.SETTINGS if s.in_snapshot)
+_SNAPSHOT = tuple(s for s in schema.SETTINGS if s.in_snapshot and s.scope == schema.SCENE)
 
 
 def _post_init(self) -> None:
@@ -58,6 +58,17 @@ DrawSettings = dataclasses.make_dataclass(
 DrawSettings.__doc__ = "A plain, immutable snapshot of the scene's SolidWire settings (see core/schema.py)."
 
 
+def clip_end_of(projection) -> float:
+    """The far clip distance of a GL projection matrix (perspective or
+    orthographic), from its third row."""
+    p22, p23 = float(projection[2][2]), float(projection[2][3])
+    if float(projection[3][3]) == 1.0:  # orthographic: p22 = -2/(f-n), p23 = -(f+n)/(f-n)
+        far = (p23 - 1.0) / p22
+    else:  # perspective: p22 = -(f+n)/(f-n), p23 = -2fn/(f-n)
+        far = p23 / (p22 + 1.0) if p22 != -1.0 else math.inf
+    return far if math.isfinite(far) and far > 0.0 else 1.0e30
+
+
 def pack_params(settings, viewport, projection=None) -> bytes:
     """The std140 parameter block (layout: schema.PARAM_BLOCK).
 
@@ -68,6 +79,7 @@ def pack_params(settings, viewport, projection=None) -> bytes:
     view_values = {
         "viewport": tuple(float(v) for v in viewport),
         "world_half_thickness_px": 0.5 * max(float(settings.world_thickness), 0.0) * px_per_unit,
+        "inv_clip_end": 0.0 if projection is None else 1.0 / clip_end_of(projection),
     }
     values: list[float] = []
     for member in schema.PARAM_BLOCK:

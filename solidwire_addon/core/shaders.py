@@ -3,13 +3,15 @@
 The interface (samplers, push constants, the parameter block and the flat
 varyings) is declared here once; the GLSL bodies live in files so they can be
 read, diffed and linted as GLSL. Variants are compiled on first use and kept
-for the life of the process (or until :func:`clear` at unregister), keyed by
+for the life of the process (see _cache for why), keyed by
 the feature flags that change the generated code, so a feature that is off
 costs nothing at run time.
 """
 
 from __future__ import annotations
 
+import atexit
+import contextlib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,6 +30,8 @@ DIAGONALS_HIDDEN, DIAGONALS_SOLID, DIAGONALS_PATTERN = 0, 1, 2
 
 # Fill shading (docs/image_model.md §5.8); FLAT is §5.2's flat fill.
 SHADING_FLAT, SHADING_STUDIO, SHADING_MATCAP = 0, 1, 2
+
+CLIP_PLANES = 6  # as many as Blender's clipping region (RegionView3D.clip_planes)
 
 
 @dataclass(frozen=True)
@@ -48,10 +52,22 @@ class ShaderVariant:
     # The mesh has n-gons: the fragment stage walks their outlines and
     # diagonals (USE_NGONS); tri/quad meshes get a variant without that code.
     ngons: bool = False
+    # The render's offscreen passes write view depth / clip end as depth
+    # (LINEAR_DEPTH, see solidwire_frag.glsl); the viewport overlay keeps
+    # Blender's depth mapping, whose buffer it shares.
+    linear_depth: bool = False
+    # Render passes beyond Combined and Depth (image model §6): a third and
+    # fourth colour output with d_real, I_vis and the object index, and the
+    # world-space face normal. Only the render's surface pass of a view
+    # layer that asks for them compiles this.
+    write_aovs: bool = False
     # Many instances of one mesh in one draw_instanced call,
     # each reading its matrices from a float texture by gl_InstanceID (see
     # shaders/instancing.glsl and draw.py).
     instanced: bool = False
+    # Viewport clipping region (Alt+B): fragments outside CLIP_PLANES
+    # clip-space planes are discarded (USE_CLIP_PLANES; image model §5.6).
+    clip_planes: bool = False
     # Shaded fill (SHADING_*): the vertex stage pulls corner normals.
     shading: int = SHADING_FLAT
     # Per-object wire/fill colours from the frame's colour table
@@ -70,7 +86,43 @@ class ShaderVariant:
         return self.uses_corners or self.item_colors
 
 
-_cache: dict[ShaderVariant, object] = {}
+# Two GL contexts draw SolidWire: a render (bpy.ops.render.render, F12) draws
+# in the render engine's own context, everything else (viewport overlay,
+# scripts) in the window/script context. Compiled programs are kept apart per
+# context (``gl_context``): a program compiled and drawn with in one context
+# and then drawn with in the other gave wrong images there (part of the
+# surface missing after the window context had drawn the same variant), and
+# deleting a program from one context after the other had drawn with it
+# crashed llvmpipe later inside an unrelated draw (segfault in swrast_dri
+# during batch.draw). Programs also live for the whole process: reused across
+# unregister/register and freed only at interpreter exit, while Blender's GPU
+# context still exists. A program is a few KiB of driver memory.
+_cache: dict[tuple, object] = {}
+_context = "window"
+
+
+@contextlib.contextmanager
+def gl_context(name: str):
+    """Draw calls inside use the programs of GL context ``name`` (the render
+    engine says "render-engine"; everything else is "window")."""
+    global _context
+    previous, _context = _context, name
+    try:
+        yield
+    finally:
+        _context = previous
+_exit_hook_installed = False
+
+
+def _keep(cache: dict, key, shader):
+    """Store a compiled program; the first one installs the exit hook that
+    frees them all while Blender's GPU context still exists."""
+    global _exit_hook_installed
+    cache[key] = shader
+    if not _exit_hook_installed:
+        atexit.register(release_at_exit)
+        _exit_hook_installed = True
+    return shader
 
 
 def read_source(name: str, directory: Path = SHADER_DIR) -> str:
@@ -134,6 +186,14 @@ def _create_info(variant: ShaderVariant):
         info.push_constant("INT", "instance_base")
         info.sampler(3, "FLOAT_2D", "instance_table")
         iface.flat("INT", "instance_slot")
+    if variant.clip_planes:
+        # A block of their own, not push constants: those stay within the
+        # 128 bytes every backend guarantees (object_to_clip, object_to_view_z
+        # and item_slot use 84).
+        info.uniform_buf(2, "SolidWireClip", "clip_params")
+        iface.smooth("VEC4", "clip_distance_a")
+        iface.smooth("VEC2", "clip_distance_b")
+        info.define("USE_CLIP_PLANES", "1")
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     info.sampler(2, "FLOAT_2D", "ngon_corners")
     if variant.per_item:
@@ -162,10 +222,29 @@ def _create_info(variant: ShaderVariant):
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
+    if variant.linear_depth:
+        info.define("LINEAR_DEPTH", "1")
+        compat.depth_write(info, "ANY")
     if variant.ngons:
         info.define("USE_NGONS", "1")
+    if variant.write_aovs:
+        # Per-object values in a block of their own (push constants are full);
+        # the instanced variant does not have them (draw.py draws object by
+        # object when passes are written).
+        info.uniform_buf(1, "SolidWireObject", "object_params")
+        info.sampler(7, "FLOAT_2D", "triangle_material")
+        iface.flat("FLOAT", "material_pass_index")
+        info.fragment_out(2, "VEC4", "frag_aov")
+        info.fragment_out(3, "VEC4", "frag_normal")
+        info.define("WRITE_AOVS", "1")
+        iface.flat("VEC3", "face_normal")
     if variant.depth_bias:
         info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
+    if variant.write_aovs or variant.clip_planes:
+        # One typedef source holds every block's struct (a later call
+        # replaces the one pulling_info set).
+        info.typedef_source(schema.param_block_glsl() + (OBJECT_BLOCK_GLSL if variant.write_aovs else "")
+                            + (CLIP_BLOCK_GLSL if variant.clip_planes else ""))
 
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
     style = read_source("line_style.glsl")
@@ -181,6 +260,22 @@ def _create_info(variant: ShaderVariant):
     return info
 
 
+# Per-object values of the render passes (std140): the columns of the normal
+# matrix, the object's pass index in the first column's w.
+OBJECT_BLOCK_GLSL = """struct SolidWireObject {
+  vec4 normal_matrix0;
+  vec4 normal_matrix1;
+  vec4 normal_matrix2;
+};
+"""
+OBJECT_BLOCK_FLOATS = 12
+
+# The viewport clipping region's clip-space planes (std140: vec4 stride 16).
+CLIP_BLOCK_GLSL = f"""struct SolidWireClip {{
+  vec4 planes[{CLIP_PLANES}];
+}};
+"""
+
 # Instanced variant of the exact path: shaders/instancing.glsl is prepended
 # to the unchanged stage sources (it turns the two push constants into reads
 # from `instance_table`); each stage says where its instance's texels start.
@@ -192,28 +287,30 @@ _INSTANCE_SLOT_FRAG = "#define SW_INSTANCE_SLOT instance_slot\n"
 
 def get(variant: ShaderVariant):
     """The compiled shader for ``variant`` (compiled once, then cached)."""
-    shader = _cache.get(variant)
+    key = (_context, variant)
+    shader = _cache.get(key)
     if shader is None:
-        shader = gpu.shader.create_from_info(_create_info(variant))
-        _cache[variant] = shader
+        shader = _keep(_cache, key, gpu.shader.create_from_info(_create_info(variant)))
     return shader
 
 
-def clear() -> None:
+def release_at_exit() -> None:
+    """Free every compiled program (interpreter exit only; see _cache)."""
     _cache.clear()
     _silhouette_cache.clear()
 
 
 # Full-width silhouettes (image model §5.5): the fin pass of silhouettes.py. Shares
 # the parameter block, vertex pulling and edge geometry with the exact path.
-_silhouette_cache: dict[ShaderVariant, object] = {}
+_silhouette_cache: dict[tuple, object] = {}
 
 
 def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
     """The fin shader; ``overlay_bias`` > 0 gives the viewport-overlay form
     (colour output, fixed-function occlusion; see silhouette_frag.glsl)."""
-    key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias)
-    shader = _silhouette_cache.get(key)
+    key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
+                        linear_depth=variant.linear_depth and not overlay_bias)
+    shader = _silhouette_cache.get((_context, key))
     if shader is None:
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
         iface.flat("VEC4", "fin_a")
@@ -234,11 +331,12 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
             info.fragment_out(0, "FLOAT", "frag_intensity")
         compat.depth_write(info, "ANY")
         info.define("THICKNESS_MODE", str(key.thickness_mode))
+        if key.linear_depth:
+            info.define("LINEAR_DEPTH", "1")
         if key.use_fade:
             info.define("USE_FADE", "1")
         common = read_source("common.glsl") + read_source("edge_geometry.glsl")
         info.vertex_source(common + read_source("silhouette_vert.glsl"))
         info.fragment_source(common + read_source("line_style.glsl") + read_source("silhouette_frag.glsl"))
-        shader = gpu.shader.create_from_info(info)
-        _silhouette_cache[key] = shader
+        shader = _keep(_silhouette_cache, (_context, key), gpu.shader.create_from_info(info))
     return shader

@@ -103,14 +103,15 @@ def release() -> None:
     _fin_batches.clear()
 
 
-def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay_bias: float = 0.0) -> None:
+def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay_bias: float = 0.0,
+                     linear_depth: bool = False) -> None:
     """Draw the outer halves into the bound framebuffer.
 
     Render: an R32F intensity target with its own depth buffer cleared to 1,
     ``scene_depth_texture`` the main pass's depth (see the module docstring).
     Viewport overlay (``overlay_bias`` > 0): straight into the viewport with
     "over" blending, occluded by its depth buffer; the caller sets the blend."""
-    shader = shaders.get_silhouette(shader_variant(settings), overlay_bias)
+    shader = shaders.get_silhouette(shader_variant(settings, linear_depth=linear_depth), overlay_bias)
     ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
     shader.bind()
     shader.uniform_block("params", ubo)

@@ -35,12 +35,27 @@ class Targets:
         self.view_depth = gpu.types.GPUTexture((width, height), format="R32F")
         self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
         self.outer = self.outer_depth = None  # silhouette targets, made on first use
+        self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
 
-    def framebuffer(self):
+    def framebuffer(self, aovs: bool = False):
         """A framebuffer over the textures. Made per use: textures are shared
         between GL contexts but framebuffer objects are not, and the render
-        engine's context differs from the one scripts draw in."""
-        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.color, self.view_depth))
+        engine's context differs from the one scripts draw in. With ``aovs``
+        the render passes' two targets too (RGBA32F: d_real, I_vis, object
+        index; world normal), created on first use."""
+        slots = (self.color, self.view_depth)
+        if aovs:
+            if self.aov is None:
+                self.aov = gpu.types.GPUTexture(self.size, format="RGBA32F")
+                self.normal = gpu.types.GPUTexture(self.size, format="RGBA32F")
+            slots += (self.aov, self.normal)
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=slots)
+
+    def hidden_framebuffer(self):
+        """The Hidden Wire pass's own colour target over the surface depth."""
+        if self.hidden is None:
+            self.hidden = gpu.types.GPUTexture(self.size, format="RGBA32F")
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.hidden,))
 
     def color_framebuffer(self):
         """Colour and depth only, for blended passes that must leave the
@@ -61,8 +76,12 @@ class Targets:
         BACKGROUND_DEPTH where nothing was drawn)."""
         rgba = read_texture(self.color, 4)
         depth = read_texture(self.view_depth, 1)[..., 0]
-        covered = read_texture(self.depth, 1)[..., 0] < 1.0
+        covered = self.covered()
         return rgba, np.where(covered, depth, BACKGROUND_DEPTH)
+
+    def covered(self) -> np.ndarray:
+        """(H, W) bool: a surface was drawn there."""
+        return read_texture(self.depth, 1)[..., 0] < 1.0
 
 
 _targets: Targets | None = None

@@ -30,13 +30,30 @@ class View:
         return int(self.viewport[3])
 
 
+@dataclass(frozen=True)
+class Style:
+    """An object's own wire colour, thickness and fill colour (its override,
+    docs/image_model.md §5.9): replaces those three scene settings for its
+    faces. Hashable, so items group by it."""
+
+    wire_color: tuple
+    thickness: float
+    fill_color: tuple
+
+
 @dataclass
 class DrawItem:
-    """One drawn object or instance: a GPU mesh and its object -> world matrix."""
+    """One drawn object or instance: a GPU mesh, its object -> world matrix
+    and its style override (None: the scene's settings)."""
 
     mesh: object  # core.cache.GPUMesh
     matrix: np.ndarray  # (4, 4) float64
     source: object = None  # core.colors.ItemSource: inputs of the colour sources (when asked for)
+    style: Style | None = None
+    pass_index: int = 0  # the IndexOB pass value (object.pass_index)
+    # For the IndexMA pass only: (material slot index per face (F,) int32,
+    # the pass_index of each material slot). None: every face 0.
+    materials: tuple | None = None
 
 
 @dataclass

@@ -10,11 +10,20 @@ window-space distances to the near-clipped projection of each face's edges.
     result.on_silhouette   # (H, W) samples within 0.01 px of a face change
     result.face            # (H, W) visible face id, -1 for background
     result.depth           # (H, W) view depth of the visible point (inf: none)
+    result.d_real          # (H, W) distance to the visible face's real edges (inf: none)
+    result.face_object     # (H, W) index into result.objects of the visible
+                           # face's style object (-1: background)
+
+Per-object settings (object.solidwire, docs/image_model.md §5.9): an instance
+is drawn when its instancer and the object it instances both have
+``show_in_render``; the style override (thickness here; colours are composed
+by the tests from ``face_object``) is the instanced object's.
 
 Method:
 - Visibility: every triangle is clipped to the near plane only to bound the
-  pixels it may cover; for those pixels a float64 ray (from the near to the
-  far clip plane through the sample) is intersected with the triangle
+  pixels it may cover; for those pixels a float64 ray through the sample
+  (from the camera centre, or for orthographic cameras from the near plane
+  along the view direction) is intersected with the triangle
   (Moller-Trumbore). The nearest hit between clip start and end wins.
   Zero-area and edge-on triangles never hit.
 - Silhouette flag: the visible face is also found for four samples 0.01 px
@@ -48,6 +57,11 @@ class ReferenceResult:
     # covered sample (NaN on background), linear RGB.
     fill: np.ndarray = None  # (H, W, 3)
     wire: np.ndarray = None  # (H, W, 3)
+    d_real: np.ndarray = None
+    face_object: np.ndarray = None
+    objects: list = None  # names of the objects whose settings style each face
+    object_face_offsets: list = None  # first face id of each entry of objects
+    hidden: np.ndarray = None  # (H, W) H of image model §5.4 (hidden lines on only)
 
 
 @dataclass
@@ -67,6 +81,10 @@ class _Geometry:
     tri_normals: np.ndarray = None  # (T, 3, 3) corner normals in view space (not normalised), tri_view's order
     face_fill: np.ndarray = None  # (F, 3) base fill colour of each global face
     face_wire: np.ndarray = None  # (F, 3) wire colour of each global face
+    face_thickness: np.ndarray = None  # (F,) override thickness per face (NaN: the scene's)
+    face_object: np.ndarray = None  # (F,) index into objects
+    objects: list = None
+    offsets: list = None  # first face id of each object
 
 
 # ---------------------------------------------------------------- scene input
@@ -140,6 +158,7 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
     tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
     sil_edges, sil_third = [], []
     tri_normals, face_fill, face_wire = [], [], []
+    face_thickness, face_object, objects, offsets = [], [], [], []
     face_offset = 0
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -147,13 +166,19 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             continue
         if not inst.is_instance and not inst.show_self:
             continue
-        exclude = getattr(obj.original, "solidwire_exclude", False)
-        if exclude:
+        source = obj.original
+        instancer = inst.parent.original if inst.is_instance and inst.parent is not None else source
+        if not (source.solidwire.show_in_render and instancer.solidwire.show_in_render):
             continue
         mesh = obj.data
         nv, nl, npoly = len(mesh.vertices), len(mesh.loops), len(mesh.polygons)
         if npoly == 0:
             continue
+        override = source.solidwire.thickness if source.solidwire.use_override else np.nan
+        face_thickness.append(np.full(npoly, override, np.float64))
+        face_object.append(np.full(npoly, len(objects), np.int64))
+        objects.append(source.name)
+        offsets.append(face_offset)
         co = np.empty(nv * 3, np.float32)
         mesh.vertices.foreach_get("co", co)
         co = co.reshape(-1, 3).astype(np.float64)
@@ -271,6 +296,10 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         cat(tri_normals, (0, 3, 3), np.float64),
         cat(face_fill, (0, 3), np.float64),
         cat(face_wire, (0, 3), np.float64),
+        cat(face_thickness, (0,), np.float64),
+        cat(face_object, (0,), np.int64),
+        objects,
+        offsets,
     )
 
 
@@ -322,16 +351,37 @@ def _triangle_pixel_bounds(proj, tri_view, width, height):
     return x0, x1, y0, y1
 
 
-def _rays(inv_proj, px, py, width, height):
-    """Float64 rays through window points: origin on the near plane, and the
-    vector to the far plane point (t in [0, 1] spans clip start..end)."""
+def _clip_depths(proj):
+    """View depths (positive) of the near and far clip planes of ``proj``:
+    where NDC z is -1 and +1. The far one is inf when the far plane is at
+    infinity (a huge clip end rounds the float32 camera matrix to that)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        near = (proj[3, 3] + proj[2, 3]) / (proj[2, 2] + proj[3, 2])
+        far = (proj[2, 3] - proj[3, 3]) / (proj[2, 2] - proj[3, 2])
+    return float(near), (float(far) if np.isfinite(far) and far > near else np.inf)
+
+
+def _rays(inv_proj, proj, px, py, width, height):
+    """Float64 rays through window points: (origin, direction, t_near, t_far).
+
+    Perspective: from the camera centre through the sample's point on the
+    near plane; orthographic: from that near-plane point along the view
+    direction. Hits are kept for t in [t_near, t_far] (clip start..end).
+    Nothing is unprojected from the far plane: with a huge clip end its
+    point has w ~ 0 (or exactly 0) and the ray would turn NaN."""
     x = px / width * 2.0 - 1.0
     y = py / height * 2.0 - 1.0
-    near = np.stack([x, y, -np.ones_like(x), np.ones_like(x)], axis=-1) @ inv_proj.T
-    far = np.stack([x, y, np.ones_like(x), np.ones_like(x)], axis=-1) @ inv_proj.T
-    near = near[..., :3] / near[..., 3:4]
-    far = far[..., :3] / far[..., 3:4]
-    return near, far - near
+    near_h = np.stack([x, y, -np.ones_like(x), np.ones_like(x)], axis=-1) @ inv_proj.T
+    near_pt = near_h[..., :3] / near_h[..., 3:4]
+    near_depth, far_depth = _clip_depths(proj)
+    if proj[3, 2] != 0.0:  # perspective: camera centre at the view origin
+        origin = np.zeros_like(near_pt)
+        direction = near_pt  # t = 1 on the near plane, t = depth / near beyond
+        return origin, direction, 1.0, far_depth / near_depth
+    origin = near_pt  # orthographic: parallel rays down -z from the near plane
+    direction = np.zeros_like(near_pt)
+    direction[..., 2] = -1.0
+    return origin, direction, 0.0, far_depth - near_depth
 
 
 def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None, centre_hit=None):
@@ -387,7 +437,7 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
         e2 = geo.tri_view[pair_tri, 2] - v0
         scale = np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
         for s, (ox, oy) in enumerate(OFFSETS):
-            origin, direction = _rays(inv_proj, px + 0.5 + ox, py + 0.5 + oy, width, height)
+            origin, direction, t_near, t_far = _rays(inv_proj, proj, px + 0.5 + ox, py + 0.5 + oy, width, height)
             pvec = np.cross(direction, e2)
             det = np.einsum("ij,ij->i", e1, pvec)
             ok = np.abs(det) > 1e-13 * scale * np.linalg.norm(direction, axis=1)
@@ -400,7 +450,7 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
                 qvec = np.cross(tvec, e1)
                 v = np.einsum("ij,ij->i", direction, qvec) * inv_det
                 t = np.einsum("ij,ij->i", e2, qvec) * inv_det
-            hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= 0) & (t <= 1)
+            hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= t_near) & (t <= t_far)
             depth = -(origin[:, 2] + t * direction[:, 2])
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
             if s == 0 and all_hits is not None:
@@ -513,9 +563,14 @@ def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_a
     return best, best_along
 
 
-def _thickness_at(s, z, proj, height):
-    """Core width T at view depth z for the thickness mode (issue 7)."""
+def _thickness_at(s, z, proj, height, override=None):
+    """Core width T at view depth z for the thickness mode (image model
+    §4.2). ``override`` (same shape as z, NaN: none) is the object's own
+    Thickness, used in place of the scene's (PIXELS and DEPTH's near width)."""
     mode = getattr(s, "thickness_mode", "PIXELS")
+    near = float(s.thickness)
+    if override is not None:
+        near = np.where(np.isnan(override), near, override)
     if mode == "WORLD":
         clip_w = proj[3, 2] * (-z) + proj[3, 3]  # z for perspective, 1 for orthographic
         return float(s.world_thickness) * 0.5 * height * abs(proj[1, 1]) / clip_w
@@ -525,8 +580,8 @@ def _thickness_at(s, z, proj, height):
             t = np.clip((z - start) / (end - start), 0.0, 1.0)
         else:
             t = (z > start).astype(np.float64)
-        return float(s.thickness) + t * (float(s.thickness_far) - float(s.thickness))
-    return np.full_like(z, float(s.thickness))
+        return near + t * (float(s.thickness_far) - near)
+    return np.broadcast_to(near, np.shape(z)).astype(np.float64)
 
 
 def _eye(proj):
@@ -646,7 +701,7 @@ def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, va
         return coverage
     xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
     d, along = _min_distance_per_pixel(f, xy, geo, wa, wb, valid, geo.edge_real, want_along=True)
-    a = profile(d, _thickness_at(s, z, proj, height), float(s.softness))
+    a = profile(d, _thickness_at(s, z, proj, height, geo.face_thickness[f]), float(s.softness))
     a *= float(s.hidden_alpha) * pattern_mask(np.abs(along), float(s.hidden_period), float(s.hidden_duty))
     a *= _fade(s, z) * wire_alpha
     transmit = np.ones(len(face))
@@ -684,14 +739,17 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
     on_silhouette = (faces[1:] != face[None, :]).any(axis=0)
 
     intensity = np.zeros(len(face))
+    hidden_all = np.zeros(len(face))
+    d_real_all = np.full(len(face), np.inf)
     covered = np.nonzero(face >= 0)[0]
     if len(covered):
         pix_xy = np.stack([covered % width + 0.5, rows[covered // width] + 0.5], axis=1).astype(np.float64)
         pix_face = face[covered]
         wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
         softness = float(s.softness)
-        thickness = _thickness_at(s, depth[covered], proj, height)
+        thickness = _thickness_at(s, depth[covered], proj, height, geo.face_thickness[pix_face])
         d_real, _ = _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, geo.edge_real)
+        d_real_all[covered] = d_real
         value = profile(d_real, thickness, softness)
         mode = s.diagonal_mode
         if mode != "HIDDEN":
@@ -706,6 +764,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         if hidden_lines:
             wire_alpha = float(s.wire_color[3])
             hidden = _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha)
+            hidden_all = hidden
             # The visible wire over the hidden lines ("over" with one colour),
             # expressed as an intensity relative to the wire alpha.
             a_vis = value * wire_alpha
@@ -728,6 +787,11 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         rows,
         fill.reshape(*shape, 3),
         wire.reshape(*shape, 3),
+        d_real_all.reshape(shape),
+        np.where(face >= 0, geo.face_object[np.maximum(face, 0)] if len(geo.face_object) else -1, -1).reshape(shape),
+        geo.objects,
+        geo.offsets,
+        hidden_all.reshape(shape),
     )
 
 

@@ -1,0 +1,133 @@
+"""F12 against Blender's own engines: SolidWire vs Workbench flat vs
+Workbench wireframe (and Freestyle over Cycles at 1 sample), the whole
+``bpy.ops.render.render`` of the same applied mesh and camera, plus the
+per-stage breakdown of a SolidWire frame.
+
+    .venv/bin/python -m scripts.bench_engines [--size 1280x720] [--size 3840x2160]
+        [--subdivisions 5] [--repeats 3] [--freestyle]
+
+The engines take turns render by render (so load on a shared machine hits
+them alike) and ratios come from one run; the first render of each engine is
+reported apart (shader compilation, GPU set-up) and left out of the median.
+Prints a Markdown table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import tempfile
+import time
+
+os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
+
+import bpy  # noqa: E402
+
+import solidwire_addon  # noqa: E402
+from tests.support import scenes  # noqa: E402
+
+ENGINES = (
+    ("SOLIDWIRE", "SolidWire (fill)"),
+    ("WORKBENCH_FLAT", "Workbench flat, single colour, no AA"),
+    ("WORKBENCH_WIRE", "Workbench wireframe, no AA"),
+)
+
+
+def applied_mesh_scene(width: int, height: int, subdivisions: int):
+    """Suzanne subdivided and applied (no modifier left), framed by the camera."""
+    scene = scenes.empty_scene(width, height, use_fill=True)
+    obj = scenes.monkey(scene, "Suzanne", subdivisions=subdivisions)
+    scenes.frame_object(scene, obj, azimuth=-75.0)
+    return scene, obj
+
+
+def configure(scene, engine: str) -> None:
+    render = scene.render
+    if engine == "SOLIDWIRE":
+        render.engine = "SOLIDWIRE"
+        return
+    render.engine = "BLENDER_WORKBENCH"
+    shading = scene.display.shading
+    shading.light = "FLAT"
+    shading.color_type = "SINGLE"
+    scene.display.render_aa = "OFF"
+    shading.type = "WIREFRAME" if engine == "WORKBENCH_WIRE" else "SOLID"
+
+
+def time_render(scene) -> float:
+    start = time.perf_counter()
+    bpy.ops.render.render(scene=scene.name)
+    return time.perf_counter() - start
+
+
+def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
+    width, height = size
+    scene, obj = applied_mesh_scene(width, height, subdivisions)
+    triangles = sum(len(p.vertices) - 2 for p in obj.data.polygons)
+    engines = list(ENGINES)
+    first, times = {}, {name: [] for name, _label in engines}
+    stages = []
+    for turn in range(repeats + 1):
+        for name, _label in engines:
+            configure(scene, name)
+            seconds = time_render(scene)
+            if turn == 0:
+                first[name] = seconds
+            else:
+                times[name].append(seconds)
+                if name == "SOLIDWIRE":
+                    stages.append(solidwire_addon.stats())
+    if freestyle:
+        scene.render.engine = "CYCLES"
+        scene.cycles.samples = 1
+        cycles_alone = time_render(scene)
+        scene.render.use_freestyle = True
+        scene.view_layers[0].use_freestyle = True
+        with_freestyle = time_render(scene)
+        scene.render.use_freestyle = False
+        engines.append(("FREESTYLE", "Freestyle (Cycles 1 spp + Freestyle - Cycles alone)"))
+        times["FREESTYLE"] = [with_freestyle - cycles_alone]
+        first["FREESTYLE"] = float("nan")
+    base = statistics.median(times["WORKBENCH_FLAT"])
+    lines = [
+        f"### {width} x {height}, Suzanne subdivided {subdivisions}x and applied ({triangles:,} triangles)",
+        "",
+        "| engine | steady s (median) | first s | x Workbench flat |",
+        "|---|---:|---:|---:|",
+    ]
+    for name, label in engines:
+        median = statistics.median(times[name])
+        lines.append(f"| {label} | {median:.3f} | {first[name]:.3f} | {median / base:.2f} |")
+    stage = {key: statistics.median(s[key] for s in stages) for key in ("ms_extract", "ms_upload", "ms_draw", "ms_total")}
+    total_ms = statistics.median(times["SOLIDWIRE"]) * 1000.0
+    lines += [
+        "",
+        "SolidWire frame by stage (median ms): "
+        f"extract/validate {stage['ms_extract']:.1f}, upload {stage['ms_upload']:.1f}, "
+        f"draw + readback {stage['ms_draw']:.1f}, SolidWire total {stage['ms_total']:.1f}; "
+        f"the rest of the {total_ms:.0f} ms F12 (depsgraph, result hand-over, Blender's own work) "
+        f"{total_ms - stage['ms_total']:.0f}.",
+        "",
+    ]
+    return lines
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", action="append", help="WxH (repeatable; default 1280x720)")
+    parser.add_argument("--subdivisions", type=int, default=5)
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--freestyle", action="store_true")
+    args = parser.parse_args()
+    solidwire_addon.register()
+    try:
+        for text in args.size or ["1280x720"]:
+            width, height = (int(v) for v in text.lower().split("x"))
+            print("\n".join(run((width, height), args.subdivisions, args.repeats, args.freestyle)), flush=True)
+    finally:
+        solidwire_addon.unregister()
+
+
+if __name__ == "__main__":
+    main()
