@@ -3,7 +3,7 @@
 A small still life that shows what SolidWire draws: Suzanne with a
 subdivision modifier (quads), a torus (quads), a cylinder with 16-sided
 n-gon caps, a bevelled cube (quads, triangles and n-gons after the
-modifier) and a floor grid, in fill mode with dotted diagonals so the
+modifier) and a floor grid, in fill mode (studio-lit) with dotted diagonals so the
 triangulation of quads and n-gons is visible but quieter than the real edges.
 
 The scene is built in a new scene of the current file with bmesh and
@@ -25,7 +25,7 @@ RESOLUTION = (960, 540)
 # Colours are linear (scene-referred); the Standard view transform shows them
 # as written.
 WORLD_COLOR = (0.30, 0.36, 0.45)
-FILL_COLOR = (0.93, 0.91, 0.86, 1.0)
+FILL_COLOR = (0.93, 0.91, 0.86)
 WIRE_COLOR = (0.045, 0.05, 0.07, 1.0)
 
 
@@ -91,6 +91,7 @@ def build(name: str = SCENE_NAME):
 
     look = scene.solidwire
     look.use_fill = True
+    look.fill_shading = "STUDIO"
     look.fill_color = FILL_COLOR
     look.wire_color = WIRE_COLOR
     look.thickness = 1.1
@@ -105,11 +106,13 @@ def build(name: str = SCENE_NAME):
     )
     subdivision = suzanne.modifiers.new("Subdivision", "SUBSURF")
     subdivision.levels = subdivision.render_levels = 1
+    suzanne.data.shade_smooth()  # the studio-lit fill follows Blender's smooth normals
 
-    _object(
+    torus = _object(
         scene, "Torus", _torus,
         location=(-2.45, -0.6, -0.25), rotation=(math.radians(58), 0.0, math.radians(-25)), scale=(0.8, 0.8, 0.8),
     )
+    torus.data.shade_smooth()
 
     def cylinder(bm):
         bmesh.ops.create_cone(

@@ -26,7 +26,7 @@ CELL = preset_gallery.CELL
 PAPER = (0.93, 0.92, 0.88)
 INK = (0.02, 0.04, 0.12, 1.0)
 
-LOOK = dict(use_fill=True, fill_color=(*PAPER, 1.0), wire_color=INK, thickness=1.6, softness=0.9)
+LOOK = dict(use_fill=True, fill_shading="FLAT", fill_color=PAPER, wire_color=INK, thickness=1.6, softness=0.9)
 STYLES = (
     ("Single pass (SPEC): outlines half width", {}),
     ("Full-width silhouettes", dict(use_silhouettes=True)),

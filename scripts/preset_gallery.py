@@ -90,9 +90,9 @@ def render_cells(scene, folder: Path):
     return cells
 
 
-def compose(cells, columns: int = COLUMNS) -> np.ndarray:
+def compose(cells, columns: int = COLUMNS, cell=CELL) -> np.ndarray:
     """(H, W, 3) uint8, top row first, with a label strip under each cell."""
-    width, height = CELL
+    width, height = cell
     rows = -(-len(cells) // columns)
     sheet = np.zeros((rows * (height + LABEL_HEIGHT), columns * width, 3), dtype=np.uint8)
     sheet[:] = LABEL_BACKGROUND
@@ -104,7 +104,7 @@ def compose(cells, columns: int = COLUMNS) -> np.ndarray:
     return sheet
 
 
-def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS) -> None:
+def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS, cell=CELL) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         from PIL import Image, ImageDraw, ImageFont
@@ -117,7 +117,7 @@ def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS) -> None:
         font = ImageFont.load_default(size=19)
     except TypeError:  # Pillow < 10.1
         font = ImageFont.load_default()
-    width, height = CELL
+    width, height = cell
     for index, (label, _linear) in enumerate(cells):
         r, c = divmod(index, columns)
         x = c * width + 10

@@ -15,6 +15,8 @@
 #define HAS_QUAD_CORNER 8 /* p3 is the 4th corner of a quad: p2-p3, p3-p0 are real */
 #define IS_NGON 16 /* part of a polygon with more than 4 corners; see NGON_SHIFT */
 #define NGON_SHIFT 8 /* edge_flags >> NGON_SHIFT: the n-gon's corner count */
+#define EDGE3_HIDDEN 64 /* a quad's p2-p3 is not drawn (edge angle): a diagonal */
+#define EDGE4_HIDDEN 128 /* a quad's p3-p0 likewise */
 /* Set by the vertex stage: the whole triangle (and a quad's 4th corner) is in
  * front of the near plane and its polygon projects convex, so line
  * distances are segment distances for every sample inside it. */

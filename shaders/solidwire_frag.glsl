@@ -6,6 +6,8 @@
  *   USE_FADE           depth fade
  *   DIAGONALS          0 hidden, 1 solid, 2 patterned (dotted/dashed)
  *   WRITE_VIEW_DEPTH   second colour target receives the view depth (render)
+ *   SHADING, ITEM_COLORS, MATERIAL_COLORS   fill shading and colour sources
+ *                      (fill_shading.glsl)
  *   USE_CLIP_PLANES    viewport clipping region: discard outside its planes
  *   WRITE_AOVS         third and fourth targets: (d_real, I_vis, object
  *                      index, material index) and the camera-facing world normal (render
@@ -96,8 +98,11 @@ void main()
   keep_nearest(real0, d0, edge_line0, edge_span0, d_real, real_line, real_span);
   keep_nearest(real1, d1, edge_line1, edge_span1, d_real, real_line, real_span);
   keep_nearest(real2, d2, edge_line2, edge_span2, d_real, real_line, real_span);
-  keep_nearest(true, d3, edge_line3, edge_span3, d_real, real_line, real_span);
-  keep_nearest(true, d4, edge_line4, edge_span4, d_real, real_line, real_span);
+  /* A quad's edges to its 4th corner, unless not drawn (edge angle). */
+  bool real3 = (triangle_flags & EDGE3_HIDDEN) == 0;
+  bool real4 = (triangle_flags & EDGE4_HIDDEN) == 0;
+  keep_nearest(real3, d3, edge_line3, edge_span3, d_real, real_line, real_span);
+  keep_nearest(real4, d4, edge_line4, edge_span4, d_real, real_line, real_span);
   /* An n-gon's boundary edges may pass near this fragment although they
    * belong to another of its triangles (thin ears, concave outlines): walk
    * the whole outline. Compiled only into the variant for meshes that have
@@ -106,12 +111,14 @@ void main()
 #ifdef USE_NGONS
   int corners = triangle_flags >> NGON_SHIFT;
   for (int k = 0; k < corners; k++) {
-    float id_a = fetch_texel(ngon_corners, ngon_corner_start + k).x;
+    vec4 slot_a = fetch_texel(ngon_corners, ngon_corner_start + k);
+    float id_a = slot_a.x;
     float id_b = fetch_texel(ngon_corners, ngon_corner_start + (k + 1) % corners).x;
     vec3 line;
     vec2 span;
     edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
-    keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_real, real_line, real_span);
+    /* .y: this outline edge is not drawn (edge angle); see the diagonals. */
+    keep_nearest(slot_a.y < 0.5, edge_distance_sq(line, span, p), line, span, d_real, real_line, real_span);
   }
 #endif
   d_real = sqrt(d_real);
@@ -132,6 +139,8 @@ void main()
   keep_nearest(!real0, d0, edge_line0, edge_span0, d_diag, diag_line, diag_span);
   keep_nearest(!real1, d1, edge_line1, edge_span1, d_diag, diag_line, diag_span);
   keep_nearest(!real2, d2, edge_line2, edge_span2, d_diag, diag_line, diag_span);
+  keep_nearest(!real3, d3, edge_line3, edge_span3, d_diag, diag_line, diag_span);
+  keep_nearest(!real4, d4, edge_line4, edge_span4, d_diag, diag_line, diag_span);
   /* Every diagonal of an n-gon, not only this triangle's own. */
 #ifdef USE_NGONS
   for (int k = 0; k < corners - 3; k++) {
@@ -142,6 +151,18 @@ void main()
     vec2 span;
     edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
     keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_diag, diag_line, diag_span);
+  }
+  /* Outline edges that are not drawn (edge angle) count as diagonals. */
+  for (int k = 0; k < corners; k++) {
+    vec4 slot_a = fetch_texel(ngon_corners, ngon_corner_start + k);
+    if (slot_a.y > 0.5) {
+      float id_a = slot_a.x;
+      float id_b = fetch_texel(ngon_corners, ngon_corner_start + (k + 1) % corners).x;
+      vec3 line;
+      vec2 span;
+      edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
+      keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_diag, diag_line, diag_span);
+    }
   }
 #endif
   d_diag = sqrt(d_diag);
@@ -160,11 +181,21 @@ void main()
 #endif
 
   float wire_weight = intensity * params.wire_color.a;
+#ifdef ITEM_COLORS
+  vec3 wire_rgb = item_wire; /* colour sources (fill_shading.glsl) */
+#else
+  vec3 wire_rgb = params.wire_color.rgb;
+#endif
 #if defined(USE_FILL) && !defined(HIDDEN_PASS)
-  frag_color = vec4(mix(params.fill_color.rgb, params.wire_color.rgb, wire_weight), 1.0);
+#  ifdef ITEM_COLORS
+  vec3 fill_rgb = item_fill;
+#  else
+  vec3 fill_rgb = params.fill_color.rgb;
+#  endif
+  frag_color = vec4(mix(shaded_fill(fill_rgb), wire_rgb, wire_weight), 1.0);
 #else
   /* Premultiplied: what the render pass expects and what blending needs. */
-  frag_color = vec4(params.wire_color.rgb * wire_weight, wire_weight);
+  frag_color = vec4(wire_rgb * wire_weight, wire_weight);
 #endif
 #if defined(WRITE_VIEW_DEPTH) && !defined(HIDDEN_PASS)
   frag_view_depth = view_depth;

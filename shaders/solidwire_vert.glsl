@@ -61,6 +61,10 @@ void main()
     else {
       simple = !is_ngon;
     }
+    /* An edge that is not drawn (edge angle) moves to the diagonals: then a
+     * line distance is no longer a segment distance for every sample. */
+    int drawn_mask = is_quad ? (EDGE0_REAL | EDGE1_REAL) : (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
+    simple = simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0;
   }
   else {
     /* Some corner is behind the near plane: clip each edge (edge_setup). */
@@ -97,16 +101,35 @@ void main()
   vec3 local = fetch_texel(vertex_positions,
                            int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
+#ifdef USE_CORNERS
+  /* This corner's normal and its face's material (one texel per triangle
+   * corner, in draw order; extract.corner_table). */
+  vec4 corner_data = fetch_texel(corner_table, gl_VertexID);
+  shading_normal = mat3(normal_to_view) * corner_data.xyz;
+#endif
+#ifdef ITEM_COLORS
+  /* The object's block of the frame's colour table (core/colors.py). */
+  int item_base = int(item_info.x);
+  vec4 item_head = fetch_texel(item_colors, item_base);
+  item_wire = item_head.rgb;
+  item_fill = fetch_texel(item_colors, item_base + 1).rgb;
+#  ifdef MATERIAL_COLORS
+  int material_count = int(item_head.w);
+  if (material_count > 0) {
+    item_fill = fetch_texel(item_colors, item_base + 2 + clamp(int(corner_data.w), 0, material_count - 1)).rgb;
+  }
+#  endif
+#endif
 #ifdef USE_CLIP_PLANES
   /* Viewport clipping region: signed distances to the clip-space planes
    * (draw.py, clip_space_planes), linear in clip space so the interpolated
    * value is exact; the fragment stage discards where one is negative.
    * Taken before the depth bias, which moves only z. */
-  clip_distance_a = vec4(dot(clip_planes[0], position),
-                         dot(clip_planes[1], position),
-                         dot(clip_planes[2], position),
-                         dot(clip_planes[3], position));
-  clip_distance_b = vec2(dot(clip_planes[4], position), dot(clip_planes[5], position));
+  clip_distance_a = vec4(dot(clip_params.planes[0], position),
+                         dot(clip_params.planes[1], position),
+                         dot(clip_params.planes[2], position),
+                         dot(clip_params.planes[3], position));
+  clip_distance_b = vec2(dot(clip_params.planes[4], position), dot(clip_params.planes[5], position));
 #endif
 #ifdef DEPTH_BIAS
   /* Viewport overlay only: Blender's own Solid shading has already written

@@ -15,8 +15,8 @@ import atexit
 
 import bpy
 
-from .blender import cli, engine, ops, ops_composite, overlay, properties, runtime, ui
-from .core import log, silhouettes, targets
+from .blender import cli, engine, matcap_files, ops, ops_composite, overlay, properties, runtime, ui
+from .core import log, matcaps, silhouettes, targets
 
 _classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
 _registered = False
@@ -33,6 +33,7 @@ def register() -> None:
     ui.register_appends()
     ops.register_keymaps()
     overlay.register()
+    matcap_files.register()
     cli.register_command()
     atexit.register(_at_exit)
     _registered = True
@@ -43,6 +44,7 @@ def unregister() -> None:
     if not _registered:
         return
     cli.unregister_command()
+    matcap_files.unregister()
     overlay.unregister()
     ops.unregister_keymaps()
     ui.unregister_appends()
@@ -71,6 +73,7 @@ def release_gpu() -> None:
     targets.release()
     runtime.release()
     silhouettes.release()
+    matcaps.clear()
 
 
 def stats() -> dict:

@@ -85,7 +85,7 @@ def test_thickness_500_fills_every_visible_pixel(output_dir):
         ("pattern_period", math.nan),
         ("wire_color", (math.nan, 1.0, 1.0, 1.0)),
         ("wire_color", (1.0, 1.0, 1.0, math.nan)),
-        ("fill_color", (math.nan, 0.5, 0.5, 1.0)),
+        ("fill_color", (math.nan, 0.5, 0.5)),
     ],
 )
 def test_non_finite_setting_falls_back_to_its_default(name, value, output_dir, capfd):

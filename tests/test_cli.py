@@ -146,7 +146,13 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
         target = srgb_from_linear(colour_linear[:3])
         return float(np.mean(np.max(np.abs(rgb - target), axis=-1) <= 3.0 / 255.0))
 
-    wire, fill, world = (share_near(c) for c in (demo_scene.WIRE_COLOR, demo_scene.FILL_COLOR, demo_scene.WORLD_COLOR))
+    wire, world = (share_near(c) for c in (demo_scene.WIRE_COLOR, demo_scene.WORLD_COLOR))
+    # The fill is studio-lit: the fill colour times a light level (one factor
+    # for all three channels).
+    linear = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+    ratio = linear / np.asarray(demo_scene.FILL_COLOR)
+    lit = (np.ptp(ratio, axis=-1) < 0.03) & (ratio.mean(axis=-1) > 0.3)
+    fill = float(np.mean(lit))
     assert wire > 0.01, f"too few wire pixels ({wire:.3%})"
     assert fill > 0.02, f"too few fill pixels ({fill:.3%})"
     assert world > 0.3, f"too little background ({world:.3%})"
@@ -161,7 +167,7 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
              "--fill-color", "0.1,0.2,0.3", "--diagonals", "SOLID", "--opaque",
              "--width", "120", "--height", "80", "--percentage", "50"),
             dict(thickness=3.0, softness=0.6, wire_color=(1.0, 0.2, 0.1, 1.0), use_fill=True,
-                 fill_color=(0.1, 0.2, 0.3, 1.0), diagonal_mode="SOLID"),
+                 fill_color=(0.1, 0.2, 0.3), diagonal_mode="SOLID"),
             dict(film_transparent=False, resolution_x=120, resolution_y=80, resolution_percentage=50),
             id="options",
         ),
@@ -179,6 +185,14 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
             dict(thickness_mode="WORLD", world_thickness=0.03),
             {},
             id="world-thickness",
+        ),
+        pytest.param(
+            ("--fill", "--shading", "matcap", "--matcap", "clay_brown", "--fill-source", "random",
+             "--wire-source", "OBJECT", "--edge-angle", "0.2"),
+            dict(use_fill=True, fill_shading="MATCAP", matcap="clay_brown", fill_color_source="RANDOM",
+                 wire_color_source="OBJECT", edge_angle=0.2),
+            {},
+            id="shading-and-colour-sources",
         ),
     ],
 )

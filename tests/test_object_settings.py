@@ -50,11 +50,11 @@ def _assert_matches_reference(scene, rgba, ref):
 @pytest.mark.parametrize("use_fill", [True, False])
 def test_show_in_render_and_override_match_the_reference(use_fill):
     scene = scenes.empty_scene(WIDTH, HEIGHT, use_fill=use_fill)
-    scene.solidwire.fill_color = (0.0, 0.4, 0.0, 1.0)
+    scene.solidwire.fill_color = (0.0, 0.4, 0.0)
     scenes.add_camera(scene, location=(0.0, -10.0, 2.0), target=(0.0, 0.0, 0.0))
     scenes.cube(scene, "Plain", size=1.6, location=(-2.4, 0.0, 0.0), rotation=(0.3, 0.2, 0.5))
     styled = scenes.uv_sphere(scene, "Styled", location=(0.0, 0.0, 0.0), radius=1.2)
-    _override(styled, (1.0, 0.2, 0.0, 0.8), 4.0, (0.0, 0.0, 1.0, 1.0))
+    _override(styled, (1.0, 0.2, 0.0, 0.8), 4.0, (0.0, 0.0, 1.0))
     old = scenes.monkey(scene, "OldFile", location=(2.6, 0.0, 0.0))
     old.solidwire_exclude = True  # the older viewport opt-out: still rendered
     occluder = scenes.cube(scene, "NotRendered", size=3.0, location=(0.0, -3.0, 0.0))
@@ -86,14 +86,14 @@ def test_instances_take_the_settings_of_the_object_they_instance():
         obj.rotation_euler = (0.1 * k, 0.2, 0.05 * k)
         duplicates.append(obj)
     for obj in duplicates[::2]:
-        _override(obj, (0.0, 1.0, 0.0, 1.0), 3.0, (1.0, 1.0, 1.0, 1.0))
+        _override(obj, (0.0, 1.0, 0.0, 1.0), 3.0, (1.0, 1.0, 1.0))
     # A collection instance of a styled sphere the scene does not hold, and
     # a second instancer of it that is off in renders.
     proto = bpy.data.collections.new("Proto")
     sphere = scenes.uv_sphere(scene, "ProtoSphere", radius=0.9)
     scene.collection.objects.unlink(sphere)
     proto.objects.link(sphere)
-    _override(sphere, (1.0, 0.0, 1.0, 1.0), 2.5, (1.0, 1.0, 1.0, 1.0))
+    _override(sphere, (1.0, 0.0, 1.0, 1.0), 2.5, (1.0, 1.0, 1.0))
     for name, location, shown in (("Shown", (0.0, -3.0, 2.5), True), ("Off", (3.0, -3.0, 2.5), False)):
         instancer = bpy.data.objects.new(name, None)
         instancer.instance_type = "COLLECTION"

@@ -71,7 +71,7 @@ def test_field_ranges_match_the_settings():
         elif field.kind == "ENUM":
             assert set(field.choices) == {item.identifier for item in prop.enum_items}, key
         elif field.kind == "COLOR":
-            assert (prop.array_length, prop.hard_min, prop.hard_max) == (4, 0.0, 1.0), key
+            assert (prop.array_length, prop.hard_min, prop.hard_max) == (field.size, 0.0, 1.0), key
         else:
             assert prop.type == "BOOLEAN", key
 
@@ -109,7 +109,7 @@ def test_user_preset_round_trips(user_dir):
     props = scene.solidwire
     props.thickness, props.softness = 2.75, 0.5
     props.wire_color = (0.1, 0.2, 0.3, 0.8)
-    props.use_fill, props.fill_color = True, (0.9, 0.8, 0.7, 1.0)
+    props.use_fill, props.fill_color = True, (0.9, 0.8, 0.7)
     props.diagonal_mode = "DASHED"
     props.pattern_period, props.pattern_duty = 12.0, 0.4
     props.use_fade, props.fade_start, props.fade_end = True, 3.0, 7.5

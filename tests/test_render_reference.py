@@ -126,7 +126,7 @@ def test_fill_mode_colour_is_mix_of_wire_and_fill(output_dir):
     """Fill: colour = I * wire + (1 - I) * fill, opaque where a surface is."""
     scene = scenes.empty_scene(200, 150, use_fill=True)
     scene.solidwire.wire_color = (1.0, 1.0, 1.0, 1.0)
-    scene.solidwire.fill_color = (0.0, 0.0, 0.0, 1.0)
+    scene.solidwire.fill_color = (0.0, 0.0, 0.0)
     scenes.monkey(scene, subdivisions=1)
     scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0, 0, 0))
     rgba = scenes.render_to_file(scene, output_dir / "fill_mode.png")
@@ -234,7 +234,7 @@ def test_hidden_lines_match_reference(fill, output_dir):
     drawn dimmed and dashed, under the visible wire and over the fill."""
     scene = scenes.empty_scene(200, 150, use_hidden_lines=True, hidden_alpha=0.5, hidden_period=6.0, use_fill=fill)
     scene.solidwire.wire_color = (1.0, 1.0, 1.0, 1.0)
-    scene.solidwire.fill_color = (0.0, 0.0, 0.0, 1.0)
+    scene.solidwire.fill_color = (0.0, 0.0, 0.0)
     scenes.cube(scene, rotation=(0.2, 0.3, 0.4))
     scenes.uv_sphere(scene, location=(-1.6, 1.8, 0.0), radius=0.9)
     scenes.add_camera(scene)

@@ -220,6 +220,7 @@ def test_rows_that_do_not_apply_are_greyed_not_hidden(context):
 
     props.use_fill, props.diagonal_mode, props.use_fade, props.show_overlay = True, "DASHED", True, True
     props.use_hidden_lines, props.thickness_mode = True, "DEPTH"
+    props.fill_shading = "MATCAP"
     greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
     assert {name for name, g in greyed.items() if g} == {"world_thickness"}
 

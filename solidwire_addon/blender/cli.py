@@ -155,8 +155,10 @@ def _add_setting_option(group, setting: schema.Setting) -> None:
         group.add_argument(setting.flag, dest=setting.name, action=argparse.BooleanOptionalAction,
                            default=None, help=help_text)
     elif setting.kind == schema.ENUM:
-        group.add_argument(setting.flag, dest=setting.name, choices=setting.choices, type=str.upper,
-                           help=help_text)
+        # Upper-case identifiers take any case; names (matcaps) as written.
+        upper = all(choice == choice.upper() for choice in setting.choices)
+        group.add_argument(setting.flag, dest=setting.name, choices=setting.choices,
+                           type=str.upper if upper else str, help=help_text)
     elif setting.kind == schema.COLOR:
         group.add_argument(setting.flag, dest=setting.name, type=_color, metavar="R,G,B[,A]",
                            help=help_text + " (0..1 or #RRGGBB)")

@@ -90,6 +90,7 @@ class PreparedFrame:
             object_settings=gather.ObjectSettings(
                 gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes),
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
+            **passes.gather_options(self.settings),
         )
         self.draw_stats = None
         self.ms_draw = 0.0

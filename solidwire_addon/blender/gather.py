@@ -25,6 +25,7 @@ import numpy as np
 
 from ..core import extract
 from ..core.cache import MeshCache
+from ..core.colors import ItemSource
 from ..core.log import warn_once
 from ..core.view import DrawItem, Style, outside_frustum_many
 from . import runtime
@@ -90,11 +91,14 @@ def _is_plain(obj_orig) -> bool:
     )
 
 
-def fingerprint(mesh):
-    """(fingerprint, (positions, corner_vert)) of a mesh's drawn geometry.
+def fingerprint(mesh, corners: bool = False):
+    """(fingerprint, (positions, corner_vert, corner inputs)) of a mesh's
+    drawn geometry.
 
     Counts plus CRC32 of the vertex positions and corner vertices (~4 GB/s),
-    read with the same bulk reads extraction needs, which then reuses them."""
+    read with the same bulk reads extraction needs, which then reuses them.
+    With ``corners`` (shaded fill), the corner normals and material indices
+    too: sharp edges or materials can change without moving a vertex."""
     positions = extract.read_positions(mesh)
     corner_vert = extract.read_corner_verts(mesh)
     # Topology first, the positions' checksum last (MeshCache.get_validated
@@ -107,11 +111,26 @@ def fingerprint(mesh):
         zlib.crc32(memoryview(corner_vert).cast("B")),
         zlib.crc32(memoryview(positions).cast("B")),
     )
-    return content, (positions, corner_vert)
+    corner_inputs = None
+    if corners:
+        corner_inputs = extract.read_corner_inputs(mesh)
+        content += tuple(zlib.crc32(memoryview(np.ascontiguousarray(a)).cast("B")) for a in corner_inputs)
+    return content, (positions, corner_vert, corner_inputs)
+
+
+def item_source(obj) -> ItemSource:
+    """What the colour sources read from an evaluated object (core/colors.py):
+    its name, its viewport colour and its material slots' viewport colours."""
+    materials = []
+    for slot in obj.material_slots:
+        material = slot.material
+        materials.append(None if material is None else tuple(float(c) for c in material.diffuse_color[:3]))
+    return ItemSource(obj.name, tuple(float(c) for c in obj.color[:3]), tuple(materials))
 
 
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None, object_settings: ObjectSettings | None = None, materials: bool = False):
+           should_stop=None, corners: bool = False, colors: bool = False, edge_angle: float = 0.0,
+           object_settings: ObjectSettings | None = None, materials: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -124,6 +143,11 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     frustum (its evaluated bound box against the clip planes); those
     instances count as culled. ``should_stop()`` (a render's Esc) is asked
     before each object's work; when it says True, gathering ends there.
+    ``corners``: meshes carry their corner table (shaded fill, material
+    colours; a separate cache entry, so FLAT draws never pay for it).
+    ``colors``: each item carries its object's :class:`ItemSource`.
+    ``edge_angle`` (radians, > 0): flat edges are not drawn (extraction
+    clears their flags; a separate cache entry per angle).
 
     ``object_settings`` applies the per-object settings: an object drawn
     itself follows its own; an instance is drawn only if both its instancer
@@ -147,6 +171,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     instancer_meshes: dict[int, int] = {}  # geometry-nodes parent uid -> distinct meshes so far
     view_projection = None if view is None else view.projection @ view.view_matrix
     deferred: dict[int, tuple] = {}  # culled, never-extracted mesh -> (key, uids, bound box, instances culled)
+    sources: dict[int, ItemSource] = {}  # evaluated object -> its colour-source inputs this frame
     face_slots: dict[int, np.ndarray] = {}  # evaluated mesh -> material slot per face (materials only)
 
     for instance in depsgraph.object_instances:
@@ -183,7 +208,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
             seen.add(key)
             mesh = None
             try:
-                mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions)
+                mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions,
+                                    corners, edge_angle)
                 ms_extract += ms
             except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
                 warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
@@ -197,13 +223,18 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
             if len(data.polygons) or obj.original.mode == "EDIT":
                 try:
                     key, uids = _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes)
+                    if corners:
+                        key = (*key, "corners")
+                    if edge_angle > 0.0:
+                        key = (*key, "angle", float(edge_angle))
                     if view_projection is not None and key not in cache:
                         box = _bound_box(obj)
                         if box is not None and _outside(view_projection, instance, box):
                             deferred[pointer] = (key, uids, box, 1)
                             continue
                     seen.add(key)
-                    mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions)
+                    mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions,
+                                        corners, edge_angle)
                     ms_extract += ms
                 except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
                     warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
@@ -215,7 +246,12 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                 )
             by_pointer[pointer] = mesh
         if mesh is not None:
-            item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), style, pass_index)
+            source = None
+            if colors:
+                source = sources.get(obj.as_pointer())
+                if source is None:
+                    source = sources[obj.as_pointer()] = item_source(obj)
+            item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), source, style, pass_index)
             if materials:
                 item.materials = _materials_of(obj, data, pointer, face_slots)
             items.append(item)
@@ -254,9 +290,10 @@ def _outside(view_projection, instance, box) -> bool:
     return bool(outside_frustum_many(object_to_clip[None], *box)[0])
 
 
-def _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions):
+def _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions, corners=False,
+             edge_angle=0.0):
     trust = (depsgraph_id, epoch) if trust_updates else None
-    return _mesh_for(obj, data, pointer, key, uids, cache, trust, versions)
+    return _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners, edge_angle)
 
 
 def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
@@ -283,7 +320,7 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
     return key, uids
 
 
-def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions):
+def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False, edge_angle=0.0):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
     obj_orig = obj.original
     fast = None
@@ -303,9 +340,10 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions):
         return source[0]
 
     def make_arrays(context):
-        positions, corner_vert = context
+        positions, corner_vert, corner_inputs = context
         try:
-            arrays = extract.extract_mesh(get_source(), positions=positions, corner_vert=corner_vert)
+            arrays = extract.extract_mesh(get_source(), positions=positions, corner_vert=corner_vert,
+                                          corners=corner_inputs if corners else None, edge_angle=edge_angle)
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
             return None
@@ -324,12 +362,17 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions):
         return arrays
 
     def reposition(entry, context):
-        positions, corner_vert = context
+        positions, corner_vert = context[:2]
         return extract.reposition(entry, positions, corner_vert, extract.read_face_offsets(get_source()))
 
     try:
+        # Positions-only re-upload (reposition) only for meshes without a
+        # corner table or edge angle: corner normals and which edges are flat
+        # follow the positions, so those meshes are extracted again.
+        simple = not corners and edge_angle <= 0.0
         mesh, _extracted = cache.get_validated(
-            key, fast, lambda: fingerprint(get_source()), make_arrays, reposition
+            key, fast, (lambda: fingerprint(get_source(), True)) if corners else (lambda: fingerprint(get_source())),
+            make_arrays, reposition if simple else None
         )
     finally:
         if in_edit_mode and source:

@@ -166,7 +166,8 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
-                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects))
+                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
+                                            **passes.gather_options(settings))
     start = time.perf_counter()
     stats = passes.draw_over_viewport(
         items,

@@ -21,6 +21,7 @@ from bpy.props import (
 
 from ..core import schema
 from ..core.settings import DrawSettings
+from . import matcap_files
 
 # Where each scope's PropertyGroup is attached.
 _OWNERS = {schema.SCENE: "Scene", schema.OBJECT: "Object", schema.VIEW_LAYER: "ViewLayer"}
@@ -43,6 +44,13 @@ def _diagonal_mode_changed(self, _context) -> None:
     redraw_viewports()
 
 
+def _matcap_changed(self, _context) -> None:
+    """Decode the chosen matcap now, in the main thread (matcap_files.py)."""
+    if self.fill_shading == "MATCAP":
+        matcap_files.request(self.matcap)
+    redraw_viewports()
+
+
 def _passes_changed(self, _context) -> None:
     """A pass switched on or off: Blender asks the engine for its passes
     again (the compositor's Render Layers node shows them at once)."""
@@ -58,6 +66,8 @@ def _passes_changed(self, _context) -> None:
 # Settings whose change does more than redraw.
 _UPDATES = {
     "diagonal_mode": _diagonal_mode_changed,
+    "fill_shading": _matcap_changed,
+    "matcap": _matcap_changed,
     **{s.name: _passes_changed for s in schema.settings_in(schema.VIEW_LAYER) if s.name.startswith("use_pass_")},
 }
 
@@ -79,7 +89,7 @@ def make_property(setting: schema.Setting):
         if value is not None and abs(value) != float("inf"):
             limits[key] = value
     if setting.kind == schema.COLOR:
-        return FloatVectorProperty(default=setting.default, size=4, subtype="COLOR", **limits, **common)
+        return FloatVectorProperty(default=setting.default, size=setting.size, subtype="COLOR", **limits, **common)
     return FloatProperty(default=setting.default, subtype=setting.subtype, **limits, **common)
 
 

@@ -13,6 +13,8 @@ Blender's ``gpu`` module. Modules, in the order data flows through them:
     draw        one pass: shader variant + parameter block + batches
     silhouettes the full-width silhouette fin pass
     targets     offscreen float targets and their readback
+    colors      per-object colours (colour sources) and their table
+    matcaps     matcap images as textures (loaded by the Blender side)
     passes      the pass plan, run offscreen or over a viewport
     exr         reading back layers other engines rendered
 """

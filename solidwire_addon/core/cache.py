@@ -49,8 +49,13 @@ class GPUMesh:
         self.triangles = table_texture(arrays.triangles.astype(np.float32))
         ngon = np.zeros((max(len(arrays.ngon_corners), 1), 4), dtype=np.float32)
         ngon[: len(arrays.ngon_corners), 0] = arrays.ngon_corners
+        if arrays.ngon_hidden is not None:
+            ngon[: len(arrays.ngon_hidden), 1] = arrays.ngon_hidden  # outline edge not drawn (edge angle)
         self.ngon_corners = table_texture(ngon)
         self.has_ngons = len(arrays.ngon_corners) > 0
+        # Corner normals and material indices, one texel per triangle corner
+        # (read by gl_VertexID); only for a shaded or per-material fill.
+        self.corners = None if arrays.corners is None else table_texture(arrays.corners)
         # Kept (no copy) so the silhouette pass can derive its edge table on
         # first use without re-extracting; see silhouettes.py.
         self.triangles_cpu = arrays.triangles
@@ -76,6 +81,7 @@ class GPUMesh:
             + self.triangles.width * self.triangles.height * 16
             + 3 * self.triangle_count * 4
             + self.ngon_corners.width * self.ngon_corners.height * 16
+            + (0 if self.corners is None else self.corners.width * self.corners.height * 16)
         )
 
 

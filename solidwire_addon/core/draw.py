@@ -14,8 +14,9 @@ from dataclasses import replace
 import gpu
 import numpy as np
 
-from . import shaders
+from . import colors, matcaps, shaders
 from .cache import table_texture
+from .log import warn_once
 from .settings import pack_params
 from .view import DrawStats, View, outside_frustum_many, translation
 
@@ -37,7 +38,25 @@ def shader_variant(settings, write_view_depth: bool = False, depth_bias: float =
         thickness_mode={"WORLD": shaders.THICKNESS_WORLD, "DEPTH": shaders.THICKNESS_DEPTH}.get(
             settings.thickness_mode, shaders.THICKNESS_PIXELS
         ),
+        shading=fill_shading(settings),
+        item_colors=colors.needs_item_colors(settings),
+        material_colors=colors.needs_material_colors(settings),
     )
+
+
+def fill_shading(settings) -> int:
+    """The shading the fill asks for (none without a fill)."""
+    if not settings.use_fill:
+        return shaders.SHADING_FLAT
+    return {"STUDIO": shaders.SHADING_STUDIO, "MATCAP": shaders.SHADING_MATCAP}.get(
+        settings.fill_shading, shaders.SHADING_FLAT
+    )
+
+
+def needs_corners(settings) -> bool:
+    """Whether meshes must carry their corner table (normals, material
+    indices): extracted and uploaded only then (see gather)."""
+    return fill_shading(settings) != shaders.SHADING_FLAT or colors.needs_material_colors(settings)
 
 
 class ExactProgram:
@@ -81,41 +100,59 @@ def styled(settings, style, show_wire: bool = True):
 def _groups(items, view: View, cull: bool, stats: DrawStats, pass_indices: bool = False):
     """Items grouped by GPU mesh and style with their float64-composed
     matrices, culled (vectorised over each group). Yields (mesh, style,
-    world (N,4,4), object_to_view, object_to_clip, pass indices (N,) or
-    None) with only the visible instances."""
+    world (N,4,4), object_to_view, object_to_clip, item indices (N,),
+    (pass indices (N,), materials) or (None, None)) with only the visible
+    instances."""
     by_mesh: dict = {}
-    for item in items:
+    for index, item in enumerate(items):
         # Plain items key by mesh alone: no tuple per item on the common path.
         key = id(item.mesh) if item.style is None else (id(item.mesh), item.style)
-        by_mesh.setdefault(key, []).append(item)
+        by_mesh.setdefault(key, []).append(index)
     for group in by_mesh.values():
-        mesh, style = group[0].mesh, group[0].style
-        world = np.stack([item.matrix for item in group]) if len(group) > 1 else group[0].matrix[None]
+        mesh, style = items[group[0]].mesh, items[group[0]].style
+        indices = np.asarray(group, dtype=np.int64)
+        world = np.stack([items[i].matrix for i in group]) if len(group) > 1 else items[group[0]].matrix[None]
         # float64 all the way to here: the mesh centre and any large world
         # translation cancel against the view before rounding to float32.
         object_to_view = view.view_matrix @ world @ translation(mesh.centre)
         object_to_clip = view.projection @ object_to_view
-        indices = np.array([item.pass_index for item in group], dtype=np.float64) if pass_indices else None
-        materials = [item.materials for item in group] if pass_indices else None
+        pass_index = np.array([items[i].pass_index for i in group], dtype=np.float64) if pass_indices else None
+        materials = [items[i].materials for i in group] if pass_indices else None
         if cull:
             outside = outside_frustum_many(object_to_clip, mesh.bounds_min, mesh.bounds_max)
             if outside.any():
                 stats.objects_culled += int(outside.sum())
                 keep = ~outside
                 world, object_to_view, object_to_clip = world[keep], object_to_view[keep], object_to_clip[keep]
-                if indices is not None:
-                    indices = indices[keep]
+                indices = indices[keep]
+                if pass_index is not None:
+                    pass_index = pass_index[keep]
                     materials = [m for m, k in zip(materials, keep) if k]
         if len(world):
-            yield mesh, style, world, object_to_view, object_to_clip, (indices, materials)
+            yield mesh, style, world, object_to_view, object_to_clip, indices, (pass_index, materials)
 
 
-def _instance_rows(object_to_view: np.ndarray, object_to_clip: np.ndarray) -> np.ndarray:
+def normal_to_view(object_to_view: np.ndarray) -> np.ndarray:
+    """(..., 4, 4): the inverse transpose of the 3x3 part (normals to view
+    space), as a 4x4 with zeros elsewhere; non-invertible -> zeros."""
+    linear = object_to_view[..., :3, :3]
+    out = np.zeros(linear.shape[:-2] + (4, 4))
+    with np.errstate(all="ignore"):
+        ok = np.abs(np.linalg.det(linear)) > 1e-300
+        safe = np.where(ok[..., None, None], linear, np.eye(3))
+        out[..., :3, :3] = np.swapaxes(np.linalg.inv(safe), -1, -2) * ok[..., None, None]
+    return out
+
+
+def _instance_rows(object_to_view, object_to_clip, info) -> np.ndarray:
     """(N * INSTANCE_TEXELS, 4) float32: per instance the 4 columns of
-    object_to_clip then the view-z row (shaders/instancing.glsl)."""
-    rows = np.empty((len(object_to_clip), shaders.INSTANCE_TEXELS, 4), dtype=np.float32)
+    object_to_clip, the view-z row, the 3 columns of the normal matrix and
+    the item info (colour-table base, mirrored) (shaders/instancing.glsl)."""
+    rows = np.zeros((len(object_to_clip), shaders.INSTANCE_TEXELS, 4), dtype=np.float32)
     rows[:, :4, :] = np.swapaxes(object_to_clip, 1, 2)
     rows[:, 4, :] = object_to_view[:, 2, :]
+    rows[:, 5:8, :] = np.swapaxes(normal_to_view(object_to_view), 1, 2)[:, :3, :]
+    rows[:, 8, :] = info
     return rows.reshape(-1, 4)
 
 
@@ -152,13 +189,41 @@ def draw(
     settings = styled(settings, None, show_wire)
     variant = shader_variant(settings, write_view_depth, depth_bias, linear_depth)
     if hidden_pass:
-        variant = replace(variant, hidden_pass=True, write_view_depth=False)
+        variant = replace(variant, hidden_pass=True, write_view_depth=False, shading=shaders.SHADING_FLAT,
+                          material_colors=False)
     if write_aovs:
         variant = replace(variant, write_aovs=True)
     clip_rows = None
     if clip_planes is not None:
         variant = replace(variant, clip_planes=True)
         clip_rows = clip_space_planes(clip_planes, view)
+    extras = {}
+    if clip_rows is not None:
+        extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
+    if variant.shading == shaders.SHADING_MATCAP:
+        extras["matcap_image"] = matcaps.texture(settings.matcap)
+        if extras["matcap_image"] is None:
+            variant = replace(variant, shading=shaders.SHADING_FLAT)
+    if variant.shading != shaders.SHADING_FLAT or variant.material_colors:
+        if any(item.mesh.corners is None for item in items):
+            # Meshes gathered without their corner table (a caller that did
+            # not ask for it): draw flat rather than read a missing table.
+            warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
+            variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
+    # Two per-object mechanisms side by side (merge of issue11 and issue12):
+    # an object's style override (wire colour, thickness, fill colour) is a
+    # parameter block per distinct style (``ubo(style)``), since thickness
+    # and the wire's alpha live there; per-item colours of the colour sources
+    # and the fill shading's normal matrix come from the frame's item table
+    # (colors.color_table, item_table.glsl), whose colours are computed from
+    # each item's styled settings, so an override also holds for the colour
+    # sources' SINGLE values. The render passes' world normal and pass index
+    # keep their own object block (_set_object_block).
+    bases = np.zeros(len(items), dtype=np.int64)
+    if variant.item_colors:
+        table, bases = colors.color_table(items, settings,
+                                          lambda style: styled(settings, style, show_wire))
+        extras["item_colors"] = table_texture(table)
     blocks = {None: gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))}
 
     def ubo(style):
@@ -181,7 +246,8 @@ def draw(
         for with_ngons in (False, True):
             batch = [g for g in groups if (program.supports_ngons and g[0].has_ngons) == with_ngons]
             if batch:
-                _draw_groups(batch, replace(variant, ngons=with_ngons), ubo, settings, program, flip, stats, clip_rows)
+                _draw_groups(batch, replace(variant, ngons=with_ngons), ubo, settings, program, flip, stats,
+                             extras, bases)
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
@@ -202,60 +268,102 @@ def clip_space_planes(planes, view: View) -> list:
     return rows.astype(np.float32).ravel().tolist()
 
 
-def _set_clip_planes(shader, rows: list) -> None:
-    # An array uniform: uniform_float takes at most 16 floats.
-    buffer = gpu.types.Buffer("FLOAT", len(rows), rows)
-    shader.uniform_vector_float(shader.uniform_from_name("clip_planes"), buffer, 4, shaders.CLIP_PLANES)
+def _set_clip_planes(shader, block) -> None:
+    # A uniform block (shaders.CLIP_BLOCK_GLSL), not push constants: those
+    # stay within 128 bytes.
+    shader.uniform_block("clip_params", block)
 
 
-def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats, clip_rows=None) -> None:
-    """Draw (mesh, style, world, object_to_view, object_to_clip) groups with
-    one shader variant: per object, or instanced for meshes with many
-    instances. ``ubo(style)`` is the parameter block of a style."""
+def _bind_extras(shader, variant, extras) -> None:
+    """Samplers of the shaded fill and the colour sources, and the clipping
+    region's block."""
+    if variant.shading == shaders.SHADING_MATCAP:
+        shader.uniform_sampler("matcap_image", extras["matcap_image"])
+    if variant.item_colors:
+        shader.uniform_sampler("item_colors", extras["item_colors"])
+    if variant.clip_planes:
+        _set_clip_planes(shader, extras["clip_block"])
+
+
+def _bind_mesh(shader, variant, mesh) -> None:
+    shader.uniform_sampler("vertex_positions", mesh.positions)
+    shader.uniform_sampler("triangle_vertices", mesh.triangles)
+    if variant.ngons:
+        shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
+    if variant.uses_corners:
+        shader.uniform_sampler("corner_table", mesh.corners)
+
+
+def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats, extras=None,
+                 bases=None) -> None:
+    """Draw (mesh, style, world, object_to_view, object_to_clip, item
+    indices, pass data) groups with one shader variant: per object, or
+    instanced for meshes with many instances. ``ubo(style)`` is the
+    parameter block of a style."""
+    extras = extras or {}
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
     shader.bind()
     bound = None
     shader.uniform_block("params", ubo(bound))
-    if clip_rows is not None:
-        _set_clip_planes(shader, clip_rows)
-    instanced = []  # (mesh, style, object_to_view, object_to_clip, mirrored) drawn with draw_instanced
-    object_block = None  # the render passes' per-object block (write_aovs only)
-    material_tables: dict = {}  # (mesh, materials) -> triangle -> material pass index texture
-    for mesh, style, world, object_to_view_all, object_to_clip_all, (indices, materials) in groups:
+    _bind_extras(shader, variant, extras)
+    instanced = []  # (mesh, style, object_to_view, object_to_clip, info, mirrored) drawn with draw_instanced
+    # (mesh, style, world, object_to_view, object_to_clip, info, mirrored, pass index, materials) drawn one by one
+    single = []
+    for mesh, style, world, object_to_view_all, object_to_clip_all, indices, (pass_index, materials) in groups:
         mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
+        info_all = np.zeros((len(world), 4))
+        if bases is not None and len(bases):
+            info_all[:, 0] = bases[indices]
+        info_all[:, 1] = mirrored_all
         # (The instanced variant has no per-object pass values: with passes
         # every object is drawn on its own.)
         if program.supports_instancing and len(world) >= INSTANCING_MIN and not variant.write_aovs:
             if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
                 for side in (False, True):
                     pick = mirrored_all == side
-                    instanced.append((mesh, style, object_to_view_all[pick], object_to_clip_all[pick], side))
+                    instanced.append((mesh, style, object_to_view_all[pick], object_to_clip_all[pick], info_all[pick],
+                                      side))
             else:
-                instanced.append((mesh, style, object_to_view_all, object_to_clip_all, bool(mirrored_all[0])))
+                instanced.append((mesh, style, object_to_view_all, object_to_clip_all, info_all,
+                                  bool(mirrored_all[0])))
             continue
-        if style is not bound:
-            bound = style
-            shader.uniform_block("params", ubo(style))
-        for k, (object_to_view, object_to_clip, mirrored) in enumerate(
-                zip(object_to_view_all, object_to_clip_all, mirrored_all)):
+        for k in range(len(world)):
+            single.append((mesh, style, world[k], object_to_view_all[k], object_to_clip_all[k], info_all[k],
+                           bool(mirrored_all[k]), None if pass_index is None else float(pass_index[k]),
+                           None if materials is None else materials[k]))
+    if single and variant.per_item:
+        # Normal matrices and item info of every object in one texture
+        # (item_table.glsl); each draw says its slot.
+        rows = np.zeros((len(single), shaders.ITEM_TEXELS, 4), dtype=np.float32)
+        rows[:, :3, :] = np.swapaxes(normal_to_view(np.stack([entry[3] for entry in single])), 1, 2)[:, :3, :]
+        rows[:, 3, :] = np.stack([entry[5] for entry in single])
+        item_table = table_texture(rows.reshape(-1, 4))  # kept alive until the draws are done
+        shader.uniform_sampler("item_table", item_table)
+    object_block = None  # the render passes' per-object block (write_aovs only)
+    material_tables: dict = {}  # (mesh, materials) -> triangle -> material pass index texture
+    if single:
+        for slot, (mesh, style, world, object_to_view, object_to_clip, _info, mirrored, pass_index,
+                   materials) in enumerate(single):
+            if style is not bound:
+                bound = style
+                shader.uniform_block("params", ubo(style))
             if settings.use_backface_culling:
                 gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
             if variant.write_aovs:
-                object_block = _set_object_block(shader, object_block, world[k], bool(mirrored), float(indices[k]))
-                shader.uniform_sampler("triangle_material", _material_table(mesh, materials[k], material_tables))
+                object_block = _set_object_block(shader, object_block, world, bool(mirrored), pass_index)
+                shader.uniform_sampler("triangle_material", _material_table(mesh, materials, material_tables))
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             if uses_view_depth:
                 shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
-            shader.uniform_sampler("vertex_positions", mesh.positions)
-            shader.uniform_sampler("triangle_vertices", mesh.triangles)
-            if variant.ngons:
-                shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
+            if variant.per_item:
+                shader.uniform_int("item_slot", slot)
+            _bind_mesh(shader, variant, mesh)
             program.batch(mesh).draw(shader)
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
-        _draw_instanced(instanced, variant, ubo, settings, stats, clip_rows)
+        _draw_instanced(instanced, variant, ubo, settings, stats, extras)
 
 
 def _material_table(mesh, materials, tables: dict):
@@ -301,19 +409,19 @@ def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_ind
     return block
 
 
-def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, clip_rows=None) -> None:
+def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras=None) -> None:
     """One draw_instanced call per (mesh, style, facing) group; every
     instance's matrices in one float texture for the whole frame."""
     shader = shaders.get(replace(variant, instanced=True))
-    table = table_texture(np.concatenate([_instance_rows(o2v, o2c) for _mesh, _style, o2v, o2c, _side in groups]))
+    table = table_texture(np.concatenate([_instance_rows(o2v, o2c, info)
+                                         for _mesh, _style, o2v, o2c, info, _side in groups]))
     shader.bind()
     bound = None
     shader.uniform_block("params", ubo(bound))
-    if clip_rows is not None:
-        _set_clip_planes(shader, clip_rows)
     shader.uniform_sampler("instance_table", table)
+    _bind_extras(shader, variant, extras or {})
     base = 0
-    for mesh, style, _o2v, object_to_clip, mirrored in groups:
+    for mesh, style, _o2v, object_to_clip, _info, mirrored in groups:
         count = len(object_to_clip)
         if style is not bound:
             bound = style
@@ -321,10 +429,7 @@ def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, clip_rows=
         if settings.use_backface_culling:
             gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
         shader.uniform_int("instance_base", base)
-        shader.uniform_sampler("vertex_positions", mesh.positions)
-        shader.uniform_sampler("triangle_vertices", mesh.triangles)
-        if variant.ngons:
-            shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
+        _bind_mesh(shader, variant, mesh)
         mesh.batch.draw_instanced(shader, instance_start=0, instance_count=count)
         base += count * shaders.INSTANCE_TEXELS
         stats.objects_drawn += count

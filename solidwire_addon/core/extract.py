@@ -26,6 +26,8 @@ from typing import Callable
 import numpy as np
 
 EDGE0_REAL, EDGE1_REAL, EDGE2_REAL, HAS_QUAD_CORNER, IS_NGON = 1, 2, 4, 8, 16
+# A quad's edges p2-p3 / p3-p0 not drawn (edge angle, image model §3.4).
+EDGE3_HIDDEN, EDGE4_HIDDEN = 64, 128
 NGON_SHIFT = 8  # edge_flags >> NGON_SHIFT is an n-gon's corner count
 
 # Vertex ids travel to the GPU as float32 texels: exact below 2**24.
@@ -55,6 +57,13 @@ class MeshArrays:
     # Triangles that use one vertex twice (a corrupt face such as (0, 1, 1, 2)):
     # zero area, so never rasterised; counted for the user message only.
     degenerate_triangles: int = 0
+    # Shading only (see corner_table): (3T, 4) float32, per triangle corner in
+    # the order of ``triangles``: Blender's corner normal xyz and the face's
+    # material index. None when the fill is not shaded by normals/materials.
+    corners: np.ndarray = None
+    # Edge angle (see hide_flat_edges): per entry of ngon_corners, 1 where
+    # that outline slot starts an edge that is not drawn. None: all drawn.
+    ngon_hidden: np.ndarray = None
     # Set when positions alone decide nothing but the quad diagonals (tris and
     # quads only, every vertex finite): the quads' vertex ids, their split
     # and a checksum of the face sizes, so that an edit that only moves
@@ -675,20 +684,133 @@ def read_mesh_fast(mesh) -> dict:
     }
 
 
-def extract_mesh(mesh, *, positions=None, corner_vert=None) -> MeshArrays:
+def read_face_normals(mesh) -> np.ndarray:
+    """(P, 3) float32: Blender's face normals (mesh space)."""
+    return _read(mesh.polygon_normals, "vector", len(mesh.polygons), np.float32, 3)
+
+
+def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None, edge_angle: float = 0.0) -> MeshArrays:
     """Evaluated Blender mesh -> :class:`MeshArrays` (fast path).
 
     ``positions`` / ``corner_vert`` may be passed when the caller has just
-    read them (the GPU cache reads them for its change fingerprint)."""
+    read them (the GPU cache reads them for its change fingerprint).
+    ``corners``: also build the corner table (shaded fill, material colours);
+    True, or the (normals, materials) of :func:`read_corner_inputs` when the
+    caller has them already."""
     data = read_mesh_fast(mesh) if positions is None else {
         "positions": positions,
         "corner_vert": corner_vert if corner_vert is not None else read_corner_verts(mesh),
         "face_offsets": read_face_offsets(mesh),
         "blender_tris": blender_triangles(mesh),
     }
-    return build_arrays_fast(**data)
+    arrays = build_arrays_fast(**data)
+    if corners:
+        normals, materials = read_corner_inputs(mesh) if corners is True else corners
+        arrays.corners = corner_table(arrays, data["corner_vert"], data["face_offsets"], normals, materials)
+    if edge_angle > 0.0:
+        hide_flat_edges(arrays, data["corner_vert"], data["face_offsets"], read_face_normals(mesh), edge_angle)
+    return arrays
 
 
 def extract_mesh_naive(mesh) -> MeshArrays:
     """The reference path: Blender's ``loop_triangles`` for every face."""
     return build_arrays(**read_mesh(mesh))
+
+
+def read_corner_inputs(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """(corner normals (L, 3) float32, material index per face (P,) int32):
+    what :func:`corner_table` needs. The normals are Blender's own
+    (``Mesh.corner_normals``: smooth, flat, sharp edges and custom normals as
+    the mesh defines them), so the fill is shaded as Blender shades it."""
+    normals = _read(mesh.corner_normals, "vector", len(mesh.loops), np.float32, 3)
+    materials = _read_attribute(mesh, "material_index", "value", len(mesh.polygons), np.int32)
+    if materials is None:
+        materials = np.zeros(len(mesh.polygons), dtype=np.int32)
+    return normals, materials
+
+
+def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray,
+                 normals: np.ndarray, materials: np.ndarray) -> np.ndarray:
+    """(3T, 4) float32: for each corner of each drawn triangle (the order of
+    ``arrays.triangles``, which the vertex stage reads by gl_VertexID) the
+    corner normal of that polygon corner and the polygon's material index.
+
+    A triangle row holds vertex ids, not corners: the corner is found as the
+    one of the triangle's polygon with that vertex (unique in any polygon
+    that is not degenerate; a face that uses a vertex twice has zero-area
+    triangles that never draw)."""
+    count = arrays.triangle_count
+    table = np.zeros((3 * count, 4), dtype=np.float32)
+    if count == 0:
+        return table
+    vertex_count = np.int64(max(arrays.vertex_count, 1))
+    sizes = np.diff(face_offsets).astype(np.int64)
+    corner_face = np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
+    keys = corner_face * vertex_count + corner_vert.astype(np.int64)
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    polygons = arrays.triangle_polygons.astype(np.int64)
+    wanted = (polygons[:, None] * vertex_count + arrays.triangles[:, :3].astype(np.int64)).reshape(-1)
+    at = np.minimum(np.searchsorted(sorted_keys, wanted), len(sorted_keys) - 1)
+    corner = order[at]
+    found = sorted_keys[at] == wanted
+    table[:, :3] = np.where(found[:, None], normals[corner], 0.0)
+    material = materials[polygons] if len(materials) else np.zeros(count, np.int32)
+    table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
+    return table
+
+
+def hide_flat_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray,
+                    face_normals: np.ndarray, angle: float) -> int:
+    """Edge angle (docs/image_model.md §3.4): an edge with exactly two faces
+    (two distinct polygons) whose face normals make an angle below ``angle``
+    is not drawn. Its real-edge flags are cleared (so it counts as a diagonal
+    of each face: hidden, solid or patterned with the diagonals), a quad's
+    4th-corner edges get EDGE3_HIDDEN / EDGE4_HIDDEN, and an n-gon's outline
+    slots are marked in ``arrays.ngon_hidden``. Returns the number of edges
+    not drawn."""
+    if not angle > 0.0 or arrays.triangle_count == 0 or len(corner_vert) == 0:
+        return 0
+    count = np.int64(max(arrays.vertex_count, 1))
+    offsets = np.asarray(face_offsets, dtype=np.int64)
+    sizes = np.diff(offsets)
+    face = np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
+    following = np.arange(1, len(corner_vert) + 1, dtype=np.int64)
+    following[offsets[1:][sizes > 0] - 1] = offsets[:-1][sizes > 0]
+    a = corner_vert.astype(np.int64)
+    b = a[following]
+    keys = np.minimum(a, b) * count + np.maximum(a, b)
+    order = np.argsort(keys, kind="stable")
+    unique, start, uses = np.unique(keys[order], return_index=True, return_counts=True)
+    two = uses == 2
+    f1, f2 = face[order[start[two]]], face[order[start[two] + 1]]
+    n1, n2 = face_normals[f1].astype(np.float64), face_normals[f2].astype(np.float64)
+    cosine = np.einsum("ij,ij->i", n1, n2) / np.maximum(
+        np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1), 1e-300)
+    flat = (np.arccos(np.clip(cosine, -1.0, 1.0)) < angle) & (f1 != f2)
+    hidden_keys = unique[two][flat]
+    if len(hidden_keys) == 0:
+        return 0
+
+    def hidden(x, y):
+        x, y = x.astype(np.int64), y.astype(np.int64)
+        return np.isin(np.minimum(x, y) * count + np.maximum(x, y), hidden_keys)
+
+    tri = arrays.triangles
+    flags = arrays.edge_flags
+    for bit, (i, j) in ((EDGE0_REAL, (0, 1)), (EDGE1_REAL, (1, 2)), (EDGE2_REAL, (2, 0))):
+        flags[((flags & bit) != 0) & hidden(tri[:, i], tri[:, j])] &= ~bit
+    quad = (flags & HAS_QUAD_CORNER) != 0
+    flags[quad & hidden(tri[:, 2], tri[:, 3])] |= EDGE3_HIDDEN
+    flags[quad & hidden(tri[:, 3], tri[:, 0])] |= EDGE4_HIDDEN
+    ngon = (flags & IS_NGON) != 0
+    if ngon.any():
+        blocks = np.unique(np.stack([tri[ngon, 3], flags[ngon] >> NGON_SHIFT], axis=1), axis=0)
+        block_start, block_size = blocks[:, 0].astype(np.int64), blocks[:, 1].astype(np.int64)
+        local = np.arange(block_size.sum()) - np.repeat(np.cumsum(block_size) - block_size, block_size)
+        slot = np.repeat(block_start, block_size) + local
+        slot_next = np.repeat(block_start, block_size) + (local + 1) % np.repeat(block_size, block_size)
+        marks = np.zeros(len(arrays.ngon_corners), dtype=np.int32)
+        marks[slot] = hidden(arrays.ngon_corners[slot], arrays.ngon_corners[slot_next])
+        arrays.ngon_hidden = marks
+    return int(len(hidden_keys))

@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 import gpu
 import numpy as np
 
+from . import colors
 from . import draw as draw_mod
 from . import silhouettes
 from .targets import BACKGROUND_DEPTH, read_texture, targets_for
@@ -62,6 +63,14 @@ def plan(settings) -> tuple[Pass, ...]:
     if settings.use_silhouettes:
         passes.append(Pass(SILHOUETTES, settings))
     return tuple(passes)
+
+
+def gather_options(settings) -> dict:
+    """What the draw items of a frame with ``settings`` must carry (keyword
+    arguments of blender/gather.gather): corner tables for a shaded fill or
+    material colours, colour-source inputs for per-object colours."""
+    return {"corners": draw_mod.needs_corners(settings), "colors": colors.needs_item_colors(settings),
+            "edge_angle": float(settings.edge_angle)}
 
 
 def render(items, view: View, settings, *, cull: bool = True):

@@ -65,6 +65,7 @@ class Setting:
     param: Param | None = None  # slot in the shader parameter block
     in_snapshot: bool = True  # part of the draw path's settings snapshot
     in_preset: bool = True  # saved in and applied from presets
+    size: int = 4  # COLOR: 4 (RGBA) or 3 (RGB, no alpha slider)
 
     @property
     def choices(self) -> tuple:
@@ -89,11 +90,16 @@ class Setting:
                 raise ValueError(f"'{self.name}' must be one of {', '.join(self.choices)}, not {value!r}")
             return value
         if self.kind == COLOR:
-            if not (isinstance(value, (list, tuple)) and len(value) == 4 and all(_is_number(c) for c in value)):
-                raise ValueError(f"'{self.name}' must be a list of 4 numbers (RGBA, linear), not {value!r}")
+            what = "RGBA" if self.size == 4 else "RGB"
+            # An RGB colour also takes RGBA (older presets, '#RRGGBBAA'): the
+            # alpha is dropped. An RGBA colour needs all four.
+            sizes = (3, 4) if self.size == 3 else (4,)
+            if not (isinstance(value, (list, tuple)) and len(value) in sizes and all(_is_number(c) for c in value)):
+                raise ValueError(f"'{self.name}' must be a list of {self.size} numbers ({what}, linear), not {value!r}")
             if not all(0.0 <= c <= 1.0 for c in value):
                 raise ValueError(f"'{self.name}' components must lie in 0..1, got {list(value)}")
-            return tuple(float(c) for c in value)
+            value = tuple(float(c) for c in value)
+            return value[: self.size]
         if not _is_number(value):
             raise ValueError(f"'{self.name}' must be a number, not {value!r}")
         if not math.isfinite(value):
@@ -116,6 +122,11 @@ def _clamp01(value) -> float:
     return min(max(float(value), 0.0), 1.0)
 
 
+def _rgb1(value) -> tuple:
+    """An RGB colour in a vec4 slot."""
+    return (*(float(c) for c in tuple(value)[:3]), 1.0)
+
+
 def _at_least(low: float) -> Callable:
     return lambda value: max(float(value), low)
 
@@ -124,10 +135,21 @@ def _at_least(low: float) -> Callable:
 SECTIONS = (
     ("line", ""),
     ("fill", ""),
+    ("colors", ""),
     ("diagonals", ""),
     ("fade", ""),
     ("hidden", ""),
     ("culling", ""),
+)
+
+# Blender's bundled matcaps (datafiles/studiolights/matcap/NAME.exr, the same
+# set from 4.0 to 5.x); a name whose file is missing falls back to FLAT with
+# one message.
+MATCAPS = (
+    "basic_bright", "basic_dark", "basic_grey", "basic_side", "ceramic_dark", "ceramic_lightbulb",
+    "check_normal+y", "check_rim_dark", "check_rim_light", "clay_brown", "clay_green", "clay_studio",
+    "clay_warm", "fullmetal", "hard_surface_grey", "hard_surface_red", "metal_bronze", "metal_carpaint",
+    "pearl", "red_wax", "resin", "toon_dark", "toon_light",
 )
 
 PATTERN_MODES = ("DOTTED", "DASHED")
@@ -205,18 +227,63 @@ SETTINGS: tuple[Setting, ...] = (
         "interior edges (renders; hidden by nearer surfaces)",
         section="line", cli="--silhouettes",
     ),
+    # -- edges ---------------------------------------------------------------
+    Setting(
+        "edge_angle", FLOAT, 0.0, "Edge Angle",
+        "Edges between two faces that meet at less than this angle are not drawn (treated like diagonals); "
+        "boundary and non-manifold edges always are",
+        minimum=0.0, maximum=math.pi, subtype="ANGLE", section="line",
+    ),
     # -- fill ----------------------------------------------------------------
     Setting(
-        "use_fill", BOOL, False, "Fill",
-        "Fill faces with an opaque colour under the wire instead of drawing the wire alone",
+        "use_fill", BOOL, True, "Fill",
+        "Fill faces with an opaque, shaded colour under the wire instead of drawing the wire alone",
         section="fill", cli="--fill",
     ),
     Setting(
-        "fill_color", COLOR, (1.0, 1.0, 1.0, 1.0), "Fill Color",
-        "Colour of the faces when Fill is on (drawn opaque)",
-        minimum=0.0, maximum=1.0, subtype="COLOR",
+        "fill_shading", ENUM, "STUDIO", "Shading",
+        "How the fill is lit (docs/image_model.md §5.8)",
+        items=(
+            ("FLAT", "Flat", "One flat colour, no lighting"),
+            ("STUDIO", "Studio", "Lit by lights fixed to the camera, like Workbench's studio lighting"),
+            ("MATCAP", "MatCap", "One of Blender's bundled material captures, indexed by the view-space normal"),
+        ),
+        section="fill", active_if=lambda p: p.use_fill, cli="--shading",
+    ),
+    Setting(
+        "matcap", ENUM, "clay_studio", "MatCap",
+        "Which of Blender's bundled matcaps (datafiles/studiolights/matcap) lights the fill",
+        items=tuple((name, name.replace("_", " ").title(), f"Blender's bundled matcap {name}.exr") for name in MATCAPS),
+        section="fill", active_if=lambda p: p.use_fill and p.fill_shading == "MATCAP",
+    ),
+    Setting(
+        "fill_color", COLOR, (0.8, 0.8, 0.8), "Fill Color",
+        "Colour of the faces when Fill is on (always opaque: there is no fill alpha)",
+        minimum=0.0, maximum=1.0, subtype="COLOR", size=3,
         section="fill", active_if=lambda p: p.use_fill,
-        param=Param("fill_color", tuple),
+        param=Param("fill_color", _rgb1),
+    ),
+    # -- colour sources --------------------------------------------------------
+    Setting(
+        "fill_color_source", ENUM, "SINGLE", "Fill Source",
+        "Where each face's fill colour comes from",
+        items=(
+            ("SINGLE", "Single", "Fill Color for every object"),
+            ("OBJECT", "Object", "The object's own colour (Object Properties > Viewport Display > Color)"),
+            ("MATERIAL", "Material", "Each face's material viewport colour (Material > Viewport Display > Color)"),
+            ("RANDOM", "Random", "A stable colour per object, made from its name"),
+        ),
+        section="colors", active_if=lambda p: p.use_fill, cli="--fill-source",
+    ),
+    Setting(
+        "wire_color_source", ENUM, "SINGLE", "Wire Source",
+        "Where each object's wire colour comes from (the alpha is always Wire Color's)",
+        items=(
+            ("SINGLE", "Single", "Wire Color for every object"),
+            ("OBJECT", "Object", "The object's own colour (Object Properties > Viewport Display > Color)"),
+            ("RANDOM", "Random", "A stable colour per object, made from its name"),
+        ),
+        section="colors", cli="--wire-source",
     ),
     # -- diagonals -----------------------------------------------------------
     Setting(
@@ -344,9 +411,9 @@ OBJECT_SETTINGS: tuple[Setting, ...] = (
         active_if=_OVERRIDE_ACTIVE, cli=NO_FLAG, in_snapshot=False, in_preset=False,
     ),
     Setting(
-        "fill_color", COLOR, (1.0, 1.0, 1.0, 1.0), "Fill Color",
-        "This object's fill colour (when Fill is on)",
-        scope=OBJECT, minimum=0.0, maximum=1.0, subtype="COLOR", section="object",
+        "fill_color", COLOR, (1.0, 1.0, 1.0), "Fill Color",
+        "This object's fill colour (when Fill is on; RGB like the scene's, always opaque)",
+        scope=OBJECT, minimum=0.0, maximum=1.0, subtype="COLOR", size=3, section="object",
         active_if=_OVERRIDE_ACTIVE, cli=NO_FLAG, in_snapshot=False, in_preset=False,
     ),
 )

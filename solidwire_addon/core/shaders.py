@@ -28,6 +28,9 @@ EDGE_COUNT = 5  # three triangle edges + two edges to a quad's 4th corner
 
 DIAGONALS_HIDDEN, DIAGONALS_SOLID, DIAGONALS_PATTERN = 0, 1, 2
 
+# Fill shading (docs/image_model.md §5.8); FLAT is §5.2's flat fill.
+SHADING_FLAT, SHADING_STUDIO, SHADING_MATCAP = 0, 1, 2
+
 CLIP_PLANES = 6  # as many as Blender's clipping region (RegionView3D.clip_planes)
 
 
@@ -65,6 +68,22 @@ class ShaderVariant:
     # Viewport clipping region (Alt+B): fragments outside CLIP_PLANES
     # clip-space planes are discarded (USE_CLIP_PLANES; image model §5.6).
     clip_planes: bool = False
+    # Shaded fill (SHADING_*): the vertex stage pulls corner normals.
+    shading: int = SHADING_FLAT
+    # Per-object wire/fill colours from the frame's colour table
+    # (core/colors.py); with material_colors, the fill per face material.
+    item_colors: bool = False
+    material_colors: bool = False
+
+    @property
+    def uses_corners(self) -> bool:
+        """The corner table (normals, material indices) is read."""
+        return self.shading != SHADING_FLAT or self.material_colors
+
+    @property
+    def per_item(self) -> bool:
+        """The per-object normal matrix and item info are read."""
+        return self.uses_corners or self.item_colors
 
 
 # Two GL contexts draw SolidWire: a render (bpy.ops.render.render, F12) draws
@@ -168,12 +187,35 @@ def _create_info(variant: ShaderVariant):
         info.sampler(3, "FLOAT_2D", "instance_table")
         iface.flat("INT", "instance_slot")
     if variant.clip_planes:
-        info.push_constant("VEC4", "clip_planes", CLIP_PLANES)
+        # A block of their own, not push constants: those stay within the
+        # 128 bytes every backend guarantees (object_to_clip, object_to_view_z
+        # and item_slot use 84).
+        info.uniform_buf(2, "SolidWireClip", "clip_params")
         iface.smooth("VEC4", "clip_distance_a")
         iface.smooth("VEC2", "clip_distance_b")
         info.define("USE_CLIP_PLANES", "1")
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     info.sampler(2, "FLOAT_2D", "ngon_corners")
+    if variant.per_item:
+        if not variant.instanced:
+            # normal_to_view / item_info come from item_table (item_table.glsl).
+            info.push_constant("INT", "item_slot")
+            info.sampler(3, "FLOAT_2D", "item_table")
+        info.define("PER_ITEM", "1")
+    if variant.uses_corners:
+        info.sampler(4, "FLOAT_2D", "corner_table")
+        info.define("USE_CORNERS", "1")
+        iface.smooth("VEC3", "shading_normal")
+    info.define("SHADING", str(variant.shading))
+    if variant.shading == SHADING_MATCAP:
+        info.sampler(6, "FLOAT_2D", "matcap_image")
+    if variant.item_colors:
+        info.sampler(5, "FLOAT_2D", "item_colors")
+        info.define("ITEM_COLORS", "1")
+        iface.flat("VEC3", "item_wire")
+        iface.flat("VEC3", "item_fill")
+    if variant.material_colors:
+        info.define("MATERIAL_COLORS", "1")
     info.vertex_in(0, "INT", "edge_flags")
     info.vertex_out(iface)
     output_and_feature_defines(info, variant)
@@ -189,9 +231,8 @@ def _create_info(variant: ShaderVariant):
         # Per-object values in a block of their own (push constants are full);
         # the instanced variant does not have them (draw.py draws object by
         # object when passes are written).
-        info.typedef_source(schema.param_block_glsl() + OBJECT_BLOCK_GLSL)
         info.uniform_buf(1, "SolidWireObject", "object_params")
-        info.sampler(4, "FLOAT_2D", "triangle_material")
+        info.sampler(7, "FLOAT_2D", "triangle_material")
         iface.flat("FLOAT", "material_pass_index")
         info.fragment_out(2, "VEC4", "frag_aov")
         info.fragment_out(3, "VEC4", "frag_normal")
@@ -199,16 +240,23 @@ def _create_info(variant: ShaderVariant):
         iface.flat("VEC3", "face_normal")
     if variant.depth_bias:
         info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
+    if variant.write_aovs or variant.clip_planes:
+        # One typedef source holds every block's struct (a later call
+        # replaces the one pulling_info set).
+        info.typedef_source(schema.param_block_glsl() + (OBJECT_BLOCK_GLSL if variant.write_aovs else "")
+                            + (CLIP_BLOCK_GLSL if variant.clip_planes else ""))
 
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
     style = read_source("line_style.glsl")
+    fill = read_source("fill_shading.glsl")
     if variant.instanced:
         instancing = read_source("instancing.glsl")
         info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + style + read_source("solidwire_frag.glsl"))
+        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + style + fill + read_source("solidwire_frag.glsl"))
     else:
-        info.vertex_source(common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(common + style + read_source("solidwire_frag.glsl"))
+        items = read_source("item_table.glsl") if variant.per_item else ""
+        info.vertex_source(items + common + read_source("solidwire_vert.glsl"))
+        info.fragment_source(items + common + style + fill + read_source("solidwire_frag.glsl"))
     return info
 
 
@@ -222,11 +270,18 @@ OBJECT_BLOCK_GLSL = """struct SolidWireObject {
 """
 OBJECT_BLOCK_FLOATS = 12
 
+# The viewport clipping region's clip-space planes (std140: vec4 stride 16).
+CLIP_BLOCK_GLSL = f"""struct SolidWireClip {{
+  vec4 planes[{CLIP_PLANES}];
+}};
+"""
+
 # Instanced variant of the exact path: shaders/instancing.glsl is prepended
 # to the unchanged stage sources (it turns the two push constants into reads
 # from `instance_table`); each stage says where its instance's texels start.
-INSTANCE_TEXELS = 5
-_INSTANCE_SLOT_VERT = "#define SW_INSTANCE_SLOT (instance_slot = instance_base + 5 * gl_InstanceID)\n"
+INSTANCE_TEXELS = 9
+ITEM_TEXELS = 4  # per object of the non-instanced path (item_table.glsl)
+_INSTANCE_SLOT_VERT = f"#define SW_INSTANCE_SLOT (instance_slot = instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
 _INSTANCE_SLOT_FRAG = "#define SW_INSTANCE_SLOT instance_slot\n"
 
 

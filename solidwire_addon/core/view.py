@@ -48,6 +48,7 @@ class DrawItem:
 
     mesh: object  # core.cache.GPUMesh
     matrix: np.ndarray  # (4, 4) float64
+    source: object = None  # core.colors.ItemSource: inputs of the colour sources (when asked for)
     style: Style | None = None
     pass_index: int = 0  # the IndexOB pass value (object.pass_index)
     # For the IndexMA pass only: (material slot index per face (F,) int32,

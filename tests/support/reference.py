@@ -53,6 +53,10 @@ class ReferenceResult:
     face: np.ndarray
     depth: np.ndarray
     rows: np.ndarray  # window rows (j, bottom = 0) that the arrays hold
+    # Image model §5.8: the shaded fill colour and the wire colour of each
+    # covered sample (NaN on background), linear RGB.
+    fill: np.ndarray = None  # (H, W, 3)
+    wire: np.ndarray = None  # (H, W, 3)
     d_real: np.ndarray = None
     face_object: np.ndarray = None
     objects: list = None  # names of the objects whose settings style each face
@@ -73,6 +77,10 @@ class _Geometry:
     # Silhouette candidates (issue 7): real edges with one or two faces.
     sil_edges: np.ndarray = None  # (S, 2, 3) view-space endpoints
     sil_third: np.ndarray = None  # (S, 2, 3) third vertex of the face on each side (NaN: none)
+    # Fill shading and colour sources (image model §5.8).
+    tri_normals: np.ndarray = None  # (T, 3, 3) corner normals in view space (not normalised), tri_view's order
+    face_fill: np.ndarray = None  # (F, 3) base fill colour of each global face
+    face_wire: np.ndarray = None  # (F, 3) wire colour of each global face
     face_thickness: np.ndarray = None  # (F,) override thickness per face (NaN: the scene's)
     face_object: np.ndarray = None  # (F,) index into objects
     objects: list = None
@@ -95,9 +103,61 @@ def _camera(scene, depsgraph, width, height):
     return np.linalg.inv(m), proj
 
 
-def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
+def _hsv_name_color(name, saturation, value):
+    """RANDOM colour source (image model §5.8): hue = crc32(UTF-8 name) / 2^32."""
+    import colorsys
+    import zlib
+
+    return colorsys.hsv_to_rgb(zlib.crc32(name.encode("utf-8")) / 2.0**32, saturation, value)
+
+
+def _object_colors(obj, s, npoly, material_index):
+    """(face fill (P, 3), wire (3,)) of one object under the colour sources."""
+    wire = np.array(s.wire_color[:3], dtype=np.float64)
+    fill = np.array(s.fill_color[:3], dtype=np.float64)
+    fill_source = getattr(s, "fill_color_source", "SINGLE") if getattr(s, "use_fill", False) else "SINGLE"
+    wire_source = getattr(s, "wire_color_source", "SINGLE")
+    if wire_source == "OBJECT":
+        wire = np.array(obj.color[:3], dtype=np.float64)
+    elif wire_source == "RANDOM":
+        wire = np.array(_hsv_name_color(obj.name, 0.8, 0.3))
+    faces = np.tile(fill, (npoly, 1))
+    if fill_source == "OBJECT":
+        faces[:] = np.array(obj.color[:3], dtype=np.float64)
+    elif fill_source == "RANDOM":
+        faces[:] = np.array(_hsv_name_color(obj.name, 0.5, 0.8))
+    elif fill_source == "MATERIAL":
+        slots = [fill if slot.material is None else np.array(slot.material.diffuse_color[:3], dtype=np.float64)
+                 for slot in obj.material_slots]
+        if slots:
+            faces[:] = np.array(slots)[np.clip(material_index, 0, len(slots) - 1)]
+    return faces, wire
+
+
+def _flat_edges(mesh, loop_poly, real_a, real_b, angle) -> set:
+    """{(lo, hi)} vertex pairs of the edges that the edge angle hides."""
+    if not angle > 0.0:
+        return set()
+    normals = np.empty(len(mesh.polygons) * 3, np.float32)
+    mesh.polygon_normals.foreach_get("vector", normals)
+    normals = normals.reshape(-1, 3).astype(np.float64)
+    faces: dict = {}
+    for f, a, b in zip(loop_poly.tolist(), real_a.tolist(), real_b.tolist()):
+        faces.setdefault((min(a, b), max(a, b)), []).append(f)
+    hidden = set()
+    for key, fs in faces.items():
+        if len(fs) == 2 and fs[0] != fs[1]:
+            n1, n2 = normals[fs[0]], normals[fs[1]]
+            c = np.dot(n1, n2) / max(np.linalg.norm(n1) * np.linalg.norm(n2), 1e-300)
+            if np.arccos(np.clip(c, -1.0, 1.0)) < angle:
+                hidden.add(key)
+    return hidden
+
+
+def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
     tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
     sil_edges, sil_third = [], []
+    tri_normals, face_fill, face_wire = [], [], []
     face_thickness, face_object, objects, offsets = [], [], [], []
     face_offset = 0
     for inst in depsgraph.object_instances:
@@ -161,7 +221,11 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
 
         # A face with a non-finite (NaN/Inf) corner is not drawn at all.
         finite = np.isfinite(vco).all(axis=1)
-        sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2]
+        # Edge angle (image model §3.4): an edge of exactly two distinct
+        # faces whose face normals differ by less than the angle is not
+        # drawn; it then counts as a diagonal of each face.
+        not_drawn = _flat_edges(mesh, loop_poly, real_a, real_b, float(getattr(s, "edge_angle", 0.0) or 0.0))
+        sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2 and (a, b) not in not_drawn]
         if sil:
             sa = np.array([e[0] for e in sil])
             sb = np.array([e[1] for e in sil])
@@ -177,14 +241,36 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
         # The front side is the side the (transformed) normal points to: a
         # mirroring object or camera matrix reverses view-space winding, so
         # reverse it back for the back-face test (as Blender draws them).
-        front_winding = tri_v[:, ::-1] if np.linalg.det(to_view[:3, :3]) < 0.0 else tri_v
+        mirrored = np.linalg.det(to_view[:3, :3]) < 0.0
+        front_winding = tri_v[:, ::-1] if mirrored else tri_v
         tris.append(vco[front_winding[tri_ok]])
+        if s is not None:
+            # Corner normals (Blender's own) to view space with the inverse
+            # transpose; interpolated over the triangle, then normalised.
+            corner_n = np.empty(nl * 3, np.float32)
+            mesh.corner_normals.foreach_get("vector", corner_n)
+            corner_n = corner_n.reshape(-1, 3).astype(np.float64)
+            tri_l = np.empty(ntri * 3, np.int64)
+            lt.foreach_get("loops", tri_l)
+            tri_l = tri_l.reshape(-1, 3)
+            tri_l = tri_l[:, ::-1] if mirrored else tri_l
+            with np.errstate(all="ignore"):
+                nmat = np.linalg.inv(to_view[:3, :3]).T
+            tri_normals.append(corner_n[tri_l[tri_ok]] @ nmat.T)
+            material_index = np.zeros(npoly, np.int64)
+            if npoly and "material_index" in mesh.attributes:
+                mesh.attributes["material_index"].data.foreach_get("value", material_index)
+            fills, wire = _object_colors(obj, s, npoly, material_index)
+            face_fill.append(fills)
+            face_wire.append(np.tile(wire, (npoly, 1)))
         tri_faces.append(face_offset + tri_p[tri_ok])
         ra, rb = real_a, real_b
         ok = poly_ok[loop_poly]
         edges.append(np.stack([vco[ra[ok]], vco[rb[ok]]], axis=1))
         edge_faces.append(face_offset + loop_poly[ok])
-        edge_real.append(np.ones(ok.sum(), bool))
+        drawn = np.array([(min(x, y), max(x, y)) not in not_drawn for x, y in zip(ra[ok].tolist(), rb[ok].tolist())],
+                         dtype=bool).reshape(-1)
+        edge_real.append(drawn)
         edge_origin.append(ra[ok] < rb[ok])
         if len(diag):
             da, db = diag[:, 1], diag[:, 2]
@@ -207,6 +293,9 @@ def _gather_geometry(depsgraph, view_matrix) -> _Geometry:
         cat(edge_origin, (0,), bool),
         cat(sil_edges, (0, 2, 3), np.float64),
         cat(sil_third, (0, 2, 3), np.float64),
+        cat(tri_normals, (0, 3, 3), np.float64),
+        cat(face_fill, (0, 3), np.float64),
+        cat(face_wire, (0, 3), np.float64),
         cat(face_thickness, (0,), np.float64),
         cat(face_object, (0,), np.int64),
         objects,
@@ -295,11 +384,13 @@ def _rays(inv_proj, proj, px, py, width, height):
     return origin, direction, 0.0, far_depth - near_depth
 
 
-def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None):
+def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None, centre_hit=None):
     """Nearest face for the sample of each pixel of ``rows`` and its 4 offsets.
 
     With a list as ``all_hits``, every hit of the centre sample is appended
-    to it as (pixel, depth, face) arrays (hidden-line style)."""
+    to it as (pixel, depth, face) arrays (hidden-line style). With a dict as
+    ``centre_hit``, it receives the centre sample's triangle, barycentric
+    (u, v) and whether its front side is seen ("tri", "u", "v", "front")."""
     inv_proj = np.linalg.inv(proj)
     n_rows = len(rows)
     row_of = np.full(height, -1, np.int64)
@@ -307,6 +398,11 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None)
     n_samples = len(OFFSETS)
     best_depth = np.full((n_samples, n_rows * width), np.inf)
     best_face = np.full((n_samples, n_rows * width), -1, np.int64)
+    if centre_hit is not None:
+        centre_hit["tri"] = np.full(n_rows * width, -1, np.int64)
+        centre_hit["u"] = np.zeros(n_rows * width)
+        centre_hit["v"] = np.zeros(n_rows * width)
+        centre_hit["front"] = np.ones(n_rows * width, bool)
 
     x0, x1, y0, y1 = _triangle_pixel_bounds(proj, geo.tri_view, width, height)
     tri_ids = np.nonzero(x1 >= x0)[0]
@@ -359,15 +455,24 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None)
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
             if s == 0 and all_hits is not None:
                 all_hits.append((h_pix, h_depth, h_face))
+            h_tri, h_u, h_v, h_front = pair_tri[hit], u[hit], v[hit], det[hit] > 0.0
             # Nearest hit per pixel (ties: lowest face id, deterministic).
             order = np.lexsort((h_face, h_depth, h_pix))
             h_pix, h_depth, h_face = h_pix[order], h_depth[order], h_face[order]
+            h_tri, h_u, h_v, h_front = h_tri[order], h_u[order], h_v[order], h_front[order]
             first = np.ones(len(h_pix), bool)
             first[1:] = h_pix[1:] != h_pix[:-1]
             h_pix, h_depth, h_face = h_pix[first], h_depth[first], h_face[first]
+            h_tri, h_u, h_v, h_front = h_tri[first], h_u[first], h_v[first], h_front[first]
             closer = h_depth < best_depth[s, h_pix]
             best_depth[s, h_pix[closer]] = h_depth[closer]
             best_face[s, h_pix[closer]] = h_face[closer]
+            if s == 0 and centre_hit is not None:
+                px_c = h_pix[closer]
+                centre_hit["tri"][px_c] = h_tri[closer]
+                centre_hit["u"][px_c] = h_u[closer]
+                centre_hit["v"][px_c] = h_v[closer]
+                centre_hit["front"][px_c] = h_front[closer]
         start = stop
     return best_face, best_depth
 
@@ -623,10 +728,11 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
     rows = np.arange(height) if rows is None else np.sort(np.asarray(rows, dtype=np.int64))
 
     view_matrix, proj = _camera(scene, depsgraph, width, height)
-    geo = _gather_geometry(depsgraph, view_matrix)
+    geo = _gather_geometry(depsgraph, view_matrix, s)
     hidden_lines = bool(getattr(s, "use_hidden_lines", False))
     all_hits = [] if hidden_lines else None
-    faces, depths = _visibility(geo, proj, width, height, rows, bool(s.use_backface_culling), all_hits)
+    centre_hit = {}
+    faces, depths = _visibility(geo, proj, width, height, rows, bool(s.use_backface_culling), all_hits, centre_hit)
 
     face = faces[0]
     depth = depths[0]
@@ -671,6 +777,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         a_base = intensity * wire_alpha
         intensity = (a_out + (1.0 - a_out) * a_base) / max(wire_alpha, 1e-12)
 
+    fill, wire = _colors(s, geo, face, centre_hit)
     shape = (len(rows), width)
     return ReferenceResult(
         intensity.reshape(shape),
@@ -678,12 +785,91 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         face.reshape(shape),
         depth.reshape(shape),
         rows,
+        fill.reshape(*shape, 3),
+        wire.reshape(*shape, 3),
         d_real_all.reshape(shape),
         np.where(face >= 0, geo.face_object[np.maximum(face, 0)] if len(geo.face_object) else -1, -1).reshape(shape),
         geo.objects,
         geo.offsets,
         hidden_all.reshape(shape),
     )
+
+
+# ---------------------------------------------------------------- fill shading
+
+# STUDIO (image model §5.8): ambient + Lambert lights fixed to the camera
+# (view space: x right, y up, +z towards the viewer): (direction, power).
+STUDIO_AMBIENT = 0.25
+STUDIO_LIGHTS = (((-0.35, 0.55, 0.75), 0.6), ((0.6, 0.1, 0.8), 0.2), ((0.0, 0.8, -0.6), 0.15))
+
+
+def studio_light(n):
+    light = np.full(n.shape[:-1], STUDIO_AMBIENT)
+    for direction, power in STUDIO_LIGHTS:
+        d = np.array(direction) / np.linalg.norm(direction)
+        light += power * np.maximum(n @ d, 0.0)
+    return light
+
+
+def load_matcap(name):
+    """Blender's bundled matcap ``name``: (diffuse, specular), each (H, W, 3)
+    float64 bottom row first (specular zeros when the file has none).
+
+    Multilayer matcaps come through Blender's compositor
+    (blender/matcap_files.py): the pixels are Blender's decoding of the file,
+    which nothing else here can read (DWAA-compressed EXR)."""
+    from solidwire_addon.blender import matcap_files
+
+    diffuse, specular = matcap_files.load_pixels(name)
+    diffuse = diffuse[..., :3].astype(np.float64)
+    specular = np.zeros_like(diffuse) if specular is None else specular[..., :3].astype(np.float64)
+    return diffuse, specular
+
+
+def matcap_bilinear(image, uv):
+    """Bilinear between texel centres ((i + 1/2) / size), clamped at the border."""
+    h, w = image.shape[:2]
+    x = uv[:, 0] * w - 0.5
+    y = uv[:, 1] * h - 0.5
+    x0, y0 = np.floor(x), np.floor(y)
+    tx, ty = (x - x0)[:, None], (y - y0)[:, None]
+    i0 = np.clip(x0.astype(np.int64), 0, w - 1)
+    i1 = np.clip(x0.astype(np.int64) + 1, 0, w - 1)
+    j0 = np.clip(y0.astype(np.int64), 0, h - 1)
+    j1 = np.clip(y0.astype(np.int64) + 1, 0, h - 1)
+    top = image[j1, i0] * (1 - tx) + image[j1, i1] * tx
+    bottom = image[j0, i0] * (1 - tx) + image[j0, i1] * tx
+    return bottom * (1 - ty) + top * ty
+
+
+def _colors(s, geo, face, centre_hit):
+    """(fill, wire) per sample (N, 3): §5.8's shaded fill and wire colour."""
+    fill = np.full((len(face), 3), np.nan)
+    wire = np.full((len(face), 3), np.nan)
+    covered = face >= 0
+    if not covered.any() or geo.face_fill is None or len(geo.face_fill) == 0:
+        return fill, wire
+    f = face[covered]
+    base = geo.face_fill[f]
+    wire[covered] = geo.face_wire[f]
+    shading = getattr(s, "fill_shading", "FLAT") if getattr(s, "use_fill", False) else "FLAT"
+    if shading == "FLAT":
+        fill[covered] = base
+        return fill, wire
+    tri = centre_hit["tri"][covered]
+    u, v = centre_hit["u"][covered][:, None], centre_hit["v"][covered][:, None]
+    corners = geo.tri_normals[tri]
+    n = (1 - u - v) * corners[:, 0] + u * corners[:, 1] + v * corners[:, 2]
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    n = np.where(length > 1e-20, n / np.where(length > 0, length, 1.0), np.array([0.0, 0.0, 1.0]))
+    n = np.where(centre_hit["front"][covered][:, None], n, -n)  # the side that is seen
+    if shading == "STUDIO":
+        fill[covered] = base * studio_light(n)[:, None]
+    else:
+        diffuse, specular = load_matcap(s.matcap)
+        uv = n[:, :2] * 0.5 + 0.5
+        fill[covered] = base * matcap_bilinear(diffuse, uv) + matcap_bilinear(specular, uv)
+    return fill, wire
 
 
 def error_report(measured: np.ndarray, ref: ReferenceResult) -> dict:
@@ -702,4 +888,34 @@ def error_report(measured: np.ndarray, ref: ReferenceResult) -> dict:
         "silhouette_pixels": int(np.count_nonzero(ref.on_silhouette)),
         "silhouette_max": float(np.nan_to_num(diff[ref.on_silhouette], nan=1.0).max()) if ref.on_silhouette.any() else 0.0,
         "nan": nan,
+    }
+
+
+def srgb_encode(linear):
+    """Linear -> the sRGB-encoded values a PNG holds (Standard view), clipped."""
+    x = np.clip(linear, 0.0, 1.0)
+    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
+
+
+def expected_fill_rgb(ref: ReferenceResult, wire_alpha: float) -> np.ndarray:
+    """§5.2 with §5.8's colours: A c_w + (1 - A) shaded fill, A = alpha_w I."""
+    a = (ref.intensity * wire_alpha)[..., None]
+    return a * ref.wire + (1.0 - a) * ref.fill
+
+
+def color_error_report(measured_srgb: np.ndarray, expected_linear: np.ndarray, ref: ReferenceResult) -> dict:
+    """The colour error of a fill render: per sample the largest |difference|
+    over R, G, B between the file's values and the encoded expected colour,
+    covered samples off silhouettes only; the statistics of error_report."""
+    diff = np.abs(measured_srgb[..., :3] - srgb_encode(expected_linear)).max(axis=-1)
+    covered = ref.face >= 0
+    off = ~ref.on_silhouette & covered
+    d = np.nan_to_num(diff[off], nan=1.0)
+    return {
+        "mean": float(d.mean()) if d.size else 0.0,
+        "p999": float(np.percentile(d, 99.9)) if d.size else 0.0,
+        "max": float(d.max()) if d.size else 0.0,
+        "over_2_255": int(np.count_nonzero(d > 2.0 / 255.0)),
+        "pixels": int(d.size),
+        "nan": int(np.count_nonzero(~np.isfinite(measured_srgb[..., :3][off]))),
     }
