@@ -39,6 +39,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import bpy
+import warnings
+
 import numpy as np
 
 SILHOUETTE_OFFSET = 0.01  # px, SPEC 1.5
@@ -335,8 +337,8 @@ def _triangle_pixel_bounds(proj, tri_view, width, height):
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         win = _window(proj, pts, width, height)
     win = np.where(ok[..., None] & np.isfinite(win), win, np.nan)
-    with np.errstate(invalid="ignore"), np.testing.suppress_warnings() as sup:
-        sup.filter(RuntimeWarning)
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows: triangles with no visible corner
         lo = np.nanmin(win, axis=1)
         hi = np.nanmax(win, axis=1)
     any_ok = ok.any(axis=1) & np.isfinite(lo).all(axis=1)
