@@ -155,109 +155,145 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     the object it instances (docs/image_model.md §5.9). ``materials`` (the
     IndexMA pass) gives each item its faces' material slots and the slots'
     material pass indices."""
-    mode = depsgraph.mode
     if trust_updates is None:
-        trust_updates = mode == "VIEWPORT"
-    depsgraph_id = depsgraph.as_pointer()
-    versions = runtime.geometry_version
-    epoch = runtime.epoch
-
+        trust_updates = depsgraph.mode == "VIEWPORT"
+    frame = _FrameGather(depsgraph, cache, trust_updates=trust_updates, view=view, corners=corners,
+                         edge_angle=edge_angle)
     items: list[DrawItem] = []
-    seen = SeenKeys()
-    seen.scope = (mode,)
-    ms_extract = 0.0
-    by_pointer: dict[int, object] = {}  # evaluated mesh -> GPUMesh (or None) this frame
-    key_pointer: dict[tuple, int] = {}  # key -> the evaluated mesh it stands for this frame
-    instancer_meshes: dict[int, int] = {}  # geometry-nodes parent uid -> distinct meshes so far
-    view_projection = None if view is None else view.projection @ view.view_matrix
-    deferred: dict[int, tuple] = {}  # culled, never-extracted mesh -> (key, uids, bound box, instances culled)
-    sources: dict[int, ItemSource] = {}  # evaluated object -> its colour-source inputs this frame
-    face_slots: dict[int, np.ndarray] = {}  # evaluated mesh -> material slot per face (materials only)
-
     for instance in depsgraph.object_instances:
         obj = instance.object
         if obj.type != "MESH":
             continue
         if should_stop is not None and should_stop():
             break
-        is_instance = instance.is_instance
-        if not is_instance and not instance.show_self:
+        shown = _shown(instance, obj, object_filter, object_settings)
+        if shown is None:
             continue
-        # An instance is as visible as the object that instances it (its
-        # source may well be hidden or in an excluded collection).
-        parent = instance.parent if is_instance else None
-        owner = parent if parent is not None else obj
-        if object_filter is not None and not object_filter(owner.original):
+        parent, style, pass_index = shown
+        mesh = frame.mesh_for(instance, obj, parent)
+        if mesh is None:
             continue
-        style, pass_index = None, 0
-        if object_settings is not None and object_settings.active:
-            shown, style, pass_index = object_settings.lookup(obj)
-            if not shown or (parent is not None and not object_settings.lookup(parent)[0]):
-                continue
+        item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), frame.source_of(obj) if colors else None,
+                        style, pass_index)
+        if materials:
+            item.materials = _materials_of(obj, obj.data, obj.data.as_pointer(), frame.face_slots)
+        items.append(item)
+    frame.finish()
+    return items, frame.seen, frame.ms_extract
+
+
+def _shown(instance, obj, object_filter, object_settings):
+    """(parent, style, pass index) of a drawn instance, or None when the
+    target does not draw it. An instance is as visible as the object that
+    instances it (its source may well be hidden or in an excluded
+    collection); per-object settings need both shown (image model §5.9)."""
+    is_instance = instance.is_instance
+    if not is_instance and not instance.show_self:
+        return None
+    parent = instance.parent if is_instance else None
+    owner = parent if parent is not None else obj
+    if object_filter is not None and not object_filter(owner.original):
+        return None
+    style, pass_index = None, 0
+    if object_settings is not None and object_settings.active:
+        shown, style, pass_index = object_settings.lookup(obj)
+        if not shown or (parent is not None and not object_settings.lookup(parent)[0]):
+            return None
+    return parent, style, pass_index
+
+
+class _FrameGather:
+    """What one gather() keeps while it walks the instances: which evaluated
+    mesh became which GPU mesh this frame, keys in use, meshes deferred
+    because every instance so far lay outside the view, colour-source inputs
+    and material slots read once per object/mesh."""
+
+    def __init__(self, depsgraph, cache: MeshCache, *, trust_updates: bool, view, corners: bool, edge_angle: float):
+        self.cache = cache
+        self.mode = depsgraph.mode
+        self.trust = (depsgraph.as_pointer(), runtime.epoch) if trust_updates else None
+        self.versions = runtime.geometry_version
+        self.corners, self.edge_angle = corners, edge_angle
+        self.view_projection = None if view is None else view.projection @ view.view_matrix
+        self.seen = SeenKeys()
+        self.seen.scope = (self.mode,)
+        self.ms_extract = 0.0
+        self.by_pointer: dict[int, object] = {}  # evaluated mesh -> GPUMesh (or None) this frame
+        self.key_pointer: dict[tuple, int] = {}  # key -> the evaluated mesh it stands for this frame
+        self.instancer_meshes: dict[int, int] = {}  # geometry-nodes parent uid -> distinct meshes so far
+        self.deferred: dict[int, tuple] = {}  # culled, never-extracted mesh -> (key, uids, bound box, culled)
+        self.sources: dict[int, ItemSource] = {}  # evaluated object -> its colour-source inputs
+        self.face_slots: dict[int, np.ndarray] = {}  # evaluated mesh -> material slot per face
+
+    def mesh_for(self, instance, obj, parent):
+        """The GPU mesh an instance draws (None: nothing to draw, or culled)."""
         data = obj.data
         pointer = data.as_pointer()
-        if pointer in deferred:
-            key, uids, box, culled = deferred[pointer]
-            if _outside(view_projection, instance, box):
-                deferred[pointer] = (key, uids, box, culled + 1)
-                continue
+        if pointer in self.deferred:
+            key, uids, box, culled = self.deferred[pointer]
+            if _outside(self.view_projection, instance, box):
+                self.deferred[pointer] = (key, uids, box, culled + 1)
+                return None
             # A visible instance after all: extract now (the earlier ones are
             # outside the view and stay culled).
-            del deferred[pointer]
-            cache.culled += culled
-            seen.add(key)
-            mesh = None
-            try:
-                mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions,
-                                    corners, edge_angle)
-                ms_extract += ms
-            except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
-                warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
-            by_pointer[pointer] = mesh
-        if pointer in by_pointer:
-            mesh = by_pointer[pointer]
-        else:
+            del self.deferred[pointer]
+            self.cache.culled += culled
+            self.seen.add(key)
+            self.by_pointer[pointer] = self._resolve_safely(obj, data, pointer, key, uids)
+        if pointer not in self.by_pointer:
             mesh = None
             # Objects without faces are never extracted; in Edit Mode the
-            # evaluated mesh can be an empty wrapper (see get_source below).
+            # evaluated mesh can be an empty wrapper (see _mesh_for).
             if len(data.polygons) or obj.original.mode == "EDIT":
                 try:
-                    key, uids = _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes)
-                    if corners:
-                        key = (*key, "corners")
-                    if edge_angle > 0.0:
-                        key = (*key, "angle", float(edge_angle))
-                    if view_projection is not None and key not in cache:
-                        box = _bound_box(obj)
-                        if box is not None and _outside(view_projection, instance, box):
-                            deferred[pointer] = (key, uids, box, 1)
-                            continue
-                    seen.add(key)
-                    mesh, ms = _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions,
-                                        corners, edge_angle)
-                    ms_extract += ms
+                    key, uids = self._key(obj, pointer, parent)
                 except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
                     warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
+                    key = None
+                if key is not None:
+                    if self.view_projection is not None and key not in self.cache:
+                        box = _bound_box(obj)
+                        if box is not None and _outside(self.view_projection, instance, box):
+                            self.deferred[pointer] = (key, uids, box, 1)
+                            return None
+                    self.seen.add(key)
+                    mesh = self._resolve_safely(obj, data, pointer, key, uids)
             elif len(data.vertices):  # (an empty mesh, e.g. a pure instancer's own, says nothing)
                 warn_once(
                     ("nofaces", obj.name),
                     f"SolidWire: object '{obj.name}' has no faces; nothing to draw "
                     "(loose edges and vertices are not drawn)",
                 )
-            by_pointer[pointer] = mesh
-        if mesh is not None:
-            source = None
-            if colors:
-                source = sources.get(obj.as_pointer())
-                if source is None:
-                    source = sources[obj.as_pointer()] = item_source(obj)
-            item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), source, style, pass_index)
-            if materials:
-                item.materials = _materials_of(obj, data, pointer, face_slots)
-            items.append(item)
-    for _key, _uids, _box, culled in deferred.values():
-        cache.culled += culled  # never extracted: every instance outside the view
-    return items, seen, ms_extract
+            self.by_pointer[pointer] = mesh
+        return self.by_pointer[pointer]
+
+    def _key(self, obj, pointer, parent):
+        key, uids = _key_for(obj, pointer, parent, self.mode, self.key_pointer, self.instancer_meshes)
+        if self.corners:
+            key = (*key, "corners")
+        if self.edge_angle > 0.0:
+            key = (*key, "angle", float(self.edge_angle))
+        return key, uids
+
+    def _resolve_safely(self, obj, data, pointer, key, uids):
+        try:
+            mesh, ms = _mesh_for(obj, data, pointer, key, uids, self.cache, self.trust, self.versions,
+                                 self.corners, self.edge_angle)
+        except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
+            warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
+            return None
+        self.ms_extract += ms
+        return mesh
+
+    def source_of(self, obj) -> ItemSource:
+        source = self.sources.get(obj.as_pointer())
+        if source is None:
+            source = self.sources[obj.as_pointer()] = item_source(obj)
+        return source
+
+    def finish(self) -> None:
+        for _key, _uids, _box, culled in self.deferred.values():
+            self.cache.culled += culled  # never extracted: every instance outside the view
 
 
 def _materials_of(obj, data, pointer, face_slots) -> tuple | None:
@@ -288,12 +324,6 @@ def _bound_box(obj):
 def _outside(view_projection, instance, box) -> bool:
     object_to_clip = view_projection @ np.array(instance.matrix_world, dtype=np.float64)
     return bool(outside_frustum_many(object_to_clip[None], *box)[0])
-
-
-def _resolve(obj, data, pointer, key, uids, cache, trust_updates, depsgraph_id, epoch, versions, corners=False,
-             edge_angle=0.0):
-    trust = (depsgraph_id, epoch) if trust_updates else None
-    return _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners, edge_angle)
 
 
 def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
