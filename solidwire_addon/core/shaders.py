@@ -196,6 +196,34 @@ def _create_info(variant: ShaderVariant):
         info.define("USE_CLIP_PLANES", "1")
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     info.sampler(2, "FLOAT_2D", "ngon_corners")
+    _add_fill_and_colours(info, iface, variant)
+    info.vertex_in(0, "INT", "edge_flags")
+    info.vertex_out(iface)
+    output_and_feature_defines(info, variant)
+    info.define("THICKNESS_MODE", str(variant.thickness_mode))
+    if variant.hidden_pass:
+        info.define("HIDDEN_PASS", "1")
+    if variant.linear_depth:
+        info.define("LINEAR_DEPTH", "1")
+        compat.depth_write(info, "ANY")
+    if variant.ngons:
+        info.define("USE_NGONS", "1")
+    if variant.write_aovs:
+        _add_render_pass_outputs(info, iface)
+    if variant.depth_bias:
+        info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
+    if variant.write_aovs or variant.clip_planes:
+        # One typedef source holds every block's struct (a later call
+        # replaces the one pulling_info set).
+        info.typedef_source(schema.param_block_glsl() + (OBJECT_BLOCK_GLSL if variant.write_aovs else "")
+                            + (CLIP_BLOCK_GLSL if variant.clip_planes else ""))
+    _add_sources(info, variant)
+    return info
+
+
+def _add_fill_and_colours(info, iface, variant: ShaderVariant) -> None:
+    """Per-item tables, corner normals, shading and colour sources (image
+    model §5.8): only what the variant uses is declared."""
     if variant.per_item:
         if not variant.instanced:
             # normal_to_view / item_info come from item_table (item_table.glsl).
@@ -216,36 +244,24 @@ def _create_info(variant: ShaderVariant):
         iface.flat("VEC3", "item_fill")
     if variant.material_colors:
         info.define("MATERIAL_COLORS", "1")
-    info.vertex_in(0, "INT", "edge_flags")
-    info.vertex_out(iface)
-    output_and_feature_defines(info, variant)
-    info.define("THICKNESS_MODE", str(variant.thickness_mode))
-    if variant.hidden_pass:
-        info.define("HIDDEN_PASS", "1")
-    if variant.linear_depth:
-        info.define("LINEAR_DEPTH", "1")
-        compat.depth_write(info, "ANY")
-    if variant.ngons:
-        info.define("USE_NGONS", "1")
-    if variant.write_aovs:
-        # Per-object values in a block of their own (push constants are full);
-        # the instanced variant does not have them (draw.py draws object by
-        # object when passes are written).
-        info.uniform_buf(1, "SolidWireObject", "object_params")
-        info.sampler(7, "FLOAT_2D", "triangle_material")
-        iface.flat("FLOAT", "material_pass_index")
-        info.fragment_out(2, "VEC4", "frag_aov")
-        info.fragment_out(3, "VEC4", "frag_normal")
-        info.define("WRITE_AOVS", "1")
-        iface.flat("VEC3", "face_normal")
-    if variant.depth_bias:
-        info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
-    if variant.write_aovs or variant.clip_planes:
-        # One typedef source holds every block's struct (a later call
-        # replaces the one pulling_info set).
-        info.typedef_source(schema.param_block_glsl() + (OBJECT_BLOCK_GLSL if variant.write_aovs else "")
-                            + (CLIP_BLOCK_GLSL if variant.clip_planes else ""))
 
+
+def _add_render_pass_outputs(info, iface) -> None:
+    """The render passes' extra outputs and inputs (image model §6)."""
+    # Per-object values in a block of their own (push constants are full);
+    # the instanced variant does not have them (draw.py draws object by
+    # object when passes are written).
+    info.uniform_buf(1, "SolidWireObject", "object_params")
+    info.sampler(7, "FLOAT_2D", "triangle_material")
+    iface.flat("FLOAT", "material_pass_index")
+    info.fragment_out(2, "VEC4", "frag_aov")
+    info.fragment_out(3, "VEC4", "frag_normal")
+    info.define("WRITE_AOVS", "1")
+    iface.flat("VEC3", "face_normal")
+
+
+def _add_sources(info, variant: ShaderVariant) -> None:
+    """The GLSL files of the exact path, in the order each stage needs them."""
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
     style = read_source("line_style.glsl")
     fill = read_source("fill_shading.glsl")
@@ -257,7 +273,6 @@ def _create_info(variant: ShaderVariant):
         items = read_source("item_table.glsl") if variant.per_item else ""
         info.vertex_source(items + common + read_source("solidwire_vert.glsl"))
         info.fragment_source(items + common + style + fill + read_source("solidwire_frag.glsl"))
-    return info
 
 
 # Per-object values of the render passes (std140): the columns of the normal
