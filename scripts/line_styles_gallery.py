@@ -14,13 +14,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 
 import bpy  # noqa: E402
-import numpy as np  # noqa: E402
 
 from scripts import preset_gallery  # noqa: E402  (compose/write: the same sheet layout as the presets gallery)
 from tests.support import scenes  # noqa: E402
 import solidwire_addon  # noqa: E402
-from solidwire_addon.blender import engine
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
 
 CELL = preset_gallery.CELL
 PAPER = (0.93, 0.92, 0.88)
@@ -53,16 +50,7 @@ def build_scene():
 
 
 def render_cells(scene):
-    ensure_gpu()
-    cells = []
-    for label, overrides in STYLES:
-        for name, value in {**LOOK, **overrides}.items():
-            setattr(scene.solidwire, name, value)
-        rgba, _depth = engine.render_scene(bpy.context.evaluated_depsgraph_get(), CELL)
-        cells.append((label, rgba[..., :3]))
-        for name in overrides:  # back to the base look for the next cell
-            scene.solidwire.property_unset(name)
-    return cells
+    return preset_gallery.render_looks(scene, STYLES, LOOK, CELL, reset=True)
 
 
 def main(argv=None) -> int:

@@ -21,8 +21,6 @@ import bpy  # noqa: E402
 from scripts import preset_gallery  # noqa: E402  (compose/write: the same sheet layout as the presets gallery)
 from tests.support import scenes  # noqa: E402
 import solidwire_addon  # noqa: E402
-from solidwire_addon.blender import engine  # noqa: E402
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
 
 CELL = (360, 270)
 LOOK = dict(use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0),
@@ -63,14 +61,7 @@ def build_scene():
 
 
 def render_cells(scene):
-    ensure_gpu()
-    cells = []
-    for label, overrides in CELLS:
-        for name, value in {**LOOK, **overrides}.items():
-            setattr(scene.solidwire, name, value)
-        rgba, _depth = engine.render_scene(bpy.context.evaluated_depsgraph_get(), CELL)
-        cells.append((label, rgba[..., :3]))
-    return cells
+    return preset_gallery.render_looks(scene, CELLS, LOOK, CELL, reset=False)
 
 
 def main(argv=None) -> int:

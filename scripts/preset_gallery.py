@@ -158,5 +158,22 @@ def main(argv=None) -> int:
     return 0
 
 
+def render_looks(scene, looks, base: dict, size, *, reset: bool = True) -> list:
+    """(label, RGB) for each (label, overrides) of ``looks``: ``base`` plus
+    the overrides, drawn in one piece by the engine at ``size``. With
+    ``reset`` each cell's overrides go back to their defaults afterwards."""
+    ensure_gpu()
+    cells = []
+    for label, overrides in looks:
+        for name, value in {**base, **overrides}.items():
+            setattr(scene.solidwire, name, value)
+        rgba, _depth = engine.render_scene(bpy.context.evaluated_depsgraph_get(), size)
+        cells.append((label, rgba[..., :3]))
+        if reset:
+            for name in overrides:
+                scene.solidwire.property_unset(name)
+    return cells
+
+
 if __name__ == "__main__":
     sys.exit(main())
