@@ -38,6 +38,12 @@ def applied_mesh_scene(width: int, height: int, subdivisions: int):
     """Suzanne subdivided and applied (no modifier left), framed by the camera."""
     scene = scenes.empty_scene(width, height, use_fill=True)
     obj = scenes.monkey(scene, "Suzanne", subdivisions=subdivisions)
+    # Apply the subdivision: every engine then draws the same plain mesh
+    # (Workbench would otherwise evaluate it on the GPU, slowly on llvmpipe).
+    evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    applied = bpy.data.meshes.new_from_object(evaluated)
+    obj.modifiers.clear()
+    obj.data = applied
     scenes.frame_object(scene, obj, azimuth=-75.0)
     return scene, obj
 
