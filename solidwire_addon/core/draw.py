@@ -210,7 +210,7 @@ def draw(
             # not ask for it): draw flat rather than read a missing table.
             warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
             variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
-    # Two per-object mechanisms side by side (merge of issue11 and issue12):
+    # Two per-object mechanisms side by side:
     # an object's style override (wire colour, thickness, fill colour) is a
     # parameter block per distinct style (``ubo(style)``), since thickness
     # and the wire's alpha live there; per-item colours of the colour sources
