@@ -12,6 +12,7 @@ Blender has one, else this repository's package, registered for the run.
 
 from __future__ import annotations
 
+import atexit
 import importlib
 import os
 import runpy
@@ -85,12 +86,17 @@ def main(argv: list[str]) -> int:
 _EXIT_CRASHES = "mathutils" not in sys.builtin_module_names and bpy.app.version < (4, 5, 0)
 
 
+def _leave_without_finalising(code: int) -> None:
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
+
+
 if __name__ == "__main__":
     code = main(sys.argv)
     if _EXIT_CRASHES:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(code)
+        # At exit, not now: a caller that ran this script (runpy) goes on first.
+        atexit.register(_leave_without_finalising, code)
     # Inside Blender a script that returns lets Blender exit 0, so a failure
     # must leave through SystemExit; with the bpy module the same is harmless.
     if code:
