@@ -208,3 +208,22 @@ def test_defaults_make_a_readable_picture_of_the_default_scene(output_dir):
     rows, cols = np.nonzero(fill)
     box = grey[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1]
     assert np.count_nonzero(box < world - 0.05) > 100
+
+
+def test_a_matcap_is_never_decoded_inside_a_render(monkeypatch):
+    """Decoding renders a scratch scene; started from inside a render it
+    deadlocked Blender 5.3. Inside the engine's render the loader only asks
+    for it (the render draws a flat fill until then); outside, choosing the
+    matcap decodes it at once in background mode."""
+    from solidwire_addon.blender import matcap_files
+    from solidwire_addon.core import matcaps, shaders
+
+    monkeypatch.setattr(matcap_files, "_decoded", {})
+    monkeypatch.setattr(matcap_files, "_requested", set())
+    decoded = []
+    monkeypatch.setattr(matcap_files, "decode_pixels", lambda name: decoded.append(name) or None)
+    with shaders.gl_context("render-engine"):
+        assert matcap_files.load_pixels("clay_brown") is matcaps.PENDING
+    assert decoded == []
+    matcap_files.prepare("clay_brown")
+    assert decoded == ["clay_brown"]

@@ -26,7 +26,7 @@ import bpy
 from bpy.app.handlers import persistent
 import numpy as np
 
-from ..core import exr, matcaps
+from ..core import exr, matcaps, shaders
 
 SUBFOLDER = "studiolights/matcap"
 
@@ -97,12 +97,36 @@ def load_pixels(name: str):
     matcaps.PENDING (asked for; decoded soon in the main thread)."""
     if name in _decoded:
         return _decoded[name]
-    main_thread = threading.current_thread() is threading.main_thread()
-    if bpy.app.background and main_thread:
+    if _can_decode_now():
         return _decode_once(name)
-    if main_thread:
+    if threading.current_thread() is threading.main_thread():
         request(name)
     return matcaps.PENDING
+
+
+def _can_decode_now() -> bool:
+    """Decoding renders a scratch scene, so never inside a render (a render
+    started from a render deadlocks Blender 5.3) nor off the main thread;
+    in a UI session it waits for a timer (outside any draw)."""
+    return (bpy.app.background and threading.current_thread() is threading.main_thread()
+            and shaders.current_gl_context() != "render-engine")
+
+
+def prepare(name: str) -> None:
+    """Decode matcap ``name`` before it is needed: now when that is safe
+    (background, main thread, not rendering), else soon in the main thread.
+    Called when the matcap or the shading is chosen and when a file opens."""
+    if name in _decoded:
+        return
+    if _can_decode_now():
+        try:
+            _decode_once(name)
+        except Exception as exc:  # noqa: BLE001 - an update callback must not raise
+            print(f"SolidWire: matcap '{name}' could not be read ({exc})")
+            _decoded[name] = None
+        matcaps.forget(name)
+    else:
+        request(name)
 
 
 def request(name: str) -> None:
@@ -166,7 +190,7 @@ def request_for_scenes(*_args) -> None:
     for scene in bpy.data.scenes:
         props = getattr(scene, "solidwire", None)
         if props is not None and props.use_fill and props.fill_shading == "MATCAP":
-            request(props.matcap)
+            prepare(props.matcap)
 
 
 _on_load = persistent(request_for_scenes)

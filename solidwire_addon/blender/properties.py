@@ -47,7 +47,7 @@ def _diagonal_mode_changed(self, _context) -> None:
 def _matcap_changed(self, _context) -> None:
     """Decode the chosen matcap now, in the main thread (matcap_files.py)."""
     if self.fill_shading == "MATCAP":
-        matcap_files.request(self.matcap)
+        matcap_files.prepare(self.matcap)
     redraw_viewports()
 
 

@@ -101,6 +101,11 @@ _cache: dict[tuple, object] = {}
 _context = "window"
 
 
+def current_gl_context() -> str:
+    """The GL context the draw calls of the moment go to (see gl_context)."""
+    return _context
+
+
 @contextlib.contextmanager
 def gl_context(name: str):
     """Draw calls inside use the programs of GL context ``name`` (the render
