@@ -166,7 +166,7 @@ def test_matcap_decoding_leaves_nothing_in_the_file():
     before = (len(bpy.data.scenes), len(bpy.data.node_groups), len(bpy.data.images))
     diffuse, specular = matcap_files.decode_pixels("metal_carpaint")
     assert diffuse.shape == (512, 512, 4)
-X
+    if bpy.app.version >= (5, 0, 0):  # 4.x's compositor does not hand over the specular layer (no highlight there)
         assert specular is not None and specular.max() > 0.0
     assert (len(bpy.data.scenes), len(bpy.data.node_groups), len(bpy.data.images)) == before
     assert matcap_files.decode_pixels("no_such_matcap") is None
