@@ -32,6 +32,7 @@ import solidwire_addon  # noqa: E402
 from solidwire_addon.blender import engine  # noqa: E402
 from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
 from solidwire_addon.core import exr, targets  # noqa: E402
+from tests.support import scenes  # noqa: E402
 
 TMP = Path(tempfile.mkdtemp(prefix="swxfer-", dir="/dev/shm" if os.path.isdir("/dev/shm") else None))
 
@@ -157,16 +158,7 @@ def bench_scene(width, height):
 
 def verify(scene, rgba, depth):
     """Bit-exact check of both passes through a float multilayer EXR."""
-    settings = scene.render.image_settings
-    if hasattr(settings, "media_type"):
-        settings.media_type = "MULTI_LAYER_IMAGE"
-    settings.file_format = "OPEN_EXR_MULTILAYER"
-    settings.color_depth = "32"
-    settings.exr_codec = "NONE"
-    scene.render.use_file_extension = False
-    scene.render.filepath = str(TMP / "verify.exr")
-    bpy.ops.render.render(write_still=True, scene=scene.name)
-    channels = exr.read_exr(TMP / "verify.exr")
+    channels = scenes.render_multilayer_exr(scene, TMP / "verify.exr")
     layer = scene.view_layers[0].name
     got_rgba = exr.exr_pass(channels, layer, "Combined", "RGBA").reshape(-1, 4)
     got_depth = exr.exr_pass(channels, layer, "Depth", "Z").reshape(-1, 1)

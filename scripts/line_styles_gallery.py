@@ -7,17 +7,13 @@ next to the plain SPEC look, and write a labelled sheet (docs/line_styles.png).
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
-import bpy  # noqa: E402
 
 from scripts import preset_gallery  # noqa: E402  (compose/write: the same sheet layout as the presets gallery)
-from tests.support import scenes  # noqa: E402
-import solidwire_addon  # noqa: E402
 
 CELL = preset_gallery.CELL
 PAPER = (0.93, 0.92, 0.88)
@@ -37,15 +33,7 @@ STYLES = (
 
 
 def build_scene():
-    scene = scenes.empty_scene(*CELL, transparent=False)
-    world = bpy.data.worlds.new("Paper")
-    world.color = PAPER
-    scene.world = world
-    scenes.monkey(scene, subdivisions=1, location=(0.0, 0.0, 0.05), rotation=(0.0, 0.0, -0.35))
-    scenes.cube(scene, size=1.1, location=(1.7, 1.2, -0.4), rotation=(0.0, 0.0, 0.6))
-    scenes.uv_sphere(scene, segments=20, rings=10, radius=0.7, location=(-1.9, 1.4, -0.3))
-    scenes.grid(scene, "Floor", x_segments=14, y_segments=14, size=16.0, location=(0, 3.0, -1.0))
-    scenes.add_camera(scene, location=(2.6, -5.2, 2.2), target=(0.0, 0.6, -0.3), lens=42.0)
+    scene, _objects = preset_gallery.still_life(CELL, "Paper", PAPER)
     return scene
 
 
@@ -54,18 +42,8 @@ def render_cells(scene):
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("-o", "--output", type=Path, default=ROOT / "docs" / "line_styles.png")
-    args = parser.parse_args(argv)
-    solidwire_addon.register()
-    try:
-        scene = build_scene()
-        cells = render_cells(scene)
-        preset_gallery.write(preset_gallery.compose(cells, columns=3), cells, args.output, columns=3)
-    finally:
-        solidwire_addon.unregister()
-    print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")
-    return 0
+    return preset_gallery.run_gallery(argv, __doc__.splitlines()[0], ROOT / "docs" / "line_styles.png", build_scene,
+                                      render_cells)
 
 
 if __name__ == "__main__":

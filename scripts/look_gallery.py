@@ -10,7 +10,6 @@ The world is Blender's default 0.05 grey, as in a new file.
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
@@ -19,8 +18,6 @@ ROOT = Path(__file__).resolve().parent.parent
 import bpy  # noqa: E402
 
 from scripts import preset_gallery  # noqa: E402  (compose/write: the same sheet layout as the presets gallery)
-from tests.support import scenes  # noqa: E402
-import solidwire_addon  # noqa: E402
 
 CELL = (360, 270)
 LOOK = dict(use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0),
@@ -36,14 +33,9 @@ CELLS = (
 
 
 def build_scene():
-    scene = scenes.empty_scene(*CELL, transparent=False)
-    world = bpy.data.worlds.new("World")
-    world.color = (0.05, 0.05, 0.05)  # Blender's default world
-    scene.world = world
-    suzanne = scenes.monkey(scene, subdivisions=1, location=(0.0, 0.0, 0.05), rotation=(0.0, 0.0, -0.35))
+    scene, (suzanne, cube, sphere, floor) = preset_gallery.still_life(CELL, "World", (0.05, 0.05, 0.05))
     suzanne.data.shade_smooth()
     suzanne.color = (0.85, 0.45, 0.2, 1.0)
-    cube = scenes.cube(scene, size=1.1, location=(1.7, 1.2, -0.4), rotation=(0.0, 0.0, 0.6))
     cube.color = (0.2, 0.5, 0.85, 1.0)
     for name, colour in (("Teal", (0.1, 0.55, 0.5, 1.0)), ("Sand", (0.85, 0.7, 0.4, 1.0))):
         material = bpy.data.materials.new(name)
@@ -51,12 +43,9 @@ def build_scene():
         cube.data.materials.append(material)
     for poly in cube.data.polygons:
         poly.material_index = poly.index % 2
-    sphere = scenes.uv_sphere(scene, segments=20, rings=10, radius=0.7, location=(-1.9, 1.4, -0.3))
     sphere.data.shade_smooth()
     sphere.color = (0.4, 0.75, 0.3, 1.0)
-    floor = scenes.grid(scene, "Floor", x_segments=14, y_segments=14, size=16.0, location=(0, 3.0, -1.0))
     floor.color = (0.6, 0.6, 0.62, 1.0)
-    scenes.add_camera(scene, location=(2.6, -5.2, 2.2), target=(0.0, 0.6, -0.3), lens=42.0)
     return scene
 
 
@@ -65,19 +54,8 @@ def render_cells(scene):
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("-o", "--output", type=Path, default=ROOT / "docs" / "looks.png")
-    args = parser.parse_args(argv)
-    solidwire_addon.register()
-    try:
-        scene = build_scene()
-        cells = render_cells(scene)
-        preset_gallery.write(preset_gallery.compose(cells, columns=3, cell=CELL), cells, args.output, columns=3,
-                             cell=CELL)
-    finally:
-        solidwire_addon.unregister()
-    print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")
-    return 0
+    return preset_gallery.run_gallery(argv, __doc__.splitlines()[0], ROOT / "docs" / "looks.png", build_scene,
+                                      render_cells, cell=CELL)
 
 
 if __name__ == "__main__":

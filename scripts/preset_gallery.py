@@ -158,6 +158,37 @@ def main(argv=None) -> int:
     return 0
 
 
+def still_life(size, world_name: str, world_color) -> tuple:
+    """The galleries' shared scene: Suzanne, a cube, a sphere and a floor under
+    one camera, over a world colour. Returns (scene, (suzanne, cube, sphere, floor))."""
+    scene = scenes.empty_scene(*size, transparent=False)
+    world = bpy.data.worlds.new(world_name)
+    world.color = world_color
+    scene.world = world
+    suzanne = scenes.monkey(scene, subdivisions=1, location=(0.0, 0.0, 0.05), rotation=(0.0, 0.0, -0.35))
+    cube = scenes.cube(scene, size=1.1, location=(1.7, 1.2, -0.4), rotation=(0.0, 0.0, 0.6))
+    sphere = scenes.uv_sphere(scene, segments=20, rings=10, radius=0.7, location=(-1.9, 1.4, -0.3))
+    floor = scenes.grid(scene, "Floor", x_segments=14, y_segments=14, size=16.0, location=(0, 3.0, -1.0))
+    scenes.add_camera(scene, location=(2.6, -5.2, 2.2), target=(0.0, 0.6, -0.3), lens=42.0)
+    return scene, (suzanne, cube, sphere, floor)
+
+
+def run_gallery(argv, description: str, default_output: Path, build_scene, render_cells, *, cell=None) -> int:
+    """Command line of a 3-column gallery sheet: build, render, compose, write."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("-o", "--output", type=Path, default=default_output)
+    args = parser.parse_args(argv)
+    solidwire_addon.register()
+    try:
+        cells = render_cells(build_scene())
+        sizing = {} if cell is None else {"cell": cell}
+        write(compose(cells, columns=3, **sizing), cells, args.output, columns=3, **sizing)
+    finally:
+        solidwire_addon.unregister()
+    print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")
+    return 0
+
+
 def render_looks(scene, looks, base: dict, size, *, reset: bool = True) -> list:
     """(label, RGB) for each (label, overrides) of ``looks``: ``base`` plus
     the overrides, drawn in one piece by the engine at ``size``. With

@@ -62,19 +62,10 @@ def occlusion_scene(*, front: bool = True):
 
 def plain_render(scene, engine: str, path: Path, *, transparent: bool | None = None) -> dict:
     """An ordinary render of ``scene`` with ``engine`` to a float EXR, read back."""
-    render = scene.render
-    render.engine = engine
+    scene.render.engine = engine
     if transparent is not None:
-        render.film_transparent = transparent
-    image = render.image_settings
-    compat.set_media_type(image, "MULTI_LAYER_IMAGE")  # Blender 5 (no-op on 4.x)
-    image.file_format = "OPEN_EXR_MULTILAYER"
-    image.color_depth = "32"
-    image.exr_codec = "NONE"
-    render.use_file_extension = False
-    render.filepath = str(path)
-    bpy.ops.render.render(write_still=True, scene=scene.name)
-    return composite.read_exr(path)
+        scene.render.film_transparent = transparent
+    return scenes.render_multilayer_exr(scene, path)
 
 
 def rgba_of(channels: dict) -> np.ndarray:

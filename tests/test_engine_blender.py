@@ -3,8 +3,6 @@ result always ended, Esc, and Blender's generic panels."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import bpy
 import numpy as np
 import pytest
@@ -14,17 +12,7 @@ from solidwire_addon.core import exr
 from tests.support import scenes
 
 
-def _multilayer_render(scene, path: Path) -> dict:
-    image = scene.render.image_settings
-    if hasattr(image, "media_type"):
-        image.media_type = "MULTI_LAYER_IMAGE"
-    image.file_format = "OPEN_EXR_MULTILAYER"
-    image.color_depth = "32"
-    image.exr_codec = "NONE"
-    scene.render.use_file_extension = False
-    scene.render.filepath = str(path)
-    bpy.ops.render.render(write_still=True, scene=scene.name)
-    return exr.read_exr(path)
+_multilayer_render = scenes.render_multilayer_exr
 
 
 def _two_layer_scene():

@@ -36,15 +36,8 @@ def render_exr(scene, path: Path) -> np.ndarray:
     32-bit float OpenEXR file, and read it back: (H, W, 4) float32, bottom row
     first, premultiplied (alpha = wire alpha * I on a transparent film). Unlike
     a PNG, the file keeps NaN and Inf, so a poisoned pixel cannot hide."""
-    path = Path(path).resolve()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    scene.render.filepath = str(path)
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR"
-    settings.color_mode = "RGBA"
-    settings.color_depth = "32"
-    settings.exr_codec = "ZIP"
-    bpy.ops.render.render(write_still=True, scene=scene.name)
+    path = scenes.render_still(scene, path, file_format="OPEN_EXR", color_mode="RGBA", color_depth="32",
+                               exr_codec="ZIP")
     image = bpy.data.images.load(str(path), check_existing=False)
     try:
         width, height = image.size

@@ -128,20 +128,39 @@ def uv_sphere(scene, name="Sphere", segments=16, rings=8, radius=1.0, **kwargs):
     )
 
 
+def render_still(scene, path: Path, **image_settings) -> Path:
+    """Render ``scene`` through the real engine with write_still to ``path``
+    (its folder made), with these image settings applied in order."""
+    path = Path(path).resolve()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    scene.render.filepath = str(path)
+    settings = scene.render.image_settings
+    for name, value in image_settings.items():
+        setattr(settings, name, value)
+    bpy.ops.render.render(write_still=True, scene=scene.name)
+    return path
+
+
 def render_to_file(scene, path: Path, *, depth16: bool = True) -> np.ndarray:
     """Render through the real engine with write_still and read the file back.
 
     Returns straight RGBA, float64, shape (H, W, 4), bottom row first (window
     row j = array row j)."""
-    path = Path(path).resolve()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    scene.render.filepath = str(path)
-    settings = scene.render.image_settings
-    settings.file_format = "PNG"
-    settings.color_mode = "RGBA"
-    settings.color_depth = "16" if depth16 else "8"
-    bpy.ops.render.render(write_still=True, scene=scene.name)
+    path = render_still(scene, path, file_format="PNG", color_mode="RGBA", color_depth="16" if depth16 else "8")
     return load_png(path)
+
+
+def render_multilayer_exr(scene, path: Path) -> dict:
+    """Render to an uncompressed float multilayer EXR (every view layer and
+    pass Blender writes) and read it back: {channel name: (H, W) float32}."""
+    # Imported here: this module is also used by a process that must only
+    # see the installed extension (tests/test_packaging.py).
+    from solidwire_addon.core import compat, exr
+
+    compat.set_media_type(scene.render.image_settings, "MULTI_LAYER_IMAGE")  # Blender 5; no-op on 4.x
+    scene.render.use_file_extension = False
+    path = render_still(scene, path, file_format="OPEN_EXR_MULTILAYER", color_depth="32", exr_codec="NONE")
+    return exr.read_exr(path)
 
 
 def load_png(path: Path) -> np.ndarray:
