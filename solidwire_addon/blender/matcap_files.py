@@ -44,6 +44,7 @@ def _passes_through_compositor(image, outputs) -> dict:
     scene = bpy.data.scenes.new("solidwire_matcap")
     tree = bpy.data.node_groups.new("solidwire_matcap", "CompositorNodeTree")
     result = {}
+    images_before = set(bpy.data.images)
     try:
         tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
         node = tree.nodes.new("CompositorNodeImage")
@@ -75,6 +76,11 @@ def _passes_through_compositor(image, outputs) -> dict:
     finally:
         bpy.data.node_groups.remove(tree)
         bpy.data.scenes.remove(scene)
+        # A process's first render makes the "Render Result" image; this
+        # decode is not a render the user asked for, so it leaves none.
+        for made in set(bpy.data.images) - images_before:
+            if made.type == "RENDER_RESULT":
+                bpy.data.images.remove(made)
     return result
 
 
