@@ -58,7 +58,15 @@ void main()
   vec2 p = gl_FragCoord.xy - viewport_centre();
   /* Squared distances to the five candidate edges. */
   float d0, d1, d2, d3, d4;
-  if ((triangle_flags & SIMPLE_TRIANGLE) != 0) {
+#ifdef USE_DENSITY_FADE
+  /* The argument below needs every line at full strength: with lines of
+   * different fade a diagonal's line distance could show where its
+   * segment is farther. */
+  const bool use_line_distances = false;
+#else
+  bool use_line_distances = (triangle_flags & SIMPLE_TRIANGLE) != 0;
+#endif
+  if (use_line_distances) {
     /* Inside a convex polygon wholly in front of the camera the nearest
      * boundary point of the nearest edge line lies on that edge's segment,
      * so the line distance is exact and the segment ends need no test.
@@ -85,95 +93,170 @@ void main()
     d4 = edge_distance_sq(edge_line4, edge_span4, p);
   }
 
+  /* Which of the triangle's own edges are lines (drawn polygon edges) and
+   * which are diagonals (added by triangulation). A triangle that walks its
+   * region's segments takes every line from that block instead; its own
+   * edges then only give diagonals. Polygon edges that are not drawn are
+   * neither. A quad's edges p2-p3, p3-p0 are NO_EDGE unless it has them. */
+  bool listed = (triangle_flags & IN_REGION) != 0;
   bool real0 = (triangle_flags & EDGE0_REAL) != 0;
   bool real1 = (triangle_flags & EDGE1_REAL) != 0;
   bool real2 = (triangle_flags & EDGE2_REAL) != 0;
+  bool diag0 = !real0 && (triangle_flags & EDGE0_HIDDEN) == 0;
+  bool diag1 = !real1 && (triangle_flags & (EDGE0_HIDDEN << 1)) == 0;
+  bool diag2 = !real2 && (triangle_flags & (EDGE0_HIDDEN << 2)) == 0;
 
-  /* The nearest real edge, with its line and span (for the hidden-line
-   * dashes; unused otherwise and compiled away). Quad edges p2-p3 and p3-p0
-   * are NO_EDGE unless the triangle has them. */
-  float d_real = NO_EDGE * NO_EDGE;
-  vec3 real_line = vec3(0.0, 0.0, NO_EDGE);
-  vec2 real_span = vec2(0.0);
-  keep_nearest(real0, d0, edge_line0, edge_span0, d_real, real_line, real_span);
-  keep_nearest(real1, d1, edge_line1, edge_span1, d_real, real_line, real_span);
-  keep_nearest(real2, d2, edge_line2, edge_span2, d_real, real_line, real_span);
-  /* A quad's edges to its 4th corner, unless not drawn (edge angle). */
+  /* The nearest line of each style (image model §3.6: style 0 is the wire,
+   * styles 1.. the edge classes), with its line and span (for patterns and
+   * the density fade). */
+  float d_style[STYLE_COUNT];
+  vec3 line_style[STYLE_COUNT];
+  vec2 span_style[STYLE_COUNT];
+  int chain_style[STYLE_COUNT]; /* texel of the chain ends, -1: the edge itself */
+  for (int k = 0; k < STYLE_COUNT; k++) {
+    d_style[k] = NO_EDGE * NO_EDGE;
+    line_style[k] = vec3(0.0, 0.0, NO_EDGE);
+    span_style[k] = vec2(0.0);
+    chain_style[k] = -1;
+  }
+  keep_nearest(real0 && !listed, d0, edge_line0, edge_span0, d_style[0], line_style[0], span_style[0]);
+  keep_nearest(real1 && !listed, d1, edge_line1, edge_span1, d_style[0], line_style[0], span_style[0]);
+  keep_nearest(real2 && !listed, d2, edge_line2, edge_span2, d_style[0], line_style[0], span_style[0]);
   bool real3 = (triangle_flags & EDGE3_HIDDEN) == 0;
   bool real4 = (triangle_flags & EDGE4_HIDDEN) == 0;
-  keep_nearest(real3, d3, edge_line3, edge_span3, d_real, real_line, real_span);
-  keep_nearest(real4, d4, edge_line4, edge_span4, d_real, real_line, real_span);
-  /* An n-gon's boundary edges may pass near this fragment although they
-   * belong to another of its triangles (thin ears, concave outlines): walk
-   * the whole outline. Compiled only into the variant for meshes that have
-   * n-gons: llvmpipe pays for this loop on every fragment even when it runs
-   * zero times. */
-#ifdef USE_NGONS
-  int corners = triangle_flags >> NGON_SHIFT;
-  for (int k = 0; k < corners; k++) {
-    vec4 slot_a = fetch_texel(ngon_corners, ngon_corner_start + k);
-    float id_a = slot_a.x;
-    float id_b = fetch_texel(ngon_corners, ngon_corner_start + (k + 1) % corners).x;
-    vec3 line;
-    vec2 span;
-    edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
-    /* .y: this outline edge is not drawn (edge angle); see the diagonals. */
-    keep_nearest(slot_a.y < 0.5, edge_distance_sq(line, span, p), line, span, d_real, real_line, real_span);
-  }
-#endif
-  d_real = sqrt(d_real);
-  float half_thickness = half_thickness_at(view_depth, gl_FragCoord.w);
-  float intensity = line_profile(d_real, half_thickness);
+  keep_nearest(real3, d3, edge_line3, edge_span3, d_style[0], line_style[0], span_style[0]);
+  keep_nearest(real4, d4, edge_line4, edge_span4, d_style[0], line_style[0], span_style[0]);
 
-#ifdef HIDDEN_PASS
-  /* Hidden-line style (docs/image_model.md §5.4): this face is behind the visible surface;
-   * its real edges are drawn dimmed and dashed along the nearest edge, from
-   * that edge's lower-id end. No diagonals, no fill. */
-  float along_real = dot(vec2(-real_line.y, real_line.x), p);
-  intensity *= params.hidden_alpha * pattern_mask(abs(along_real - real_span.x), params.hidden_period, params.hidden_duty);
-#elif DIAGONALS >= 1
   /* The nearest diagonal, with its line and span for the pattern. */
   float d_diag = NO_EDGE * NO_EDGE;
   vec3 diag_line = vec3(0.0, 0.0, NO_EDGE);
   vec2 diag_span = vec2(0.0);
-  keep_nearest(!real0, d0, edge_line0, edge_span0, d_diag, diag_line, diag_span);
-  keep_nearest(!real1, d1, edge_line1, edge_span1, d_diag, diag_line, diag_span);
-  keep_nearest(!real2, d2, edge_line2, edge_span2, d_diag, diag_line, diag_span);
-  keep_nearest(!real3, d3, edge_line3, edge_span3, d_diag, diag_line, diag_span);
-  keep_nearest(!real4, d4, edge_line4, edge_span4, d_diag, diag_line, diag_span);
-  /* Every diagonal of an n-gon, not only this triangle's own. */
+#if !defined(HIDDEN_PASS) && DIAGONALS >= 1
+  keep_nearest(diag0, d0, edge_line0, edge_span0, d_diag, diag_line, diag_span);
+  keep_nearest(diag1, d1, edge_line1, edge_span1, d_diag, diag_line, diag_span);
+  keep_nearest(diag2, d2, edge_line2, edge_span2, d_diag, diag_line, diag_span);
+#endif
+
+  /* An n-gon's boundary edges may pass near this fragment although they
+   * belong to another of its triangles (thin ears, concave outlines): walk
+   * the whole outline; a region's lines likewise come from all of its drawn
+   * edges. Compiled only into the variant for meshes that have n-gons or
+   * regions: llvmpipe pays for these loops on every fragment even when they
+   * run zero times. */
 #ifdef USE_NGONS
-  for (int k = 0; k < corners - 3; k++) {
-    int slot = ngon_corner_start + corners + 2 * k;
-    float id_a = fetch_texel(ngon_corners, slot).x;
-    float id_b = fetch_texel(ngon_corners, slot + 1).x;
-    vec3 line;
-    vec2 span;
-    edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
-    keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_diag, diag_line, diag_span);
+  int block_size = triangle_flags >> NGON_SHIFT;
+  if (listed) {
+    for (int k = 0; k < block_size; k++) {
+      int texel = ngon_corner_start + SEGMENT_TEXELS * k;
+      vec4 segment = fetch_texel(ngon_corners, texel);
+      vec3 line;
+      vec2 span;
+      /* Stored lower id first: patterns run from the lower-id end. */
+      edge_setup(vertex_clip(segment.x), vertex_clip(segment.y), line, span);
+      float d = edge_distance_sq(line, span, p);
+      int style = int(segment.z);
+      if (style == DIAGONAL_STYLE) {
+#  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
+        keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
+#  endif
+      }
+      else {
+        style = min(style, STYLE_COUNT - 1);
+        if (d < d_style[style]) {
+          d_style[style] = d;
+          line_style[style] = line;
+          span_style[style] = span;
+          chain_style[style] = texel + 1;
+        }
+      }
+    }
   }
-  /* Outline edges that are not drawn (edge angle) count as diagonals. */
-  for (int k = 0; k < corners; k++) {
-    vec4 slot_a = fetch_texel(ngon_corners, ngon_corner_start + k);
-    if (slot_a.y > 0.5) {
+  else {
+    int corners = block_size;
+    for (int k = 0; k < corners; k++) {
+      vec4 slot_a = fetch_texel(ngon_corners, ngon_corner_start + k);
+      if (slot_a.y > 0.5) {
+        continue; /* an outline edge that is not drawn */
+      }
       float id_a = slot_a.x;
       float id_b = fetch_texel(ngon_corners, ngon_corner_start + (k + 1) % corners).x;
       vec3 line;
       vec2 span;
       edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
+      keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_style[0], line_style[0], span_style[0]);
+    }
+#  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
+    /* Every diagonal of an n-gon, not only this triangle's own. */
+    for (int k = 0; k < corners - 3; k++) {
+      int slot = ngon_corner_start + corners + 2 * k;
+      float id_a = fetch_texel(ngon_corners, slot).x;
+      float id_b = fetch_texel(ngon_corners, slot + 1).x;
+      vec3 line;
+      vec2 span;
+      edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
       keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_diag, diag_line, diag_span);
     }
+#  endif
   }
 #endif
+
+  /* The nearest line of any style: the Edge Distance pass and hidden lines. */
+  float d_real = d_style[0];
+  vec3 real_line = line_style[0];
+  vec2 real_span = span_style[0];
+  for (int k = 1; k < STYLE_COUNT; k++) {
+    keep_nearest(true, d_style[k], line_style[k], span_style[k], d_real, real_line, real_span);
+  }
+  d_real = sqrt(d_real);
+  float half_thickness = half_thickness_at(view_depth, gl_FragCoord.w);
+
+#ifdef HIDDEN_PASS
+  /* Hidden-line style (docs/image_model.md §5.4): this face is behind the visible surface;
+   * its lines are drawn dimmed and dashed along the nearest one, from
+   * that edge's lower-id end. No diagonals, no styles, no fill. */
+  float intensity = line_profile(d_real, half_thickness);
+  float along_real = dot(vec2(-real_line.y, real_line.x), p);
+  intensity *= params.hidden_alpha * pattern_mask(abs(along_real - real_span.x), params.hidden_period, params.hidden_duty);
+  int winner = 0;
+#else
+  /* Each style's intensity at its nearest line; the pixel takes the style
+   * whose intensity is largest (image model §3.6). */
+  float intensity = 0.0;
+  int winner = 0;
+  for (int k = 0; k < STYLE_COUNT; k++) {
+    float value = line_profile(sqrt(d_style[k]), style_half_thickness(k, half_thickness));
+#  if STYLE_COUNT > 1
+    float duty = style_duty(k);
+    if (duty < 1.0) {
+      float along = dot(vec2(-line_style[k].y, line_style[k].x), p);
+      value *= pattern_mask(abs(along - span_style[k].x), params.pattern_period, duty);
+    }
+#  endif
+#  ifdef USE_DENSITY_FADE
+    value *= density_fade(chain_length(chain_style[k], span_style[k]));
+#  endif
+    if (value > intensity) {
+      intensity = value;
+      winner = k;
+    }
+  }
+#  if DIAGONALS >= 1
   d_diag = sqrt(d_diag);
   float diag_intensity = line_profile(d_diag, half_thickness);
-#  if DIAGONALS == 2
+#    if DIAGONALS == 2
   /* Position along the nearest diagonal from its lower-id end (stable for a
    * still camera whatever the settings). */
   float along = dot(vec2(-diag_line.y, diag_line.x), p);
   diag_intensity *= pattern_mask(abs(along - diag_span.x), params.pattern_period, params.pattern_duty);
+#    endif
+#    ifdef USE_DENSITY_FADE
+  diag_intensity *= density_fade(diag_span.y - diag_span.x);
+#    endif
+  if (diag_intensity > intensity) {
+    intensity = diag_intensity;
+    winner = 0;
+  }
 #  endif
-  intensity = max(intensity, diag_intensity);
 #endif
 
 #ifdef USE_FADE
@@ -185,6 +268,13 @@ void main()
   vec3 wire_rgb = item_wire; /* colour sources (fill_shading.glsl) */
 #else
   vec3 wire_rgb = params.wire_color.rgb;
+#endif
+#if STYLE_COUNT > 1
+  if (winner > 0) {
+    vec4 class_color = style_color(winner);
+    wire_rgb = class_color.rgb;
+    wire_weight = intensity * class_color.a;
+  }
 #endif
 #if defined(USE_FILL) && !defined(HIDDEN_PASS)
 #  ifdef ITEM_COLORS

@@ -29,8 +29,9 @@ void main()
 
   bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
   bool is_ngon = (edge_flags & IS_NGON) != 0;
-  /* For a quad the 4th id is its 4th corner; for an n-gon triangle it is
-   * where its polygon's block starts in `ngon_corners`. */
+  /* For a quad the 4th id is its 4th corner; for an n-gon triangle (or one
+   * that walks its region's segments) it is where its block starts in
+   * `ngon_corners`. */
   vec4 c3 = is_quad ? vertex_clip(ids.w) : c2;
   ngon_corner_start = int(ids.w);
   bool in_front = min(min(c0.z + c0.w, c1.z + c1.w), min(c2.z + c2.w, c3.z + c3.w)) >= 0.0;
@@ -64,7 +65,8 @@ void main()
     /* An edge that is not drawn (edge angle) moves to the diagonals: then a
      * line distance is no longer a segment distance for every sample. */
     int drawn_mask = is_quad ? (EDGE0_REAL | EDGE1_REAL) : (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
-    simple = simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0;
+    simple = simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0
+             && (edge_flags & IN_REGION) == 0;
   }
   else {
     /* Some corner is behind the near plane: clip each edge (edge_setup). */

@@ -1,6 +1,7 @@
 """Edge angle (image model §3.4): edges between two faces that meet at less
-than `edge_angle` are not drawn (they count as diagonals of each face);
-boundary and non-manifold edges always are. Against the float64 reference."""
+than `edge_angle` are not drawn (neither lines nor diagonals), and the lines
+of the faces around them come from their whole region; boundary and
+non-manifold edges always are drawn. Against the float64 reference."""
 
 from __future__ import annotations
 
@@ -17,6 +18,8 @@ from tests.support import scenes
 
 
 def _smooth_subdivided(scene):
+    # The angle alone: every evaluated edge is a candidate (cage edges off).
+    scene.solidwire.use_cage_edges = False
     monkey = scenes.monkey(scene, subdivisions=2, rotation=(0.2, 0.0, 0.5))
     scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0, 0, 0))
     return monkey

@@ -15,6 +15,7 @@ import bpy
 import pytest
 
 from tests.support import scenes
+from solidwire_addon.core import schema
 import solidwire_addon
 from solidwire_addon.blender import ops
 from solidwire_addon.blender import presets
@@ -215,10 +216,14 @@ def test_rows_that_do_not_apply_are_greyed_not_hidden(context):
         assert greyed[name], f"{name} should be greyed"
     assert not greyed["thickness"]
 
-    for name in ("hidden_alpha", "hidden_period", "hidden_duty", "world_thickness", "thickness_far"):
+    for name in ("hidden_alpha", "hidden_period", "hidden_duty", "world_thickness", "thickness_far",
+                 "density_fade_length", "seam_color", "sharp_thickness", "boundary_pattern"):
         assert greyed[name], f"{name} should be greyed"
 
     props.use_fill, props.diagonal_mode, props.use_fade, props.show_overlay = True, "DASHED", True, True
+    props.use_density_fade = True
+    for name, *_rest in schema.EDGE_CLASS_STYLES:
+        setattr(props, f"use_{name}_edges", True)
     props.use_hidden_lines, props.thickness_mode = True, "DEPTH"
     props.fill_shading = "MATCAP"
     greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
@@ -231,6 +236,9 @@ def test_rows_that_do_not_apply_are_greyed_not_hidden(context):
         "thickness", "thickness_far", "thickness_depth_start", "thickness_depth_end"
     }
     props.use_hidden_lines, props.thickness_mode = False, "PIXELS"
+    props.use_density_fade = False
+    for name, *_rest in schema.EDGE_CLASS_STYLES:
+        setattr(props, f"use_{name}_edges", False)
 
 
 def test_render_panel_and_its_poll(context):

@@ -20,15 +20,16 @@ from __future__ import annotations
 
 import time
 import zlib
+from dataclasses import replace
 
 import numpy as np
 
-from ..core import extract
+from ..core import edge_select, extract
 from ..core.cache import MeshCache
 from ..core.colors import ItemSource
 from ..core.log import warn_once
 from ..core.view import DrawItem, Style, outside_frustum_many
-from . import runtime
+from . import cage, runtime
 
 # Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
 SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
@@ -91,14 +92,16 @@ def _is_plain(obj_orig) -> bool:
     )
 
 
-def fingerprint(mesh, corners: bool = False):
+def fingerprint(mesh, corners: bool = False, edge_classes: tuple = ()):
     """(fingerprint, (positions, corner_vert, corner inputs)) of a mesh's
     drawn geometry.
 
     Counts plus CRC32 of the vertex positions and corner vertices (~4 GB/s),
     read with the same bulk reads extraction needs, which then reuses them.
     With ``corners`` (shaded fill), the corner normals and material indices
-    too: sharp edges or materials can change without moving a vertex."""
+    too: sharp edges or materials can change without moving a vertex. With
+    ``edge_classes``, the edge data of those classes (marking a seam moves
+    nothing either)."""
     positions = extract.read_positions(mesh)
     corner_vert = extract.read_corner_verts(mesh)
     # Topology first, the positions' checksum last (MeshCache.get_validated
@@ -109,6 +112,7 @@ def fingerprint(mesh, corners: bool = False):
         len(corner_vert),
         len(mesh.polygons),
         zlib.crc32(memoryview(corner_vert).cast("B")),
+        *_edge_class_checksums(mesh, edge_classes),
         zlib.crc32(memoryview(positions).cast("B")),
     )
     corner_inputs = None
@@ -116,6 +120,13 @@ def fingerprint(mesh, corners: bool = False):
         corner_inputs = extract.read_corner_inputs(mesh)
         content += tuple(zlib.crc32(memoryview(np.ascontiguousarray(a)).cast("B")) for a in corner_inputs)
     return content, (positions, corner_vert, corner_inputs)
+
+
+def _edge_class_checksums(mesh, edge_classes: tuple) -> tuple:
+    if not edge_classes:
+        return ()
+    bits = edge_select.read_edge_classes(mesh, edge_classes)
+    return (0,) if bits is None else (zlib.crc32(memoryview(np.ascontiguousarray(bits)).cast("B")),)
 
 
 def item_source(obj) -> ItemSource:
@@ -129,7 +140,8 @@ def item_source(obj) -> ItemSource:
 
 
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None, corners: bool = False, colors: bool = False, edge_angle: float = 0.0,
+           should_stop=None, corners: bool = False, colors: bool = False,
+           edges: edge_select.Selection = edge_select.Selection(),
            object_settings: ObjectSettings | None = None, materials: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
@@ -146,8 +158,9 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     ``corners``: meshes carry their corner table (shaded fill, material
     colours; a separate cache entry, so FLAT draws never pay for it).
     ``colors``: each item carries its object's :class:`ItemSource`.
-    ``edge_angle`` (radians, > 0): flat edges are not drawn (extraction
-    clears their flags; a separate cache entry per angle).
+    ``edges``: which edges are drawn and in which style (edge angle, cage
+    edges, edge classes; core/edge_select.py), a separate cache entry for
+    each selection.
 
     ``object_settings`` applies the per-object settings: an object drawn
     itself follows its own; an instance is drawn only if both its instancer
@@ -158,7 +171,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     if trust_updates is None:
         trust_updates = depsgraph.mode == "VIEWPORT"
     frame = _FrameGather(depsgraph, cache, trust_updates=trust_updates, view=view, corners=corners,
-                         edge_angle=edge_angle)
+                         edges=edges)
     items: list[DrawItem] = []
     for instance in depsgraph.object_instances:
         obj = instance.object
@@ -208,12 +221,13 @@ class _FrameGather:
     because every instance so far lay outside the view, colour-source inputs
     and material slots read once per object/mesh."""
 
-    def __init__(self, depsgraph, cache: MeshCache, *, trust_updates: bool, view, corners: bool, edge_angle: float):
+    def __init__(self, depsgraph, cache: MeshCache, *, trust_updates: bool, view, corners: bool,
+                 edges: edge_select.Selection):
         self.cache = cache
         self.mode = depsgraph.mode
         self.trust = (depsgraph.as_pointer(), runtime.epoch) if trust_updates else None
         self.versions = runtime.geometry_version
-        self.corners, self.edge_angle = corners, edge_angle
+        self.corners, self.edges = corners, edges
         self.view_projection = None if view is None else view.projection @ view.view_matrix
         self.seen = SeenKeys()
         self.seen.scope = (self.mode,)
@@ -271,19 +285,32 @@ class _FrameGather:
         key, uids = _key_for(obj, pointer, parent, self.mode, self.key_pointer, self.instancer_meshes)
         if self.corners:
             key = (*key, "corners")
-        if self.edge_angle > 0.0:
-            key = (*key, "angle", float(self.edge_angle))
+        edges, cage_key = self._edges_for(obj)
+        if edges.active:
+            key = (*key, "edges", edges, cage_key)
         return key, uids
 
     def _resolve_safely(self, obj, data, pointer, key, uids):
         try:
             mesh, ms = _mesh_for(obj, data, pointer, key, uids, self.cache, self.trust, self.versions,
-                                 self.corners, self.edge_angle)
+                                 self.corners, self._edges_for(obj)[0], self.mode == "RENDER")
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
             warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
             return None
         self.ms_extract += ms
         return mesh
+
+    def _edges_for(self, obj):
+        """(selection, cage key) for one object: cage edges only count on a
+        mesh that a subdivision modifier subdivides (any other mesh keeps
+        the plain, cheaper path)."""
+        edges = self.edges
+        cage_key = None
+        if edges.use_cage:
+            cage_key = cage.cage_key(obj.original, self.mode == "RENDER")
+            if cage_key is None:
+                edges = replace(edges, use_cage=False)
+        return edges, cage_key
 
     def source_of(self, obj) -> ItemSource:
         source = self.sources.get(obj.as_pointer())
@@ -350,7 +377,8 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
     return key, uids
 
 
-def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False, edge_angle=0.0):
+def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False,
+              edges: edge_select.Selection = edge_select.Selection(), render: bool = False):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
     obj_orig = obj.original
     fast = None
@@ -372,8 +400,14 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
     def make_arrays(context):
         positions, corner_vert, corner_inputs = context
         try:
-            arrays = extract.extract_mesh(get_source(), positions=positions, corner_vert=corner_vert,
-                                          corners=corner_inputs if corners else None, edge_angle=edge_angle)
+            source_mesh = get_source()
+            arrays = extract.extract_mesh(source_mesh, positions=positions, corner_vert=corner_vert,
+                                          corners=corner_inputs if corners else None)
+            if edges.active:
+                cage_edges = cage.cage_edges(obj.original, source_mesh, render=render) if edges.use_cage else None
+                edge_select.apply_to_mesh(
+                    arrays, source_mesh, corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
+                    extract.read_face_offsets(source_mesh), edges, cage_edges)
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
             return None
@@ -397,11 +431,11 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
 
     try:
         # Positions-only re-upload (reposition) only for meshes without a
-        # corner table or edge angle: corner normals and which edges are flat
-        # follow the positions, so those meshes are extracted again.
-        simple = not corners and edge_angle <= 0.0
+        # corner table or edge selection: corner normals and which edges are
+        # flat follow the positions, so those meshes are extracted again.
+        simple = not corners and not edges.active
         mesh, _extracted = cache.get_validated(
-            key, fast, (lambda: fingerprint(get_source(), True)) if corners else (lambda: fingerprint(get_source())),
+            key, fast, lambda: fingerprint(get_source(), corners, edges.classes),
             make_arrays, reposition if simple else None
         )
     finally:

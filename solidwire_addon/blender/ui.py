@@ -24,8 +24,11 @@ def draw_look_settings(layout, props) -> None:
     not apply right now is greyed out by its setting's ``active_if``."""
     layout.use_property_split = True
     layout.use_property_decorate = False
-    for section, _heading in schema.SECTIONS:
+    for section, heading in schema.SECTIONS:
         col = layout.column(align=True)
+        if section == "classes":
+            _draw_edge_classes(col, props, heading)
+            continue
         for setting in schema.settings_in(schema.SCENE):
             if setting.section != section:
                 continue
@@ -35,6 +38,23 @@ def draw_look_settings(layout, props) -> None:
             row.prop(props, setting.name)
         for idname, icon in _SECTION_OPERATORS.get(section, ()):
             col.operator(idname, icon=icon)
+
+
+def _draw_edge_classes(col, props, heading) -> None:
+    """One compact row per edge class: its switch, then colour, width and
+    pattern (greyed while the class is off)."""
+    col.label(text=heading)
+    for name, label, *_rest in schema.EDGE_CLASS_STYLES:
+        row = col.row(align=True)
+        split = row.split(factor=0.4, align=True)
+        split.use_property_split = False
+        split.prop(props, f"use_{name}_edges", text=label)
+        values = split.row(align=True)
+        values.use_property_split = False
+        values.active = bool(getattr(props, f"use_{name}_edges"))
+        values.prop(props, f"{name}_color", text="")
+        values.prop(props, f"{name}_thickness", text="")
+        values.prop(props, f"{name}_pattern", text="")
 
 
 def draw_object_settings(layout, obj) -> None:

@@ -47,12 +47,17 @@ class GPUMesh:
         positions[:, :3] = arrays.positions
         self.positions = table_texture(positions)
         self.triangles = table_texture(arrays.triangles.astype(np.float32))
-        ngon = np.zeros((max(len(arrays.ngon_corners), 1), 4), dtype=np.float32)
+        # One outline table: the n-gon blocks, then the segment blocks of the
+        # triangles that walk their region (core/edge_select.py).
+        region = arrays.region_table if arrays.region_table is not None else np.zeros((0, 4), np.float32)
+        outline_rows = len(arrays.ngon_corners) + len(region)
+        ngon = np.zeros((max(outline_rows, 1), 4), dtype=np.float32)
         ngon[: len(arrays.ngon_corners), 0] = arrays.ngon_corners
         if arrays.ngon_hidden is not None:
-            ngon[: len(arrays.ngon_hidden), 1] = arrays.ngon_hidden  # outline edge not drawn (edge angle)
+            ngon[: len(arrays.ngon_hidden), 1] = arrays.ngon_hidden  # outline edge not drawn
+        ngon[len(arrays.ngon_corners) : outline_rows] = region
         self.ngon_corners = table_texture(ngon)
-        self.has_ngons = len(arrays.ngon_corners) > 0
+        self.has_ngons = outline_rows > 0
         # Corner normals and material indices, one texel per triangle corner
         # (read by gl_VertexID); only for a shaded or per-material fill.
         self.corners = None if arrays.corners is None else table_texture(arrays.corners)

@@ -16,6 +16,7 @@ import numpy as np
 
 from . import colors, matcaps, shaders
 from .cache import table_texture
+from .edge_select import EDGE_CLASSES
 from .log import warn_once
 from .settings import pack_params
 from .view import DrawStats, View, outside_frustum_many, translation
@@ -41,7 +42,14 @@ def shader_variant(settings, write_view_depth: bool = False, depth_bias: float =
         shading=fill_shading(settings),
         item_colors=colors.needs_item_colors(settings),
         material_colors=colors.needs_material_colors(settings),
+        edge_classes=bool(edge_classes_of(settings)),
+        density_fade=bool(settings.use_density_fade),
     )
+
+
+def edge_classes_of(settings) -> tuple:
+    """The edge classes switched on (image model §3.6), in style order."""
+    return tuple(name for name in EDGE_CLASSES if getattr(settings, f"use_{name}_edges"))
 
 
 def fill_shading(settings) -> int:

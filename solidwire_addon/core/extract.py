@@ -26,9 +26,16 @@ from typing import Callable
 import numpy as np
 
 EDGE0_REAL, EDGE1_REAL, EDGE2_REAL, HAS_QUAD_CORNER, IS_NGON = 1, 2, 4, 8, 16
-# A quad's edges p2-p3 / p3-p0 not drawn (edge angle, image model §3.4).
+# A quad's edges p2-p3 / p3-p0 not drawn (edge angle, cage edges; image
+# model §3.4): neither a line nor a diagonal.
 EDGE3_HIDDEN, EDGE4_HIDDEN = 64, 128
-NGON_SHIFT = 8  # edge_flags >> NGON_SHIFT is an n-gon's corner count
+# The triangle's own edge k is a polygon edge that is not drawn.
+EDGE0_HIDDEN = 256  # << k for edges 1 and 2
+# The triangle walks a block of segments (its region's drawn edges, see
+# edge_select.py) that starts at column 3; edge_flags >> NGON_SHIFT is the
+# segment count.
+IN_REGION = 2048
+NGON_SHIFT = 12  # edge_flags >> NGON_SHIFT is an n-gon's corner count
 
 # Vertex ids travel to the GPU as float32 texels: exact below 2**24.
 MAX_VERTICES = 1 << 24
@@ -61,9 +68,12 @@ class MeshArrays:
     # the order of ``triangles``: Blender's corner normal xyz and the face's
     # material index. None when the fill is not shaded by normals/materials.
     corners: np.ndarray = None
-    # Edge angle (see hide_flat_edges): per entry of ngon_corners, 1 where
+    # Edge selection (edge_select.py): per entry of ngon_corners, 1 where
     # that outline slot starts an edge that is not drawn. None: all drawn.
     ngon_hidden: np.ndarray = None
+    # (S, 4) float32 segment blocks of listed triangles (edge_select.py);
+    # they follow ngon_corners in the GPU's outline table. None: no blocks.
+    region_table: np.ndarray = None
     # Set when positions alone decide nothing but the quad diagonals (tris and
     # quads only, every vertex finite): the quads' vertex ids, their split
     # and a checksum of the face sizes, so that an edit that only moves
@@ -689,7 +699,7 @@ def read_face_normals(mesh) -> np.ndarray:
     return _read(mesh.polygon_normals, "vector", len(mesh.polygons), np.float32, 3)
 
 
-def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None, edge_angle: float = 0.0) -> MeshArrays:
+def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> MeshArrays:
     """Evaluated Blender mesh -> :class:`MeshArrays` (fast path).
 
     ``positions`` / ``corner_vert`` may be passed when the caller has just
@@ -707,8 +717,6 @@ def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None, edge_a
     if corners:
         normals, materials = read_corner_inputs(mesh) if corners is True else corners
         arrays.corners = corner_table(arrays, data["corner_vert"], data["face_offsets"], normals, materials)
-    if edge_angle > 0.0:
-        hide_flat_edges(arrays, data["corner_vert"], data["face_offsets"], read_face_normals(mesh), edge_angle)
     return arrays
 
 
@@ -758,59 +766,3 @@ def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     material = materials[polygons] if len(materials) else np.zeros(count, np.int32)
     table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
     return table
-
-
-def hide_flat_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray,
-                    face_normals: np.ndarray, angle: float) -> int:
-    """Edge angle (docs/image_model.md §3.4): an edge with exactly two faces
-    (two distinct polygons) whose face normals make an angle below ``angle``
-    is not drawn. Its real-edge flags are cleared (so it counts as a diagonal
-    of each face: hidden, solid or patterned with the diagonals), a quad's
-    4th-corner edges get EDGE3_HIDDEN / EDGE4_HIDDEN, and an n-gon's outline
-    slots are marked in ``arrays.ngon_hidden``. Returns the number of edges
-    not drawn."""
-    if not angle > 0.0 or arrays.triangle_count == 0 or len(corner_vert) == 0:
-        return 0
-    count = np.int64(max(arrays.vertex_count, 1))
-    offsets = np.asarray(face_offsets, dtype=np.int64)
-    sizes = np.diff(offsets)
-    face = np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
-    following = np.arange(1, len(corner_vert) + 1, dtype=np.int64)
-    following[offsets[1:][sizes > 0] - 1] = offsets[:-1][sizes > 0]
-    a = corner_vert.astype(np.int64)
-    b = a[following]
-    keys = np.minimum(a, b) * count + np.maximum(a, b)
-    order = np.argsort(keys, kind="stable")
-    unique, start, uses = np.unique(keys[order], return_index=True, return_counts=True)
-    two = uses == 2
-    f1, f2 = face[order[start[two]]], face[order[start[two] + 1]]
-    n1, n2 = face_normals[f1].astype(np.float64), face_normals[f2].astype(np.float64)
-    cosine = np.einsum("ij,ij->i", n1, n2) / np.maximum(
-        np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1), 1e-300)
-    flat = (np.arccos(np.clip(cosine, -1.0, 1.0)) < angle) & (f1 != f2)
-    hidden_keys = unique[two][flat]
-    if len(hidden_keys) == 0:
-        return 0
-
-    def hidden(x, y):
-        x, y = x.astype(np.int64), y.astype(np.int64)
-        return np.isin(np.minimum(x, y) * count + np.maximum(x, y), hidden_keys)
-
-    tri = arrays.triangles
-    flags = arrays.edge_flags
-    for bit, (i, j) in ((EDGE0_REAL, (0, 1)), (EDGE1_REAL, (1, 2)), (EDGE2_REAL, (2, 0))):
-        flags[((flags & bit) != 0) & hidden(tri[:, i], tri[:, j])] &= ~bit
-    quad = (flags & HAS_QUAD_CORNER) != 0
-    flags[quad & hidden(tri[:, 2], tri[:, 3])] |= EDGE3_HIDDEN
-    flags[quad & hidden(tri[:, 3], tri[:, 0])] |= EDGE4_HIDDEN
-    ngon = (flags & IS_NGON) != 0
-    if ngon.any():
-        blocks = np.unique(np.stack([tri[ngon, 3], flags[ngon] >> NGON_SHIFT], axis=1), axis=0)
-        block_start, block_size = blocks[:, 0].astype(np.int64), blocks[:, 1].astype(np.int64)
-        local = np.arange(block_size.sum()) - np.repeat(np.cumsum(block_size) - block_size, block_size)
-        slot = np.repeat(block_start, block_size) + local
-        slot_next = np.repeat(block_start, block_size) + (local + 1) % np.repeat(block_size, block_size)
-        marks = np.zeros(len(arrays.ngon_corners), dtype=np.int32)
-        marks[slot] = hidden(arrays.ngon_corners[slot], arrays.ngon_corners[slot_next])
-        arrays.ngon_hidden = marks
-    return int(len(hidden_keys))

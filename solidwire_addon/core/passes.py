@@ -21,7 +21,7 @@ from dataclasses import dataclass, replace
 import gpu
 import numpy as np
 
-from . import colors
+from . import colors, edge_select
 from . import draw as draw_mod
 from . import silhouettes
 from .targets import BACKGROUND_DEPTH, read_texture, targets_for
@@ -70,7 +70,8 @@ def gather_options(settings) -> dict:
     arguments of blender/gather.gather): corner tables for a shaded fill or
     material colours, colour-source inputs for per-object colours."""
     return {"corners": draw_mod.needs_corners(settings), "colors": colors.needs_item_colors(settings),
-            "edge_angle": float(settings.edge_angle)}
+            "edges": edge_select.Selection(float(settings.edge_angle), draw_mod.edge_classes_of(settings),
+                                           bool(settings.use_cage_edges))}
 
 
 def render(items, view: View, settings, *, cull: bool = True):

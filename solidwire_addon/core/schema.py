@@ -136,6 +136,8 @@ SECTIONS = (
     ("line", ""),
     ("fill", ""),
     ("colors", ""),
+    ("edges", "Edges"),
+    ("classes", "Edge Classes"),
     ("diagonals", ""),
     ("fade", ""),
     ("hidden", ""),
@@ -156,6 +158,53 @@ PATTERN_MODES = ("DOTTED", "DASHED")
 # Dotted and dashed have their own natural duty cycle (image model §4.3):
 # choosing one of these modes sets the duty.
 DEFAULT_DUTY = {"DOTTED": 0.25, "DASHED": 0.5}
+
+# Edge classes (docs/image_model.md §3.6), in style order (core/edge_select.py
+# EDGE_CLASSES): (name, label, what it is, default colour, width, pattern).
+EDGE_CLASS_STYLES = (
+    ("boundary", "Boundary", "edges with one face", (0.0, 0.0, 0.0, 1.0), 3.0, "SOLID"),
+    ("sharp", "Sharp", "edges marked Sharp", (0.0, 0.3, 0.85, 1.0), 2.0, "SOLID"),
+    ("crease", "Crease", "edges with a subdivision crease", (0.85, 0.1, 0.6, 1.0), 2.0, "SOLID"),
+    ("seam", "Seam", "edges marked as UV seams", (0.9, 0.2, 0.05, 1.0), 2.0, "DASHED"),
+    ("freestyle", "Freestyle", "edges marked for Freestyle", (0.05, 0.6, 0.2, 1.0), 2.0, "SOLID"),
+)
+LINE_PATTERNS = (
+    ("SOLID", "Solid", "A continuous line"),
+    ("DOTTED", "Dotted", "Short dashes (a quarter of each period)"),
+    ("DASHED", "Dashed", "Dashes half of each period long"),
+)
+# The fraction of each period a pattern draws (1: solid).
+PATTERN_DUTY = {"SOLID": 1.0, "DOTTED": 0.25, "DASHED": 0.5}
+
+
+def edge_class_settings(name, label, what, color, width, pattern) -> tuple:
+    """The four settings of one edge class: on/off, colour, width, pattern."""
+    active = lambda p, flag=f"use_{name}_edges": getattr(p, flag)  # noqa: E731
+    return (
+        Setting(
+            f"use_{name}_edges", BOOL, False, f"{label} Edges",
+            f"Draw {what} in their own style (they are then always drawn)",
+            section="classes", cli=f"--{name}-edges",
+        ),
+        Setting(
+            f"{name}_color", COLOR, color, "Color", f"Colour and opacity of {what}",
+            minimum=0.0, maximum=1.0, subtype="COLOR", section="classes", active_if=active,
+            cli=NO_FLAG, param=Param(f"{name}_color", tuple),
+        ),
+        Setting(
+            f"{name}_thickness", FLOAT, width, "Thickness",
+            f"Core width of {what}, in pixels (in every thickness mode)",
+            minimum=0.0, maximum=1000.0, soft_max=20.0, subtype="PIXEL", section="classes", active_if=active,
+            cli=NO_FLAG, param=Param(f"{name}_half_thickness", _half),
+        ),
+        Setting(
+            f"{name}_pattern", ENUM, pattern, "Pattern",
+            f"Line pattern of {what} (the period is the diagonals' Period)",
+            items=LINE_PATTERNS, section="classes", active_if=active,
+            cli=NO_FLAG, param=Param(f"{name}_duty", PATTERN_DUTY.__getitem__),
+        ),
+    )
+
 
 SETTINGS: tuple[Setting, ...] = (
     Setting(
@@ -227,13 +276,33 @@ SETTINGS: tuple[Setting, ...] = (
         "interior edges (renders; hidden by nearer surfaces)",
         section="line", cli="--silhouettes",
     ),
-    # -- edges ---------------------------------------------------------------
+    # -- which edges are drawn (docs/image_model.md §3.4-§3.6) ----------------
+    Setting(
+        "use_cage_edges", BOOL, True, "Cage Edges",
+        "On meshes subdivided by a Subdivision Surface or Multiresolution modifier, draw only the edges that "
+        "come from the original mesh's edges, running along the smooth surface (like Blender's overlay)",
+        section="edges", cli="--cage-edges",
+    ),
     Setting(
         "edge_angle", FLOAT, 0.0, "Edge Angle",
-        "Edges between two faces that meet at less than this angle are not drawn (treated like diagonals); "
-        "boundary and non-manifold edges always are",
-        minimum=0.0, maximum=math.pi, subtype="ANGLE", section="line",
+        "Edges between two faces that meet at less than this angle are not drawn; boundary and non-manifold "
+        "edges always are",
+        minimum=0.0, maximum=math.pi, subtype="ANGLE", section="edges",
     ),
+    Setting(
+        "use_density_fade", BOOL, False, "Density Fade",
+        "Fade out lines whose edge is short on screen, so dense or distant meshes stay readable",
+        section="edges", cli="--density-fade",
+    ),
+    Setting(
+        "density_fade_length", FLOAT, 8.0, "Fade Below",
+        "An edge this long on screen (pixels) is drawn in full; shorter edges fade, and edges under half of it "
+        "are not drawn",
+        minimum=0.0, maximum=10000.0, soft_max=64.0, subtype="PIXEL",
+        section="edges", active_if=lambda p: p.use_density_fade,
+        param=Param("density_fade_length", lambda v: max(float(v), 0.0)),
+    ),
+    *(setting for edge_class in EDGE_CLASS_STYLES for setting in edge_class_settings(*edge_class)),
     # -- fill ----------------------------------------------------------------
     Setting(
         "use_fill", BOOL, True, "Fill",

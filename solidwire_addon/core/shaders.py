@@ -74,6 +74,11 @@ class ShaderVariant:
     # (core/colors.py); with material_colors, the fill per face material.
     item_colors: bool = False
     material_colors: bool = False
+    # Edge classes (image model §3.6): the fragment stage keeps the nearest
+    # edge of each of STYLE_COUNT line styles instead of one.
+    edge_classes: bool = False
+    # Density fade (image model §3.7): lines of short edges fade.
+    density_fade: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -213,6 +218,9 @@ def _create_info(variant: ShaderVariant):
         compat.depth_write(info, "ANY")
     if variant.ngons:
         info.define("USE_NGONS", "1")
+    info.define("STYLE_COUNT", "6" if variant.edge_classes else "1")
+    if variant.density_fade:
+        info.define("USE_DENSITY_FADE", "1")
     if variant.write_aovs:
         _add_render_pass_outputs(info, iface)
     if variant.depth_bias:
@@ -268,7 +276,7 @@ def _add_render_pass_outputs(info, iface) -> None:
 def _add_sources(info, variant: ShaderVariant) -> None:
     """The GLSL files of the exact path, in the order each stage needs them."""
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
-    style = read_source("line_style.glsl")
+    style = read_source("line_style.glsl") + read_source("edge_styles.glsl")
     fill = read_source("fill_shading.glsl")
     if variant.instanced:
         instancing = read_source("instancing.glsl")

@@ -74,7 +74,7 @@ class _Geometry:
     tri_face: np.ndarray  # (T,) global face id
     edges_view: np.ndarray  # (E, 2, 3) view-space edge endpoints
     edge_face: np.ndarray  # (E,) global face id
-    edge_real: np.ndarray  # (E,) bool: polygon boundary (else diagonal)
+    edge_real: np.ndarray  # (E,) bool: a drawn line (else a diagonal)
     edge_origin_first: np.ndarray  # (E,) bool: pattern measured from endpoint 0
     # Silhouette candidates (issue 7): real edges with one or two faces.
     sil_edges: np.ndarray = None  # (S, 2, 3) view-space endpoints
@@ -87,6 +87,12 @@ class _Geometry:
     face_object: np.ndarray = None  # (F,) index into objects
     objects: list = None
     offsets: list = None  # first face id of each object
+    # Edge selection (image model §3.4-§3.7). A line entry's edge_face is the
+    # key of the block it belongs to (face_key of the faces that measure
+    # to it: their region, or the face itself); diagonals keep their face.
+    face_key: np.ndarray = None  # (F,) block key of each face
+    edge_style: np.ndarray = None  # (E,) 0 wire, 1.. edge classes (lines only)
+    chain_view: np.ndarray = None  # (E, 2, 3) ends of each entry's edge chain (density fade)
 
 
 # ---------------------------------------------------------------- scene input
@@ -156,11 +162,177 @@ def _flat_edges(mesh, loop_poly, real_a, real_b, angle) -> set:
     return hidden
 
 
+# Edge classes in style order (style k + 1 is class k), with Blender's
+# attribute names; the reference reads Blender's data on its own.
+EDGE_CLASSES = ("boundary", "sharp", "crease", "seam", "freestyle")
+_CLASS_ATTRIBUTES = {"sharp": ("sharp_edge",), "crease": ("crease_edge",), "seam": ("uv_seam", ".uv_seam"),
+                     "freestyle": ("freestyle_edge",)}
+# A region with more drawn edges than this measures per face (image model
+# §3.5: the documented bound of the implementation).
+REGION_EDGE_LIMIT = 64
+PATTERN_DUTY = {"SOLID": 1.0, "DOTTED": 0.25, "DASHED": 0.5}
+
+
+def _cage_masks(depsgraph, s) -> dict:
+    """{object name: (drawn mask, chain id) per evaluated edge} for the
+    meshes a subdivision modifier subdivides, found independently of the
+    add-on: a temporary boolean edge attribute on the original mesh is True
+    everywhere; Blender's subdivision carries it onto the child edges of
+    original edges only. Removed again before returning."""
+    if s is None or not getattr(s, "use_cage_edges", False):
+        return {}
+    render = depsgraph.mode == "RENDER"
+    marked = []
+    for obj in bpy.context.scene.objects:
+        if obj.type != "MESH" or obj.mode == "EDIT":
+            continue
+        subdivides = [m for m in obj.modifiers if m.type in ("SUBSURF", "MULTIRES")
+                      and (m.show_render if render else m.show_viewport)
+                      and (m.render_levels if render else m.levels) > 0]
+        if subdivides and "__reference_cage" not in obj.data.attributes:
+            attribute = obj.data.attributes.new("__reference_cage", "INT", "EDGE")
+            attribute.data.foreach_set("value", np.arange(1, len(obj.data.edges) + 1, dtype=np.int32))
+            marked.append(obj)
+    masks = {}
+    if not marked:
+        return masks
+    try:
+        depsgraph.update()
+        for obj in marked:
+            mesh = obj.evaluated_get(depsgraph).data
+            values = np.zeros(len(mesh.edges), np.int32)
+            attribute = mesh.attributes.get("__reference_cage")
+            if attribute is None or attribute.domain != "EDGE":
+                continue
+            attribute.data.foreach_get("value", values)
+            # Child edges of an original edge carry its id + 1 (an integer
+            # edge attribute is copied to them); new inner edges get 0.
+            masks[obj.name] = (values > 0, values - 1)
+    finally:
+        for obj in marked:
+            obj.data.attributes.remove(obj.data.attributes["__reference_cage"])
+        depsgraph.update()
+    return masks
+
+
+def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
+    """Lines of one mesh (image model §3.4-§3.7), plain Python on small
+    meshes: for each face its block key (its region if the region is walked,
+    else itself) and the line entries of each block: ends (lower id first),
+    style, chain ends."""
+    ne = len(mesh.edges)
+    ev = np.empty(ne * 2, np.int64)
+    mesh.edges.foreach_get("vertices", ev)
+    ev = ev.reshape(-1, 2)
+    corner_edge = np.empty(len(mesh.loops), np.int64)
+    mesh.loops.foreach_get("edge_index", corner_edge)
+    classes_on = s is not None and any(getattr(s, f"use_{name}_edges", False) for name in EDGE_CLASSES)
+    if not not_drawn and cage is None and not classes_on:
+        # Every edge drawn, one style: each face measures to its own edges
+        # (§1.3); vectorised for the big meshes of the stress scenes.
+        pairs = np.unique(np.stack([loop_poly, corner_edge], axis=1), axis=0)
+        a, b = ev[pairs[:, 1]].min(axis=1), ev[pairs[:, 1]].max(axis=1)
+        return {"key": np.arange(npoly), "owner": pairs[:, 0], "a": a, "b": b, "style": np.zeros(len(a), np.int64),
+                "chain_a": a, "chain_b": b, "hidden": set()}
+    uses = np.bincount(corner_edge, minlength=ne)
+    drawn = np.ones(ne, bool)
+    for e in range(ne):
+        if (min(ev[e]), max(ev[e])) in not_drawn:
+            drawn[e] = False
+    chain = np.arange(ne)
+    if cage is not None and len(cage[0]) == ne:
+        drawn &= cage[0]
+        chain = np.where(cage[0], cage[1], -1 - np.arange(ne))
+    bits = np.zeros(ne, np.int64)
+    for k, name in enumerate(EDGE_CLASSES):
+        if s is None or not getattr(s, f"use_{name}_edges", False):
+            continue
+        if name == "boundary":
+            bits[uses == 1] |= 1 << k
+            continue
+        for attr_name in _CLASS_ATTRIBUTES[name]:
+            attribute = mesh.attributes.get(attr_name)
+            if attribute is not None and attribute.domain == "EDGE":
+                values = np.zeros(ne, np.float64)
+                for i, item in enumerate(attribute.data):
+                    values[i] = float(item.value)
+                bits[values > 0] |= 1 << k
+                break
+    drawn |= (uses != 2) | (bits != 0)
+
+    # Regions: union-find over edges that are not drawn.
+    parent = list(range(npoly))
+
+    def find(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    faces_of_edge = [[] for _ in range(ne)]
+    for corner, e in enumerate(corner_edge):
+        faces_of_edge[e].append(int(loop_poly[corner]))
+    for e in np.flatnonzero(~drawn):
+        fs = faces_of_edge[e]
+        for f in fs[1:]:
+            ra, rb = find(fs[0]), find(f)
+            if ra != rb:
+                parent[max(ra, rb)] = min(ra, rb)
+    label = np.array([find(f) for f in range(npoly)], np.int64)
+    region_edges: dict = {}
+    face_edges: dict = {}
+    for corner, e in enumerate(corner_edge):
+        if drawn[e]:
+            f = int(loop_poly[corner])
+            region_edges.setdefault(int(label[f]), set()).add(int(e))
+            face_edges.setdefault(f, set()).add(int(e))
+    size = np.bincount(label, minlength=npoly)
+    walked = np.array([size[label[f]] > 1 and len(region_edges.get(int(label[f]), ())) <= REGION_EDGE_LIMIT
+                       for f in range(npoly)], bool)
+    key = np.where(walked, label, np.arange(npoly))
+    entries = []  # (owner key, edge)
+    for owner in sorted(set(key.tolist())):
+        f = owner
+        source = region_edges.get(int(label[f]), set()) if walked[f] else face_edges.get(f, set())
+        entries += [(owner, e) for e in sorted(source)]
+
+    # Chains (cage edges cut by subdivision): the ends of each chain's path.
+    chain_ends = {}
+    members: dict = {}
+    for e in range(ne):
+        members.setdefault(int(chain[e]), []).append(e)
+    for c, es in members.items():
+        count: dict = {}
+        for e in es:
+            for v in ev[e]:
+                count[int(v)] = count.get(int(v), 0) + 1
+        odd = [v for v, n in count.items() if n % 2 == 1]
+        for e in es:
+            chain_ends[e] = tuple(odd) if len(odd) == 2 else (int(ev[e, 0]), int(ev[e, 1]))
+
+    owner, a, b, style, ca, cb = [], [], [], [], [], []
+    for o, e in entries:
+        styles = [k + 1 for k in range(len(EDGE_CLASSES)) if bits[e] >> k & 1] or [0]
+        for st in styles:
+            owner.append(o)
+            a.append(min(ev[e]))
+            b.append(max(ev[e]))
+            style.append(st)
+            ca.append(chain_ends[e][0])
+            cb.append(chain_ends[e][1])
+    hidden = {(int(min(ev[e])), int(max(ev[e]))) for e in np.flatnonzero(~drawn)}
+    as_array = lambda x: np.array(x, np.int64)  # noqa: E731
+    return {"key": key, "owner": as_array(owner), "a": as_array(a), "b": as_array(b), "style": as_array(style),
+            "chain_a": as_array(ca), "chain_b": as_array(cb), "hidden": hidden}
+
+
 def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
     tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
     sil_edges, sil_third = [], []
     tri_normals, face_fill, face_wire = [], [], []
     face_thickness, face_object, objects, offsets = [], [], [], []
+    face_key, edge_style, chain_view = [], [], []
+    cage_masks = _cage_masks(depsgraph, s)
     face_offset = 0
     for inst in depsgraph.object_instances:
         obj = inst.object
@@ -225,9 +397,10 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         finite = np.isfinite(vco).all(axis=1)
         # Edge angle (image model §3.4): an edge of exactly two distinct
         # faces whose face normals differ by less than the angle is not
-        # drawn; it then counts as a diagonal of each face.
+        # drawn (neither a line nor a diagonal).
         not_drawn = _flat_edges(mesh, loop_poly, real_a, real_b, float(getattr(s, "edge_angle", 0.0) or 0.0))
-        sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2 and (a, b) not in not_drawn]
+        sel = _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage_masks.get(source.name))
+        sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2 and (a, b) not in sel["hidden"]]
         if sil:
             sa = np.array([e[0] for e in sil])
             sb = np.array([e[1] for e in sil])
@@ -266,14 +439,15 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             face_fill.append(fills)
             face_wire.append(np.tile(wire, (npoly, 1)))
         tri_faces.append(face_offset + tri_p[tri_ok])
-        ra, rb = real_a, real_b
-        ok = poly_ok[loop_poly]
-        edges.append(np.stack([vco[ra[ok]], vco[rb[ok]]], axis=1))
-        edge_faces.append(face_offset + loop_poly[ok])
-        drawn = np.array([(min(x, y), max(x, y)) not in not_drawn for x, y in zip(ra[ok].tolist(), rb[ok].tolist())],
-                         dtype=bool).reshape(-1)
-        edge_real.append(drawn)
-        edge_origin.append(ra[ok] < rb[ok])
+        face_key.append(face_offset + sel["key"])
+        ea, eb = sel["a"], sel["b"]
+        ok = finite[ea] & finite[eb]
+        edges.append(np.stack([vco[ea[ok]], vco[eb[ok]]], axis=1))
+        edge_faces.append(face_offset + sel["owner"][ok])
+        edge_real.append(np.ones(ok.sum(), bool))
+        edge_origin.append(np.ones(ok.sum(), bool))  # stored lower id first
+        edge_style.append(sel["style"][ok])
+        chain_view.append(np.stack([vco[sel["chain_a"][ok]], vco[sel["chain_b"][ok]]], axis=1))
         if len(diag):
             da, db = diag[:, 1], diag[:, 2]
             ok = poly_ok[diag[:, 0]]
@@ -281,6 +455,8 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             edge_faces.append(face_offset + diag[ok, 0])
             edge_real.append(np.zeros(ok.sum(), bool))
             edge_origin.append(np.ones(ok.sum(), bool))  # da < db by construction
+            edge_style.append(np.zeros(ok.sum(), np.int64))
+            chain_view.append(np.stack([vco[da[ok]], vco[db[ok]]], axis=1))
         face_offset += npoly
 
     def cat(parts, shape, dtype):
@@ -302,6 +478,9 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         cat(face_object, (0,), np.int64),
         objects,
         offsets,
+        cat(face_key, (0,), np.int64),
+        cat(edge_style, (0,), np.int64),
+        cat(chain_view, (0, 2, 3), np.float64),
     )
 
 
@@ -528,14 +707,16 @@ def pattern_mask(t, period, duty):
     return integral(t + 0.5) - integral(t - 0.5)
 
 
-def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False):
-    """For every pixel: min distance to the selected edges of its own face."""
+def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False, want_index=False):
+    """For every pixel: min distance to the selected edges of its own face
+    (edge_face == pix_face; for lines, pass the faces' block keys)."""
     n = len(pix_face)
     best = np.full(n, np.inf)
     best_along = np.zeros(n)
+    best_index = np.full(n, -1)
     idx = np.nonzero(select & valid)[0]
     if len(idx) == 0 or n == 0:
-        return best, best_along
+        return (best, best_along, best_index) if want_index else (best, best_along)
     order = idx[np.argsort(geo.edge_face[idx], kind="stable")]
     faces_sorted = geo.edge_face[order]
     lo = np.searchsorted(faces_sorted, pix_face, side="left")
@@ -544,7 +725,7 @@ def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_a
     pair_pix = np.repeat(np.arange(n), count)
     pair_edge = order[np.repeat(lo, count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))]
     if len(pair_pix) == 0:
-        return best, best_along
+        return (best, best_along, best_index) if want_index else (best, best_along)
     # Pattern origin: endpoint 0 when edge_origin_first, else endpoint 1.
     first = geo.edge_origin_first[pair_edge]
     a = np.where(first[:, None], wa[pair_edge], wb[pair_edge])
@@ -557,12 +738,52 @@ def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_a
         with np.errstate(divide="ignore", invalid="ignore"):
             along = np.where(len_ab > 0, np.einsum("ij,ij->i", pix_xy[pair_pix] - a, ab) / len_ab, 0.0)
     order2 = np.lexsort((d, pair_pix))
-    pair_pix, d, along = pair_pix[order2], d[order2], along[order2]
+    pair_pix, d, along, pair_edge = pair_pix[order2], d[order2], along[order2], pair_edge[order2]
     keep = np.ones(len(pair_pix), bool)
     keep[1:] = pair_pix[1:] != pair_pix[:-1]
     best[pair_pix[keep]] = d[keep]
     best_along[pair_pix[keep]] = along[keep]
-    return best, best_along
+    best_index[pair_pix[keep]] = pair_edge[keep]
+    return (best, best_along, best_index) if want_index else (best, best_along)
+
+
+def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height, thickness, softness):
+    """(I, d_real, winning style, density(entry index)) per covered sample:
+    the nearest line of each style in the sample's block, each style's
+    P(d) times its pattern and density fade, the largest taken (§3.6-§3.7)."""
+    keys = geo.face_key[pix_face]
+    chain_a, chain_b, chain_ok = _clip_edges_to_window(proj, geo.chain_view, width, height)
+    chain_length = np.where(chain_ok, np.linalg.norm(np.nan_to_num(chain_b - chain_a), axis=1), np.inf)
+    full = float(getattr(s, "density_fade_length", 0.0))
+    use_density = bool(getattr(s, "use_density_fade", False)) and full > 0.0
+
+    def density(index):
+        if not use_density:
+            return np.ones(len(index))
+        length = np.where(index >= 0, chain_length[np.maximum(index, 0)], np.inf)
+        return np.clip(2.0 * length / full - 1.0, 0.0, 1.0)
+
+    value = np.zeros(len(pix_face))
+    d_real = np.full(len(pix_face), np.inf)
+    winner = np.zeros(len(pix_face), np.int64)
+    for style in range(len(EDGE_CLASSES) + 1):
+        select = geo.edge_real & (geo.edge_style == style)
+        if not select.any():
+            continue
+        name = EDGE_CLASSES[style - 1] if style else None
+        pattern = getattr(s, f"{name}_pattern") if name else "SOLID"
+        d, along, index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
+                                                  want_along=pattern != "SOLID", want_index=True)
+        d_real = np.minimum(d_real, d)
+        width_px = float(getattr(s, f"{name}_thickness")) if name else thickness
+        v = profile(d, width_px, softness)
+        if pattern != "SOLID":
+            v *= pattern_mask(np.abs(along), float(s.pattern_period), PATTERN_DUTY[pattern])
+        v *= density(index)
+        wins = v > value
+        winner[wins] = style
+        value = np.maximum(value, v)
+    return value, d_real, winner, density
 
 
 def _thickness_at(s, z, proj, height, override=None):
@@ -702,7 +923,7 @@ def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, va
     if len(pix) == 0:
         return coverage
     xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
-    d, along = _min_distance_per_pixel(f, xy, geo, wa, wb, valid, geo.edge_real, want_along=True)
+    d, along = _min_distance_per_pixel(geo.face_key[f], xy, geo, wa, wb, valid, geo.edge_real, want_along=True)
     a = profile(d, _thickness_at(s, z, proj, height, geo.face_thickness[f]), float(s.softness))
     a *= float(s.hidden_alpha) * pattern_mask(np.abs(along), float(s.hidden_period), float(s.hidden_duty))
     a *= _fade(s, z) * wire_alpha
@@ -741,6 +962,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
     on_silhouette = (faces[1:] != face[None, :]).any(axis=0)
 
     intensity = np.zeros(len(face))
+    winner_all = np.zeros(len(face), np.int64)  # the line style each sample takes (§3.6)
     hidden_all = np.zeros(len(face))
     d_real_all = np.full(len(face), np.inf)
     covered = np.nonzero(face >= 0)[0]
@@ -750,17 +972,22 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
         softness = float(s.softness)
         thickness = _thickness_at(s, depth[covered], proj, height, geo.face_thickness[pix_face])
-        d_real, _ = _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, geo.edge_real)
+        value, d_real, winner, density = _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height,
+                                                         thickness, softness)
         d_real_all[covered] = d_real
-        value = profile(d_real, thickness, softness)
+        winner_all[covered] = winner
         mode = s.diagonal_mode
         if mode != "HIDDEN":
-            d_diag, along = _min_distance_per_pixel(
-                pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, want_along=(mode in ("DOTTED", "DASHED"))
+            d_diag, along, index = _min_distance_per_pixel(
+                pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, want_along=(mode in ("DOTTED", "DASHED")),
+                want_index=True,
             )
             diag_value = profile(d_diag, thickness, softness)
             if mode in ("DOTTED", "DASHED"):
                 diag_value *= pattern_mask(np.abs(along), float(s.pattern_period), float(s.pattern_duty))
+            diag_value *= density(index)
+            wins = diag_value > value
+            winner_all[covered[wins]] = 0
             value = np.maximum(value, diag_value)
         value *= _fade(s, depth[covered])
         if hidden_lines:
@@ -780,6 +1007,10 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         intensity = (a_out + (1.0 - a_out) * a_base) / max(wire_alpha, 1e-12)
 
     fill, wire = _colors(s, geo, face, centre_hit)
+    for k, name in enumerate(EDGE_CLASSES):
+        styled = winner_all == k + 1
+        if styled.any():
+            wire[styled] = np.array(getattr(s, f"{name}_color")[:3], np.float64)
     shape = (len(rows), width)
     return ReferenceResult(
         intensity.reshape(shape),

@@ -18,7 +18,7 @@ from mathutils import Vector
 # The look of the image model's sections 1.2-1.4 (no shading, no colour
 # sources, no fill): what the accuracy tests measure unless they ask for more.
 CORE_LOOK = dict(use_fill=False, fill_shading="FLAT", fill_color=(1.0, 1.0, 1.0),
-                 fill_color_source="SINGLE", wire_color_source="SINGLE")
+                 fill_color_source="SINGLE", wire_color_source="SINGLE", use_cage_edges=False)
 
 
 def empty_scene(width: int = 160, height: int = 120, *, transparent: bool = True, **solidwire):
@@ -36,8 +36,9 @@ def empty_scene(width: int = 160, height: int = 120, *, transparent: bool = True
     scene.view_settings.exposure = 0.0
     scene.view_settings.gamma = 1.0
     scene.solidwire.wire_color = (1.0, 1.0, 1.0, 1.0)
-    # Tests measure the core image model (wire only, flat fill): the
-    # add-on's friendlier defaults (shaded fill) are set explicitly off.
+    # Tests measure the core image model (wire only, flat fill, every
+    # evaluated edge): the add-on's friendlier defaults (shaded fill, cage
+    # edges) are set explicitly off.
     for key, value in CORE_LOOK.items():
         setattr(scene.solidwire, key, value)
     for key, value in solidwire.items():

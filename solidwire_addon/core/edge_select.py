@@ -1,0 +1,419 @@
+"""Edge selection: which edges of a mesh are drawn, in which style, and the
+regions their lines bound (docs/image_model.md §3.4-§3.6).
+
+Every edge of the evaluated mesh is *drawn* or *not drawn* (edge angle, cage
+edges). Faces joined across edges that are not drawn form a *region*; a
+fragment measures its distance to the drawn edges bounding its face's
+region, so a line never stops short where a neighbouring edge is hidden.
+Drawn edges may carry *classes* (boundary, sharp, crease, seam, Freestyle);
+each enabled class is a line style of its own.
+
+The exact path keeps its fast per-triangle form wherever that is already the
+image: a face whose edges are all drawn and carry no class ("plain") draws
+from its own edges as before. Every other face is *listed*: its triangles
+walk a block of segments (the drawn edges of its region, each with its
+style, plus the diagonals of n-gons in it) in a table the fragment stage
+reads (``region_table``). A region whose boundary has more than
+``MAX_REGION_EDGES`` drawn edges is not walked as a whole (every fragment
+would loop over all of them): its faces keep their own edges, and a line
+may then stop short by up to h + 2s px at a hidden edge (the documented
+limit, §3.4).
+
+Plain numpy on arrays; no Blender.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .extract import (
+    EDGE0_HIDDEN, EDGE0_REAL, EDGE1_REAL, EDGE2_REAL, EDGE3_HIDDEN, EDGE4_HIDDEN, HAS_QUAD_CORNER, IN_REGION,
+    IS_NGON, NGON_SHIFT, MeshArrays,
+)
+
+# Edge classes, in style order: style k + 1 is class k (style 0 is the
+# ordinary wire). The order is part of the shader interface (line_style.glsl).
+EDGE_CLASSES = ("boundary", "sharp", "crease", "seam", "freestyle")
+CLASS_BIT = {name: 1 << k for k, name in enumerate(EDGE_CLASSES)}
+# Style of a diagonal segment in a region block (n-gon diagonals).
+DIAGONAL_STYLE = 15
+# Above this many drawn edges a region is not walked as a whole (see above).
+# 64 covers a quad cage face subdivided four times (4 * 2^4 edges).
+MAX_REGION_EDGES = 64
+# Texels per segment in the region table: (lower id, upper id, style, 0)
+# and (chain end, chain end, 0, 0) for the density fade.
+TEXELS_PER_SEGMENT = 2
+
+
+@dataclass
+class EdgeInputs:
+    """What Blender's data says about each evaluated edge (mesh.edges order).
+
+    ``drawn``: False for an edge that is not drawn (edge angle, not a cage
+    edge); None: all drawn. ``classes``: bits of CLASS_BIT for the enabled
+    classes the edge belongs to (the boundary bit is derived here from the
+    topology when ``boundary_class`` is set). ``chain``: edges with the same
+    chain id are pieces of one longer edge (a cage edge cut by subdivision);
+    the density fade measures the chain, not the piece. None: each edge is
+    its own chain."""
+
+    verts: np.ndarray  # (E, 2) vertex ids
+    drawn: np.ndarray | None = None
+    classes: np.ndarray | None = None
+    boundary_class: bool = False
+    chain: np.ndarray | None = None
+
+    @property
+    def selects_anything(self) -> bool:
+        return self.drawn is not None or self.classes is not None or self.boundary_class or self.chain is not None
+
+
+@dataclass
+class SelectionStats:
+    hidden_edges: int = 0
+    regions: int = 0  # regions of more than one face walked as a whole
+    listed_triangles: int = 0
+    segments: int = 0
+    large_regions: int = 0  # regions over MAX_REGION_EDGES (own edges only)
+
+
+def _face_of_corner(sizes: np.ndarray) -> np.ndarray:
+    return np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
+
+
+def _region_labels(face_count: int, f1: np.ndarray, f2: np.ndarray) -> np.ndarray:
+    """Connected components of faces joined by the pairs (f1, f2): each face's
+    label is the smallest face id of its component. Hooking plus pointer
+    jumping: a few passes over the pairs even for a long chain of faces."""
+    label = np.arange(face_count, dtype=np.int64)
+    while True:
+        l1, l2 = label[f1], label[f2]
+        differ = l1 != l2
+        if not differ.any():
+            return label
+        low = np.minimum(l1[differ], l2[differ])
+        np.minimum.at(label, l1[differ], low)
+        np.minimum.at(label, l2[differ], low)
+        while True:
+            jumped = label[label]
+            if np.array_equal(jumped, label):
+                break
+            label = jumped
+
+
+def _chain_ends(verts: np.ndarray, chain: np.ndarray | None) -> np.ndarray:
+    """(E, 2) the two ends of each edge's chain (its own ends when the chain
+    is not a simple open path)."""
+    ends = verts.astype(np.int64).copy()
+    if chain is None or len(verts) == 0:
+        return ends
+    chain = chain.astype(np.int64)
+    vertex_count = int(verts.max()) + 1
+    keys = np.repeat(chain, 2) * vertex_count + verts.astype(np.int64).reshape(-1)
+    unique, counts = np.unique(keys, return_counts=True)
+    odd = unique[counts % 2 == 1]  # path ends appear once
+    odd_chain, odd_vertex = odd // vertex_count, odd % vertex_count
+    chains, first, per_chain = np.unique(odd_chain, return_index=True, return_counts=True)
+    path = per_chain == 2
+    chains, first = chains[path], first[path]
+    at = np.searchsorted(chains, chain)
+    at = np.minimum(at, max(len(chains) - 1, 0))
+    has = len(chains) > 0
+    if has:
+        ok = chains[at] == chain
+        ends[ok, 0] = odd_vertex[first[at[ok]]]
+        ends[ok, 1] = odd_vertex[first[at[ok]] + 1]
+    return ends
+
+
+def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray,
+                 inputs: EdgeInputs, max_region_edges: int = MAX_REGION_EDGES) -> SelectionStats:
+    """Apply ``inputs`` to ``arrays`` in place (edge flags, column 3 of
+    listed triangles, ``region_table``) and say what it did."""
+    stats = SelectionStats()
+    verts = np.asarray(inputs.verts, dtype=np.int64).reshape(-1, 2)
+    edge_count = len(verts)
+    offsets = np.asarray(face_offsets, dtype=np.int64)
+    sizes = np.diff(offsets)
+    face_count = len(sizes)
+    corner_edge = np.asarray(corner_edge, dtype=np.int64)
+    if edge_count == 0 or face_count == 0 or arrays.triangle_count == 0:
+        return stats
+    corner_face = _face_of_corner(sizes)
+    uses = np.bincount(corner_edge, minlength=edge_count)
+
+    drawn = np.ones(edge_count, bool) if inputs.drawn is None else np.asarray(inputs.drawn, bool).copy()
+    classes = np.zeros(edge_count, np.int64) if inputs.classes is None else np.asarray(inputs.classes, np.int64).copy()
+    if inputs.boundary_class:
+        classes[uses == 1] |= CLASS_BIT["boundary"]
+    # Boundary and non-manifold edges are always drawn, and so is an edge of
+    # an enabled class (asking for sharp edges shows them even where the
+    # angle or the cage would not).
+    drawn |= (uses != 2) | (classes != 0)
+    stats.hidden_edges = int((~drawn).sum())
+
+    # Regions: faces joined across edges that are not drawn.
+    hidden_corners = np.flatnonzero(~drawn[corner_edge])
+    hidden_corners = hidden_corners[np.argsort(corner_edge[hidden_corners], kind="stable")]
+    f1, f2 = corner_face[hidden_corners[0::2]], corner_face[hidden_corners[1::2]]
+    label = _region_labels(face_count, f1, f2)
+    region_size = np.bincount(label, minlength=face_count)
+
+    # Drawn edges of each region (unique (label, edge) pairs).
+    drawn_corner = drawn[corner_edge]
+    pairs = np.unique(np.stack([label[corner_face[drawn_corner]], corner_edge[drawn_corner]], axis=1), axis=0)
+    region_edges = np.bincount(pairs[:, 0], minlength=face_count) if len(pairs) else np.zeros(face_count, np.int64)
+    walked_region = (region_size > 1) & (region_edges <= max_region_edges)
+    stats.large_regions = int(((region_size > 1) & ~walked_region & (np.arange(face_count) == label)).sum())
+    styled_face = np.bincount(corner_face, weights=(classes[corner_edge] != 0), minlength=face_count) > 0
+    walked = walked_region[label]
+    ngon_face = sizes > 4
+    # Owner of each listed face's block: its region's block (id = the region
+    # label), or a block of its own (id = face_count + face) holding its
+    # region's drawn edges (or, outside a walked region, its own) plus its
+    # own n-gon diagonals: a diagonal belongs to its face only (§1.3).
+    # -1: a plain face, drawn from its own edges.
+    faces = np.arange(face_count)
+    own_block = (walked & ngon_face) | (~walked & styled_face)
+    owner = np.where(own_block, face_count + faces, np.where(walked, label, -1))
+
+    _mark_own_edges(arrays, verts, drawn)
+    listed_face = owner >= 0
+    if not listed_face.any():
+        return stats
+
+    # Segments of each block.
+    by_label = pairs[np.argsort(pairs[:, 0], kind="stable")] if len(pairs) else pairs.reshape(0, 2)
+    block_owner = np.unique(owner[listed_face])
+    block_face = np.where(block_owner >= face_count, block_owner - face_count, block_owner)
+    from_region = walked[block_face]
+    # Region-fed blocks: every drawn edge of the region.
+    region_owner, region_label = block_owner[from_region], label[block_face[from_region]]
+    lo = np.searchsorted(by_label[:, 0], region_label, side="left")
+    hi = np.searchsorted(by_label[:, 0], region_label, side="right")
+    count = hi - lo
+    rows = np.repeat(lo, count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
+    seg_owner = np.repeat(region_owner, count)
+    seg_edge = by_label[rows, 1]
+    # Face-fed blocks: the face's own drawn edges.
+    face_owned = np.zeros(face_count, bool)
+    face_owned[block_face[~from_region]] = True
+    own_corner = face_owned[corner_face] & drawn_corner
+    own = np.unique(np.stack([face_count + corner_face[own_corner], corner_edge[own_corner]], axis=1), axis=0)
+    seg_owner = np.concatenate([seg_owner, own[:, 0]])
+    seg_edge = np.concatenate([seg_edge, own[:, 1]])
+    # One segment per class of the edge (an edge with no class: one
+    # ordinary segment).
+    bits = classes[seg_edge]
+    popcount = np.array([bin(b).count("1") for b in range(1 << len(EDGE_CLASSES))])
+    per_edge = np.maximum(popcount[bits], 1)
+    seg_owner, seg_edge, bits = np.repeat(seg_owner, per_edge), np.repeat(seg_edge, per_edge), np.repeat(bits, per_edge)
+    rank = np.arange(len(bits)) - np.repeat(np.cumsum(per_edge) - per_edge, per_edge)
+    seg_style = np.zeros(len(bits), np.int64)
+    for k in range(len(EDGE_CLASSES)):  # the rank-th set bit of each edge's classes
+        below = popcount[bits & ((1 << k) - 1)]
+        seg_style = np.where(((bits >> k) & 1 == 1) & (below == rank), k + 1, seg_style)
+    ends = _chain_ends(verts, inputs.chain)
+    seg_a = np.minimum(verts[seg_edge, 0], verts[seg_edge, 1])
+    seg_b = np.maximum(verts[seg_edge, 0], verts[seg_edge, 1])
+    chain_a, chain_b = ends[seg_edge, 0], ends[seg_edge, 1]
+
+    # The diagonals of each listed n-gon, into its own block.
+    diag_owner, diag_a, diag_b = _ngon_diagonals(arrays, owner)
+    seg_owner = np.concatenate([seg_owner, diag_owner])
+    seg_a = np.concatenate([seg_a, diag_a])
+    seg_b = np.concatenate([seg_b, diag_b])
+    chain_a = np.concatenate([chain_a, diag_a])
+    chain_b = np.concatenate([chain_b, diag_b])
+    seg_style = np.concatenate([seg_style, np.full(len(diag_a), DIAGONAL_STYLE)])
+
+    order = np.argsort(seg_owner, kind="stable")
+    seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style = (
+        x[order] for x in (seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style))
+    owners, first, count = np.unique(seg_owner, return_index=True, return_counts=True)
+    if not np.array_equal(owners, block_owner):  # a block with no segment at all
+        missing = np.setdiff1d(block_owner, owners)
+        owners = np.concatenate([owners, missing])
+        first = np.concatenate([first, np.zeros(len(missing), first.dtype)])
+        count = np.concatenate([count, np.zeros(len(missing), count.dtype)])
+        order = np.argsort(owners)
+        owners, first, count = owners[order], first[order], count[order]
+    table = np.zeros((TEXELS_PER_SEGMENT * len(seg_a), 4), dtype=np.float32)
+    table[0::2, 0], table[0::2, 1], table[0::2, 2] = seg_a, seg_b, seg_style
+    table[1::2, 0], table[1::2, 1] = chain_a, chain_b
+    base = len(arrays.ngon_corners)  # region blocks follow the n-gon blocks in one table
+    arrays.region_table = table
+
+    tri_owner = owner[arrays.triangle_polygons]
+    listed = tri_owner >= 0
+    at = np.searchsorted(owners, tri_owner[listed])
+    flags = arrays.edge_flags
+    keep = ~(HAS_QUAD_CORNER | IS_NGON | (-1 << NGON_SHIFT))
+    flags[listed] = (flags[listed] & keep) | IN_REGION | (count[at].astype(np.int32) << NGON_SHIFT)
+    flags[listed] &= ~(EDGE3_HIDDEN | EDGE4_HIDDEN)
+    arrays.triangles[listed, 3] = base + TEXELS_PER_SEGMENT * first[at]
+    # Listed triangles no longer need (or have) the positions-only update.
+    arrays.quads = None
+    stats.regions = int((walked_region & (np.arange(face_count) == label)).sum())
+    stats.listed_triangles = int(listed.sum())
+    stats.segments = int(len(seg_a))
+    return stats
+
+
+def _mark_own_edges(arrays: MeshArrays, verts: np.ndarray, drawn: np.ndarray) -> None:
+    """A triangle's own polygon edges that are not drawn: EDGEk_REAL cleared
+    and EDGEk_HIDDEN set (neither a line nor a diagonal); the same for a
+    quad's edges to its 4th corner and an n-gon's outline slots."""
+    if drawn.all():
+        return
+    vertex_count = np.int64(max(arrays.vertex_count, int(verts.max()) + 1))
+    keys = np.minimum(verts[:, 0], verts[:, 1]) * vertex_count + np.maximum(verts[:, 0], verts[:, 1])
+    hidden_keys = np.sort(keys[~drawn])
+
+    def hidden(x, y):
+        x, y = x.astype(np.int64), y.astype(np.int64)
+        k = np.minimum(x, y) * vertex_count + np.maximum(x, y)
+        at = np.minimum(np.searchsorted(hidden_keys, k), len(hidden_keys) - 1)
+        return hidden_keys[at] == k
+
+    tri, flags = arrays.triangles, arrays.edge_flags
+    for k, (bit, (i, j)) in enumerate(((EDGE0_REAL, (0, 1)), (EDGE1_REAL, (1, 2)), (EDGE2_REAL, (2, 0)))):
+        off = ((flags & bit) != 0) & hidden(tri[:, i], tri[:, j])
+        flags[off] = (flags[off] & ~bit) | (EDGE0_HIDDEN << k)
+    quad = (flags & HAS_QUAD_CORNER) != 0
+    flags[quad & hidden(tri[:, 2], tri[:, 3])] |= EDGE3_HIDDEN
+    flags[quad & hidden(tri[:, 3], tri[:, 0])] |= EDGE4_HIDDEN
+    ngon = (flags & IS_NGON) != 0
+    if ngon.any():
+        blocks = np.unique(np.stack([tri[ngon, 3], flags[ngon] >> NGON_SHIFT], axis=1), axis=0)
+        block_start, block_size = blocks[:, 0].astype(np.int64), blocks[:, 1].astype(np.int64)
+        local = np.arange(block_size.sum()) - np.repeat(np.cumsum(block_size) - block_size, block_size)
+        slot = np.repeat(block_start, block_size) + local
+        slot_next = np.repeat(block_start, block_size) + (local + 1) % np.repeat(block_size, block_size)
+        marks = np.zeros(len(arrays.ngon_corners), dtype=np.int32)
+        marks[slot] = hidden(arrays.ngon_corners[slot], arrays.ngon_corners[slot_next])
+        arrays.ngon_hidden = marks
+
+
+def _ngon_diagonals(arrays: MeshArrays, owner: np.ndarray):
+    """(owner, lower id, upper id) of every diagonal of the listed n-gons."""
+    flags = arrays.edge_flags
+    ngon = ((flags & IS_NGON) != 0) & (owner[arrays.triangle_polygons] >= 0)
+    empty = np.zeros(0, np.int64)
+    if not ngon.any():
+        return empty, empty, empty
+    polys, first = np.unique(arrays.triangle_polygons[ngon], return_index=True)
+    rows = np.flatnonzero(ngon)[first]
+    start = arrays.triangles[rows, 3].astype(np.int64)
+    size = (flags[rows] >> NGON_SHIFT).astype(np.int64)
+    diagonals = size - 3
+    poly_of = np.repeat(np.arange(len(polys)), diagonals)
+    rank = np.arange(diagonals.sum()) - np.repeat(np.cumsum(diagonals) - diagonals, diagonals)
+    slot = start[poly_of] + size[poly_of] + 2 * rank
+    a = arrays.ngon_corners[slot].astype(np.int64)
+    b = arrays.ngon_corners[slot + 1].astype(np.int64)
+    keep = a != b  # a degenerate placeholder pair (fewer diagonals than n - 3)
+    return owner[polys[poly_of]][keep], np.minimum(a, b)[keep], np.maximum(a, b)[keep]
+
+
+def flat_edges(corner_edge: np.ndarray, face_offsets: np.ndarray, face_normals: np.ndarray, edge_count: int,
+               angle: float) -> np.ndarray:
+    """(E,) True for an edge of exactly two distinct faces whose face normals
+    differ by less than ``angle`` radians (the edge angle, §3.4)."""
+    flat = np.zeros(edge_count, bool)
+    if not angle > 0.0 or edge_count == 0:
+        return flat
+    corner_edge = np.asarray(corner_edge, np.int64)
+    corner_face = _face_of_corner(np.diff(np.asarray(face_offsets, np.int64)))
+    uses = np.bincount(corner_edge, minlength=edge_count)
+    corners = np.flatnonzero(uses[corner_edge] == 2)
+    corners = corners[np.argsort(corner_edge[corners], kind="stable")]
+    first, second = corners[0::2], corners[1::2]
+    f1, f2 = corner_face[first], corner_face[second]
+    n1, n2 = face_normals[f1].astype(np.float64), face_normals[f2].astype(np.float64)
+    cosine = np.einsum("ij,ij->i", n1, n2) / np.maximum(np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1), 1e-300)
+    flat[corner_edge[first]] = (np.arccos(np.clip(cosine, -1.0, 1.0)) < angle) & (f1 != f2)
+    return flat
+
+
+# Blender's edge data per class: (attribute names to try, kind). Seams are
+# "uv_seam" from Blender 5.0 on and ".uv_seam" before; a crease counts when
+# it is above zero.
+_CLASS_ATTRIBUTES = {
+    "sharp": ("sharp_edge",),
+    "crease": ("crease_edge",),
+    "seam": ("uv_seam", ".uv_seam"),
+    "freestyle": ("freestyle_edge",),
+}
+
+
+def read_edge_classes(mesh, enabled) -> np.ndarray | None:
+    """(E,) class bits of ``mesh``'s edges for the enabled classes (other
+    than boundary, which is topology), read from Blender's edge attributes;
+    None when no enabled class has data."""
+    count = len(mesh.edges)
+    bits = None
+    for name in enabled:
+        for attribute_name in _CLASS_ATTRIBUTES.get(name, ()):
+            attribute = mesh.attributes.get(attribute_name)
+            if attribute is None or attribute.domain != "EDGE":
+                continue
+            values = np.zeros(count, dtype=np.float32 if attribute.data_type == "FLOAT" else bool)
+            if count:
+                attribute.data.foreach_get("value", values)
+            if bits is None:
+                bits = np.zeros(count, np.int64)
+            bits[values > 0] |= CLASS_BIT[name]
+            break
+    return bits
+
+
+def read_edge_topology(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """((E, 2) edge vertex ids, (L,) the edge of each face corner)."""
+    verts = np.empty(len(mesh.edges) * 2, np.int32)
+    if len(mesh.edges):
+        mesh.edges.foreach_get("vertices", verts)
+    corner_edge = np.empty(len(mesh.loops), np.int32)
+    if len(mesh.loops):
+        mesh.loops.foreach_get("edge_index", corner_edge)
+    return verts.reshape(-1, 2), corner_edge
+
+
+@dataclass(frozen=True)
+class Selection:
+    """What decides the drawn edges and their styles for one mesh (hashable:
+    part of the GPU cache key)."""
+
+    edge_angle: float = 0.0
+    classes: tuple = ()  # enabled classes, names from EDGE_CLASSES
+    use_cage: bool = False  # the caller passes the cage mask
+
+    @property
+    def active(self) -> bool:
+        return self.edge_angle > 0.0 or bool(self.classes) or self.use_cage
+
+
+def apply_to_mesh(arrays: MeshArrays, mesh, corner_vert: np.ndarray, face_offsets: np.ndarray, selection: Selection,
+                  cage: tuple | None = None) -> SelectionStats:
+    """Read ``mesh``'s edges and apply ``selection`` to ``arrays``. ``cage``:
+    (drawn mask, chain ids) of the evaluated edges from the cage
+    detection, or None (no subdivision, or cage edges off)."""
+    verts, corner_edge = read_edge_topology(mesh)
+    drawn = None
+    chain = None
+    if cage is not None:
+        drawn, chain = np.asarray(cage[0], bool).copy(), cage[1]
+    if selection.edge_angle > 0.0:
+        normals = np.empty(len(mesh.polygons) * 3, np.float32)
+        if len(mesh.polygons):
+            mesh.polygon_normals.foreach_get("vector", normals)
+        flat = flat_edges(corner_edge, face_offsets, normals.reshape(-1, 3), len(verts), selection.edge_angle)
+        drawn = ~flat if drawn is None else drawn & ~flat
+    others = tuple(c for c in selection.classes if c != "boundary")
+    inputs = EdgeInputs(verts, drawn, read_edge_classes(mesh, others) if others else None,
+                        "boundary" in selection.classes, chain)
+    if not inputs.selects_anything:
+        return SelectionStats()
+    return select_edges(arrays, corner_vert, face_offsets, corner_edge, inputs)
