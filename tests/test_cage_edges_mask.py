@@ -1,0 +1,490 @@
+"""Cage edges (blender/cage.py): which evaluated edges of a subdivided mesh
+come from edges of its cage, read from Blender's subdivision edge order and
+checked here against the geometry, never against that order itself."""
+
+from __future__ import annotations
+
+import math
+
+import bmesh
+import bpy
+import numpy as np
+import pytest
+from mathutils import Matrix
+
+from solidwire_addon.blender.cage import cage_edge_mask, cage_key, peel
+from tests.support import scenes
+
+
+# -- helpers ---------------------------------------------------------------
+
+
+def _evaluated(obj):
+    """(evaluated object, evaluated mesh, cleanup) as gather() reads them:
+    Object.data, or to_mesh() in Edit Mode."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    obj_eval = obj.evaluated_get(depsgraph)
+    if obj.mode == "EDIT":
+        return obj_eval, obj_eval.to_mesh(), obj_eval.to_mesh_clear
+    return obj_eval, obj_eval.data, lambda: None
+
+
+def _mask(obj, *, render=False, original=False):
+    obj_eval, mesh, cleanup = _evaluated(obj)
+    try:
+        mask = cage_edge_mask(obj if original else obj_eval, mesh, render=render)
+        return mask, _edges(mesh), _positions(mesh)
+    finally:
+        cleanup()
+
+
+def _edges(mesh) -> np.ndarray:
+    out = np.empty(2 * len(mesh.edges), dtype=np.int32)
+    mesh.edges.foreach_get("vertices", out)
+    return out.reshape(-1, 2)
+
+
+def _positions(mesh) -> np.ndarray:
+    out = np.empty(3 * len(mesh.vertices), dtype=np.float64)
+    mesh.vertices.foreach_get("co", out)
+    return out.reshape(-1, 3)
+
+
+def _on_box_edge(p, q, center=(0.0, 0.0, 0.0), half=1.0, tol=1e-5):
+    """Both points on one edge of the axis-aligned box (|x - c| <= half):
+    they share two coordinates that are at the box's extent."""
+    p = np.asarray(p) - center
+    q = np.asarray(q) - center
+    shared = [i for i in range(3) if abs(abs(p[i]) - half) < tol and abs(p[i] - q[i]) < tol]
+    return len(shared) >= 2
+
+
+def _box_edge_set(edges, positions, centers):
+    return {i for i, (a, b) in enumerate(edges)
+            if any(_on_box_edge(positions[a], positions[b], c) for c in centers)}
+
+
+def _subdivided_cube(levels=1, kind="CATMULL_CLARK", name="Cube"):
+    scene = scenes.empty_scene()
+    obj = scenes.cube(scene, name)
+    mod = obj.modifiers.new("Subdivision", "SUBSURF")
+    mod.subdivision_type = kind
+    mod.levels = mod.render_levels = levels
+    return scene, obj, mod
+
+
+def _assert_simple_cube_cage(mask, edges, positions, cage_edges=12, centers=((0.0, 0.0, 0.0),), level=1):
+    assert mask is not None and mask.dtype == bool and mask.shape == (len(edges),)
+    assert int(mask.sum()) == cage_edges * 2**level
+    assert set(np.flatnonzero(mask).tolist()) == _box_edge_set(edges, positions, centers)
+
+
+def _assert_catmull_clark_cube_cage(mask, edges, positions, level):
+    """The masked edges are 12 chains of 2^L edges joining the 8 evaluated
+    corner vertices (one per original corner, on its diagonal)."""
+    n = 2**level
+    assert mask is not None and int(mask.sum()) == 12 * n
+    masked = edges[mask]
+    degree = np.bincount(masked.ravel(), minlength=len(positions))
+    corners = np.flatnonzero(degree == 3)
+    assert len(corners) == 8
+    assert int((degree == 2).sum()) == 12 * (n - 1)
+    assert int((degree > 3).sum()) == 0
+    directions = positions[corners] / np.linalg.norm(positions[corners], axis=1, keepdims=True)
+    assert np.allclose(np.abs(directions), 1 / math.sqrt(3), atol=1e-4)
+    assert len({tuple(np.sign(d).astype(int)) for d in directions}) == 8  # one per original corner
+    # Walk each chain from a corner: 2^L edges to another corner.
+    neighbours: dict[int, list[int]] = {}
+    for a, b in masked:
+        neighbours.setdefault(int(a), []).append(int(b))
+        neighbours.setdefault(int(b), []).append(int(a))
+    corner_set = set(corners.tolist())
+    chains = 0
+    for start in corners:
+        for first in neighbours[int(start)]:
+            prev, cur, length = int(start), first, 1
+            while cur not in corner_set:
+                nxt = [v for v in neighbours[cur] if v != prev]
+                assert len(nxt) == 1
+                prev, cur, length = cur, nxt[0], length + 1
+            assert length == n and cur != start
+            chains += 1
+    assert chains == 24  # 12 chains, walked from both ends
+
+
+# -- Subdivision Surface -----------------------------------------------------
+
+
+@pytest.mark.parametrize("level", [1, 2, 3])
+def test_simple_subdivision_masks_exactly_the_edges_on_the_cube_edges(level):
+    _scene, obj, _mod = _subdivided_cube(level, "SIMPLE")
+    mask, edges, positions = _mask(obj)
+    _assert_simple_cube_cage(mask, edges, positions, level=level)
+
+
+@pytest.mark.parametrize("level", [1, 2, 3])
+def test_catmull_clark_masks_chains_between_the_original_corners(level):
+    _scene, obj, _mod = _subdivided_cube(level)
+    mask, edges, positions = _mask(obj)
+    _assert_catmull_clark_cube_cage(mask, edges, positions, level)
+
+
+def test_original_and_evaluated_object_give_the_same_mask():
+    _scene, obj, _mod = _subdivided_cube(2)
+    from_eval, _e, _p = _mask(obj)
+    from_orig, _e, _p = _mask(obj, original=True)
+    assert np.array_equal(from_eval, from_orig)
+
+
+def test_no_modifier_level_zero_or_disabled_draws_everything():
+    scene = scenes.empty_scene()
+    plain = scenes.cube(scene, "Plain")
+    assert _mask(plain)[0] is None
+    _scene, obj, mod = _subdivided_cube(0)
+    assert _mask(obj)[0] is None
+    mod.levels = 2
+    mod.show_viewport = False
+    assert _mask(obj)[0] is None
+
+
+def test_mirror_before_the_subdivision():
+    scene = scenes.empty_scene()
+    obj = scenes.mesh_object(scene, "Half", lambda bm: bmesh.ops.create_cube(
+        bm, size=2.0, matrix=Matrix.Translation((2.0, 0.0, 0.0))))
+    obj.modifiers.new("Mirror", "MIRROR")
+    mod = obj.modifiers.new("Subdivision", "SUBSURF")
+    mod.subdivision_type = "SIMPLE"
+    mod.levels = 2
+    mask, edges, positions = _mask(obj)
+    _assert_simple_cube_cage(mask, edges, positions, cage_edges=24, centers=((2, 0, 0), (-2, 0, 0)), level=2)
+
+
+def test_a_deform_modifier_after_the_subdivision_keeps_the_mask():
+    _scene, obj, _mod = _subdivided_cube(2)
+    before, edges, positions = _mask(obj)
+    texture = bpy.data.textures.new("Noise", "CLOUDS")
+    displace = obj.modifiers.new("Displace", "DISPLACE")
+    displace.texture = texture
+    displace.strength = 0.2
+    smooth = obj.modifiers.new("Smooth", "SMOOTH")
+    after, edges_after, positions_after = _mask(obj)
+    assert not np.allclose(positions, positions_after)  # it did move the vertices
+    assert np.array_equal(before, after) and np.array_equal(edges, edges_after)
+    smooth.show_viewport = False
+    assert np.array_equal(_mask(obj)[0], before)
+
+
+@pytest.mark.parametrize("kind", ["TRIANGULATE", "WELD", "DECIMATE", "NODES"])
+def test_a_topology_changing_modifier_after_the_subdivision_gives_none(kind):
+    _scene, obj, _mod = _subdivided_cube(2)
+    obj.modifiers.new("After", kind)
+    assert _mask(obj)[0] is None
+    obj.modifiers["After"].show_viewport = False  # disabled: does not count
+    assert _mask(obj)[0] is not None
+
+
+def test_stacked_subdivisions_compose():
+    _scene, obj, _mod = _subdivided_cube(1, "SIMPLE")
+    second = obj.modifiers.new("Second", "SUBSURF")
+    second.subdivision_type = "SIMPLE"
+    second.levels = 2
+    mask, edges, positions = _mask(obj)
+    _assert_simple_cube_cage(mask, edges, positions, level=3)
+
+
+def test_simplify_lowering_the_level_is_followed():
+    scene, obj, _mod = _subdivided_cube(3)
+    scene.render.use_simplify = True
+    scene.render.simplify_subdivision = 1
+    mask, edges, positions = _mask(obj)
+    _assert_catmull_clark_cube_cage(mask, edges, positions, 1)
+    scene.render.simplify_subdivision = 0
+    assert _mask(obj)[0] is None
+
+
+def test_ngon_loose_edge_and_loose_vertex():
+    scene = scenes.empty_scene()
+    ring = [(math.cos(a), math.sin(a), 0.0) for a in np.linspace(0.0, 2 * math.pi, 6)[:5]]
+    mesh = bpy.data.meshes.new("Ngon")
+    mesh.from_pydata(ring + [(3.0, 0.0, 0.0), (4.0, 0.0, 0.0), (5.0, 5.0, 5.0)], [(5, 6)], [(0, 1, 2, 3, 4)])
+    obj = bpy.data.objects.new("Ngon", mesh)
+    scene.collection.objects.link(obj)
+    mod = obj.modifiers.new("Subdivision", "SUBSURF")
+    mod.subdivision_type = "SIMPLE"
+    segments = [(ring[i], ring[(i + 1) % 5]) for i in range(5)] + [((3.0, 0.0, 0.0), (4.0, 0.0, 0.0))]
+
+    def on_segment(p):
+        for a, b in segments:
+            a, b = np.asarray(a), np.asarray(b)
+            t = np.dot(p - a, b - a) / np.dot(b - a, b - a)
+            if -1e-6 <= t <= 1 + 1e-6 and np.linalg.norm(a + t * (b - a) - p) < 1e-5:
+                return True
+        return False
+
+    for level in (1, 2, 3):
+        mod.levels = level
+        mask, edges, positions = _mask(obj)
+        assert mask is not None and int(mask.sum()) == 6 * 2**level
+        geometric = {i for i, (a, b) in enumerate(edges) if on_segment(positions[a]) and on_segment(positions[b])}
+        assert set(np.flatnonzero(mask).tolist()) == geometric
+
+
+def test_a_mesh_without_faces_is_all_cage():
+    scene = scenes.empty_scene()
+    mesh = bpy.data.meshes.new("Wire")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (1, 1, 0)], [(0, 1), (1, 2)], [])
+    obj = bpy.data.objects.new("Wire", mesh)
+    scene.collection.objects.link(obj)
+    obj.modifiers.new("Subdivision", "SUBSURF").levels = 2
+    assert _mask(obj)[0] is None  # every evaluated edge comes from a cage edge
+
+
+def test_a_mesh_that_is_not_the_objects_gives_none():
+    scene, obj, _mod = _subdivided_cube(2)
+    other = scenes.uv_sphere(scene, "Sphere")
+    other.modifiers.new("Subdivision", "SUBSURF").levels = 2
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    assert cage_edge_mask(obj, other.evaluated_get(depsgraph).data, render=False) is None
+
+
+def test_peel_rejects_a_layout_that_only_fits_the_counts():
+    _scene, obj, _mod = _subdivided_cube(2)
+    _mask_, edges, positions = _mask(obj)
+    faces = 96
+    assert peel(edges, len(positions), faces, 2) is not None
+    assert peel(edges, len(positions), faces, 1) is None  # wrong level
+    shuffled = edges.copy()
+    shuffled[[0, 100]] = shuffled[[100, 0]]
+    assert peel(shuffled, len(positions), faces, 2) is None
+
+
+# -- Multiresolution -----------------------------------------------------------
+
+
+def _multires_cube(levels=3):
+    scene = scenes.empty_scene()
+    obj = scenes.cube(scene, "Multires")
+    mod = obj.modifiers.new("Multires", "MULTIRES")
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        for _ in range(levels):
+            bpy.ops.object.multires_subdivide(modifier=mod.name, mode="CATMULL_CLARK")
+    return scene, obj, mod
+
+
+def test_multires_levels():
+    _scene, obj, mod = _multires_cube(3)
+    for level in (3, 2, 1):
+        mod.levels = level
+        mask, edges, positions = _mask(obj)
+        _assert_catmull_clark_cube_cage(mask, edges, positions, level)
+    mod.levels = 0
+    assert _mask(obj)[0] is None
+
+
+def test_multires_in_sculpt_mode():
+    """Sculpt Mode shows sculpt_levels; without Sculpt Base Mesh the
+    evaluated mesh is the coarse one (the grids are not a mesh): all cage."""
+    _scene, obj, mod = _multires_cube(2)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.object.mode_set(mode="SCULPT")
+    try:
+        mod.sculpt_levels = 1
+        assert _mask(obj)[0] is None
+        mod.use_sculpt_base_mesh = True
+        mask, edges, positions = _mask(obj)
+        _assert_catmull_clark_cube_cage(mask, edges, positions, 1)
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+
+
+# -- render vs viewport ----------------------------------------------------------
+
+
+class _Probe(bpy.types.RenderEngine):
+    """Records, in a render depsgraph, what cage_edge_mask says."""
+
+    bl_idname = "SOLIDWIRE_CAGE_PROBE"
+    bl_label = "Cage probe"
+    found: dict = {}
+
+    def render(self, depsgraph):
+        for instance in depsgraph.object_instances:
+            obj = instance.object
+            if obj.type == "MESH":
+                mesh = obj.data
+                mask = cage_edge_mask(obj, mesh, render=depsgraph.mode == "RENDER")
+                type(self).found[obj.name] = (depsgraph.mode, len(mesh.edges), None if mask is None else int(mask.sum()))
+
+
+@pytest.fixture
+def probe_engine():
+    bpy.utils.register_class(_Probe)
+    _Probe.found = {}
+    try:
+        yield _Probe
+    finally:
+        bpy.utils.unregister_class(_Probe)
+
+
+def test_render_levels_in_a_render_depsgraph(probe_engine):
+    scene, obj, mod = _subdivided_cube(1)
+    mod.render_levels = 3
+    scenes.add_camera(scene)
+    scene.render.engine = probe_engine.bl_idname
+    bpy.ops.render.render(scene=scene.name)
+    assert probe_engine.found["Cube"] == ("RENDER", 768, 12 * 8)  # level 3: 768 edges
+    # The viewport depsgraph has the viewport level.
+    mask, _edges_, _positions = _mask(obj)
+    assert int(mask.sum()) == 12 * 2
+    # Render Simplify lowers the render level only.
+    scene.render.use_simplify = True
+    scene.render.simplify_subdivision_render = 2
+    bpy.ops.render.render(scene=scene.name)
+    assert probe_engine.found["Cube"][2] == 12 * 4
+    mod.show_render = False
+    bpy.ops.render.render(scene=scene.name)
+    assert probe_engine.found["Cube"][2] is None
+    assert int(_mask(obj)[0].sum()) == 12 * 2  # still on in the viewport
+
+
+# -- Edit Mode, user data, save/load -----------------------------------------------------
+
+
+def _enter_edit_mode(obj):
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.object.mode_set(mode="EDIT")
+
+
+def test_edit_mode_follows_the_edited_cage():
+    _scene, obj, _mod = _subdivided_cube(2, "SIMPLE")
+    _enter_edit_mode(obj)
+    try:
+        mask, edges, positions = _mask(obj)
+        _assert_simple_cube_cage(mask, edges, positions, level=2)
+        bm = bmesh.from_edit_mesh(obj.data)
+        bm.edges.ensure_lookup_table()
+        bmesh.ops.subdivide_edges(bm, edges=[bm.edges[0]], cuts=1)  # 13 cage edges, two pentagons
+        bmesh.update_edit_mesh(obj.data)
+        mask, edges, positions = _mask(obj)
+        assert mask is not None and int(mask.sum()) == 13 * 4
+        assert set(np.flatnonzero(mask).tolist()) == _box_edge_set(edges, positions, [(0, 0, 0)])
+        obj.modifiers["Subdivision"].show_in_editmode = False  # not evaluated in Edit Mode
+        assert _mask(obj)[0] is None
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+    mask, _edges_, _positions = _mask(obj)
+    assert int(mask.sum()) == 13 * 4
+
+
+def _user_data_snapshot(obj):
+    data = obj.data
+    ids = {name: len(getattr(bpy.data, name)) for name in (
+        "meshes", "objects", "textures", "node_groups", "images", "texts", "materials")}
+    attributes = sorted((a.name, a.domain, a.data_type) for a in data.attributes)
+    layers = None
+    if data.is_editmode:  # the edit BMesh's layers (the mesh's own are stale)
+        bm = bmesh.from_edit_mesh(data)
+        layers = sorted(
+            (domain, kind, name)
+            for domain in ("verts", "edges", "faces", "loops")
+            for kind in ("int", "float", "bool", "string", "float_vector", "float_color", "color")
+            if hasattr(getattr(bm, domain).layers, kind)
+            for name in getattr(getattr(bm, domain).layers, kind).keys()
+        )
+    modifiers = [(m.name, m.type) for m in obj.modifiers]
+    return ids, attributes, layers, modifiers, dict(data.items()), dict(obj.items())
+
+
+@pytest.mark.parametrize("mode", ["OBJECT", "EDIT"])
+def test_nothing_is_left_in_the_users_data(mode):
+    _scene, obj, _mod = _subdivided_cube(2)
+    if mode == "EDIT":
+        _enter_edit_mode(obj)
+    try:
+        before = _user_data_snapshot(obj)
+        for render in (False, True):
+            _mask(obj, render=render)
+            _mask(obj, render=render, original=True)
+            cage_key(obj, render)
+        assert _user_data_snapshot(obj) == before
+    finally:
+        if obj.mode == "EDIT":
+            bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def test_same_mask_after_save_and_load(tmp_path):
+    _scene, obj, _mod = _subdivided_cube(2)
+    before = _mask(obj)[0]
+    path = tmp_path / "cage.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(path), copy=True)
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    loaded = bpy.data.objects["Cube"]
+    after = _mask(loaded)[0]
+    assert after is not None and np.array_equal(before, after)
+    assert "Subdivision" in loaded.modifiers and len(loaded.modifiers) == 1
+
+
+# -- cache key -----------------------------------------------------------------------
+
+
+def test_cage_key_changes_with_what_decides_the_mask():
+    _scene, obj, mod = _subdivided_cube(2)
+    key = cage_key(obj, False)
+    hash(key)
+    assert cage_key(obj, False) == key
+    assert cage_key(obj.evaluated_get(bpy.context.evaluated_depsgraph_get()), False) == key
+    assert cage_key(obj, True) != key
+    changes = [
+        lambda: setattr(mod, "levels", 3),
+        lambda: setattr(mod, "render_levels", 1),
+        lambda: setattr(mod, "show_viewport", False),
+        lambda: setattr(mod, "show_render", False),
+        lambda: setattr(mod, "show_in_editmode", False),
+        lambda: obj.modifiers.new("Tri", "TRIANGULATE"),
+    ]
+    seen = {key}
+    for change in changes:
+        change()
+        new = cage_key(obj, False)
+        assert new not in seen
+        seen.add(new)
+
+
+# -- edge data on the children of cage edges (documents Blender's behaviour) ----------
+
+
+def test_edge_attributes_propagate_to_the_child_edges_of_cage_edges():
+    """sharp_edge, crease_edge, uv_seam and freestyle_edge (bpy 5.0 names)
+    are copied from a cage edge to each of its 2^L child edges and to no
+    other evaluated edge, for Subdivision Surface (both types) and
+    Multiresolution."""
+    scene = scenes.empty_scene()
+    obj = scenes.cube(scene)
+    mesh = obj.data
+    mesh.edges[3].use_seam = True
+    mesh.edges[3].use_edge_sharp = True
+    mesh.attributes.new("crease_edge", "FLOAT", "EDGE").data[3].value = 0.5
+    mesh.attributes.new("freestyle_edge", "BOOLEAN", "EDGE").data[3].value = True
+    assert {"uv_seam", "sharp_edge"} <= set(mesh.attributes.keys())
+    cases = [("SUBSURF", "CATMULL_CLARK"), ("SUBSURF", "SIMPLE"), ("MULTIRES", None)]
+    for kind, subdivision_type in cases:
+        obj.modifiers.clear()
+        mod = obj.modifiers.new("Sub", kind)
+        if kind == "SUBSURF":
+            mod.subdivision_type = subdivision_type
+            mod.levels = 2
+        else:
+            with bpy.context.temp_override(object=obj, active_object=obj):
+                for _ in range(2):
+                    bpy.ops.object.multires_subdivide(modifier=mod.name, mode="CATMULL_CLARK")
+        obj_eval, evaluated, _cleanup = _evaluated(obj)
+        mask = cage_edge_mask(obj_eval, evaluated, render=False)
+        children = set(range(3 * 4, 4 * 4))
+        assert set(np.flatnonzero(mask).tolist()) >= children
+        for name in ("uv_seam", "sharp_edge", "crease_edge", "freestyle_edge"):
+            values = np.array([d.value for d in evaluated.attributes[name].data])
+            assert set(np.flatnonzero(values).tolist()) == children, (kind, name)
+        crease = np.array([d.value for d in evaluated.attributes["crease_edge"].data])
+        assert np.allclose(crease[sorted(children)], 0.5)
