@@ -199,3 +199,36 @@ class _with:
 
     def __getattr__(self, name):
         return self._values[name] if name in self._values else getattr(self._props, name)
+
+
+# ---------------------------------------------------------------- cage edges
+
+
+def _subdivided_monkey(scene, levels=2):
+    monkey = scenes.monkey(scene, subdivisions=levels, rotation=(0.2, 0.0, 0.5))
+    scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0, 0, 0))
+    return monkey
+
+
+@pytest.mark.parametrize("look", [
+    dict(),
+    dict(edge_angle=math.radians(25.0)),
+    dict(use_density_fade=True, density_fade_length=30.0, diagonal_mode="DASHED"),
+])
+def test_cage_edges_match_the_reference(look, output_dir):
+    """The lines of a subdivided mesh come from its cage edges, running along
+    the smooth surface (the reference finds them on its own, through an
+    attribute Blender carries onto child edges)."""
+    scene = scenes.empty_scene(240, 180, use_cage_edges=True, thickness=1.0, **look)
+    monkey = _subdivided_monkey(scene)
+    name = "cage_" + ("_".join(look) or "plain")
+    before = (set(monkey.data.attributes.keys()), [m.name for m in monkey.modifiers], len(bpy.data.meshes))
+    report = accuracy.measure(scene, name, output_dir)
+    accuracy.assert_accurate(report)
+    assert (set(monkey.data.attributes.keys()), [m.name for m in monkey.modifiers], len(bpy.data.meshes)) == before
+    if look.get("use_density_fade"):
+        return  # (every evaluated edge is short enough to fade out entirely)
+    # Far fewer lines than every evaluated edge.
+    everything = reference.render_reference(scene, settings=_with(scene.solidwire, use_cage_edges=False))
+    ref = reference.render_reference(scene)
+    assert ref.intensity.sum() < 0.6 * everything.intensity.sum()

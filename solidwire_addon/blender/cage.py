@@ -179,7 +179,7 @@ def _cage_counts(obj):
     return counts
 
 
-def cage_edge_mask(obj, mesh, *, render: bool):
+def _cage_layout(obj, mesh, *, render: bool):
     """(E,) bool, True for the edges of ``mesh`` (the evaluated mesh of
     ``obj``, original or evaluated object) that come from an edge of the
     cage (the mesh before its Subdivision Surface / Multiresolution
@@ -187,7 +187,10 @@ def cage_edge_mask(obj, mesh, *, render: bool):
     mode (``render``: the render depsgraph's settings), level 0, a mesh the
     subdivision left coarse, or one whose origin cannot be told (a modifier
     after the subdivision that changes the topology, an edge layout that is
-    not the subdivision's)."""
+    not the subdivision's).
+
+    Returned as (edges that are cage children, children per cage edge):
+    the mask is the first ones, each cage edge's children consecutive."""
     stack = _stack(obj, render)
     if stack is None:
         return None
@@ -216,9 +219,37 @@ def cage_edge_mask(obj, mesh, *, render: bool):
     cage_children = len(edges) * total
     if cage_children >= edges_num:
         return None  # a mesh without faces: every edge comes from a cage edge
-    mask = np.zeros(edges_num, dtype=bool)
-    mask[:cage_children] = True
+    return cage_children, total
+
+
+def cage_edge_mask(obj, mesh, *, render: bool):
+    """(E,) bool: True for the evaluated edges that come from a cage edge, or
+    None to draw every edge (see _cage_layout)."""
+    layout = _cage_layout(obj, mesh, render=render)
+    if layout is None:
+        return None
+    mask = np.zeros(len(mesh.edges), dtype=bool)
+    mask[: layout[0]] = True
     return mask
+
+
+def cage_edges(obj, mesh, *, render: bool):
+    """(drawn mask, chain id per edge) for core/edge_select.py, or None: the
+    children of one cage edge share a chain id, so the density fade measures
+    the whole cage edge, not its pieces."""
+    layout = _cage_layout(obj, mesh, render=render)
+    if layout is None:
+        return None
+    children, per_edge = layout
+    index = np.arange(len(mesh.edges), dtype=np.int64)
+    mask = index < children
+    return mask, np.where(mask, index // per_edge, -1 - index)
+
+
+def subdivides(obj, render: bool) -> bool:
+    """Whether a subdivision modifier enabled for this mode subdivides
+    ``obj``: only then can cage edges differ from all edges."""
+    return _stack(obj, render) is not None
 
 
 def cage_key(obj, render: bool):

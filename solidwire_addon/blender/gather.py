@@ -307,8 +307,10 @@ class _FrameGather:
         edges = self.edges
         cage_key = None
         if edges.use_cage:
-            cage_key = cage.cage_key(obj.original, self.mode == "RENDER")
-            if cage_key is None:
+            render = self.mode == "RENDER"
+            if cage.subdivides(obj.original, render):
+                cage_key = cage.cage_key(obj.original, render)
+            else:
                 edges = replace(edges, use_cage=False)
         return edges, cage_key
 
