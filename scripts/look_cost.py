@@ -24,7 +24,9 @@ from solidwire_addon.blender.gpu_context import ensure_gpu
 
 SIZE = (1920, 1080)
 BASE = dict(use_fill=True, fill_shading="FLAT", fill_color_source="SINGLE", wire_color_source="SINGLE",
-            fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0), edge_angle=0.0)
+            fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0), edge_angle=0.0,
+            use_cage_edges=False, use_density_fade=False, use_boundary_edges=False, use_sharp_edges=False,
+            use_seam_edges=False)
 OPTIONS = (
     ("Flat fill (baseline)", {}),
     ("STUDIO shading", dict(fill_shading="STUDIO")),
@@ -34,6 +36,12 @@ OPTIONS = (
     ("Fill + wire source RANDOM", dict(fill_color_source="RANDOM", wire_color_source="RANDOM")),
     ("STUDIO + MATERIAL", dict(fill_shading="STUDIO", fill_color_source="MATERIAL")),
     ("Edge angle 10°", dict(edge_angle=0.1745)),
+    ("Cage edges (regions of 16 faces)", dict(use_cage_edges=True)),
+    ("Density fade", dict(use_density_fade=True, density_fade_length=8.0)),
+    ("Cage edges + density fade", dict(use_cage_edges=True, use_density_fade=True, density_fade_length=8.0)),
+    ("Edge classes: boundary, sharp, seam", dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True)),
+    ("Cage edges + edge classes", dict(use_cage_edges=True, use_boundary_edges=True, use_sharp_edges=True,
+                                       use_seam_edges=True)),
 )
 
 
@@ -45,6 +53,9 @@ def build_scene():
         suzanne = scenes.monkey(scene, f"Suzanne{k}", subdivisions=2,
                                 location=(2.6 * (k % 4) - 3.9, 2.5 * (k // 4), 0.0))
         suzanne.data.shade_smooth()
+        for edge in suzanne.data.edges[: 60]:  # some marked edges for the edge classes
+            edge.use_seam = edge.index % 2 == 0
+            edge.use_edge_sharp = edge.index % 2 == 1
         suzanne.data.materials.append(red)
         suzanne.color = (0.1 * k, 0.5, 0.8, 1.0)
     scenes.add_camera(scene, location=(0.0, -7.0, 3.0), target=(0.0, 1.5, 0.0), lens=30.0)
