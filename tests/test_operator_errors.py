@@ -94,7 +94,7 @@ def test_fade_range_without_a_view(capfd):
 
 
 def test_an_unexpected_exception_is_one_line(scene, capfd, monkeypatch):
-    def broken(_preset, _props):
+    def broken(_preset, _props, **_options):
         raise ValueError("settings on fire\nsecond line")
 
     monkeypatch.setattr(presets, "apply", broken)

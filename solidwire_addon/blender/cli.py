@@ -37,7 +37,7 @@ import bpy
 
 from ..core import compat, output, schema
 from ..core.ids import ENGINE_ID, EXTENSION_ID
-from . import composite, presets, runtime
+from . import composite, ops, presets, runtime
 
 EXIT_USAGE = 2
 EXIT_FAILURE = 1
@@ -300,17 +300,29 @@ def _checked(setting: schema.Setting, value, option: str):
 
 def apply_preset(settings, text: str) -> None:
     """``--preset NAME|FILE``: a preset file when the text names one, else a
-    preset by name (built-in or the user's)."""
+    preset by name (built-in or the user's). A fade range the preset takes
+    from the scene is measured from the scene camera (at the current frame)."""
     try:
         path = Path(text).expanduser()
         preset = presets.load(path) if text.endswith(".json") or path.is_file() else presets.find(text)
     except presets.PresetError as exc:
         raise UsageError(f"--preset: {exc}") from None
-    presets.apply(preset, settings)
+    presets.apply(preset, settings, depth_range=lambda: ops.camera_fade_range(settings.id_data))
 
 
 def apply_options(scene, args) -> None:
     settings = scene.solidwire
+    # The camera first: a preset may measure its fade range from it.
+    if args.camera:
+        camera = bpy.data.objects.get(args.camera)
+        if camera is None or camera.type != "CAMERA" or camera.name not in scene.objects:
+            cameras = ", ".join(o.name for o in scene.objects if o.type == "CAMERA") or "none"
+            raise UsageError(f"no camera named '{args.camera}' in scene '{scene.name}' (cameras: {cameras})")
+        scene.camera = camera
+    # Any object may be the scene camera in Blender (it renders from that
+    # object's transform with default lens settings); only none is an error.
+    if scene.camera is None:
+        raise UsageError(f"scene '{scene.name}' has no camera (add one, or pass --camera NAME)")
     if args.preset is not None:
         apply_preset(settings, args.preset)
     # Schema order: diagonal_mode is set before pattern_duty (choosing a
@@ -348,16 +360,6 @@ def apply_options(scene, args) -> None:
     if args.percentage is not None:
         render.resolution_percentage = _checked_rna(render, "resolution_percentage", args.percentage, "--percentage")
 
-    if args.camera:
-        camera = bpy.data.objects.get(args.camera)
-        if camera is None or camera.type != "CAMERA" or camera.name not in scene.objects:
-            cameras = ", ".join(o.name for o in scene.objects if o.type == "CAMERA") or "none"
-            raise UsageError(f"no camera named '{args.camera}' in scene '{scene.name}' (cameras: {cameras})")
-        scene.camera = camera
-    # Any object may be the scene camera in Blender (it renders from that
-    # object's transform with default lens settings); only none is an error.
-    if scene.camera is None:
-        raise UsageError(f"scene '{scene.name}' has no camera (add one, or pass --camera NAME)")
 
 
 def frames_to_render(scene, args) -> list[int]:

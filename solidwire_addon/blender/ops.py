@@ -1,4 +1,4 @@
-"""Operators (toggle, fade range, presets) and the add-on keymap.
+"""Operators (toggle, fade range, presets and preset files) and the add-on keymap.
 
 Operators change settings or preset files and nothing else: drawing happens in
 the overlay handler, reacting to the settings' update callbacks.
@@ -7,10 +7,12 @@ the overlay handler, reacting to the settings' update callbacks.
 from __future__ import annotations
 
 import functools
+from pathlib import Path
 
 import bpy
 import numpy as np
-from bpy.props import StringProperty
+from bpy.props import BoolProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from . import overlay, presets
 from .overlay import viewport_object_filter
@@ -134,6 +136,49 @@ def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
     return near, far
 
 
+def fade_view(context):
+    """(view matrix, 3D View space or None) that fade ranges are measured
+    from: the current 3D View, else the scene camera; None with neither."""
+    space = context.space_data if getattr(context, "space_data", None) and context.space_data.type == "VIEW_3D" else None
+    # From the sidebar the current region is not the 3D region itself:
+    # fall back to the space's main 3D region.
+    region_3d = getattr(context, "region_data", None) or getattr(space, "region_3d", None)
+    if region_3d is not None and hasattr(region_3d, "view_matrix"):
+        return region_3d.view_matrix, space
+    if context.scene.camera is not None:
+        return context.scene.camera.matrix_world.normalized().inverted(), space
+    return None
+
+
+def visible_fade_range(context):
+    """(near, far) view depth of the objects the overlay draws, seen from
+    :func:`fade_view`, or None when there is no view or no visible mesh in
+    front of it."""
+    depsgraph = context.evaluated_depsgraph_get()  # first: the camera's matrix is then current
+    view = fade_view(context)
+    if view is None:
+        return None
+    view_matrix, space = view
+    props = _solidwire(context)
+    keep = viewport_object_filter(
+        context.view_layer, space, only_selected=props.only_selected, draw_edit_mode=props.overlay_edit_mode
+    )
+    return visible_depth_extent(depsgraph, view_matrix, keep)
+
+
+def camera_fade_range(scene):
+    """(near, far) view depth, from ``scene``'s camera, of the meshes a render
+    of it draws (visible, not disabled in renders), or None: the fade range of
+    a ``from_scene`` preset on the command line."""
+    if scene.camera is None:
+        return None
+    with bpy.context.temp_override(scene=scene, view_layer=scene.view_layers[0]):
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+    camera = scene.camera.evaluated_get(depsgraph)
+    view_matrix = camera.matrix_world.normalized().inverted()
+    return visible_depth_extent(depsgraph, view_matrix, lambda obj: not obj.hide_render)
+
+
 class SOLIDWIRE_OT_fade_from_visible(bpy.types.Operator):
     """Set the depth fade range to the depth extent of the visible objects, seen from this viewport (or from the scene camera outside a viewport), and turn depth fade on"""
 
@@ -148,21 +193,10 @@ class SOLIDWIRE_OT_fade_from_visible(bpy.types.Operator):
     @one_line_errors
     def execute(self, context):
         props = _solidwire(context)
-        space = context.space_data if getattr(context, "space_data", None) and context.space_data.type == "VIEW_3D" else None
-        # From the sidebar the current region is not the 3D region itself:
-        # fall back to the space's main 3D region.
-        region_3d = getattr(context, "region_data", None) or getattr(space, "region_3d", None)
-        if region_3d is not None and hasattr(region_3d, "view_matrix"):
-            view_matrix = region_3d.view_matrix
-        elif context.scene.camera is not None:
-            view_matrix = context.scene.camera.matrix_world.normalized().inverted()
-        else:
+        if fade_view(context) is None:
             self.report({"ERROR"}, "SolidWire: no 3D viewport or scene camera to measure depth from")
             return {"CANCELLED"}
-        keep = viewport_object_filter(
-            context.view_layer, space, only_selected=props.only_selected, draw_edit_mode=props.overlay_edit_mode
-        )
-        extent = visible_depth_extent(context.evaluated_depsgraph_get(), view_matrix, keep)
+        extent = visible_fade_range(context)
         if extent is None:
             self.report({"WARNING"}, "SolidWire: no visible mesh in front of the view")
             return {"CANCELLED"}
@@ -170,6 +204,17 @@ class SOLIDWIRE_OT_fade_from_visible(bpy.types.Operator):
         props.use_fade = True
         self.report({"INFO"}, f"SolidWire: depth fade {extent[0]:.3g} to {extent[1]:.3g}")
         return {"FINISHED"}
+
+
+def _preset_tooltip(name: str) -> str:
+    """A preset's description for its menu entry (read on hover)."""
+    try:
+        preset = presets.find(name)
+    except presets.PresetError as exc:
+        return str(exc)
+    if preset.description:
+        return preset.description
+    return "Your preset" + (f" ({preset.path.name})" if preset.path is not None else "")
 
 
 class SOLIDWIRE_OT_preset_apply(bpy.types.Operator):
@@ -181,6 +226,10 @@ class SOLIDWIRE_OT_preset_apply(bpy.types.Operator):
 
     name: StringProperty(name="Preset", description="Name of the preset to apply")
 
+    @classmethod
+    def description(cls, context, properties):
+        return _preset_tooltip(properties.name) if properties.name else cls.__doc__
+
     @one_line_errors
     def execute(self, context):
         global active_preset_name
@@ -189,10 +238,35 @@ class SOLIDWIRE_OT_preset_apply(bpy.types.Operator):
         except presets.PresetError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
             return {"CANCELLED"}
-        presets.apply(preset, _solidwire(context))
+        note = presets.apply(preset, _solidwire(context), depth_range=lambda: visible_fade_range(context))
         active_preset_name = preset.name
+        if note:
+            self.report({"INFO"}, f"SolidWire: '{preset.name}': {note}")
         redraw_viewports()
         return {"FINISHED"}
+
+
+OVERWRITE_HELP = ("Replace your preset of the same name (names that differ only in case, spaces or "
+                  "punctuation are the same preset)")
+
+
+def draw_name_check(layout, operator) -> None:
+    """Under the Add dialog's name: what saving under it would do. A
+    built-in's name is refused (said here, before OK); an existing user
+    preset of that name shows the Overwrite box, unticked and in red."""
+    name = operator.name
+    try:
+        clash = presets.find(name) if name.strip() else None
+    except presets.PresetError:
+        clash = None
+    if clash is not None and clash.builtin:
+        layout.label(text=f"'{clash.name}' is a built-in preset: choose another name", icon="ERROR")
+        return
+    existing = presets.user_preset_like(name)
+    if existing is not None:
+        row = layout.row()
+        row.alert = not operator.overwrite
+        row.prop(operator, "overwrite", text=f"Overwrite '{existing.name}'")
 
 
 class SOLIDWIRE_OT_preset_add(bpy.types.Operator):
@@ -202,17 +276,29 @@ class SOLIDWIRE_OT_preset_add(bpy.types.Operator):
     bl_label = "Add SolidWire Preset"
     bl_options = {"REGISTER"}
 
-    name: StringProperty(name="Name", description="Name of the new preset", default="My Preset", maxlen=64)
+    # No maxlen: Blender counts it in bytes and could cut a character of a
+    # non-Latin name in half; the length (in characters) is checked on save.
+    name: StringProperty(name="Name", description="Name of the new preset", default="My Preset")
+    # Not "description": that name is the operator's tooltip hook in Blender.
+    preset_description: StringProperty(name="Description", description="Shown as the preset's tooltip", default="")
+    overwrite: BoolProperty(name="Overwrite", default=False, description=OVERWRITE_HELP)
 
     @one_line_errors
     def invoke(self, context, event):
         return context.window_manager.invoke_props_dialog(self)
 
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "name")
+        layout.prop(self, "preset_description")
+        draw_name_check(layout, self)
+
     @one_line_errors
     def execute(self, context):
         global active_preset_name
         try:
-            path = presets.save(self.name, _solidwire(context))
+            path = presets.save(self.name, _solidwire(context), description=self.preset_description,
+                                overwrite=self.overwrite)
         except (presets.PresetError, OSError) as exc:
             self.report({"ERROR"}, f"SolidWire: cannot save preset: {exc}")
             return {"CANCELLED"}
@@ -249,8 +335,129 @@ class SOLIDWIRE_OT_preset_remove(bpy.types.Operator):
         except (presets.PresetError, OSError) as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
             return {"CANCELLED"}
-        if active_preset_name == name:
-            active_preset_name = ""
+        if active_preset_name:
+            try:  # "my look" removes "My Look": the active one may be gone
+                presets.find(active_preset_name)
+            except presets.PresetError:
+                active_preset_name = ""
+        return {"FINISHED"}
+
+
+def _preset_names(self, context, edit_text):
+    """Search list of the Export operator's Preset field."""
+    text = edit_text.casefold()
+    return [p.name for p in presets.all_presets() if text in p.name.casefold()]
+
+
+def export_preset_file(path, props, *, preset: str = "", name: str = "", description: str = "") -> Path:
+    """What "Export Preset" writes: the preset called ``preset`` when given,
+    else ``props``' current settings under ``name``. Adds ``.json`` to a path
+    without it. PresetError / OSError when it cannot."""
+    path = Path(path)
+    if path.suffix.lower() != ".json":
+        path = path.with_name(path.name + ".json")
+    if preset:
+        chosen = presets.find(preset)
+    else:
+        chosen = presets.Preset((name or "").strip() or "My Preset", presets.values_of(props), description)
+    return presets.export(path, chosen)
+
+
+def _default_export_name() -> str:
+    """The active preset's name when it is the user's own, else "My Preset"
+    (a built-in's name could not be imported back)."""
+    if active_preset_name:
+        try:
+            if not presets.find(active_preset_name).builtin:
+                return active_preset_name
+        except presets.PresetError:
+            pass
+    return "My Preset"
+
+
+class SOLIDWIRE_OT_preset_export(bpy.types.Operator, ExportHelper):
+    """Write the current SolidWire settings (or a chosen preset) to a preset file, to keep or share"""
+
+    bl_idname = "solidwire.preset_export"
+    bl_label = "Export SolidWire Preset"
+    bl_options = {"REGISTER"}
+
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+    preset: StringProperty(
+        name="Preset", description="Preset to export (empty: the current settings)", search=_preset_names,
+    )
+    name: StringProperty(name="Name", description="Name the current settings get in the file")
+    preset_description: StringProperty(name="Description", description="Description written with the current settings")
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context.scene, "solidwire", None) is not None
+
+    @one_line_errors
+    def invoke(self, context, event):
+        if not self.name:
+            self.name = _default_export_name()
+        if not self.filepath:
+            try:
+                self.filepath = presets.filename_for(self.preset or self.name)
+            except presets.PresetError:
+                self.filepath = "preset.json"
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "preset")
+        col = layout.column()
+        col.active = not self.preset  # name and description: current settings only
+        col.prop(self, "name")
+        col.prop(self, "preset_description")
+
+    @one_line_errors
+    def execute(self, context):
+        if not self.filepath:
+            self.report({"ERROR"}, "SolidWire: cannot export preset: no file chosen")
+            return {"CANCELLED"}
+        try:
+            path = export_preset_file(bpy.path.abspath(self.filepath), _solidwire(context), preset=self.preset,
+                                      name=self.name or _default_export_name(), description=self.preset_description)
+        except (presets.PresetError, OSError) as exc:
+            self.report({"ERROR"}, f"SolidWire: cannot export preset: {' '.join(str(exc).split())}")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"SolidWire: exported preset to {path}")
+        return {"FINISHED"}
+
+
+class SOLIDWIRE_OT_preset_import(bpy.types.Operator, ImportHelper):
+    """Add a preset file (.json) to your SolidWire presets; the file is checked completely first"""
+
+    bl_idname = "solidwire.preset_import"
+    bl_label = "Import SolidWire Preset"
+    bl_options = {"REGISTER"}
+
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+    name: StringProperty(name="Name", description="Import under this name (empty: the name in the file)")
+    overwrite: BoolProperty(name="Overwrite", default=False, description=OVERWRITE_HELP)
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "name")
+        layout.prop(self, "overwrite")
+
+    @one_line_errors
+    def execute(self, context):
+        if not self.filepath:
+            self.report({"ERROR"}, "SolidWire: cannot import preset: no file chosen")
+            return {"CANCELLED"}
+        try:
+            preset = presets.import_file(Path(bpy.path.abspath(self.filepath)), name=self.name,
+                                         overwrite=self.overwrite)
+        except (presets.PresetError, OSError) as exc:
+            self.report({"ERROR"}, f"SolidWire: cannot import preset: {' '.join(str(exc).split())}")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"SolidWire: imported preset '{preset.name}'")
         return {"FINISHED"}
 
 
@@ -260,6 +467,8 @@ classes = (
     SOLIDWIRE_OT_preset_apply,
     SOLIDWIRE_OT_preset_add,
     SOLIDWIRE_OT_preset_remove,
+    SOLIDWIRE_OT_preset_export,
+    SOLIDWIRE_OT_preset_import,
 )
 
 

@@ -86,6 +86,10 @@ def draw_presets_header(layout) -> None:
 
 
 class SOLIDWIRE_MT_presets(bpy.types.Menu):
+    """Built-in presets, the user's own, then Import / Export. Each entry's
+    tooltip is its preset's description (the apply operator's
+    ``description``)."""
+
     bl_idname = "SOLIDWIRE_MT_presets"
     bl_label = "SolidWire Presets"
 
@@ -96,7 +100,7 @@ class SOLIDWIRE_MT_presets(bpy.types.Menu):
             user, problems = presets.user_presets()
         except presets.PresetError as exc:  # a broken install: say so in the menu
             layout.label(text=str(exc), icon="ERROR")
-            return
+            builtin, (user, problems) = [], ([], [])
         for preset in builtin:
             layout.operator(ops.SOLIDWIRE_OT_preset_apply.bl_idname, text=preset.name).name = preset.name
         if user:
@@ -107,6 +111,9 @@ class SOLIDWIRE_MT_presets(bpy.types.Menu):
                 )
         for problem in problems:
             layout.label(text=problem, icon="ERROR")
+        layout.separator()
+        layout.operator(ops.SOLIDWIRE_OT_preset_import.bl_idname, text="Import Preset...", icon="IMPORT")
+        layout.operator(ops.SOLIDWIRE_OT_preset_export.bl_idname, text="Export Preset...", icon="EXPORT")
 
 
 class VIEW3D_PT_solidwire(bpy.types.Panel):
