@@ -113,11 +113,13 @@ void main()
   vec3 line_style[STYLE_COUNT];
   vec2 span_style[STYLE_COUNT];
   int chain_style[STYLE_COUNT]; /* texel of the chain ends, -1: the edge itself */
+  float chain_length_style[STYLE_COUNT]; /* the chain's length when known, -1: see chain_style */
   for (int k = 0; k < STYLE_COUNT; k++) {
     d_style[k] = NO_EDGE * NO_EDGE;
     line_style[k] = vec3(0.0, 0.0, NO_EDGE);
     span_style[k] = vec2(0.0);
     chain_style[k] = -1;
+    chain_length_style[k] = -1.0;
   }
   keep_nearest(real0 && !listed, d0, edge_line0, edge_span0, d_style[0], line_style[0], span_style[0]);
   keep_nearest(real1 && !listed, d1, edge_line1, edge_span1, d_style[0], line_style[0], span_style[0]);
@@ -145,7 +147,43 @@ void main()
    * run zero times. */
 #ifdef USE_NGONS
   int block_size = triangle_flags >> NGON_SHIFT;
-  if (listed) {
+  if (listed && segment_count >= 0) {
+    /* The segments within reach of this triangle, set up by the vertex
+     * stage (solidwire_vert.glsl, select_segments). */
+    for (int k = 0; k < SEGMENT_SLOTS; k++) {
+      if (k >= segment_count) {
+        break;
+      }
+      vec4 a, b;
+      switch (k) {
+        case 0: a = segment_line0; b = segment_rest0; break;
+        case 1: a = segment_line1; b = segment_rest1; break;
+        case 2: a = segment_line2; b = segment_rest2; break;
+        case 3: a = segment_line3; b = segment_rest3; break;
+        case 4: a = segment_line4; b = segment_rest4; break;
+        default: a = segment_line5; b = segment_rest5; break;
+      }
+      vec3 line = a.xyz;
+      vec2 span = vec2(a.w, b.x);
+      float d = edge_distance_sq(line, span, p);
+      int style = int(b.y);
+      if (style == DIAGONAL_STYLE) {
+#  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
+        keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
+#  endif
+      }
+      else {
+        style = min(style, STYLE_COUNT - 1);
+        if (d < d_style[style]) {
+          d_style[style] = d;
+          line_style[style] = line;
+          span_style[style] = span;
+          chain_length_style[style] = b.z;
+        }
+      }
+    }
+  }
+  else if (listed) {
     for (int k = 0; k < block_size; k++) {
       int texel = ngon_corner_start + SEGMENT_TEXELS * k;
       vec4 segment = fetch_texel(ngon_corners, texel);
@@ -233,7 +271,8 @@ void main()
     }
 #  endif
 #  ifdef USE_DENSITY_FADE
-    value *= density_fade(chain_length(chain_style[k], span_style[k]));
+    value *= density_fade((chain_length_style[k] >= 0.0) ? chain_length_style[k] :
+                                                          chain_length(chain_style[k], span_style[k]));
 #  endif
     if (value > intensity) {
       intensity = value;

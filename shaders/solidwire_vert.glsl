@@ -17,6 +17,114 @@
  * needs the near plane: it is clipped in clip space (z + w >= 0), which is
  * where only the part of an edge in front of the near plane has a projection. */
 
+#ifdef USE_NGONS
+void store_segment(int slot, vec3 line, vec2 span, float style, float chain)
+{
+  vec4 a = vec4(line, span.x), b = vec4(span.y, style, chain, 0.0);
+  switch (slot) {
+    case 0: segment_line0 = a; segment_rest0 = b; break;
+    case 1: segment_line1 = a; segment_rest1 = b; break;
+    case 2: segment_line2 = a; segment_rest2 = b; break;
+    case 3: segment_line3 = a; segment_rest3 = b; break;
+    case 4: segment_line4 = a; segment_rest4 = b; break;
+    default: segment_line5 = a; segment_rest5 = b; break;
+  }
+}
+
+float point_segment_distance(vec2 p, vec2 a, vec2 b)
+{
+  vec2 ab = b - a;
+  float len2 = dot(ab, ab);
+  float t = (len2 > 0.0) ? clamp(dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+  return length(p - (a + t * ab));
+}
+
+/* Signed area test: whether segments ab and cd cross. */
+bool segments_cross(vec2 a, vec2 b, vec2 c, vec2 d)
+{
+  vec2 r = b - a, s = d - c;
+  float c1 = r.x * (c.y - a.y) - r.y * (c.x - a.x);
+  float c2 = r.x * (d.y - a.y) - r.y * (d.x - a.x);
+  float c3 = s.x * (a.y - c.y) - s.y * (a.x - c.x);
+  float c4 = s.x * (b.y - c.y) - s.y * (b.x - c.x);
+  return c1 * c2 <= 0.0 && c3 * c4 <= 0.0;
+}
+
+/* Window distance between segment ab and triangle t0 t1 t2 (0 when they
+ * meet): conservative only through rounding, which `reach` covers. */
+float segment_triangle_distance(vec2 a, vec2 b, vec2 t0, vec2 t1, vec2 t2)
+{
+  float e0 = (t1.x - t0.x) * (a.y - t0.y) - (t1.y - t0.y) * (a.x - t0.x);
+  float e1 = (t2.x - t1.x) * (a.y - t1.y) - (t2.y - t1.y) * (a.x - t1.x);
+  float e2 = (t0.x - t2.x) * (a.y - t2.y) - (t0.y - t2.y) * (a.x - t2.x);
+  bool inside = (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0);
+  if (inside || segments_cross(a, b, t0, t1) || segments_cross(a, b, t1, t2) || segments_cross(a, b, t2, t0)) {
+    return 0.0;
+  }
+  float d = min(min(point_segment_distance(t0, a, b), point_segment_distance(t1, a, b)),
+                point_segment_distance(t2, a, b));
+  d = min(d, min(point_segment_distance(a, t0, t1), point_segment_distance(b, t0, t1)));
+  d = min(d, min(point_segment_distance(a, t1, t2), point_segment_distance(b, t1, t2)));
+  d = min(d, min(point_segment_distance(a, t2, t0), point_segment_distance(b, t2, t0)));
+  return d;
+}
+
+/* A triangle that walks its region's segments: the vertex stage sets up
+ * every segment of the block once per corner and keeps those that pass
+ * within reach of the triangle's window box, so that each fragment measures
+ * a handful of precomputed lines instead of setting up the whole block
+ * (docs/image_model.md §3.4: edges beyond h + 2s cannot change a pixel).
+ * t0..t2: the triangle's window corners relative to the viewport centre.
+ * Returns how many it kept, or -1 when more than SEGMENT_SLOTS are near
+ * (the fragment stage then walks the whole block). */
+int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
+{
+  int block = edge_flags >> NGON_SHIFT;
+  int kept = 0;
+  for (int k = 0; k < block; k++) {
+    int texel = ngon_corner_start + SEGMENT_TEXELS * k;
+    vec4 segment = fetch_texel(ngon_corners, texel);
+    vec3 line;
+    vec2 span;
+    edge_setup(vertex_clip(segment.x), vertex_clip(segment.y), line, span);
+    if (dot(line.xy, line.xy) == 0.0) {
+      continue; /* NO_EDGE: nothing in front of the near plane */
+    }
+    vec2 dir = vec2(-line.y, line.x);
+    vec2 foot = -line.z * line.xy; /* the line's point nearest the centre */
+    if (segment_triangle_distance(foot + span.x * dir, foot + span.y * dir, t0, t1, t2) > reach) {
+      continue;
+    }
+    if (kept == SEGMENT_SLOTS) {
+      return -1;
+    }
+    float chain = span.y - span.x;
+#  ifdef USE_DENSITY_FADE
+    chain = chain_length(texel + 1, span);
+#  endif
+    store_segment(kept, line, span, segment.z, chain);
+    kept++;
+  }
+  return kept;
+}
+
+/* The widest reach of any line at this triangle: the largest half width of
+ * the wire and of every style at its corners, plus the 2s falloff and a
+ * hundredth of a pixel for rounding. */
+float line_reach(float w0, float w1, float w2)
+{
+  float half_width = max(max(half_thickness_at(0.0, 1.0 / w0), half_thickness_at(0.0, 1.0 / w1)),
+                         half_thickness_at(0.0, 1.0 / w2));
+#  if THICKNESS_MODE == 2
+  half_width = max(params.half_thickness, params.half_thickness_far);
+#  endif
+  for (int k = 1; k < STYLE_COUNT; k++) {
+    half_width = max(half_width, style_half_thickness(k, half_width));
+  }
+  return half_width + 2.0 * params.softness + 0.01;
+}
+#endif
+
 void main()
 {
   int triangle = gl_VertexID / 3;
@@ -36,6 +144,7 @@ void main()
   ngon_corner_start = int(ids.w);
   bool in_front = min(min(c0.z + c0.w, c1.z + c1.w), min(c2.z + c2.w, c3.z + c3.w)) >= 0.0;
   bool simple = false;
+  vec2 t0 = vec2(0.0), t1 = vec2(0.0), t2 = vec2(0.0); /* window corners, relative to the viewport centre */
   if (in_front) {
     /* The common case: every corner projects; one division per corner. */
     vec2 w0 = c0.xy / c0.w, w1 = c1.xy / c1.w, w2 = c2.xy / c2.w, w3 = c3.xy / c3.w;
@@ -45,6 +154,9 @@ void main()
     w1 = w1 * to_window + origin;
     w2 = w2 * to_window + origin;
     w3 = w3 * to_window + origin;
+    t0 = w0 - viewport_centre();
+    t1 = w1 - viewport_centre();
+    t2 = w2 - viewport_centre();
     line_through_from_lower(w0, w1, ids.x, ids.y, edge_line0, edge_span0);
     line_through_from_lower(w1, w2, ids.y, ids.z, edge_line1, edge_span1);
     line_through_from_lower(w2, w0, ids.z, ids.x, edge_line2, edge_span2);
@@ -83,6 +195,24 @@ void main()
     edge_span3 = edge_span4 = vec2(0.0);
   }
   triangle_flags = edge_flags | (simple ? SIMPLE_TRIANGLE : 0);
+#ifdef USE_NGONS
+  segment_count = 0;
+  for (int k = 0; k < SEGMENT_SLOTS; k++) {
+    store_segment(k, vec3(0.0, 0.0, NO_EDGE), vec2(0.0), 0.0, 0.0);
+  }
+  /* Flat outputs come from the provoking vertex only (the first: Blender
+   * sets that convention on every backend), so the other two corners skip
+   * the selection. */
+  /* Flat outputs come from the provoking corner only: the last one under
+   * OpenGL (Blender keeps GL's default), so there the other two skip the
+   * selection; other backends may provoke from the first, so both ends
+   * select (PROVOKING_CORNERS, core/shaders.py). */
+  bool provoking = (corner == 2) || (PROVOKING_CORNERS == 2 && corner == 0);
+  if ((edge_flags & IN_REGION) != 0 && provoking) {
+    /* Behind the near plane a corner has no window position: walk. */
+    segment_count = in_front ? select_segments(t0, t1, t2, line_reach(c0.w, c1.w, c2.w)) : -1;
+  }
+#endif
 
 #ifdef WRITE_AOVS
   /* Normal pass: the triangle's world-space normal (loop order, through the

@@ -25,6 +25,10 @@ SHADER_DIR = Path(__file__).resolve().parents[2] / "shaders"
 THICKNESS_PIXELS, THICKNESS_WORLD, THICKNESS_DEPTH = 0, 1, 2
 
 EDGE_COUNT = 5  # three triangle edges + two edges to a quad's 4th corner
+# Segments of a region block that the vertex stage hands to the fragment
+# stage (those within reach of the triangle); more than this and the
+# fragment stage walks the whole block (solidwire_vert.glsl).
+SEGMENT_SLOTS = 6
 
 DIAGONALS_HIDDEN, DIAGONALS_SOLID, DIAGONALS_PATTERN = 0, 1, 2
 
@@ -189,6 +193,11 @@ def _create_info(variant: ShaderVariant):
         iface.flat("VEC2", f"edge_span{i}")
     iface.flat("INT", "triangle_flags")
     iface.flat("INT", "ngon_corner_start")
+    if variant.ngons:
+        iface.flat("INT", "segment_count")
+        for i in range(SEGMENT_SLOTS):
+            iface.flat("VEC4", f"segment_line{i}")  # line xyz, span.x
+            iface.flat("VEC4", f"segment_rest{i}")  # span.y, style, chain length, -
     iface.smooth("FLOAT", "view_depth")
 
     info = pulling_info(push_matrices=not variant.instanced)
@@ -218,6 +227,8 @@ def _create_info(variant: ShaderVariant):
         compat.depth_write(info, "ANY")
     if variant.ngons:
         info.define("USE_NGONS", "1")
+        info.define("SEGMENT_SLOTS", str(SEGMENT_SLOTS))
+        info.define("PROVOKING_CORNERS", str(_provoking_corners()))
     info.define("STYLE_COUNT", "6" if variant.edge_classes else "1")
     if variant.density_fade:
         info.define("USE_DENSITY_FADE", "1")
@@ -232,6 +243,15 @@ def _create_info(variant: ShaderVariant):
                             + (CLIP_BLOCK_GLSL if variant.clip_planes else ""))
     _add_sources(info, variant)
     return info
+
+
+def _provoking_corners() -> int:
+    """1 when the provoking vertex of flat outputs is known to be the last
+    (OpenGL, whose default Blender keeps), else 2 (first or last)."""
+    try:
+        return 1 if gpu.platform.backend_type_get() == "OPENGL" else 2
+    except (AttributeError, RuntimeError):
+        return 2
 
 
 def _add_fill_and_colours(info, iface, variant: ShaderVariant) -> None:
@@ -276,16 +296,16 @@ def _add_render_pass_outputs(info, iface) -> None:
 def _add_sources(info, variant: ShaderVariant) -> None:
     """The GLSL files of the exact path, in the order each stage needs them."""
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
-    style = read_source("line_style.glsl") + read_source("edge_styles.glsl")
+    styles = read_source("line_style.glsl") + read_source("edge_styles.glsl")
     fill = read_source("fill_shading.glsl")
     if variant.instanced:
         instancing = read_source("instancing.glsl")
-        info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + style + fill + read_source("solidwire_frag.glsl"))
+        info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + styles + read_source("solidwire_vert.glsl"))
+        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + styles + fill + read_source("solidwire_frag.glsl"))
     else:
         items = read_source("item_table.glsl") if variant.per_item else ""
-        info.vertex_source(items + common + read_source("solidwire_vert.glsl"))
-        info.fragment_source(items + common + style + fill + read_source("solidwire_frag.glsl"))
+        info.vertex_source(items + common + styles + read_source("solidwire_vert.glsl"))
+        info.fragment_source(items + common + styles + fill + read_source("solidwire_frag.glsl"))
 
 
 # Per-object values of the render passes (std140): the columns of the normal
