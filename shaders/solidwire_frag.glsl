@@ -35,6 +35,49 @@ void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float bes
   }
 }
 
+#ifdef USE_DENSITY_FADE
+/* With the density fade each line has a fade of its own, so a style's
+ * intensity is the largest P(d) m(t) g(l) over its lines, not that of the
+ * nearest line alone (which would jump where two edges of different length
+ * meet; docs/image_model.md §3.7). `chain`: the fade's length l. */
+float faded_line(int style, float d_sq, vec3 line, vec2 span, vec2 p, float wire_half, float chain)
+{
+  float value = line_profile(sqrt(d_sq), style_half_thickness(style, wire_half));
+  float duty = 1.0;
+#  if DIAGONALS == 2
+  if (style == DIAGONAL_STYLE) {
+    duty = params.pattern_duty;
+  }
+#  endif
+#  if STYLE_COUNT > 1
+  if (style != DIAGONAL_STYLE) {
+    duty = style_duty(style);
+  }
+#  endif
+  if (duty < 1.0) {
+    float along = dot(vec2(-line.y, line.x), p);
+    value *= pattern_mask(abs(along - span.x), params.pattern_period, duty);
+  }
+  return value * density_fade(chain);
+}
+
+void offer_faded(int style, float d_sq, vec3 line, vec2 span, vec2 p, float wire_half, float chain,
+                 inout float faded[STYLE_COUNT], inout float faded_diagonal)
+{
+  if (style == DIAGONAL_STYLE) {
+    faded_diagonal = max(faded_diagonal, faded_line(style, d_sq, line, span, p, wire_half, chain));
+  }
+  else {
+    int k = min(style, STYLE_COUNT - 1);
+    faded[k] = max(faded[k], faded_line(k, d_sq, line, span, p, wire_half, chain));
+  }
+}
+#  define OFFER(style, d_sq, line, span, chain) \
+    offer_faded(style, d_sq, line, span, p, half_thickness, chain, faded, faded_diagonal)
+#else
+#  define OFFER(style, d_sq, line, span, chain)
+#endif
+
 void main()
 {
 #ifdef LINEAR_DEPTH
@@ -98,6 +141,14 @@ void main()
    * region's segments takes every line from that block instead; its own
    * edges then only give diagonals. Polygon edges that are not drawn are
    * neither. A quad's edges p2-p3, p3-p0 are NO_EDGE unless it has them. */
+  float half_thickness = half_thickness_at(view_depth, gl_FragCoord.w);
+#ifdef USE_DENSITY_FADE
+  float faded[STYLE_COUNT];
+  for (int k = 0; k < STYLE_COUNT; k++) {
+    faded[k] = 0.0;
+  }
+  float faded_diagonal = 0.0;
+#endif
   bool listed = (triangle_flags & IN_REGION) != 0;
   bool real0 = (triangle_flags & EDGE0_REAL) != 0;
   bool real1 = (triangle_flags & EDGE1_REAL) != 0;
@@ -107,27 +158,35 @@ void main()
   bool diag2 = !real2 && (triangle_flags & (EDGE0_HIDDEN << 2)) == 0;
 
   /* The nearest line of each style (image model §3.6: style 0 is the wire,
-   * styles 1.. the edge classes), with its line and span (for patterns and
-   * the density fade). */
+   * styles 1.. the edge classes), with its line and span (for patterns).
+   * With the density fade, OFFER also keeps each style's strongest faded
+   * line (faded_line above). */
   float d_style[STYLE_COUNT];
   vec3 line_style[STYLE_COUNT];
   vec2 span_style[STYLE_COUNT];
-  int chain_style[STYLE_COUNT]; /* texel of the chain ends, -1: the edge itself */
-  float chain_length_style[STYLE_COUNT]; /* the chain's length when known, -1: see chain_style */
   for (int k = 0; k < STYLE_COUNT; k++) {
     d_style[k] = NO_EDGE * NO_EDGE;
     line_style[k] = vec3(0.0, 0.0, NO_EDGE);
     span_style[k] = vec2(0.0);
-    chain_style[k] = -1;
-    chain_length_style[k] = -1.0;
   }
   keep_nearest(real0 && !listed, d0, edge_line0, edge_span0, d_style[0], line_style[0], span_style[0]);
   keep_nearest(real1 && !listed, d1, edge_line1, edge_span1, d_style[0], line_style[0], span_style[0]);
   keep_nearest(real2 && !listed, d2, edge_line2, edge_span2, d_style[0], line_style[0], span_style[0]);
+#ifdef USE_DENSITY_FADE
+  if (!listed) {
+    if (real0) OFFER(0, d0, edge_line0, edge_span0, edge_span0.y - edge_span0.x);
+    if (real1) OFFER(0, d1, edge_line1, edge_span1, edge_span1.y - edge_span1.x);
+    if (real2) OFFER(0, d2, edge_line2, edge_span2, edge_span2.y - edge_span2.x);
+  }
+#endif
   bool real3 = (triangle_flags & EDGE3_HIDDEN) == 0;
   bool real4 = (triangle_flags & EDGE4_HIDDEN) == 0;
   keep_nearest(real3, d3, edge_line3, edge_span3, d_style[0], line_style[0], span_style[0]);
   keep_nearest(real4, d4, edge_line4, edge_span4, d_style[0], line_style[0], span_style[0]);
+#ifdef USE_DENSITY_FADE
+  if (real3) OFFER(0, d3, edge_line3, edge_span3, edge_span3.y - edge_span3.x);
+  if (real4) OFFER(0, d4, edge_line4, edge_span4, edge_span4.y - edge_span4.x);
+#endif
 
   /* The nearest diagonal, with its line and span for the pattern. */
   float d_diag = NO_EDGE * NO_EDGE;
@@ -137,6 +196,11 @@ void main()
   keep_nearest(diag0, d0, edge_line0, edge_span0, d_diag, diag_line, diag_span);
   keep_nearest(diag1, d1, edge_line1, edge_span1, d_diag, diag_line, diag_span);
   keep_nearest(diag2, d2, edge_line2, edge_span2, d_diag, diag_line, diag_span);
+#  ifdef USE_DENSITY_FADE
+  if (diag0) OFFER(DIAGONAL_STYLE, d0, edge_line0, edge_span0, edge_span0.y - edge_span0.x);
+  if (diag1) OFFER(DIAGONAL_STYLE, d1, edge_line1, edge_span1, edge_span1.y - edge_span1.x);
+  if (diag2) OFFER(DIAGONAL_STYLE, d2, edge_line2, edge_span2, edge_span2.y - edge_span2.x);
+#  endif
 #endif
 
   /* An n-gon's boundary edges may pass near this fragment although they
@@ -167,6 +231,7 @@ void main()
       vec2 span = vec2(a.w, b.x);
       float d = edge_distance_sq(line, span, p);
       int style = int(b.y);
+      OFFER(style, d, line, span, b.z);
       if (style == DIAGONAL_STYLE) {
 #  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
         keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
@@ -178,7 +243,6 @@ void main()
           d_style[style] = d;
           line_style[style] = line;
           span_style[style] = span;
-          chain_length_style[style] = b.z;
         }
       }
     }
@@ -193,6 +257,9 @@ void main()
       edge_setup(vertex_clip(segment.x), vertex_clip(segment.y), line, span);
       float d = edge_distance_sq(line, span, p);
       int style = int(segment.z);
+#  ifdef USE_DENSITY_FADE
+      OFFER(style, d, line, span, chain_length(texel + 1, span));
+#  endif
       if (style == DIAGONAL_STYLE) {
 #  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
         keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
@@ -204,7 +271,6 @@ void main()
           d_style[style] = d;
           line_style[style] = line;
           span_style[style] = span;
-          chain_style[style] = texel + 1;
         }
       }
     }
@@ -221,7 +287,9 @@ void main()
       vec3 line;
       vec2 span;
       edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
-      keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_style[0], line_style[0], span_style[0]);
+      float d = edge_distance_sq(line, span, p);
+      keep_nearest(true, d, line, span, d_style[0], line_style[0], span_style[0]);
+      OFFER(0, d, line, span, span.y - span.x);
     }
 #  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
     /* Every diagonal of an n-gon, not only this triangle's own. */
@@ -232,7 +300,9 @@ void main()
       vec3 line;
       vec2 span;
       edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
-      keep_nearest(true, edge_distance_sq(line, span, p), line, span, d_diag, diag_line, diag_span);
+      float d = edge_distance_sq(line, span, p);
+      keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
+      OFFER(DIAGONAL_STYLE, d, line, span, span.y - span.x);
     }
 #  endif
   }
@@ -246,7 +316,6 @@ void main()
     keep_nearest(true, d_style[k], line_style[k], span_style[k], d_real, real_line, real_span);
   }
   d_real = sqrt(d_real);
-  float half_thickness = half_thickness_at(view_depth, gl_FragCoord.w);
 
 #ifdef HIDDEN_PASS
   /* Hidden-line style (docs/image_model.md §5.4): this face is behind the visible surface;
@@ -262,17 +331,17 @@ void main()
   float intensity = 0.0;
   int winner = 0;
   for (int k = 0; k < STYLE_COUNT; k++) {
+#  ifdef USE_DENSITY_FADE
+    float value = faded[k];
+#  else
     float value = line_profile(sqrt(d_style[k]), style_half_thickness(k, half_thickness));
-#  if STYLE_COUNT > 1
+#  endif
+#  if STYLE_COUNT > 1 && !defined(USE_DENSITY_FADE)
     float duty = style_duty(k);
     if (duty < 1.0) {
       float along = dot(vec2(-line_style[k].y, line_style[k].x), p);
       value *= pattern_mask(abs(along - span_style[k].x), params.pattern_period, duty);
     }
-#  endif
-#  ifdef USE_DENSITY_FADE
-    value *= density_fade((chain_length_style[k] >= 0.0) ? chain_length_style[k] :
-                                                          chain_length(chain_style[k], span_style[k]));
 #  endif
     if (value > intensity) {
       intensity = value;
@@ -289,7 +358,7 @@ void main()
   diag_intensity *= pattern_mask(abs(along - diag_span.x), params.pattern_period, params.pattern_duty);
 #    endif
 #    ifdef USE_DENSITY_FADE
-  diag_intensity *= density_fade(diag_span.y - diag_span.x);
+  diag_intensity = faded_diagonal;
 #    endif
   if (diag_intensity > intensity) {
     intensity = diag_intensity;

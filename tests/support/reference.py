@@ -707,16 +707,15 @@ def pattern_mask(t, period, duty):
     return integral(t + 0.5) - integral(t - 0.5)
 
 
-def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False, want_index=False):
-    """For every pixel: min distance to the selected edges of its own face
-    (edge_face == pix_face; for lines, pass the faces' block keys)."""
+def _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select):
+    """Every (pixel, selected edge of the pixel's own face) pair with the
+    distance and the position along the edge from its pattern origin
+    (unclamped): (pair_pix, pair_edge, d, along)."""
     n = len(pix_face)
-    best = np.full(n, np.inf)
-    best_along = np.zeros(n)
-    best_index = np.full(n, -1)
     idx = np.nonzero(select & valid)[0]
+    empty = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
     if len(idx) == 0 or n == 0:
-        return (best, best_along, best_index) if want_index else (best, best_along)
+        return empty
     order = idx[np.argsort(geo.edge_face[idx], kind="stable")]
     faces_sorted = geo.edge_face[order]
     lo = np.searchsorted(faces_sorted, pix_face, side="left")
@@ -725,26 +724,46 @@ def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_a
     pair_pix = np.repeat(np.arange(n), count)
     pair_edge = order[np.repeat(lo, count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))]
     if len(pair_pix) == 0:
-        return (best, best_along, best_index) if want_index else (best, best_along)
+        return empty
     # Pattern origin: endpoint 0 when edge_origin_first, else endpoint 1.
     first = geo.edge_origin_first[pair_edge]
     a = np.where(first[:, None], wa[pair_edge], wb[pair_edge])
     b = np.where(first[:, None], wb[pair_edge], wa[pair_edge])
-    d, along = _segment_distance(pix_xy[pair_pix], a, b)
-    if want_along:
-        # unclamped projection for the pattern coordinate
-        ab = b - a
-        len_ab = np.linalg.norm(ab, axis=1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            along = np.where(len_ab > 0, np.einsum("ij,ij->i", pix_xy[pair_pix] - a, ab) / len_ab, 0.0)
-    order2 = np.lexsort((d, pair_pix))
-    pair_pix, d, along, pair_edge = pair_pix[order2], d[order2], along[order2], pair_edge[order2]
-    keep = np.ones(len(pair_pix), bool)
-    keep[1:] = pair_pix[1:] != pair_pix[:-1]
-    best[pair_pix[keep]] = d[keep]
-    best_along[pair_pix[keep]] = along[keep]
-    best_index[pair_pix[keep]] = pair_edge[keep]
+    d, _ = _segment_distance(pix_xy[pair_pix], a, b)
+    ab = b - a
+    len_ab = np.linalg.norm(ab, axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        along = np.where(len_ab > 0, np.einsum("ij,ij->i", pix_xy[pair_pix] - a, ab) / len_ab, 0.0)
+    return pair_pix, pair_edge, d, along
+
+
+def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False, want_index=False):
+    """For every pixel: min distance to the selected edges of its own face
+    (edge_face == pix_face; for lines, pass the faces' block keys)."""
+    n = len(pix_face)
+    best = np.full(n, np.inf)
+    best_along = np.zeros(n)
+    best_index = np.full(n, -1)
+    pair_pix, pair_edge, d, along = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
+    if len(pair_pix):
+        order2 = np.lexsort((d, pair_pix))
+        pair_pix, d, along, pair_edge = pair_pix[order2], d[order2], along[order2], pair_edge[order2]
+        keep = np.ones(len(pair_pix), bool)
+        keep[1:] = pair_pix[1:] != pair_pix[:-1]
+        best[pair_pix[keep]] = d[keep]
+        best_along[pair_pix[keep]] = along[keep]
+        best_index[pair_pix[keep]] = pair_edge[keep]
     return (best, best_along, best_index) if want_index else (best, best_along)
+
+
+def _max_value_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, value_of):
+    """For every pixel: the largest value_of(pair_pix, pair_edge, d, along)
+    over the selected edges of its own face (0 without any)."""
+    best = np.zeros(len(pix_face))
+    pair_pix, pair_edge, d, along = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
+    if len(pair_pix):
+        np.maximum.at(best, pair_pix, value_of(pair_pix, pair_edge, d, along))
+    return best
 
 
 def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height, thickness, softness):
@@ -776,10 +795,19 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
                                                   want_along=pattern != "SOLID", want_index=True)
         d_real = np.minimum(d_real, d)
         width_px = float(getattr(s, f"{name}_thickness")) if name else thickness
-        v = profile(d, width_px, softness)
-        if pattern != "SOLID":
-            v *= pattern_mask(np.abs(along), float(s.pattern_period), PATTERN_DUTY[pattern])
-        v *= density(index)
+        duty = PATTERN_DUTY[pattern]
+        if use_density:
+            # Each line fades on its own: the style's intensity is its
+            # strongest faded line (§3.7), not its nearest line's.
+            def faded(pair_pix, pair_edge, d_pair, along_pair, width_px=width_px, duty=duty):
+                w = width_px if np.isscalar(width_px) else width_px[pair_pix]
+                v = profile(d_pair, w, softness) * density(pair_edge)
+                return v * pattern_mask(np.abs(along_pair), float(s.pattern_period), duty) if duty < 1.0 else v
+            v = _max_value_per_pixel(keys, pix_xy, geo, wa, wb, valid, select, faded)
+        else:
+            v = profile(d, width_px, softness)
+            if pattern != "SOLID":
+                v *= pattern_mask(np.abs(along), float(s.pattern_period), duty)
         wins = v > value
         winner[wins] = style
         value = np.maximum(value, v)
@@ -985,7 +1013,15 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
             diag_value = profile(d_diag, thickness, softness)
             if mode in ("DOTTED", "DASHED"):
                 diag_value *= pattern_mask(np.abs(along), float(s.pattern_period), float(s.pattern_duty))
-            diag_value *= density(index)
+            if getattr(s, "use_density_fade", False) and float(getattr(s, "density_fade_length", 0.0)) > 0.0:
+                duty = float(s.pattern_duty) if mode in ("DOTTED", "DASHED") else 1.0
+
+                def faded(pair_pix, pair_edge, d_pair, along_pair):
+                    w = thickness if np.isscalar(thickness) else thickness[pair_pix]
+                    v = profile(d_pair, w, softness) * density(pair_edge)
+                    return v * pattern_mask(np.abs(along_pair), float(s.pattern_period), duty) if duty < 1.0 else v
+
+                diag_value = _max_value_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, faded)
             wins = diag_value > value
             winner_all[covered[wins]] = 0
             value = np.maximum(value, diag_value)
