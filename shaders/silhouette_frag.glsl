@@ -53,4 +53,7 @@ void main()
   frag_intensity = intensity;
   gl_FragDepth = 1.0 - intensity;
 #endif
+#ifdef DISPLAY_TRANSFORM
+  frag_color = display_transform(frag_color);
+#endif
 }

@@ -402,4 +402,7 @@ void main()
   frag_aov = vec4(d_real, intensity, object_params.normal_matrix0.w, material_pass_index);
   frag_normal = vec4(gl_FrontFacing ? face_normal : -face_normal, 0.0);
 #endif
+#ifdef DISPLAY_TRANSFORM
+  frag_color = display_transform(frag_color);
+#endif
 }

@@ -15,7 +15,7 @@ import atexit
 
 import bpy
 
-from .blender import cli, engine, matcap_files, ops, ops_composite, overlay, properties, runtime, ui
+from .blender import cli, color_management, engine, matcap_files, ops, ops_composite, overlay, properties, runtime, ui
 from .core import log, matcaps, silhouettes, targets
 
 _classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
@@ -67,13 +67,14 @@ def _at_exit() -> None:
 
 
 def release_gpu() -> None:
-    """Free the GPU objects the add-on holds (targets, meshes, fin batches).
-    Compiled shader programs are the exception: they live until interpreter
-    exit (core/shaders.py says why)."""
+    """Free the GPU objects the add-on holds (targets, meshes, fin batches,
+    display LUTs). Compiled shader programs are the exception: they live
+    until interpreter exit (core/shaders.py says why)."""
     targets.release()
     runtime.release()
     silhouettes.release()
     matcaps.clear()
+    color_management.release()
 
 
 def stats() -> dict:

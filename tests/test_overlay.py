@@ -170,8 +170,10 @@ def test_overlay_matches_render_engine(diagonal_mode, depth_format, output_dir):
 
 
 def test_overlay_colour_is_the_picked_linear_colour():
-    """The SRGB8_A8 target stores sRGB(linear colour): decoding a wire core
-    pixel gives back exactly the scene-linear colour the user picked."""
+    """Without a display LUT (``display=None``; the scene's colour management
+    is tests/test_overlay_color_management.py's subject) the SRGB8_A8 target
+    stores sRGB(linear colour): decoding a wire core pixel gives back exactly
+    the scene-linear colour the user picked."""
     picked = (0.2, 0.5, 0.05, 1.0)
     scene, objects = build_scene(thickness=6.0)
     scene.solidwire.wire_color = picked
@@ -179,7 +181,7 @@ def test_overlay_colour_is_the_picked_linear_colour():
     view = camera_view(scene, depsgraph, (WIDTH, HEIGHT))
     viewport = FakeViewport(WIDTH, HEIGHT)
     viewport.depth_pass(depsgraph, view, objects)
-    viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot())
+    viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
     rgba = viewport.rgba()
     core = rgba[..., 3] > 0.999
     assert core.sum() > 50

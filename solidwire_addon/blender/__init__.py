@@ -8,6 +8,7 @@ input, on top of ``core``.
     gpu_context the GPU in background mode
     engine      the SOLIDWIRE render engine
     overlay     the viewport overlay (a draw handler)
+    color_management  the scene's view transform as the overlay's display LUT
     presets     preset files, validated against the schema
     composite   wire over a Cycles/EEVEE/Workbench render
     cli         the command line (``blender -c solidwire render``)

@@ -8,13 +8,14 @@ visibility and calls it). Tests call :func:`draw_scene_overlay` directly with
 a camera's view inside an offscreen framebuffer.
 
 Colour: a POST_VIEW handler draws into the viewport's overlay framebuffer,
-whose colour texture is ``SRGB8_A8`` (gpu_viewport.cc, "dtxl_color_overlay").
-The hardware encodes linear shader output to sRGB on write and blends in
-linear, so the scene-linear colours of ``wire_color`` / ``fill_color`` (subtype
-COLOR) are passed through unchanged: the stored value is sRGB(colour), which is
-what the colour swatch in the panel shows. (Blender's builtin shaders convert
-*sRGB theme colours* to linear for that target; our inputs are already linear.)
-Alpha is never encoded, so the intensity I reaches the screen exactly.
+whose colour texture is ``SRGB8_A8`` (gpu_viewport.cc, "dtxl_color_overlay"),
+and Blender does not colour-manage that buffer: it merges it over the
+colour-managed scene in a 2.2-power space. So the overlay applies the scene's
+colour management itself, last in its fragment stages, through a display
+LUT that Blender made (color_management.py, core/display_transform.py,
+docs/image_model.md §9): the screen then shows the colours of the F12 render
+(AgX, Filmic, looks, exposure, ...). Alpha is never encoded, so the
+intensity I reaches the screen exactly.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import bpy
 from ..core import overlay_state, passes
 from ..core.log import warn_once
 from ..core.view import View
-from . import gather, properties, runtime
+from . import color_management, gather, properties, runtime
 from .views import region_view
 
 _handle = None
@@ -155,13 +156,23 @@ def viewport_state(context) -> overlay_state.ViewportState | None:
     )
 
 
-def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, plan=None) -> dict:
+# draw_scene_overlay's default: the display LUT of the depsgraph's scene.
+SCENE_COLOR_MANAGEMENT = "scene"
+
+
+def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, plan=None,
+                       display=SCENE_COLOR_MANAGEMENT) -> dict:
     """Draw the overlay of ``depsgraph``'s scene into the bound framebuffer,
     which already holds the scene's colour and depth. ``plan`` (an
     ``overlay_state.OverlayPlan``) carries the viewport state: depth source,
-    clipping planes and UI scale. Returns the frame stats."""
+    clipping planes and UI scale. ``display``: the display LUT the colours
+    leave through (color_management.display_lut), by default the scene's,
+    made now if needed; None draws scene-linear colours. Returns the frame
+    stats."""
     if plan is None:
         plan = overlay_state.plan_overlay(overlay_state.ViewportState())
+    if display is SCENE_COLOR_MANAGEMENT:
+        display = color_management.display_lut(depsgraph.scene)
     # Meshes are reused across redraws: the viewport depsgraph reports every
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
@@ -175,6 +186,7 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
         overlay_state.draw_settings(plan, settings),
         scene_depth=plan.scene_depth,
         clip_planes=plan.clip_planes,
+        display=display,
     )
     ms_draw = (time.perf_counter() - start) * 1000.0
     return runtime.end_frame(frame, stats, ms_extract, ms_draw, seen)
@@ -196,6 +208,8 @@ def _draw_callback() -> None:
             context.scene.solidwire.snapshot(),
             object_filter=object_filter(plan, context.view_layer, context.space_data),
             plan=plan,
+            # Never built inside a draw: asked of a timer (color_management).
+            display=color_management.display_lut(context.scene, request=True),
         )
     except Exception as exc:  # noqa: BLE001 - a draw handler must never raise
         warn_once(("overlay", type(exc).__name__, str(exc)), f"SolidWire overlay: {type(exc).__name__}: {exc}")

@@ -15,6 +15,8 @@ Blender's ``gpu`` module. Modules, in the order data flows through them:
     targets     offscreen float targets and their readback
     colors      per-object colours (colour sources) and their table
     matcaps     matcap images as textures (loaded by the Blender side)
+    display_transform  the overlay's colour management as a 3D LUT (made by
+                the Blender side)
     passes      the pass plan, run offscreen or over a viewport
     exr         reading back layers other engines rendered
 """

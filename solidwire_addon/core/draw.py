@@ -181,6 +181,7 @@ def draw(
     write_aovs: bool = False,
     linear_depth: bool = False,
     clip_planes=None,
+    display=None,
     program=EXACT,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
@@ -190,7 +191,9 @@ def draw(
     a style override draw with their own parameter block (one per distinct
     style); the variant does not depend on the style. ``clip_planes``
     ((6, 4) world-space planes of a viewport's clipping region): fragments
-    outside them are discarded."""
+    outside them are discarded. ``display`` (a display_transform.DisplayLUT,
+    viewport overlay only): the colour leaves through the scene's colour
+    management (image model §9)."""
     stats = DrawStats()
     if not items:
         return stats
@@ -206,6 +209,9 @@ def draw(
         variant = replace(variant, clip_planes=True)
         clip_rows = clip_space_planes(clip_planes, view)
     extras = {}
+    if display is not None:
+        variant = replace(variant, display_transform=True)
+        extras["display"] = display
     if clip_rows is not None:
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
     if variant.shading == shaders.SHADING_MATCAP:
@@ -291,6 +297,14 @@ def _bind_extras(shader, variant, extras) -> None:
         shader.uniform_sampler("item_colors", extras["item_colors"])
     if variant.clip_planes:
         _set_clip_planes(shader, extras["clip_block"])
+    if variant.display_transform:
+        bind_display_transform(shader, extras["display"])
+
+
+def bind_display_transform(shader, display) -> None:
+    """The display LUT and its shaper constants (shaders.add_display_transform)."""
+    shader.uniform_sampler("display_lut", display.texture())
+    shader.uniform_float("display_shaper", display.shaper)
 
 
 def _bind_mesh(shader, variant, mesh) -> None:

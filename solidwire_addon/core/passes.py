@@ -11,7 +11,8 @@ in where the passes land.
 * :func:`render` (render engine, command line, tests): float offscreen
   targets, read back as premultiplied RGBA plus view depth.
 * :func:`draw_over_viewport` (viewport overlay): straight into a bound
-  framebuffer that already holds the scene's colour and depth.
+  framebuffer that already holds the scene's colour and depth, through the
+  scene's colour management (a display LUT, docs/image_model.md §9).
 """
 
 from __future__ import annotations
@@ -191,7 +192,8 @@ OVERLAY_DEPTH_BIAS = 2.0**-18
 
 
 def draw_over_viewport(
-    items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS, scene_depth: bool = True, clip_planes=None
+    items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS, scene_depth: bool = True, clip_planes=None,
+    display=None,
 ):
     """Draw ``items`` over a bound framebuffer that already holds the scene's
     colour and depth (a 3D viewport after its own drawing). Returns the
@@ -201,6 +203,9 @@ def draw_over_viewport(
     the bound depth first, so only our own surfaces occlude. ``clip_planes``
     ((6, 4) world-space planes, the viewport's clipping region) discards
     everything outside them in every pass (docs/image_model.md §5.6).
+    ``display`` (a display_transform.DisplayLUT of the scene's colour
+    management) makes every colour pass write what the F12 render shows
+    (docs/image_model.md §9); None writes the scene-linear colour.
 
     A depth-only pre-pass comes first, so only the nearest of our own
     surfaces passes the colour passes (no back edges show through where the
@@ -211,14 +216,17 @@ def draw_over_viewport(
     saved_depth_test = gpu.state.depth_test_get()
     saved_depth_mask = gpu.state.depth_mask_get()
     stats = None
-    clip = {} if clip_planes is None else {"clip_planes": clip_planes}
+    # Every pass gets the clipping planes and the LUT (the depth pre-pass
+    # too: with the LUT its variant, and so its compiled program, is the
+    # surface pass's).
+    options = {"display": display} if clip_planes is None else {"clip_planes": clip_planes, "display": display}
     try:
         if not scene_depth:
             gpu.state.depth_mask_set(True)
             gpu.state.active_framebuffer_get().clear(depth=1.0)
         gpu.state.blend_set("NONE")
         gpu.state.color_mask_set(False, False, False, False)
-        draw_mod.draw(items, view, settings, depth_bias=depth_bias, **clip)
+        draw_mod.draw(items, view, settings, depth_bias=depth_bias, **options)
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set("ALPHA_PREMULT")
         for step in plan(settings):
@@ -227,14 +235,14 @@ def draw_over_viewport(
                 if settings.use_hidden_lines and not settings.use_fill:
                     continue
                 surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias,
-                                              show_wire=step.show_wire, **clip)
+                                              show_wire=step.show_wire, **options)
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
-                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias, **clip)
+                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias, **options)
             elif step.kind == WIRE:
-                stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **clip)
+                stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **options)
             elif step.kind == SILHOUETTES:
-                silhouettes.draw_silhouettes(items, view, step.settings, overlay_bias=depth_bias)
+                silhouettes.draw_silhouettes(items, view, step.settings, overlay_bias=depth_bias, display=display)
     finally:
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set(saved_blend)

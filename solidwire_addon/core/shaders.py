@@ -17,7 +17,7 @@ from pathlib import Path
 
 import gpu
 
-from . import compat, schema
+from . import compat, display_transform, schema
 
 # The extension root's shaders/ folder (this file is solidwire_addon/core/shaders.py).
 SHADER_DIR = Path(__file__).resolve().parents[2] / "shaders"
@@ -83,6 +83,9 @@ class ShaderVariant:
     edge_classes: bool = False
     # Density fade (image model §3.7): lines of short edges fade.
     density_fade: bool = False
+    # Viewport overlay only: the scene's colour management applied last
+    # (DISPLAY_TRANSFORM, shaders/display_transform.glsl, image model §9).
+    display_transform: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -208,7 +211,7 @@ def _create_info(variant: ShaderVariant):
     if variant.clip_planes:
         # A block of their own, not push constants: those stay within the
         # 128 bytes every backend guarantees (object_to_clip, object_to_view_z
-        # and item_slot use 84).
+        # and item_slot use 84, the overlay's display_shaper 8 more).
         info.uniform_buf(2, "SolidWireClip", "clip_params")
         iface.smooth("VEC4", "clip_distance_a")
         iface.smooth("VEC2", "clip_distance_b")
@@ -236,6 +239,8 @@ def _create_info(variant: ShaderVariant):
         _add_render_pass_outputs(info, iface)
     if variant.depth_bias:
         info.define("DEPTH_BIAS", repr(float(variant.depth_bias)))
+    if variant.display_transform:
+        add_display_transform(info)
     if variant.write_aovs or variant.clip_planes:
         # One typedef source holds every block's struct (a later call
         # replaces the one pulling_info set).
@@ -279,6 +284,24 @@ def _add_fill_and_colours(info, iface, variant: ShaderVariant) -> None:
         info.define("MATERIAL_COLORS", "1")
 
 
+# Sampler slot of the display LUT, above every slot the exact path and the
+# fin pass use.
+DISPLAY_LUT_SLOT = 8
+
+
+def add_display_transform(info) -> None:
+    """The overlay's colour management (core/display_transform.py): the LUT,
+    the shaper constants and the merge power."""
+    info.sampler(DISPLAY_LUT_SLOT, "FLOAT_3D", "display_lut")
+    info.push_constant("VEC2", "display_shaper")
+    info.define("DISPLAY_TRANSFORM", "1")
+    info.define("OVERLAY_MERGE_GAMMA", repr(float(display_transform.OVERLAY_MERGE_GAMMA)))
+
+
+def _display_source(variant: ShaderVariant) -> str:
+    return read_source("display_transform.glsl") if variant.display_transform else ""
+
+
 def _add_render_pass_outputs(info, iface) -> None:
     """The render passes' extra outputs and inputs (image model §6)."""
     # Per-object values in a block of their own (push constants are full);
@@ -301,11 +324,13 @@ def _add_sources(info, variant: ShaderVariant) -> None:
     if variant.instanced:
         instancing = read_source("instancing.glsl")
         info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + styles + read_source("solidwire_vert.glsl"))
-        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + styles + fill + read_source("solidwire_frag.glsl"))
+        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + styles + fill + _display_source(variant)
+                             + read_source("solidwire_frag.glsl"))
     else:
         items = read_source("item_table.glsl") if variant.per_item else ""
         info.vertex_source(items + common + styles + read_source("solidwire_vert.glsl"))
-        info.fragment_source(items + common + styles + fill + read_source("solidwire_frag.glsl"))
+        info.fragment_source(items + common + styles + fill + _display_source(variant)
+                             + read_source("solidwire_frag.glsl"))
 
 
 # Per-object values of the render passes (std140): the columns of the normal
@@ -355,9 +380,11 @@ _silhouette_cache: dict[tuple, object] = {}
 
 def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
     """The fin shader; ``overlay_bias`` > 0 gives the viewport-overlay form
-    (colour output, fixed-function occlusion; see silhouette_frag.glsl)."""
+    (colour output, fixed-function occlusion; see silhouette_frag.glsl),
+    with the variant's display transform."""
     key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
-                        linear_depth=variant.linear_depth and not overlay_bias)
+                        linear_depth=variant.linear_depth and not overlay_bias,
+                        display_transform=variant.display_transform and bool(overlay_bias))
     shader = _silhouette_cache.get((_context, key))
     if shader is None:
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
@@ -383,8 +410,11 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
             info.define("LINEAR_DEPTH", "1")
         if key.use_fade:
             info.define("USE_FADE", "1")
+        if key.display_transform:
+            add_display_transform(info)
         common = read_source("common.glsl") + read_source("edge_geometry.glsl")
         info.vertex_source(common + read_source("silhouette_vert.glsl"))
-        info.fragment_source(common + read_source("line_style.glsl") + read_source("silhouette_frag.glsl"))
+        info.fragment_source(common + read_source("line_style.glsl") + _display_source(key)
+                             + read_source("silhouette_frag.glsl"))
         shader = _keep(_silhouette_cache, (_context, key), gpu.shader.create_from_info(info))
     return shader

@@ -28,12 +28,14 @@ costs no CPU work when the camera moves.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import gpu
 import numpy as np
 
 from . import shaders
 from .cache import table_texture
-from .draw import shader_variant
+from .draw import bind_display_transform, shader_variant
 from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
 from .settings import pack_params
 from .view import translation
@@ -104,17 +106,23 @@ def release() -> None:
 
 
 def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay_bias: float = 0.0,
-                     linear_depth: bool = False) -> None:
+                     linear_depth: bool = False, display=None) -> None:
     """Draw the outer halves into the bound framebuffer.
 
     Render: an R32F intensity target with its own depth buffer cleared to 1,
     ``scene_depth_texture`` the main pass's depth (see the module docstring).
     Viewport overlay (``overlay_bias`` > 0): straight into the viewport with
-    "over" blending, occluded by its depth buffer; the caller sets the blend."""
-    shader = shaders.get_silhouette(shader_variant(settings, linear_depth=linear_depth), overlay_bias)
+    "over" blending, occluded by its depth buffer; the caller sets the blend;
+    ``display`` (a display_transform.DisplayLUT) colour-manages the colour."""
+    variant = shader_variant(settings, linear_depth=linear_depth)
+    if display is not None and overlay_bias:
+        variant = replace(variant, display_transform=True)
+    shader = shaders.get_silhouette(variant, overlay_bias)
     ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
     shader.bind()
     shader.uniform_block("params", ubo)
+    if variant.display_transform:
+        bind_display_transform(shader, display)
     if overlay_bias:
         gpu.state.depth_test_set("LESS_EQUAL")
         gpu.state.depth_mask_set(False)
