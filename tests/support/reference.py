@@ -565,6 +565,11 @@ def _rays(inv_proj, proj, px, py, width, height):
     return origin, direction, 0.0, far_depth - near_depth
 
 
+# A triangle whose facing |det| is within this fraction of its scale is seen
+# edge-on as far as float32 can tell (back-face culling may go either way).
+FACING_TOLERANCE = 1e-5
+
+
 def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None, centre_hit=None):
     """Nearest face for the sample of each pixel of ``rows`` and its 4 offsets.
 
@@ -585,6 +590,9 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
         centre_hit["v"] = np.zeros(n_rows * width)
         centre_hit["front"] = np.ones(n_rows * width, bool)
 
+    undecided_hits: list = []
+    if centre_hit is not None:
+        centre_hit["undecided"] = np.zeros(n_rows * width, bool)
     x0, x1, y0, y1 = _triangle_pixel_bounds(proj, geo.tri_view, width, height)
     tri_ids = np.nonzero(x1 >= x0)[0]
     if len(tri_ids) == 0:
@@ -623,7 +631,13 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
             det = np.einsum("ij,ij->i", e1, pvec)
             ok = np.abs(det) > 1e-13 * scale * np.linalg.norm(direction, axis=1)
             if backface_culling:
+                # Which side faces the ray is undecided for a triangle seen
+                # nearly edge-on at float32 precision (the engine's): such a
+                # hit marks its sample as undecided (§7) instead of deciding.
+                undecided = ok & (np.abs(det) <= FACING_TOLERANCE * scale * np.linalg.norm(direction, axis=1))
                 ok &= det > 0.0  # front side faces the ray
+            else:
+                undecided = np.zeros(len(det), bool)
             with np.errstate(divide="ignore", invalid="ignore"):
                 inv_det = np.where(ok, 1.0 / det, 0.0)
                 tvec = origin - v0
@@ -631,8 +645,17 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
                 qvec = np.cross(tvec, e1)
                 v = np.einsum("ij,ij->i", direction, qvec) * inv_det
                 t = np.einsum("ij,ij->i", e2, qvec) * inv_det
-            hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= t_near) & (t <= t_far)
+            inside = (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= t_near) & (t <= t_far)
+            hit = ok & inside
             depth = -(origin[:, 2] + t * direction[:, 2])
+            if s == 0 and centre_hit is not None and undecided.any():
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    inv_u = np.where(undecided, 1.0 / det, 0.0)
+                    uu = np.einsum("ij,ij->i", tvec, pvec) * inv_u
+                    vv = np.einsum("ij,ij->i", direction, qvec) * inv_u
+                    tt = np.einsum("ij,ij->i", e2, qvec) * inv_u
+                near_hit = undecided & (uu >= 0) & (vv >= 0) & (uu + vv <= 1) & (tt >= t_near) & (tt <= t_far)
+                undecided_hits.append((pixel[near_hit], -(origin[near_hit, 2] + tt[near_hit] * direction[near_hit, 2])))
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
             if s == 0 and all_hits is not None:
                 all_hits.append((h_pix, h_depth, h_face))
@@ -655,7 +678,61 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
                 centre_hit["v"][px_c] = h_v[closer]
                 centre_hit["front"][px_c] = h_front[closer]
         start = stop
+    if centre_hit is not None:
+        # Samples whose nearest surface may be an undecided triangle.
+        flagged = np.zeros(n_rows * width, bool)
+        for pix, depth in undecided_hits + _sliver_samples(geo, proj, width, height, rows, row_of):
+            near = depth <= best_depth[0, pix] * (1.0 + 1e-6)
+            flagged[pix[near]] = True
+        centre_hit["undecided"] = flagged
     return best_face, best_depth
+
+
+# A triangle thinner than this (its smallest window-space altitude, px) is a
+# sliver: whether a sample 0.01 px from it is covered depends on the
+# rasteriser's sub-pixel snapping, and probes 0.01 px apart can miss it.
+SLIVER_PX = 0.05
+SLIVER_REACH_PX = 0.01
+
+
+def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
+    """[(pixels, depth)]: samples within SLIVER_REACH_PX of a sliver triangle
+    wholly in front of the camera (§7: their visible face is undecided), with
+    the sliver's nearest depth."""
+    tri = geo.tri_view
+    if len(tri) == 0:
+        return []
+    h = np.concatenate([tri, np.ones(tri.shape[:2] + (1,))], axis=2) @ proj.T  # (T, 3, 4)
+    with np.errstate(all="ignore"):
+        front = ((h[..., 2] + h[..., 3]) >= 0).all(axis=1) & (h[..., 3] > 0).all(axis=1)
+        win = (h[..., :2] / h[..., 3:4] + 1.0) * 0.5 * np.array([width, height])
+        a, b, c = win[:, 0], win[:, 1], win[:, 2]
+        area2 = np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+        longest = np.max(np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
+                                   np.linalg.norm(a - c, axis=1)]), axis=0)
+        altitude = np.where(longest > 0, area2 / np.maximum(longest, 1e-300), 0.0)
+    thin = np.flatnonzero(front & np.isfinite(win).all(axis=(1, 2)) & (altitude < SLIVER_PX) & (longest > 0))
+    out = []
+    evaluated = np.zeros(height, bool)
+    evaluated[rows] = True
+    for k in thin:  # few, and each covers few pixels
+        lo = np.floor(win[k].min(axis=0) - 1.0).astype(int)
+        hi = np.ceil(win[k].max(axis=0) + 1.0).astype(int)
+        xs = np.arange(max(lo[0], 0), min(hi[0], width))
+        ys = np.arange(max(lo[1], 0), min(hi[1], height))
+        ys = ys[evaluated[ys]]
+        if len(xs) == 0 or len(ys) == 0:
+            continue
+        gx, gy = np.meshgrid(xs + 0.5, ys + 0.5)
+        pts = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        dist = np.min(np.stack([_segment_distance(pts, np.broadcast_to(win[k, i], pts.shape),
+                                                  np.broadcast_to(win[k, (i + 1) % 3], pts.shape))[0]
+                                for i in range(3)]), axis=0)
+        near = dist <= SLIVER_REACH_PX
+        if near.any():
+            pix = row_of[gy.ravel()[near].astype(int)] * width + gx.ravel()[near].astype(int)
+            out.append((pix, np.full(len(pix), -tri[k, :, 2].max())))
+    return out
 
 
 # ---------------------------------------------------------------- distances
@@ -987,7 +1064,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
 
     face = faces[0]
     depth = depths[0]
-    on_silhouette = (faces[1:] != face[None, :]).any(axis=0)
+    on_silhouette = (faces[1:] != face[None, :]).any(axis=0) | centre_hit["undecided"]
 
     intensity = np.zeros(len(face))
     winner_all = np.zeros(len(face), np.int64)  # the line style each sample takes (§3.6)
