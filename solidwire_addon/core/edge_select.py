@@ -356,6 +356,18 @@ def read_edge_classes(mesh, enabled) -> np.ndarray | None:
     count = len(mesh.edges)
     bits = None
     for name in enabled:
+        if name == "freestyle" and mesh.attributes.get("freestyle_edge") is None:
+            # Blender 4.x keeps Freestyle marks outside the attributes.
+            values = np.zeros(count, bool)
+            try:
+                if count:
+                    mesh.edges.foreach_get("use_freestyle_mark", values)
+            except (AttributeError, TypeError, RuntimeError):
+                continue
+            if values.any():
+                bits = np.zeros(count, np.int64) if bits is None else bits
+                bits[values] |= CLASS_BIT[name]
+            continue
         for attribute_name in _CLASS_ATTRIBUTES.get(name, ()):
             attribute = mesh.attributes.get(attribute_name)
             if attribute is None or attribute.domain != "EDGE":

@@ -250,6 +250,10 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
         if name == "boundary":
             bits[uses == 1] |= 1 << k
             continue
+        if name == "freestyle" and mesh.attributes.get("freestyle_edge") is None and hasattr(mesh.edges[0] if ne else None,
+                                                                                            "use_freestyle_mark"):
+            bits[[e for e in range(ne) if mesh.edges[e].use_freestyle_mark]] |= 1 << k  # Blender 4.x
+            continue
         for attr_name in _CLASS_ATTRIBUTES[name]:
             attribute = mesh.attributes.get(attr_name)
             if attribute is not None and attribute.domain == "EDGE":
