@@ -35,6 +35,22 @@ void keep_nearest(bool candidate, float d, vec3 line, vec2 span, inout float bes
   }
 }
 
+/* A segment of a region block: the nearest line of its style so far, or a
+ * diagonal (an n-gon's, DIAGONAL_STYLE). */
+void keep_segment(int style, float d, vec3 line, vec2 span, inout float d_style[STYLE_COUNT],
+                  inout vec3 line_style[STYLE_COUNT], inout vec2 span_style[STYLE_COUNT], inout float d_diag,
+                  inout vec3 diag_line, inout vec2 diag_span)
+{
+  if (style == DIAGONAL_STYLE) {
+#if !defined(HIDDEN_PASS) && DIAGONALS >= 1
+    keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
+#endif
+    return;
+  }
+  int k = min(style, STYLE_COUNT - 1);
+  keep_nearest(true, d, line, span, d_style[k], line_style[k], span_style[k]);
+}
+
 #ifdef USE_DENSITY_FADE
 /* With the density fade each line has a fade of its own, so a style's
  * intensity is the largest P(d) m(t) g(l) over its lines, not that of the
@@ -232,19 +248,7 @@ void main()
       float d = edge_distance_sq(line, span, p);
       int style = int(b.y);
       OFFER(style, d, line, span, b.z);
-      if (style == DIAGONAL_STYLE) {
-#  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
-        keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
-#  endif
-      }
-      else {
-        style = min(style, STYLE_COUNT - 1);
-        if (d < d_style[style]) {
-          d_style[style] = d;
-          line_style[style] = line;
-          span_style[style] = span;
-        }
-      }
+      keep_segment(style, d, line, span, d_style, line_style, span_style, d_diag, diag_line, diag_span);
     }
   }
   else if (listed) {
@@ -260,19 +264,7 @@ void main()
 #  ifdef USE_DENSITY_FADE
       OFFER(style, d, line, span, chain_length(texel + 1, span));
 #  endif
-      if (style == DIAGONAL_STYLE) {
-#  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
-        keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
-#  endif
-      }
-      else {
-        style = min(style, STYLE_COUNT - 1);
-        if (d < d_style[style]) {
-          d_style[style] = d;
-          line_style[style] = line;
-          span_style[style] = span;
-        }
-      }
+      keep_segment(style, d, line, span, d_style, line_style, span_style, d_diag, diag_line, diag_span);
     }
   }
   else {
@@ -308,11 +300,13 @@ void main()
   }
 #endif
 
+  /* Only a triangle that walks a block has lines of other styles. */
+  int styles = listed ? STYLE_COUNT : 1;
   /* The nearest line of any style: the Edge Distance pass and hidden lines. */
   float d_real = d_style[0];
   vec3 real_line = line_style[0];
   vec2 real_span = span_style[0];
-  for (int k = 1; k < STYLE_COUNT; k++) {
+  for (int k = 1; k < styles; k++) {
     keep_nearest(true, d_style[k], line_style[k], span_style[k], d_real, real_line, real_span);
   }
   d_real = sqrt(d_real);
@@ -330,7 +324,7 @@ void main()
    * whose intensity is largest (image model §3.6). */
   float intensity = 0.0;
   int winner = 0;
-  for (int k = 0; k < STYLE_COUNT; k++) {
+  for (int k = 0; k < styles; k++) {
 #  ifdef USE_DENSITY_FADE
     float value = faded[k];
 #  else
