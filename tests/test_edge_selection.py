@@ -214,6 +214,7 @@ def _subdivided_monkey(scene, levels=2):
     dict(),
     dict(edge_angle=math.radians(25.0)),
     dict(use_density_fade=True, density_fade_length=30.0, diagonal_mode="DASHED"),
+    dict(use_silhouettes=True, use_boundary_edges=True, boundary_thickness=2.5),
 ])
 def test_cage_edges_match_the_reference(look, output_dir):
     """The lines of a subdivided mesh come from its cage edges, running along
