@@ -662,7 +662,7 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
                 undecided_hits.append((pixel[near_hit], -(origin[near_hit, 2] + tt[near_hit] * direction[near_hit, 2])))
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
             if s == 0 and all_hits is not None:
-                all_hits.append((h_pix, h_depth, h_face))
+                all_hits.append((h_pix, h_depth, h_face, pair_tri[hit]))
             h_tri, h_u, h_v, h_front = pair_tri[hit], u[hit], v[hit], det[hit] > 0.0
             # Nearest hit per pixel (ties: lowest face id, deterministic).
             order = np.lexsort((h_face, h_depth, h_pix))
@@ -818,13 +818,25 @@ def _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select):
     return pair_pix, pair_edge, d, along
 
 
-def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False, want_index=False):
+# Two lines whose distances to a sample differ by less than this (px) are
+# tied: beyond the shared end of two segments of a chain every sample is as
+# far from one as from the other, and a dash pattern's phase there depends
+# on which one is taken.
+TIE_PX = 1e-3
+
+
+def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False, want_index=False,
+                            ties=None):
     """For every pixel: min distance to the selected edges of its own face
-    (edge_face == pix_face; for lines, pass the faces' block keys)."""
+    (edge_face == pix_face; for lines, pass the faces' block keys). With a
+    dict as ``ties``, ties["tied"] marks pixels whose nearest line is tied
+    (TIE_PX) with another one measured from a different position."""
     n = len(pix_face)
     best = np.full(n, np.inf)
     best_along = np.zeros(n)
     best_index = np.full(n, -1)
+    if ties is not None:
+        ties["tied"] = np.zeros(n, bool)
     pair_pix, pair_edge, d, along = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
     if len(pair_pix):
         order2 = np.lexsort((d, pair_pix))
@@ -834,6 +846,12 @@ def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_a
         best[pair_pix[keep]] = d[keep]
         best_along[pair_pix[keep]] = along[keep]
         best_index[pair_pix[keep]] = pair_edge[keep]
+        if ties is not None:
+            runner_up = np.flatnonzero(~keep)  # a second (or later) line of the same pixel
+            runner_up = runner_up[keep[runner_up - 1]]  # the second one only
+            tied = (d[runner_up] - d[runner_up - 1] <= TIE_PX) & (
+                np.abs(np.abs(along[runner_up]) - np.abs(along[runner_up - 1])) > TIE_PX)
+            ties["tied"][pair_pix[runner_up[tied]]] = True
     return (best, best_along, best_index) if want_index else (best, best_along)
 
 
@@ -866,14 +884,18 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
     value = np.zeros(len(pix_face))
     d_real = np.full(len(pix_face), np.inf)
     winner = np.zeros(len(pix_face), np.int64)
+    tied = np.zeros(len(pix_face), bool)  # a patterned line's phase is undecided
     for style in range(len(EDGE_CLASSES) + 1):
         select = geo.edge_real & (geo.edge_style == style)
         if not select.any():
             continue
         name = EDGE_CLASSES[style - 1] if style else None
         pattern = getattr(s, f"{name}_pattern") if name else "SOLID"
+        style_ties = {}
         d, along, index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
-                                                  want_along=pattern != "SOLID", want_index=True)
+                                                  want_along=pattern != "SOLID", want_index=True, ties=style_ties)
+        if pattern != "SOLID" and not use_density:
+            tied |= style_ties["tied"]
         d_real = np.minimum(d_real, d)
         width_px = float(getattr(s, f"{name}_thickness")) if name else thickness
         duty = PATTERN_DUTY[pattern]
@@ -892,7 +914,7 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
         wins = v > value
         winner[wins] = style
         value = np.maximum(value, v)
-    return value, d_real, winner, density
+    return value, d_real, winner, density, tied
 
 
 def _thickness_at(s, z, proj, height, override=None):
@@ -1008,7 +1030,36 @@ def _fade(s, z):
     return (z <= fs).astype(np.float64)
 
 
-def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha):
+def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj) -> np.ndarray:
+    """Samples within 0.01 px of an edge of a triangle hit behind the visible
+    surface (§7: whether the rasteriser covers them is undecided — at a fold
+    seen edge-on, two triangles meet within 1e-4 px of the sample)."""
+    flagged = np.zeros(len(face), bool)
+    if not all_hits:
+        return flagged
+    pix = np.concatenate([h[0] for h in all_hits])
+    f = np.concatenate([h[2] for h in all_hits])
+    tri = np.concatenate([h[3] for h in all_hits])
+    behind = (face[pix] >= 0) & (f != face[pix])
+    pix, tri = pix[behind], tri[behind]
+    if len(pix) == 0:
+        return flagged
+    corners = geo.tri_view[tri]
+    h = np.concatenate([corners, np.ones(corners.shape[:2] + (1,))], axis=2) @ proj.T
+    front = ((h[..., 2] + h[..., 3]) >= 0).all(axis=1) & (h[..., 3] > 0).all(axis=1)
+    with np.errstate(all="ignore"):
+        win = (h[..., :2] / h[..., 3:4] + 1.0) * 0.5 * np.array([width, height])
+    xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
+    near = np.zeros(len(pix), bool)
+    for k in range(3):
+        d, _ = _segment_distance(xy, win[:, k], win[:, (k + 1) % 3])
+        near |= d <= 0.01
+    flagged[pix[near & front]] = True
+    return flagged
+
+
+def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha,
+                          undecided=None):
     """Alpha of the hidden-line layer per pixel (issue 7 definition): every
     face hit behind the visible surface contributes
     a_k = wire_alpha * hidden_alpha * P(d_real) * dash(t) * fade(z_k), with
@@ -1022,17 +1073,24 @@ def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, va
     f = np.concatenate([h[2] for h in all_hits])
     behind = (face[pix] >= 0) & (f != face[pix]) & (z > depth[pix])
     pix, z, f = pix[behind], z[behind], f[behind]
-    # One hit per (pixel, face): a face's two triangles may both report a
-    # sample that lies on their shared diagonal.
+    # One hit per (pixel, face, depth): a face's two triangles may both
+    # report a sample that lies on their shared diagonal (the same depth);
+    # a folded face whose two triangles both lie behind the sample at
+    # different depths is two layers, as the rasteriser draws it.
     order = np.lexsort((z, f, pix))
     pix, z, f = pix[order], z[order], f[order]
     first = np.ones(len(pix), bool)
-    first[1:] = (pix[1:] != pix[:-1]) | (f[1:] != f[:-1])
+    same_depth = np.abs(z[1:] - z[:-1]) <= 1e-6 * np.maximum(np.abs(z[1:]), 1e-30)
+    first[1:] = (pix[1:] != pix[:-1]) | (f[1:] != f[:-1]) | ~same_depth
     pix, z, f = pix[first], z[first], f[first]
     if len(pix) == 0:
         return coverage
     xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
-    d, along = _min_distance_per_pixel(geo.face_key[f], xy, geo, wa, wb, valid, geo.edge_real, want_along=True)
+    hidden_ties = {}
+    d, along = _min_distance_per_pixel(geo.face_key[f], xy, geo, wa, wb, valid, geo.edge_real, want_along=True,
+                                       ties=hidden_ties)
+    if undecided is not None:
+        undecided[pix[hidden_ties["tied"]]] = True
     a = profile(d, _thickness_at(s, z, proj, height, geo.face_thickness[f]), float(s.softness))
     a *= float(s.hidden_alpha) * pattern_mask(np.abs(along), float(s.hidden_period), float(s.hidden_duty))
     a *= _fade(s, z) * wire_alpha
@@ -1081,16 +1139,20 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
         softness = float(s.softness)
         thickness = _thickness_at(s, depth[covered], proj, height, geo.face_thickness[pix_face])
-        value, d_real, winner, density = _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height,
-                                                         thickness, softness)
+        value, d_real, winner, density, tied = _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width,
+                                                               height, thickness, softness)
+        on_silhouette[covered[tied]] = True
         d_real_all[covered] = d_real
         winner_all[covered] = winner
         mode = s.diagonal_mode
         if mode != "HIDDEN":
+            diag_ties = {}
             d_diag, along, index = _min_distance_per_pixel(
                 pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, want_along=(mode in ("DOTTED", "DASHED")),
-                want_index=True,
+                want_index=True, ties=diag_ties,
             )
+            if mode in ("DOTTED", "DASHED"):
+                on_silhouette[covered[diag_ties["tied"]]] = True
             diag_value = profile(d_diag, thickness, softness)
             if mode in ("DOTTED", "DASHED"):
                 diag_value *= pattern_mask(np.abs(along), float(s.pattern_period), float(s.pattern_duty))
@@ -1109,7 +1171,9 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         value *= _fade(s, depth[covered])
         if hidden_lines:
             wire_alpha = float(s.wire_color[3])
-            hidden = _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha)
+            hidden = _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height,
+                                           wire_alpha, undecided=on_silhouette)
+            on_silhouette |= _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj)
             hidden_all = hidden
             # The visible wire over the hidden lines ("over" with one colour),
             # expressed as an intensity relative to the wire alpha.
