@@ -169,3 +169,32 @@ def test_random_scenes_match_reference(mesh, camera, line, transform, tmp_path_f
     except Exception:
         print("\n--- fuzz scene ---\n" + repro(mesh, camera, line, transform))
         raise
+
+
+@st.composite
+def edge_settings(draw):
+    """Line settings plus the edge selection (image model §3.4-§3.7): edge
+    angle (regions), the boundary class and the density fade."""
+    values = draw(line_settings())
+    values["edge_angle"] = draw(st.sampled_from([0.0, 0.2, 1.0, 3.0, draw(st.floats(0.0, math.pi))]))
+    if draw(st.booleans()):
+        values["use_boundary_edges"] = True
+        values["boundary_thickness"] = draw(st.sampled_from([0.0, 2.0, draw(st.floats(0.0, 6.0))]))
+        values["boundary_pattern"] = draw(st.sampled_from(["SOLID", "DOTTED", "DASHED"]))
+    if draw(st.booleans()):
+        values["use_density_fade"] = True
+        values["density_fade_length"] = draw(st.sampled_from([0.0, 4.0, draw(st.floats(0.0, 40.0))]))
+    return values
+
+
+@FUZZ
+@given(mesh=polygons(), camera=cameras(), line=edge_settings(), transform=transforms())
+def test_random_edge_selections_match_reference(mesh, camera, line, transform, tmp_path_factory):
+    log.forget()
+    scene = build(mesh, camera, line, transform)
+    path = tmp_path_factory.getbasetemp() / "fuzz_edges.exr"
+    try:
+        check(scene, path)
+    except Exception:
+        print("\n--- fuzz scene ---\n" + repro(mesh, camera, line, transform))
+        raise
