@@ -161,9 +161,13 @@ def check(scene, path):
 @FUZZ
 @given(mesh=polygons(), camera=cameras(), line=line_settings(), transform=transforms())
 def test_random_scenes_match_reference(mesh, camera, line, transform, tmp_path_factory):
+    check_example(mesh, camera, line, transform, tmp_path_factory.getbasetemp() / "fuzz.exr")
+
+
+def check_example(mesh, camera, line, transform, path):
+    """Build, render and compare one example; print its recipe when it fails."""
     log.forget()
     scene = build(mesh, camera, line, transform)
-    path = tmp_path_factory.getbasetemp() / "fuzz.exr"
     try:
         check(scene, path)
     except Exception:
@@ -190,11 +194,4 @@ def edge_settings(draw):
 @FUZZ
 @given(mesh=polygons(), camera=cameras(), line=edge_settings(), transform=transforms())
 def test_random_edge_selections_match_reference(mesh, camera, line, transform, tmp_path_factory):
-    log.forget()
-    scene = build(mesh, camera, line, transform)
-    path = tmp_path_factory.getbasetemp() / "fuzz_edges.exr"
-    try:
-        check(scene, path)
-    except Exception:
-        print("\n--- fuzz scene ---\n" + repro(mesh, camera, line, transform))
-        raise
+    check_example(mesh, camera, line, transform, tmp_path_factory.getbasetemp() / "fuzz_edges.exr")
