@@ -21,7 +21,8 @@ from scripts import preset_gallery  # noqa: E402  (compose/write: the same sheet
 
 CELL = (360, 270)
 LOOK = dict(use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0),
-            thickness=1.2, softness=1.0, fill_color_source="SINGLE", wire_color_source="SINGLE")
+            thickness=1.2, softness=1.0, fill_color_source="SINGLE", wire_color_source="SINGLE",
+            use_cage_edges=True)  # the default look (the test scenes switch cage edges off)
 CELLS = (
     ("Flat fill (the image model's core)", dict(fill_shading="FLAT")),
     ("Studio: camera-fixed lights (default)", {}),
