@@ -265,11 +265,18 @@ def draw(
         # use a variant without it (llvmpipe pays for a loop even when it runs
         # zero times), so tri/quad meshes never pay for n-gons.
         # Big tri/quad meshes take their edge set-up from the pre-pass.
+        # Only a mesh drawn once in this pass: its table is then written
+        # before its one draw and never rewritten while a draw may still read
+        # it (objects sharing a mesh keep the per-corner set-up).
         setup_ok = getattr(program, "supports_setup_table", False) and shaders.setup_available()
+        draws_of = {}
+        for g in groups:
+            draws_of[id(g[0])] = draws_of.get(id(g[0]), 0) + len(g[2])
         for with_ngons in (False, True):
             batch = [g for g in groups if (program.supports_ngons and g[0].has_ngons) == with_ngons]
             for setup_table in (False, True):
-                part = [g for g in batch if (setup_ok and not with_ngons and _setup_size(g[0])) == setup_table]
+                part = [g for g in batch if (setup_ok and not with_ngons and draws_of[id(g[0])] == 1
+                                             and _setup_size(g[0])) == setup_table]
                 if part:
                     _draw_groups(part, replace(variant, ngons=with_ngons, setup_table=setup_table), ubo, settings,
                                  program, flip, stats, extras, bases)
@@ -415,9 +422,9 @@ def _setup_size(mesh) -> bool:
 
 def _run_setup(mesh, object_to_clip, block) -> None:
     """The set-up pre-pass of one draw: every triangle's edge set-up into
-    ``mesh.setup_table`` (allocated on first use, rewritten per draw: objects
-    that share a mesh each rewrite it just before their own draw, which GL
-    orders after the previous draw's reads)."""
+    ``mesh.setup_table`` (allocated on first use, rewritten for each pass
+    that draws the mesh; gpu.compute.dispatch ends with the barrier that
+    makes the writes visible to the draw's texture fetches)."""
     count = mesh.triangle_count
     if getattr(mesh, "setup_table", None) is None:
         rows = -(-count // shaders.SETUP_ROW_TRIANGLES)
