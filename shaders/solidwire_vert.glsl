@@ -130,20 +130,56 @@ void main()
   int triangle = gl_VertexID / 3;
   int corner = gl_VertexID - triangle * 3;
   vec4 ids = fetch_texel(triangle_vertices, triangle);
+  bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
+  bool is_ngon = (edge_flags & IS_NGON) != 0;
+  bool simple = false;
+#ifdef SETUP_TABLE
+  /* A big mesh: the set-up pre-pass (setup_comp.glsl) has set up this
+   * triangle's edges once; each corner only reads them and adds what
+   * depends on the edge flags. */
+  int row = triangle / SETUP_ROW_TRIANGLES; /* a constant divisor: see setup_texel() in setup_comp.glsl */
+  ivec2 at = ivec2((triangle - row * SETUP_ROW_TRIANGLES) * SETUP_TEXELS, row);
+  vec4 s0 = texelFetch(setup_table, at, 0);
+  vec4 s1 = texelFetch(setup_table, at + ivec2(1, 0), 0);
+  vec4 s2 = texelFetch(setup_table, at + ivec2(2, 0), 0);
+  vec4 s3 = texelFetch(setup_table, at + ivec2(3, 0), 0);
+  edge_line0 = s0.xyz;
+  edge_span0 = vec2(s0.w, s1.x);
+  edge_line1 = s1.yzw;
+  edge_span1 = s2.xy;
+  edge_line2 = vec3(s2.zw, s3.x);
+  edge_span2 = s3.yz;
+  int geometry = int(s3.w);
+  bool in_front = (geometry & 1) != 0;
+  if (is_quad) {
+    vec4 s4 = texelFetch(setup_table, at + ivec2(4, 0), 0);
+    vec4 s5 = texelFetch(setup_table, at + ivec2(5, 0), 0);
+    vec4 s6 = texelFetch(setup_table, at + ivec2(6, 0), 0);
+    edge_line3 = s4.xyz;
+    edge_span3 = vec2(s4.w, s5.x);
+    edge_line4 = s5.yzw;
+    edge_span4 = s6.xy;
+  }
+  if (in_front) {
+    /* The same test as the per-corner set-up below. */
+    simple = is_quad ? (geometry & 2) != 0 : !is_ngon;
+    int drawn_mask = is_quad ? (EDGE0_REAL | EDGE1_REAL) : (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
+    simple = simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0
+             && (edge_flags & IN_REGION) == 0;
+  }
+  ngon_corner_start = int(ids.w);
+#else
 
   vec4 c0 = vertex_clip(ids.x);
   vec4 c1 = vertex_clip(ids.y);
   vec4 c2 = vertex_clip(ids.z);
 
-  bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
-  bool is_ngon = (edge_flags & IS_NGON) != 0;
   /* For a quad the 4th id is its 4th corner; for an n-gon triangle (or one
    * that walks its region's segments) it is where its block starts in
    * `ngon_corners`. */
   vec4 c3 = is_quad ? vertex_clip(ids.w) : c2;
   ngon_corner_start = int(ids.w);
   bool in_front = min(min(c0.z + c0.w, c1.z + c1.w), min(c2.z + c2.w, c3.z + c3.w)) >= 0.0;
-  bool simple = false;
   vec2 t0 = vec2(0.0), t1 = vec2(0.0), t2 = vec2(0.0); /* window corners, relative to the viewport centre */
   if (in_front) {
     /* The common case: every corner projects; one division per corner. */
@@ -190,6 +226,7 @@ void main()
       edge_setup_from_lower(c3, c0, ids.w, ids.x, edge_line4, edge_span4);
     }
   }
+#endif
   if (!is_quad) {
     edge_line3 = edge_line4 = vec3(0.0, 0.0, NO_EDGE);
     edge_span3 = edge_span4 = vec2(0.0);
@@ -229,9 +266,15 @@ void main()
   /* IndexMA: the pass_index of this triangle's material (draw.py). */
   material_pass_index = fetch_texel(triangle_material, triangle).x;
 #endif
+#ifdef SETUP_TABLE
+  vec3 local = fetch_texel(vertex_positions,
+                           int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
+  vec4 position = object_to_clip * vec4(local, 1.0); /* as vertex_clip() */
+#else
   vec4 position = (corner == 0) ? c0 : ((corner == 1) ? c1 : c2);
   vec3 local = fetch_texel(vertex_positions,
                            int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
+#endif
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
 #ifdef USE_CORNERS
   /* This corner's normal and its face's material (one texel per triangle

@@ -68,6 +68,9 @@ class GPUMesh:
         self.triangle_polygons_cpu = arrays.triangle_polygons
         self.edge_flags_cpu = arrays.edge_flags
         self.silhouette_edges = None  # (texture, count), built lazily
+        # The set-up pre-pass's output for big meshes (draw._run_setup), made
+        # on first use and rewritten by every draw of the mesh.
+        self.setup_table = None
         # What reposition() needs to tell a move of vertices from a new shape.
         self.vertex_count = arrays.vertex_count
         self.quads = arrays.quads

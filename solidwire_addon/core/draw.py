@@ -75,6 +75,7 @@ class ExactProgram:
 
     supports_ngons = True
     supports_instancing = True
+    supports_setup_table = True
 
     def shader(self, variant):
         return shaders.get(variant)
@@ -90,6 +91,12 @@ EXACT = ExactProgram()
 # draw_instanced call (matrices from a float texture) instead of one draw per
 # instance; scripts/bench_scale.py measures both.
 INSTANCING_MIN = 16
+
+# A mesh of at least this many triangles, drawn object by object without
+# n-gons, gets its edge set-up from the set-up pre-pass (one compute
+# invocation per triangle, shaders/setup_comp.glsl) instead of from every
+# corner of the vertex stage; below it the dispatch costs more than it saves.
+SETUP_TABLE_MIN = 50_000
 
 
 def styled(settings, style, show_wire: bool = True):
@@ -257,11 +264,22 @@ def draw(
         # Meshes with n-gons need the fragment stage's outline walk; the rest
         # use a variant without it (llvmpipe pays for a loop even when it runs
         # zero times), so tri/quad meshes never pay for n-gons.
+        # Big tri/quad meshes take their edge set-up from the pre-pass.
+        # Only a mesh drawn once in this pass: its table is then written
+        # before its one draw and never rewritten while a draw may still read
+        # it (objects sharing a mesh keep the per-corner set-up).
+        setup_ok = getattr(program, "supports_setup_table", False) and shaders.setup_available()
+        draws_of = {}
+        for g in groups:
+            draws_of[id(g[0])] = draws_of.get(id(g[0]), 0) + len(g[2])
         for with_ngons in (False, True):
             batch = [g for g in groups if (program.supports_ngons and g[0].has_ngons) == with_ngons]
-            if batch:
-                _draw_groups(batch, replace(variant, ngons=with_ngons), ubo, settings, program, flip, stats,
-                             extras, bases)
+            for setup_table in (False, True):
+                part = [g for g in batch if (setup_ok and not with_ngons and draws_of[id(g[0])] == 1
+                                             and _setup_size(g[0])) == setup_table]
+                if part:
+                    _draw_groups(part, replace(variant, ngons=with_ngons, setup_table=setup_table), ubo, settings,
+                                 program, flip, stats, extras, bases)
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
@@ -367,6 +385,11 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
     if single:
         for slot, (mesh, style, world, object_to_view, object_to_clip, _info, mirrored, pass_index,
                    materials) in enumerate(single):
+            if variant.setup_table:
+                _run_setup(mesh, object_to_clip, ubo(style))
+                shader.bind()
+                bound = _UNBOUND  # the pre-pass bound its own block
+                shader.uniform_sampler("setup_table", mesh.setup_table)
             if style is not bound:
                 bound = style
                 shader.uniform_block("params", ubo(style))
@@ -386,6 +409,39 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
         _draw_instanced(instanced, variant, ubo, settings, stats, extras)
+
+
+_UNBOUND = object()
+
+
+def _setup_size(mesh) -> bool:
+    """Whether ``mesh`` is big enough for the set-up pre-pass (and its table
+    fits in a texture)."""
+    return SETUP_TABLE_MIN <= mesh.triangle_count <= shaders.SETUP_MAX_TRIANGLES
+
+
+def _run_setup(mesh, object_to_clip, block) -> None:
+    """The set-up pre-pass of one draw: every triangle's edge set-up into
+    ``mesh.setup_table`` (allocated on first use, rewritten for each pass
+    that draws the mesh; gpu.compute.dispatch ends with the barrier that
+    makes the writes visible to the draw's texture fetches)."""
+    count = mesh.triangle_count
+    if getattr(mesh, "setup_table", None) is None:
+        rows = -(-count // shaders.SETUP_ROW_TRIANGLES)
+        mesh.setup_table = gpu.types.GPUTexture((shaders.SETUP_ROW_TRIANGLES * shaders.SETUP_TEXELS, rows),
+                                                format="RGBA32F")
+        mesh.gpu_bytes += mesh.setup_table.width * mesh.setup_table.height * 16
+    setup = shaders.get_setup()
+    setup.bind()
+    setup.uniform_block("params", block)
+    setup.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
+    setup.uniform_int("triangle_count", count)
+    setup.uniform_sampler("vertex_positions", mesh.positions)
+    setup.uniform_sampler("triangle_vertices", mesh.triangles)
+    setup.image("setup_table", mesh.setup_table)
+    groups = -(-count // shaders.SETUP_GROUP_SIZE)
+    groups_x = min(groups, 65535)
+    gpu.compute.dispatch(setup, groups_x, -(-groups // groups_x), 1)
 
 
 def _material_table(mesh, materials, tables: dict):
@@ -434,7 +490,7 @@ def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_ind
 def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras=None) -> None:
     """One draw_instanced call per (mesh, style, facing) group; every
     instance's matrices in one float texture for the whole frame."""
-    shader = shaders.get(replace(variant, instanced=True))
+    shader = shaders.get(replace(variant, instanced=True, setup_table=False))
     table = table_texture(np.concatenate([_instance_rows(o2v, o2c, info)
                                          for _mesh, _style, o2v, o2c, info, _side in groups]))
     shader.bind()

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import atexit
 import contextlib
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,6 +35,16 @@ DIAGONALS_HIDDEN, DIAGONALS_SOLID, DIAGONALS_PATTERN = 0, 1, 2
 
 # Fill shading (docs/image_model.md §5.8); FLAT is §5.2's flat fill.
 SHADING_FLAT, SHADING_STUDIO, SHADING_MATCAP = 0, 1, 2
+
+# Texels per triangle of the set-up table (layout in setup_comp.glsl).
+SETUP_TEXELS = 7
+# Triangles per row of the set-up table: a triangle's texels share a row
+# (4095 texels wide, under the 16384 limit for 9.5M triangles).
+SETUP_ROW_TRIANGLES = 585
+SETUP_MAX_TRIANGLES = SETUP_ROW_TRIANGLES * 16384
+# Sampler slot of the set-up table, above the display LUT's.
+SETUP_TABLE_SLOT = 9
+SETUP_GROUP_SIZE = 64  # compute invocations per work group, one per triangle
 
 CLIP_PLANES = 6  # as many as Blender's clipping region (RegionView3D.clip_planes)
 
@@ -86,6 +97,11 @@ class ShaderVariant:
     # Viewport overlay only: the scene's colour management applied last
     # (DISPLAY_TRANSFORM, shaders/display_transform.glsl, image model §9).
     display_transform: bool = False
+    # Big non-instanced tri/quad meshes: the vertex stage reads each
+    # triangle's edge set-up from the table the set-up pre-pass wrote
+    # (SETUP_TABLE, shaders/setup_comp.glsl) instead of setting it up at
+    # every corner.
+    setup_table: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -219,6 +235,13 @@ def _create_info(variant: ShaderVariant):
     info.sampler(1, "FLOAT_2D", "triangle_vertices")
     info.sampler(2, "FLOAT_2D", "ngon_corners")
     _add_fill_and_colours(info, iface, variant)
+    if variant.setup_table:
+        if variant.ngons or variant.instanced:
+            raise ValueError("the set-up table is for non-instanced tri/quad meshes")
+        info.sampler(SETUP_TABLE_SLOT, "FLOAT_2D", "setup_table")
+        info.define("SETUP_TABLE", "1")
+        info.define("SETUP_TEXELS", str(SETUP_TEXELS))
+        info.define("SETUP_ROW_TRIANGLES", str(SETUP_ROW_TRIANGLES))
     info.vertex_in(0, "INT", "edge_flags")
     info.vertex_out(iface)
     output_and_feature_defines(info, variant)
@@ -364,6 +387,46 @@ def get(variant: ShaderVariant):
     shader = _cache.get(key)
     if shader is None:
         shader = _keep(_cache, key, gpu.shader.create_from_info(_create_info(variant)))
+    return shader
+
+
+_setup_support: list = []
+
+
+def setup_available() -> bool:
+    """Whether this Blender and GPU backend run compute shaders (the set-up
+    pre-pass); asked once."""
+    if not _setup_support:
+        ok = hasattr(gpu, "compute") and hasattr(gpu.types.GPUShaderCreateInfo, "compute_source")
+        query = getattr(gpu.capabilities, "compute_shader_support_get", None)
+        if ok and query is not None:
+            # Deprecated in Blender 5 (every backend has compute there).
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", DeprecationWarning)
+                    ok = bool(query())
+            except (RuntimeError, SystemError):  # no GPU context yet: ask again later
+                return False
+        _setup_support.append(ok)
+    return _setup_support[0]
+
+
+def get_setup():
+    """The set-up pre-pass (shaders/setup_comp.glsl): one invocation per
+    triangle writes its SETUP_TEXELS texels of edge set-up."""
+    key = (_context, "setup")
+    shader = _cache.get(key)
+    if shader is None:
+        info = pulling_info()
+        info.push_constant("INT", "triangle_count")
+        info.sampler(1, "FLOAT_2D", "triangle_vertices")
+        info.image(0, "RGBA32F", "FLOAT_2D", "setup_table", qualifiers={"WRITE"})
+        info.local_group_size(SETUP_GROUP_SIZE)
+        info.define("SETUP_TEXELS", str(SETUP_TEXELS))
+        info.define("SETUP_ROW_TRIANGLES", str(SETUP_ROW_TRIANGLES))
+        info.compute_source(read_source("common.glsl") + read_source("edge_geometry.glsl")
+                            + read_source("setup_comp.glsl"))
+        shader = _keep(_cache, key, gpu.shader.create_from_info(info))
     return shader
 
 

@@ -1,0 +1,51 @@
+"""The set-up pre-pass (shaders/setup_comp.glsl): the vertex stage of a big
+mesh reads each triangle's edge set-up from a table written once per draw
+instead of setting it up at every corner. Same code path, so the image is
+the same to the bit; forced on for small scenes here."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from solidwire_addon.core import draw, shaders
+from tests.support import scenes
+
+
+def _quads_tris_mirrored_shared(scene):
+    scenes.near_plane_scene(scene)  # edges crossing the near plane
+    shared = scenes.monkey(scene, "Left", location=(-1.5, 4.0, 0.8))
+    twin = shared.copy()  # a second object drawing the same mesh
+    twin.name = "Right"
+    twin.location = (2.5, 5.0, 0.8)
+    twin.scale = (-1.0, 1.0, 1.0)  # mirrored
+    scene.collection.objects.link(twin)
+    solo = scenes.monkey(scene, "Solo", location=(0.5, 7.0, 1.5))  # its own mesh, mirrored
+    solo.scale = (1.0, -1.0, 1.0)
+    scenes.cube(scene, "Box", location=(1.0, 3.0, 0.3), size=0.6)
+
+
+def _render(scene, path, setup_min, monkeypatch):
+    calls = []
+    real = draw._run_setup
+    monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
+    monkeypatch.setattr(draw, "_run_setup", lambda *args: (calls.append(1), real(*args)))
+    channels = scenes.render_multilayer_exr(scene, path)
+    return channels, len(calls)
+
+
+@pytest.mark.parametrize("fill", [False, True])
+def test_setup_table_gives_the_same_image(fill, output_dir, monkeypatch):
+    if not shaders.setup_available():
+        pytest.skip("no compute shaders here")
+    scene = scenes.empty_scene(200, 150, use_fill=fill)
+    _quads_tris_mirrored_shared(scene)
+    per_corner, calls = _render(scene, output_dir / f"setup_off_{fill}.exr", 10**12, monkeypatch)
+    assert calls == 0
+    table, calls = _render(scene, output_dir / f"setup_on_{fill}.exr", 1, monkeypatch)
+    # Floor, wall, box and the mirrored monkey with its own mesh; the two
+    # objects that share a mesh keep the per-corner set-up.
+    assert calls >= 4
+    assert per_corner.keys() == table.keys()
+    for name, values in per_corner.items():
+        np.testing.assert_array_equal(table[name], values, err_msg=name)
