@@ -142,3 +142,57 @@ void line_through_from_lower(vec2 window_a, vec2 window_b, float id_a, float id_
     line_through(window_a, window_b, line, span);
   }
 }
+
+/* The edges of triangle c0 c1 c2 (clip positions; `ids` their vertex ids)
+ * and, with `quad`, the two edges to a quad's 4th corner c3 (c3 = c0 or c2
+ * for a triangle), as window lines and spans. `in_front`: every corner is in
+ * front of the near plane, so the lines come from one division per corner
+ * (w0..w2 are then the window corners), else each edge is clipped;
+ * `convex`: the quad projects convex (each diagonal separates the other two
+ * corners). One function for the vertex stage and the set-up pre-pass, so
+ * both give the same bits. */
+void triangle_edges(vec4 c0, vec4 c1, vec4 c2, vec4 c3, vec4 ids, bool quad, out vec3 line0, out vec2 span0,
+                    out vec3 line1, out vec2 span1, out vec3 line2, out vec2 span2, out vec3 line3, out vec2 span3,
+                    out vec3 line4, out vec2 span4, out vec2 w0, out vec2 w1, out vec2 w2, out bool in_front,
+                    out bool convex)
+{
+  in_front = min(min(c0.z + c0.w, c1.z + c1.w), min(c2.z + c2.w, c3.z + c3.w)) >= 0.0;
+  convex = false;
+  line3 = line4 = vec3(0.0, 0.0, NO_EDGE);
+  span3 = span4 = vec2(0.0);
+  w0 = w1 = w2 = vec2(0.0);
+  if (in_front) {
+    vec2 w3 = c3.xy / c3.w;
+    w0 = c0.xy / c0.w;
+    w1 = c1.xy / c1.w;
+    w2 = c2.xy / c2.w;
+    vec2 to_window = 0.5 * params.viewport.zw;
+    vec2 origin = params.viewport.xy + to_window;
+    w0 = w0 * to_window + origin;
+    w1 = w1 * to_window + origin;
+    w2 = w2 * to_window + origin;
+    w3 = w3 * to_window + origin;
+    line_through_from_lower(w0, w1, ids.x, ids.y, line0, span0);
+    line_through_from_lower(w1, w2, ids.y, ids.z, line1, span1);
+    line_through_from_lower(w2, w0, ids.z, ids.x, line2, span2);
+    if (quad) {
+      line_through_from_lower(w2, w3, ids.z, ids.w, line3, span3);
+      line_through_from_lower(w3, w0, ids.w, ids.x, line4, span4);
+      vec2 d02 = w2 - w0, d13 = w3 - w1;
+      float s1 = d02.x * (w1.y - w0.y) - d02.y * (w1.x - w0.x);
+      float s3 = d02.x * (w3.y - w0.y) - d02.y * (w3.x - w0.x);
+      float t0 = d13.x * (w0.y - w1.y) - d13.y * (w0.x - w1.x);
+      float t2 = d13.x * (w2.y - w1.y) - d13.y * (w2.x - w1.x);
+      convex = s1 * s3 < 0.0 && t0 * t2 < 0.0;
+    }
+  }
+  else {
+    edge_setup_from_lower(c0, c1, ids.x, ids.y, line0, span0);
+    edge_setup_from_lower(c1, c2, ids.y, ids.z, line1, span1);
+    edge_setup_from_lower(c2, c0, ids.z, ids.x, line2, span2);
+    if (quad) {
+      edge_setup_from_lower(c2, c3, ids.z, ids.w, line3, span3);
+      edge_setup_from_lower(c3, c0, ids.w, ids.x, line4, span4);
+    }
+  }
+}

@@ -37,35 +37,10 @@ void main()
   vec4 c3 = vertex_clip(ids.w);
   vec3 line0, line1, line2, line3, line4;
   vec2 span0, span1, span2, span3, span4;
-  bool in_front = min(min(c0.z + c0.w, c1.z + c1.w), min(c2.z + c2.w, c3.z + c3.w)) >= 0.0;
-  bool convex = false;
-  if (in_front) {
-    vec2 w0 = c0.xy / c0.w, w1 = c1.xy / c1.w, w2 = c2.xy / c2.w, w3 = c3.xy / c3.w;
-    vec2 to_window = 0.5 * params.viewport.zw;
-    vec2 origin = params.viewport.xy + to_window;
-    w0 = w0 * to_window + origin;
-    w1 = w1 * to_window + origin;
-    w2 = w2 * to_window + origin;
-    w3 = w3 * to_window + origin;
-    line_through_from_lower(w0, w1, ids.x, ids.y, line0, span0);
-    line_through_from_lower(w1, w2, ids.y, ids.z, line1, span1);
-    line_through_from_lower(w2, w0, ids.z, ids.x, line2, span2);
-    line_through_from_lower(w2, w3, ids.z, ids.w, line3, span3);
-    line_through_from_lower(w3, w0, ids.w, ids.x, line4, span4);
-    vec2 d02 = w2 - w0, d13 = w3 - w1;
-    float s1 = d02.x * (w1.y - w0.y) - d02.y * (w1.x - w0.x);
-    float s3 = d02.x * (w3.y - w0.y) - d02.y * (w3.x - w0.x);
-    float t0 = d13.x * (w0.y - w1.y) - d13.y * (w0.x - w1.x);
-    float t2 = d13.x * (w2.y - w1.y) - d13.y * (w2.x - w1.x);
-    convex = s1 * s3 < 0.0 && t0 * t2 < 0.0;
-  }
-  else {
-    edge_setup_from_lower(c0, c1, ids.x, ids.y, line0, span0);
-    edge_setup_from_lower(c1, c2, ids.y, ids.z, line1, span1);
-    edge_setup_from_lower(c2, c0, ids.z, ids.x, line2, span2);
-    edge_setup_from_lower(c2, c3, ids.z, ids.w, line3, span3);
-    edge_setup_from_lower(c3, c0, ids.w, ids.x, line4, span4);
-  }
+  vec2 w0, w1, w2;
+  bool in_front, convex;
+  triangle_edges(c0, c1, c2, c3, ids, true, line0, span0, line1, span1, line2, span2, line3, span3, line4, span4,
+                 w0, w1, w2, in_front, convex);
   float geometry = (in_front ? 1.0 : 0.0) + (convex ? 2.0 : 0.0);
   ivec2 at = setup_texel(triangle);
   imageStore(setup_table, at, vec4(line0, span0.x));

@@ -179,52 +179,20 @@ void main()
    * `ngon_corners`. */
   vec4 c3 = is_quad ? vertex_clip(ids.w) : c2;
   ngon_corner_start = int(ids.w);
-  bool in_front = min(min(c0.z + c0.w, c1.z + c1.w), min(c2.z + c2.w, c3.z + c3.w)) >= 0.0;
-  vec2 t0 = vec2(0.0), t1 = vec2(0.0), t2 = vec2(0.0); /* window corners, relative to the viewport centre */
+  vec2 w0, w1, w2;
+  bool in_front, convex;
+  triangle_edges(c0, c1, c2, c3, ids, is_quad, edge_line0, edge_span0, edge_line1, edge_span1, edge_line2,
+                 edge_span2, edge_line3, edge_span3, edge_line4, edge_span4, w0, w1, w2, in_front, convex);
+  /* Window corners relative to the viewport centre (region segments). */
+  vec2 t0 = w0 - viewport_centre(), t1 = w1 - viewport_centre(), t2 = w2 - viewport_centre();
   if (in_front) {
-    /* The common case: every corner projects; one division per corner. */
-    vec2 w0 = c0.xy / c0.w, w1 = c1.xy / c1.w, w2 = c2.xy / c2.w, w3 = c3.xy / c3.w;
-    vec2 to_window = 0.5 * params.viewport.zw;
-    vec2 origin = params.viewport.xy + to_window;
-    w0 = w0 * to_window + origin;
-    w1 = w1 * to_window + origin;
-    w2 = w2 * to_window + origin;
-    w3 = w3 * to_window + origin;
-    t0 = w0 - viewport_centre();
-    t1 = w1 - viewport_centre();
-    t2 = w2 - viewport_centre();
-    line_through_from_lower(w0, w1, ids.x, ids.y, edge_line0, edge_span0);
-    line_through_from_lower(w1, w2, ids.y, ids.z, edge_line1, edge_span1);
-    line_through_from_lower(w2, w0, ids.z, ids.x, edge_line2, edge_span2);
-    if (is_quad) {
-      line_through_from_lower(w2, w3, ids.z, ids.w, edge_line3, edge_span3);
-      line_through_from_lower(w3, w0, ids.w, ids.x, edge_line4, edge_span4);
-      /* Convex in projection: each diagonal separates the other two corners. */
-      vec2 d02 = w2 - w0, d13 = w3 - w1;
-      float s1 = d02.x * (w1.y - w0.y) - d02.y * (w1.x - w0.x);
-      float s3 = d02.x * (w3.y - w0.y) - d02.y * (w3.x - w0.x);
-      float t0 = d13.x * (w0.y - w1.y) - d13.y * (w0.x - w1.x);
-      float t2 = d13.x * (w2.y - w1.y) - d13.y * (w2.x - w1.x);
-      simple = s1 * s3 < 0.0 && t0 * t2 < 0.0;
-    }
-    else {
-      simple = !is_ngon;
-    }
-    /* An edge that is not drawn (edge angle) moves to the diagonals: then a
-     * line distance is no longer a segment distance for every sample. */
+    simple = is_quad ? convex : !is_ngon;
+    /* An edge that is not drawn makes a line distance no longer a segment
+     * distance for every sample; a triangle walking its region's block
+     * takes its lines from there. */
     int drawn_mask = is_quad ? (EDGE0_REAL | EDGE1_REAL) : (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
     simple = simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0
              && (edge_flags & IN_REGION) == 0;
-  }
-  else {
-    /* Some corner is behind the near plane: clip each edge (edge_setup). */
-    edge_setup_from_lower(c0, c1, ids.x, ids.y, edge_line0, edge_span0);
-    edge_setup_from_lower(c1, c2, ids.y, ids.z, edge_line1, edge_span1);
-    edge_setup_from_lower(c2, c0, ids.z, ids.x, edge_line2, edge_span2);
-    if (is_quad) {
-      edge_setup_from_lower(c2, c3, ids.z, ids.w, edge_line3, edge_span3);
-      edge_setup_from_lower(c3, c0, ids.w, ids.x, edge_line4, edge_span4);
-    }
   }
 #endif
   if (!is_quad) {
@@ -237,9 +205,6 @@ void main()
   for (int k = 0; k < SEGMENT_SLOTS; k++) {
     store_segment(k, vec3(0.0, 0.0, NO_EDGE), vec2(0.0), 0.0, 0.0);
   }
-  /* Flat outputs come from the provoking vertex only (the first: Blender
-   * sets that convention on every backend), so the other two corners skip
-   * the selection. */
   /* Flat outputs come from the provoking corner only: the last one under
    * OpenGL (Blender keeps GL's default), so there the other two skip the
    * selection; other backends may provoke from the first, so both ends
