@@ -49,3 +49,23 @@ def test_setup_table_gives_the_same_image(fill, output_dir, monkeypatch):
     assert per_corner.keys() == table.keys()
     for name, values in per_corner.items():
         np.testing.assert_array_equal(table[name], values, err_msg=name)
+
+
+def test_a_failing_pre_pass_falls_back_to_the_per_corner_set_up(output_dir, monkeypatch):
+    """A backend whose compiler refuses the pre-pass draws the same image
+    without it, with one message, instead of failing the render."""
+    if not shaders.setup_available():
+        pytest.skip("no compute shaders here")
+    scene = scenes.empty_scene(120, 90)
+    _quads_tris_mirrored_shared(scene)
+    expected, _calls = _render(scene, output_dir / "setup_fallback_expected.exr", 10**12, monkeypatch)
+
+    def refuse():
+        raise RuntimeError("compute shader refused")
+
+    monkeypatch.setattr(shaders, "get_setup", refuse)
+    monkeypatch.setattr(shaders, "_setup_support", [True])
+    got, calls = _render(scene, output_dir / "setup_fallback.exr", 1, monkeypatch)
+    assert calls == 0 and shaders.setup_available() is False
+    for name, values in expected.items():
+        np.testing.assert_array_equal(got[name], values, err_msg=name)

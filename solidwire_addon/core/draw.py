@@ -268,7 +268,7 @@ def draw(
         # Only a mesh drawn once in this pass: its table is then written
         # before its one draw and never rewritten while a draw may still read
         # it (objects sharing a mesh keep the per-corner set-up).
-        setup_ok = getattr(program, "supports_setup_table", False) and shaders.setup_available()
+        setup_ok = getattr(program, "supports_setup_table", False) and _setup_ready()
         draws_of = {}
         for g in groups:
             draws_of[id(g[0])] = draws_of.get(id(g[0]), 0) + len(g[2])
@@ -412,6 +412,21 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
 
 
 _UNBOUND = object()
+
+
+def _setup_ready() -> bool:
+    """Compute shaders run here and the pre-pass compiles; a backend that
+    refuses it keeps the per-corner set-up (said once), never a failed draw."""
+    if not shaders.setup_available():
+        return False
+    try:
+        shaders.get_setup()
+    except Exception as exc:  # noqa: BLE001 - any compile/link failure means: no pre-pass
+        shaders.disable_setup()
+        warn_once(("setup",), f"SolidWire: the set-up pre-pass is not available here ({exc}); "
+                              "drawing without it")
+        return False
+    return True
 
 
 def _setup_size(mesh) -> bool:

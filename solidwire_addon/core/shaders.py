@@ -411,6 +411,11 @@ def setup_available() -> bool:
     return _setup_support[0]
 
 
+def disable_setup() -> None:
+    """Never use the set-up pre-pass again in this process (it failed)."""
+    _setup_support[:] = [False]
+
+
 def get_setup():
     """The set-up pre-pass (shaders/setup_comp.glsl): one invocation per
     triangle writes its SETUP_TEXELS texels of edge set-up."""
