@@ -80,16 +80,6 @@ def test_boundary_and_sharp_folds_stay(output_dir):
     report = accuracy.measure(scene, "edge_angle_boundary", output_dir)
     accuracy.assert_accurate(report)
     ref = reference.render_reference(scene)
-    ref_all = reference.render_reference(scene, settings=_with(scene.solidwire, edge_angle=0.0))
+    ref_all = reference.render_reference(scene, settings=reference.SettingsWith(scene.solidwire, edge_angle=0.0))
     grid_only = ref.face >= 0
     assert ref.intensity[grid_only].sum() < 0.6 * ref_all.intensity[grid_only].sum()
-
-
-class _with:
-    """Settings like ``props`` with some values replaced (for the reference)."""
-
-    def __init__(self, props, **values):
-        self._props, self._values = props, values
-
-    def __getattr__(self, name):
-        return self._values[name] if name in self._values else getattr(self._props, name)

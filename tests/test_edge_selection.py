@@ -139,7 +139,7 @@ def test_edge_classes_match_the_reference(output_dir):
     # reference picks (but where two styles tie at full strength, which a
     # rounding step decides).
     solid = (rgba[..., 3] > 0.99) & ~ref.on_silhouette & np.isfinite(ref.wire).all(axis=-1)
-    expected = np.where(ref.wire <= 0.0031308, 12.92 * ref.wire, 1.055 * np.abs(ref.wire) ** (1 / 2.4) - 0.055)  # sRGB
+    expected = reference.srgb_encode(ref.wire)
     wrong = np.abs(rgba[..., :3] - expected).max(axis=-1) > 0.02
     assert solid.sum() > 500 and (wrong & solid).sum() <= 0.005 * solid.sum()
 
@@ -186,51 +186,7 @@ def test_density_fade_matches_the_reference(diagonals, output_dir):
     accuracy.assert_accurate(report)
     # Far away the short edges are gone; near the camera lines are drawn.
     ref = reference.render_reference(scene)
-    faded = reference.render_reference(scene, settings=_with(scene.solidwire, use_density_fade=False))
+    unfaded = reference.SettingsWith(scene.solidwire, use_density_fade=False)
+    faded = reference.render_reference(scene, settings=unfaded)
     assert ref.intensity.sum() < 0.8 * faded.intensity.sum()
     assert ref.intensity[: len(ref.rows) // 4].max() > 0.99
-
-
-class _with:
-    """Settings like ``props`` with some values replaced (for the reference)."""
-
-    def __init__(self, props, **values):
-        self._props, self._values = props, values
-
-    def __getattr__(self, name):
-        return self._values[name] if name in self._values else getattr(self._props, name)
-
-
-# ---------------------------------------------------------------- cage edges
-
-
-def _subdivided_monkey(scene, levels=2):
-    monkey = scenes.monkey(scene, subdivisions=levels, rotation=(0.2, 0.0, 0.5))
-    scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0, 0, 0))
-    return monkey
-
-
-@pytest.mark.parametrize("look", [
-    dict(),
-    dict(edge_angle=math.radians(25.0)),
-    dict(use_density_fade=True, density_fade_length=30.0, diagonal_mode="DASHED"),
-    dict(use_silhouettes=True, use_boundary_edges=True, boundary_thickness=2.5),
-    dict(use_hidden_lines=True, use_seam_edges=True),
-])
-def test_cage_edges_match_the_reference(look, output_dir):
-    """The lines of a subdivided mesh come from its cage edges, running along
-    the smooth surface (the reference finds them on its own, through an
-    attribute Blender carries onto child edges)."""
-    scene = scenes.empty_scene(240, 180, use_cage_edges=True, thickness=1.0, **look)
-    monkey = _subdivided_monkey(scene)
-    name = "cage_" + ("_".join(look) or "plain")
-    before = (set(monkey.data.attributes.keys()), [m.name for m in monkey.modifiers], len(bpy.data.meshes))
-    report = accuracy.measure(scene, name, output_dir)
-    accuracy.assert_accurate(report)
-    assert (set(monkey.data.attributes.keys()), [m.name for m in monkey.modifiers], len(bpy.data.meshes)) == before
-    if look.get("use_density_fade") or look.get("use_hidden_lines"):
-        return  # (every evaluated edge fades out entirely; hidden lines add lines)
-    # Far fewer lines than every evaluated edge.
-    everything = reference.render_reference(scene, settings=_with(scene.solidwire, use_cage_edges=False))
-    ref = reference.render_reference(scene)
-    assert ref.intensity.sum() < 0.6 * everything.intensity.sum()

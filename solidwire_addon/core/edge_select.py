@@ -30,7 +30,7 @@ import numpy as np
 
 from .extract import (
     EDGE0_HIDDEN, EDGE0_REAL, EDGE1_REAL, EDGE2_REAL, EDGE3_HIDDEN, EDGE4_HIDDEN, HAS_QUAD_CORNER, IN_REGION,
-    IS_NGON, NGON_SHIFT, MeshArrays,
+    IS_NGON, NGON_SHIFT, MeshArrays, read_face_normals,
 )
 
 # Edge classes, in style order: style k + 1 is class k (style 0 is the
@@ -118,10 +118,8 @@ def _chain_ends(verts: np.ndarray, chain: np.ndarray | None) -> np.ndarray:
     chains, first, per_chain = np.unique(odd_chain, return_index=True, return_counts=True)
     path = per_chain == 2
     chains, first = chains[path], first[path]
-    at = np.searchsorted(chains, chain)
-    at = np.minimum(at, max(len(chains) - 1, 0))
-    has = len(chains) > 0
-    if has:
+    if len(chains):
+        at = np.minimum(np.searchsorted(chains, chain), len(chains) - 1)
         ok = chains[at] == chain
         ends[ok, 0] = odd_vertex[first[at[ok]]]
         ends[ok, 1] = odd_vertex[first[at[ok]] + 1]
@@ -418,10 +416,7 @@ def apply_to_mesh(arrays: MeshArrays, mesh, corner_vert: np.ndarray, face_offset
     if cage is not None:
         drawn, chain = np.asarray(cage[0], bool).copy(), cage[1]
     if selection.edge_angle > 0.0:
-        normals = np.empty(len(mesh.polygons) * 3, np.float32)
-        if len(mesh.polygons):
-            mesh.polygon_normals.foreach_get("vector", normals)
-        flat = flat_edges(corner_edge, face_offsets, normals.reshape(-1, 3), len(verts), selection.edge_angle)
+        flat = flat_edges(corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle)
         drawn = ~flat if drawn is None else drawn & ~flat
     others = tuple(c for c in selection.classes if c != "boundary")
     inputs = EdgeInputs(verts, drawn, read_edge_classes(mesh, others) if others else None,

@@ -1294,15 +1294,33 @@ def error_report(measured: np.ndarray, ref: ReferenceResult) -> dict:
     nan = int(np.count_nonzero(~np.isfinite(measured)))
     d = np.nan_to_num(d, nan=1.0)
     return {
+        **_statistics(d),
+        "silhouette_pixels": int(np.count_nonzero(ref.on_silhouette)),
+        "silhouette_max": float(np.nan_to_num(diff[ref.on_silhouette], nan=1.0).max()) if ref.on_silhouette.any() else 0.0,
+        "nan": nan,
+    }
+
+
+def _statistics(d: np.ndarray) -> dict:
+    """Mean, 99.9th percentile, max, count over 2/255 and size of errors d (§7.3)."""
+    return {
         "mean": float(d.mean()) if d.size else 0.0,
         "p999": float(np.percentile(d, 99.9)) if d.size else 0.0,
         "max": float(d.max()) if d.size else 0.0,
         "over_2_255": int(np.count_nonzero(d > 2.0 / 255.0)),
         "pixels": int(d.size),
-        "silhouette_pixels": int(np.count_nonzero(ref.on_silhouette)),
-        "silhouette_max": float(np.nan_to_num(diff[ref.on_silhouette], nan=1.0).max()) if ref.on_silhouette.any() else 0.0,
-        "nan": nan,
     }
+
+
+class SettingsWith:
+    """Settings like ``props`` with some values replaced, to evaluate the
+    reference for a variant of a scene's look without touching the scene."""
+
+    def __init__(self, props, **values):
+        self._props, self._values = props, values
+
+    def __getattr__(self, name):
+        return self._values[name] if name in self._values else getattr(self._props, name)
 
 
 def srgb_encode(linear):
@@ -1326,10 +1344,6 @@ def color_error_report(measured_srgb: np.ndarray, expected_linear: np.ndarray, r
     off = ~ref.on_silhouette & covered
     d = np.nan_to_num(diff[off], nan=1.0)
     return {
-        "mean": float(d.mean()) if d.size else 0.0,
-        "p999": float(np.percentile(d, 99.9)) if d.size else 0.0,
-        "max": float(d.max()) if d.size else 0.0,
-        "over_2_255": int(np.count_nonzero(d > 2.0 / 255.0)),
-        "pixels": int(d.size),
+        **_statistics(d),
         "nan": int(np.count_nonzero(~np.isfinite(measured_srgb[..., :3][off]))),
     }
