@@ -42,6 +42,7 @@ import numpy as np
 from ..core import compat, display_transform, shaders
 from ..core.display_transform import DisplayLUT
 from ..core.log import warn_once
+from . import runtime
 
 # Tables kept (LRU): one per view-transform state recently shown. Each is
 # ~3 MB of numpy and ~2 MB of GPU memory.
@@ -266,16 +267,8 @@ def _build_requested():
         if cached(key) is None and key not in _failed:
             built = _build_and_store(scene, key) is not None or built
     if built:
-        _redraw_3d_views()
+        runtime.redraw_viewports()
     return None  # once
-
-
-def _redraw_3d_views() -> None:
-    wm = getattr(bpy.context, "window_manager", None)
-    for window in getattr(wm, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == "VIEW_3D":
-                area.tag_redraw()
 
 
 def release() -> None:

@@ -238,6 +238,7 @@ class _FrameGather:
         self.deferred: dict[int, tuple] = {}  # culled, never-extracted mesh -> (key, uids, bound box, culled)
         self.sources: dict[int, ItemSource] = {}  # evaluated object -> its colour-source inputs
         self.face_slots: dict[int, np.ndarray] = {}  # evaluated mesh -> material slot per face
+        self.edge_choice: dict[int, tuple] = {}  # evaluated object -> (edge selection, cage key)
 
     def mesh_for(self, instance, obj, parent):
         """The GPU mesh an instance draws (None: nothing to draw, or culled)."""
@@ -303,7 +304,10 @@ class _FrameGather:
     def _edges_for(self, obj):
         """(selection, cage key) for one object: cage edges only count on a
         mesh that a subdivision modifier subdivides (any other mesh keeps
-        the plain, cheaper path)."""
+        the plain, cheaper path). Asked once per object and frame."""
+        known = self.edge_choice.get(obj.as_pointer())
+        if known is not None:
+            return known
         edges = self.edges
         cage_key = None
         if edges.use_cage:
@@ -312,7 +316,8 @@ class _FrameGather:
                 cage_key = cage.cage_key(obj.original, render)
             else:
                 edges = replace(edges, use_cage=False)
-        return edges, cage_key
+        known = self.edge_choice[obj.as_pointer()] = (edges, cage_key)
+        return known
 
     def source_of(self, obj) -> ItemSource:
         source = self.sources.get(obj.as_pointer())

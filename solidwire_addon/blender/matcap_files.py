@@ -27,6 +27,7 @@ from bpy.app.handlers import persistent
 import numpy as np
 
 from ..core import exr, matcaps, shaders
+from . import runtime
 
 SUBFOLDER = "studiolights/matcap"
 
@@ -149,7 +150,7 @@ def request(name: str) -> None:
             print(f"SolidWire: matcap '{name}' could not be read ({exc})")
             _decoded[name] = None
         matcaps.forget(name)
-        properties_redraw()
+        runtime.redraw_viewports()
         return None
 
     bpy.app.timers.register(decode, first_interval=0.0)
@@ -157,13 +158,6 @@ def request(name: str) -> None:
 
 _requested: set[str] = set()
 
-
-def properties_redraw() -> None:
-    wm = getattr(bpy.context, "window_manager", None)
-    for window in getattr(wm, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == "VIEW_3D":
-                area.tag_redraw()
 
 
 def _decode_once(name: str):

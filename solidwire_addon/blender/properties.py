@@ -22,19 +22,11 @@ from bpy.props import (
 from ..core import schema
 from ..core.settings import DrawSettings
 from . import matcap_files
+from .runtime import redraw_viewports
 
 # Where each scope's PropertyGroup is attached.
 _OWNERS = {schema.SCENE: "Scene", schema.OBJECT: "Object", schema.VIEW_LAYER: "ViewLayer"}
 ATTRIBUTE = "solidwire"
-
-
-def redraw_viewports(_self=None, _context=None) -> None:
-    """Settings changes show at once in every 3D viewport."""
-    wm = getattr(bpy.context, "window_manager", None)
-    for window in getattr(wm, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == "VIEW_3D":
-                area.tag_redraw()
 
 
 def _diagonal_mode_changed(self, _context) -> None:

@@ -137,3 +137,13 @@ def release() -> None:
     mesh_cache.clear()
     geometry_version.clear()
     _last_stats.clear()
+
+
+def redraw_viewports(_self=None, _context=None) -> None:
+    """Ask every 3D viewport to draw again (a setting changed, a table is
+    ready); also the update callback of the settings."""
+    wm = getattr(bpy.context, "window_manager", None)
+    for window in getattr(wm, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                area.tag_redraw()
