@@ -190,3 +190,39 @@ def test_density_fade_matches_the_reference(diagonals, output_dir):
     faded = reference.render_reference(scene, settings=unfaded)
     assert ref.intensity.sum() < 0.8 * faded.intensity.sum()
     assert ref.intensity[: len(ref.rows) // 4].max() > 0.99
+
+
+# ---------------------------------------------------------------- cage edges
+
+
+def _subdivided_monkey(scene, levels=2):
+    monkey = scenes.monkey(scene, subdivisions=levels, rotation=(0.2, 0.0, 0.5))
+    scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0, 0, 0))
+    return monkey
+
+
+@pytest.mark.parametrize("look", [
+    dict(),
+    dict(edge_angle=math.radians(25.0)),
+    dict(use_density_fade=True, density_fade_length=30.0, diagonal_mode="DASHED"),
+    dict(use_silhouettes=True, use_boundary_edges=True, boundary_thickness=2.5),
+    dict(use_hidden_lines=True, use_seam_edges=True),
+])
+def test_cage_edges_match_the_reference(look, output_dir):
+    """The lines of a subdivided mesh come from its cage edges, running along
+    the smooth surface (the reference finds them on its own, through an
+    attribute Blender carries onto child edges)."""
+    scene = scenes.empty_scene(240, 180, use_cage_edges=True, thickness=1.0, **look)
+    monkey = _subdivided_monkey(scene)
+    name = "cage_" + ("_".join(look) or "plain")
+    before = (set(monkey.data.attributes.keys()), [m.name for m in monkey.modifiers], len(bpy.data.meshes))
+    report = accuracy.measure(scene, name, output_dir)
+    accuracy.assert_accurate(report)
+    assert (set(monkey.data.attributes.keys()), [m.name for m in monkey.modifiers], len(bpy.data.meshes)) == before
+    if look.get("use_density_fade") or look.get("use_hidden_lines"):
+        return  # (every evaluated edge fades out entirely; hidden lines add lines)
+    # Far fewer lines than every evaluated edge.
+    every_edge = reference.SettingsWith(scene.solidwire, use_cage_edges=False)
+    everything = reference.render_reference(scene, settings=every_edge)
+    ref = reference.render_reference(scene)
+    assert ref.intensity.sum() < 0.6 * everything.intensity.sum()
