@@ -25,10 +25,12 @@ os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwi
 import bpy  # noqa: E402
 
 import solidwire_addon  # noqa: E402
+from solidwire_addon.core import passes, schema  # noqa: E402
 from tests.support import scenes  # noqa: E402
 
 ENGINES = (
-    ("SOLIDWIRE", "SolidWire (fill)"),
+    ("SOLIDWIRE", "SolidWire (default look)"),
+    ("SOLIDWIRE_DIRECT", "SolidWire, direct surface pass (before the deferred surface)"),
     ("WORKBENCH_FLAT", "Workbench flat, single colour, no AA"),
     ("WORKBENCH_WIRE", "Workbench wireframe, no AA"),
 )
@@ -36,7 +38,11 @@ ENGINES = (
 
 def applied_mesh_scene(width: int, height: int, subdivisions: int):
     """Suzanne subdivided and applied (no modifier left), framed by the camera."""
-    scene = scenes.empty_scene(width, height, use_fill=True)
+    # The default look (Studio-lit fill, cage edges), as a plain F12 gets it.
+    scene = scenes.empty_scene(width, height)
+    for setting in schema.settings_in("SCENE"):
+        if setting.name in scenes.CORE_LOOK:
+            setattr(scene.solidwire, setting.name, setting.default)
     obj = scenes.monkey(scene, "Suzanne", subdivisions=subdivisions)
     # Apply the subdivision: every engine then draws the same plain mesh
     # (Workbench would otherwise evaluate it on the GPU, slowly on llvmpipe).
@@ -50,7 +56,8 @@ def applied_mesh_scene(width: int, height: int, subdivisions: int):
 
 def configure(scene, engine: str) -> None:
     render = scene.render
-    if engine == "SOLIDWIRE":
+    passes.use_deferred_surface = engine != "SOLIDWIRE_DIRECT"
+    if engine.startswith("SOLIDWIRE"):
         render.engine = "SOLIDWIRE"
         return
     render.engine = "BLENDER_WORKBENCH"

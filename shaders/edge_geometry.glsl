@@ -4,10 +4,13 @@
  * own edges once per corner; the fragment stage uses the same code for the
  * boundary of an n-gon, which no fixed number of varyings can carry. */
 
+/* Texel `index` of a table: every table is a power of two texels wide
+ * (core/cache.py, table_shape), so a shift and a mask find it; an integer
+ * division would run lane by lane on a CPU rasteriser. */
 vec4 fetch_texel(sampler2D table, int index)
 {
-  int width = textureSize(table, 0).x;
-  return texelFetch(table, ivec2(index % width, index / width), 0);
+  int shift = findMSB(textureSize(table, 0).x);
+  return texelFetch(table, ivec2(index & ((1 << shift) - 1), index >> shift), 0);
 }
 
 vec4 vertex_clip(float vertex_index)

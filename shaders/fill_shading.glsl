@@ -61,7 +61,7 @@ vec3 shaded_fill(vec3 base)
   n = len > 1e-20 ? n / len : vec3(0.0, 0.0, 1.0);
   /* item_info.y: the object (with the view) mirrors, so GL's facing is the
    * opposite of the face's own front side (see draw.py). */
-  bool front = gl_FrontFacing != (item_info.y > 0.5);
+  bool front = SW_FRONT_FACING != (item_info.y > 0.5);
   if (!front) {
     n = -n;
   }

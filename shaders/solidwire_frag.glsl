@@ -94,7 +94,13 @@ void offer_faded(int style, float d_sq, vec3 line, vec2 span, vec2 p, float wire
 #  define OFFER(style, d_sq, line, span, chain)
 #endif
 
+/* The resolve pass (resolve_frag.glsl) calls this for the one pixel it
+ * resolves, after setting every input as a plain global. */
+#ifdef RESOLVE_PASS
+void solidwire_fragment()
+#else
 void main()
+#endif
 {
 #ifdef LINEAR_DEPTH
   /* The render's own float depth buffer holds view depth / clip end: a float
@@ -157,7 +163,7 @@ void main()
    * region's segments takes every line from that block instead; its own
    * edges then only give diagonals. Polygon edges that are not drawn are
    * neither. A quad's edges p2-p3, p3-p0 are NO_EDGE unless it has them. */
-  float half_thickness = half_thickness_at(view_depth, gl_FragCoord.w);
+  float half_thickness = half_thickness_at(view_depth, SW_INV_CLIP_W);
 #ifdef USE_DENSITY_FADE
   float faded[STYLE_COUNT];
   for (int k = 0; k < STYLE_COUNT; k++) {
@@ -394,7 +400,7 @@ void main()
 #endif
 #ifdef WRITE_AOVS
   frag_aov = vec4(d_real, intensity, object_params.normal_matrix0.w, material_pass_index);
-  frag_normal = vec4(gl_FrontFacing ? face_normal : -face_normal, 0.0);
+  frag_normal = vec4(SW_FRONT_FACING ? face_normal : -face_normal, 0.0);
 #endif
 #ifdef DISPLAY_TRANSFORM
   frag_color = display_transform(frag_color);

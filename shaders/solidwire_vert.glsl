@@ -125,10 +125,27 @@ float line_reach(float w0, float w1, float w2)
 }
 #endif
 
-void main()
+/* This corner's normal in view space (one texel per triangle corner, in
+ * draw order; extract.corner_table), and its face's material in w. */
+#ifdef USE_CORNERS
+vec4 corner_shading(int corner_index)
 {
-  int triangle = gl_VertexID / 3;
-  int corner = gl_VertexID - triangle * 3;
+  vec4 corner_data = fetch_texel(corner_table, corner_index);
+  return vec4(mat3(normal_to_view) * corner_data.xyz, corner_data.w);
+}
+#endif
+
+/* The per-corner work. The resolve pass (resolve_frag.glsl) runs it too,
+ * for the provoking corner of the triangle a pixel shows, with
+ * SW_VERTEX_ID standing for gl_VertexID and every output a plain global. */
+#ifdef RESOLVE_PASS
+void solidwire_corner()
+#else
+void main()
+#endif
+{
+  int triangle = SW_VERTEX_ID / 3;
+  int corner = SW_VERTEX_ID - triangle * 3;
   vec4 ids = fetch_texel(triangle_vertices, triangle);
   bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
   bool is_ngon = (edge_flags & IS_NGON) != 0;
@@ -178,6 +195,9 @@ void main()
    * that walks its region's segments) it is where its block starts in
    * `ngon_corners`. */
   vec4 c3 = is_quad ? vertex_clip(ids.w) : c2;
+#  ifdef RESOLVE_PASS
+  sw_corner_clip = mat3x4(c0, c1, c2); /* the resolve pass's barycentrics */
+#  endif
   ngon_corner_start = int(ids.w);
   vec2 w0, w1, w2;
   bool in_front, convex;
@@ -242,10 +262,8 @@ void main()
 #endif
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
 #ifdef USE_CORNERS
-  /* This corner's normal and its face's material (one texel per triangle
-   * corner, in draw order; extract.corner_table). */
-  vec4 corner_data = fetch_texel(corner_table, gl_VertexID);
-  shading_normal = mat3(normal_to_view) * corner_data.xyz;
+  vec4 corner_data = corner_shading(SW_VERTEX_ID);
+  shading_normal = corner_data.xyz;
 #endif
 #ifdef ITEM_COLORS
   /* The object's block of the frame's colour table (core/colors.py). */
@@ -282,5 +300,7 @@ void main()
    * distances are untouched (only z changes). */
   position.z -= DEPTH_BIAS * position.w;
 #endif
+#ifndef RESOLVE_PASS
   gl_Position = position;
+#endif
 }

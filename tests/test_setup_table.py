@@ -1,14 +1,17 @@
-"""The set-up pre-pass (shaders/setup_comp.glsl): the vertex stage of a big
+"""The set-up pre-pass (shaders/setup_comp.glsl): in a direct draw (the
+viewport overlay, the hidden-line and wire passes) the vertex stage of a big
 mesh reads each triangle's edge set-up from a table written once per draw
 instead of setting it up at every corner. Same code path, so the image is
-the same to the bit; forced on for small scenes here."""
+the same to the bit; forced on for small scenes here, with the render's
+surface pass drawn directly (it is deferred otherwise and sets up each
+visible triangle per pixel, tests/test_deferred_surface.py)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from solidwire_addon.core import draw, shaders
+from solidwire_addon.core import draw, passes, shaders
 from tests.support import scenes
 
 
@@ -28,6 +31,7 @@ def _quads_tris_mirrored_shared(scene):
 def _render(scene, path, setup_min, monkeypatch):
     calls = []
     real = draw._run_setup
+    monkeypatch.setattr(passes, "use_deferred_surface", False)
     monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
     monkeypatch.setattr(draw, "_run_setup", lambda *args: (calls.append(1), real(*args)))
     channels = scenes.render_multilayer_exr(scene, path)

@@ -38,6 +38,7 @@ import gpu
 import numpy as np
 
 from solidwire_addon.core import draw as draw_mod
+from solidwire_addon.core import passes
 from solidwire_addon.core import shaders
 from solidwire_addon.core.targets import Targets, read_texture
 from solidwire_addon.core.view import View
@@ -51,6 +52,7 @@ METHODS = ("nvidia2007", "kakadu_clip", "barycentric", "fill_only", "offset_line
 SUPERSAMPLED = {"offset_lines_2x": 2, "offset_lines_4x": 4}
 ALL_METHODS = (
     "exact",
+    "exact_direct",
     "nvidia2007",
     "kakadu_clip",
     "barycentric",
@@ -75,7 +77,7 @@ def base_method(method: str) -> tuple[str, int]:
     """(shader method, supersampling factor) of a benchmark method name."""
     if method in SUPERSAMPLED:
         return "offset_lines", SUPERSAMPLED[method]
-    if method != "exact" and method not in METHODS:
+    if method not in ("exact", "exact_direct") and method not in METHODS:
         raise ValueError(f"unknown SolidWire method {method!r}; one of {ALL_METHODS}")
     return method, 1
 
@@ -186,7 +188,7 @@ def downsample_shader(factor: int):
 
 
 def _draw(items, view, settings, method: str, **kwargs):
-    program = draw_mod.EXACT if method == "exact" else MethodProgram(method)
+    program = draw_mod.EXACT if method in ("exact", "exact_direct") else MethodProgram(method)
     return draw_mod.draw(items, view, settings, program=program, **kwargs)
 
 
@@ -239,6 +241,9 @@ class Renderer:
         target = self.big or self.final
         tw, th = target.size
         draw_view = View(view.view_matrix, view.projection, (0, 0, tw, th))
+        if self.method == "exact":
+            # The add-on's own surface pass: deferred (passes.draw_surface).
+            return passes.draw_surface(target, items, draw_view, settings, cull=cull)
         framebuffer = target.framebuffer()
         with framebuffer.bind():
             framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)

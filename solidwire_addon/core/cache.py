@@ -20,11 +20,21 @@ from .extract import MeshArrays
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
 
+def table_shape(count: int) -> tuple[int, int]:
+    """(width, height) of a table of ``count`` texels: row-major, TABLE_WIDTH
+    texels a row, or the next power of two for a shorter table. Always a
+    power of two wide, so that a shader finds texel i with a shift and a mask
+    (fetch_texel in shaders/edge_geometry.glsl): an integer division runs
+    lane by lane on a CPU rasteriser, ten of them per pixel in the resolve
+    pass."""
+    count = max(count, 1)
+    width = min(1 << (count - 1).bit_length(), TABLE_WIDTH)
+    return width, -(-count // width)
+
+
 def table_texture(rows4: np.ndarray):
-    """(N, 4) float32 -> RGBA32F texture, row-major with TABLE_WIDTH texels a row."""
-    count = max(len(rows4), 1)
-    width = min(count, TABLE_WIDTH)
-    height = -(-count // width)
+    """(N, 4) float32 -> RGBA32F texture laid out by table_shape."""
+    width, height = table_shape(len(rows4))
     buf = gpu.types.Buffer("FLOAT", width * height * 4)
     # Fill through numpy's view of the buffer: one memcpy instead of a
     # per-element Python sequence copy.
@@ -71,6 +81,9 @@ class GPUMesh:
         # The set-up pre-pass's output for big meshes (draw._run_setup), made
         # on first use and rewritten by every draw of the mesh.
         self.setup_table = None
+        self._flag_table = None  # flag_table(), made on first use
+        self._visibility_batch = None  # visibility_batch(), made on first use
+        self._local_positions = positions[:, :3]  # for visibility_batch()
         # What reposition() needs to tell a move of vertices from a new shape.
         self.vertex_count = arrays.vertex_count
         self.quads = arrays.quads
@@ -93,6 +106,44 @@ class GPUMesh:
         )
 
 
+    def flag_table(self):
+        """The edge-flag word of every triangle, as an RG32F texture
+        (table_shape; low 12 bits, the rest: both halves whole
+        numbers that float32 holds exactly, and Blender's Python API uploads
+        only float data): what the deferred surface's resolve pass reads
+        where the direct draw has the per-corner attribute. Made on first
+        use."""
+        if self._flag_table is None:
+            width, height = table_shape(self.triangle_count)
+            buf = gpu.types.Buffer("FLOAT", width * height * 2)
+            view = np.asarray(buf).reshape(-1, 2)
+            flags = np.asarray(self.edge_flags_cpu, dtype=np.int64)
+            view[: self.triangle_count, 0] = flags & 0xFFF
+            view[: self.triangle_count, 1] = flags >> 12
+            view[self.triangle_count :] = 0.0
+            self._flag_table = gpu.types.GPUTexture((width, height), format="RG32F", data=buf)
+            self.gpu_bytes += width * height * 8
+        return self._flag_table
+
+    def visibility_batch(self):
+        """An indexed triangle batch (positions as a vertex attribute, the
+        triangle table as the index buffer) for the deferred surface's
+        visibility pass: each vertex is transformed once, not once per
+        corner, and gl_PrimitiveID numbers the triangles as the triangle
+        table does. Made on first use."""
+        if self._visibility_batch is None:
+            fmt = gpu.types.GPUVertFormat()
+            fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
+            vbo = gpu.types.GPUVertBuf(fmt, len(self._local_positions))
+            vbo.attr_fill("position", self._local_positions)
+            ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=np.ascontiguousarray(self.triangles_cpu[:, :3], dtype=np.int32))
+            self._visibility_batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)
+            self.gpu_bytes += self._visibility_bytes()
+        return self._visibility_batch
+
+    def _visibility_bytes(self) -> int:
+        return len(self._local_positions) * 12 + self.triangle_count * 12
+
     def replace_positions(self, local: np.ndarray, centre, bounds_min, bounds_max, source_positions=None) -> None:
         """New vertex positions, same faces and triangles: only the position
         table is uploaded again (the triangle table, the edge-flag batch and
@@ -100,6 +151,10 @@ class GPUMesh:
         positions = np.zeros((len(local), 4), dtype=np.float32)
         positions[:, :3] = local
         self.positions = table_texture(positions)
+        if self._visibility_batch is not None:
+            self.gpu_bytes -= self._visibility_bytes()
+            self._visibility_batch = None  # made again from the new positions on first use
+        self._local_positions = positions[:, :3]
         self.centre = centre
         self.bounds_min = bounds_min - centre
         self.bounds_max = bounds_max - centre

@@ -19,7 +19,7 @@ from .cache import table_texture
 from .edge_select import EDGE_CLASSES
 from .log import warn_once
 from .settings import pack_params
-from .view import DrawStats, View, outside_frustum_many, translation
+from .view import DrawStats, View, outside_frustum_many, translation, window_rect
 
 
 def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0,
@@ -76,6 +76,7 @@ class ExactProgram:
     supports_ngons = True
     supports_instancing = True
     supports_setup_table = True
+    supports_deferred = True
 
     def shader(self, variant):
         return shaders.get(variant)
@@ -97,6 +98,15 @@ INSTANCING_MIN = 16
 # invocation per triangle, shaders/setup_comp.glsl) instead of from every
 # corner of the vertex stage; below it the dispatch costs more than it saves.
 SETUP_TABLE_MIN = 50_000
+
+# The two stages of the deferred surface (docs/image_model.md §2.5; see
+# passes.render_passes): VISIBILITY records which triangle of which draw
+# each pixel shows, RESOLVE runs the exact fragment stage once per pixel of
+# that record. ``stage=None`` draws directly (one pass, every fragment).
+VISIBILITY, RESOLVE = "visibility", "resolve"
+# Triangle numbers, instances and draw numbers travel as float32 whole
+# numbers in the visibility record: exact below 2^24.
+DEFERRED_MAX = 1 << 24
 
 
 def styled(settings, style, show_wire: bool = True):
@@ -190,6 +200,8 @@ def draw(
     clip_planes=None,
     display=None,
     program=EXACT,
+    stage=None,
+    visibility=None,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
 
@@ -200,7 +212,10 @@ def draw(
     ((6, 4) world-space planes of a viewport's clipping region): fragments
     outside them are discarded. ``display`` (a display_transform.DisplayLUT,
     viewport overlay only): the colour leaves through the scene's colour
-    management (image model §9)."""
+    management (image model §9). ``stage`` VISIBILITY or RESOLVE (with
+    ``visibility``, the texture the first wrote): one half of the deferred
+    surface, see passes.render_passes; both halves must be called with the
+    same items, view and settings so that they number the draws alike."""
     stats = DrawStats()
     if not items:
         return stats
@@ -211,6 +226,10 @@ def draw(
                           material_colors=False)
     if write_aovs:
         variant = replace(variant, write_aovs=True)
+    if stage == RESOLVE:
+        variant = replace(variant, resolve=True, linear_depth=False)
+    elif stage == VISIBILITY:
+        variant = shaders.ShaderVariant(visibility=True, linear_depth=linear_depth)
     clip_rows = None
     if clip_planes is not None:
         variant = replace(variant, clip_planes=True)
@@ -219,6 +238,8 @@ def draw(
     if display is not None:
         variant = replace(variant, display_transform=True)
         extras["display"] = display
+    if visibility is not None:
+        extras["visibility"] = visibility
     if clip_rows is not None:
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
     if variant.shading == shaders.SHADING_MATCAP:
@@ -254,8 +275,8 @@ def draw(
                 pack_params(styled(settings, style, show_wire), view.viewport, view.projection))
         return block
 
-    gpu.state.depth_test_set(depth_test)
-    gpu.state.depth_mask_set(depth_write)
+    gpu.state.depth_test_set("NONE" if stage == RESOLVE else depth_test)
+    gpu.state.depth_mask_set(depth_write and stage != RESOLVE)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
@@ -268,7 +289,13 @@ def draw(
         # Only a mesh drawn once in this pass: its table is then written
         # before its one draw and never rewritten while a draw may still read
         # it (objects sharing a mesh keep the per-corner set-up).
-        setup_ok = getattr(program, "supports_setup_table", False) and _setup_ready()
+        # (The deferred stages set up each visible triangle once per pixel
+        # anyway: no pre-pass.)
+        setup_ok = stage is None and getattr(program, "supports_setup_table", False) and _setup_ready()
+        # Both deferred stages must split and number the draws alike:
+        # instancing does not depend on the stage's variant.
+        instancing = program.supports_instancing and not write_aovs
+        numbering = _DrawNumbers(stage, extras)
         draws_of = {}
         for g in groups:
             draws_of[id(g[0])] = draws_of.get(id(g[0]), 0) + len(g[2])
@@ -278,8 +305,10 @@ def draw(
                 part = [g for g in batch if (setup_ok and not with_ngons and draws_of[id(g[0])] == 1
                                              and _setup_size(g[0])) == setup_table]
                 if part:
-                    _draw_groups(part, replace(variant, ngons=with_ngons, setup_table=setup_table), ubo, settings,
-                                 program, flip, stats, extras, bases)
+                    part_variant = replace(variant, ngons=with_ngons and not variant.visibility,
+                                           setup_table=setup_table)
+                    _draw_groups(part, part_variant, ubo, settings, program, flip, stats, extras, bases,
+                                 instancing=instancing, numbering=numbering)
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
@@ -326,6 +355,8 @@ def bind_display_transform(shader, display) -> None:
 
 
 def _bind_mesh(shader, variant, mesh) -> None:
+    if variant.visibility:
+        return  # its batch holds what it reads (cache.GPUMesh.visibility_batch)
     shader.uniform_sampler("vertex_positions", mesh.positions)
     shader.uniform_sampler("triangle_vertices", mesh.triangles)
     if variant.ngons:
@@ -334,19 +365,78 @@ def _bind_mesh(shader, variant, mesh) -> None:
         shader.uniform_sampler("corner_table", mesh.corners)
 
 
+class _DrawNumbers:
+    """Numbers the draw calls of a deferred stage (1, 2, ...; 0 is "nothing
+    drawn here" in the visibility record) and makes each call: the
+    visibility stage draws the mesh's triangles, the resolve stage a
+    rectangle over the draw's window box. A direct draw (stage None) just
+    draws the batch."""
+
+    def __init__(self, stage, extras):
+        self.stage, self.extras, self.count = stage, extras, 0
+
+    def bind(self, shader) -> None:
+        if self.stage == RESOLVE:
+            shader.uniform_sampler("visibility", self.extras["visibility"])
+
+    def draw(self, shader, mesh, batch, object_to_clip, instance_count: int = 0) -> None:
+        if self.stage is None:
+            if instance_count:
+                batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
+            else:
+                batch.draw(shader)
+            return
+        self.count += 1
+        shader.uniform_int("draw_number", self.count)
+        if self.stage == VISIBILITY:
+            batch = mesh.visibility_batch()
+            if instance_count:
+                batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
+            else:
+                batch.draw(shader)
+            return
+        shader.uniform_float("resolve_rect", window_rect(object_to_clip, mesh.bounds_min, mesh.bounds_max))
+        shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
+        _rectangle().draw(shader)
+
+
+_rectangles: list = []
+
+
+def _rectangle():
+    """Two triangles over a rectangle (corner bits: x = 1, y = 2); see
+    resolve_vert.glsl. Made once."""
+    if not _rectangles:
+        fmt = gpu.types.GPUVertFormat()
+        fmt.attr_add(id="rect_corner", comp_type="I32", len=1, fetch_mode="INT")
+        vbo = gpu.types.GPUVertBuf(fmt, 6)
+        vbo.attr_fill("rect_corner", [0, 1, 3, 0, 3, 2])
+        _rectangles.append(gpu.types.GPUBatch(type="TRIS", buf=vbo))
+    return _rectangles[0]
+
+
+def release_rectangle() -> None:
+    """Drop the resolve pass's rectangle (add-on unregister frees every GPU object)."""
+    _rectangles.clear()
+
+
 def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats, extras=None,
-                 bases=None) -> None:
+                 bases=None, *, instancing: bool = True, numbering=None) -> None:
     """Draw (mesh, style, world, object_to_view, object_to_clip, item
     indices, pass data) groups with one shader variant: per object, or
     instanced for meshes with many instances. ``ubo(style)`` is the
-    parameter block of a style."""
+    parameter block of a style; ``numbering`` makes the draw calls
+    (_DrawNumbers)."""
     extras = extras or {}
+    numbering = numbering or _DrawNumbers(None, extras)
+    resolving = numbering.stage == RESOLVE
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
     shader.bind()
     bound = None
     shader.uniform_block("params", ubo(bound))
     _bind_extras(shader, variant, extras)
+    numbering.bind(shader)
     instanced = []  # (mesh, style, object_to_view, object_to_clip, info, mirrored) drawn with draw_instanced
     # (mesh, style, world, object_to_view, object_to_clip, info, mirrored, pass index, materials) drawn one by one
     single = []
@@ -358,7 +448,7 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
         info_all[:, 1] = mirrored_all
         # (The instanced variant has no per-object pass values: with passes
         # every object is drawn on its own.)
-        if program.supports_instancing and len(world) >= INSTANCING_MIN and not variant.write_aovs:
+        if instancing and len(world) >= INSTANCING_MIN:
             if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
                 for side in (False, True):
                     pick = mirrored_all == side
@@ -393,7 +483,7 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             if style is not bound:
                 bound = style
                 shader.uniform_block("params", ubo(style))
-            if settings.use_backface_culling:
+            if settings.use_backface_culling and not resolving:
                 gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
             if variant.write_aovs:
                 object_block = _set_object_block(shader, object_block, world, bool(mirrored), pass_index)
@@ -404,11 +494,11 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             if variant.per_item:
                 shader.uniform_int("item_slot", slot)
             _bind_mesh(shader, variant, mesh)
-            program.batch(mesh).draw(shader)
+            numbering.draw(shader, mesh, program.batch(mesh), object_to_clip)
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
-        _draw_instanced(instanced, variant, ubo, settings, stats, extras)
+        _draw_instanced(instanced, variant, ubo, settings, stats, extras, numbering)
 
 
 _UNBOUND = object()
@@ -502,7 +592,7 @@ def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_ind
     return block
 
 
-def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras=None) -> None:
+def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras, numbering) -> None:
     """One draw_instanced call per (mesh, style, facing) group; every
     instance's matrices in one float texture for the whole frame."""
     shader = shaders.get(replace(variant, instanced=True, setup_table=False))
@@ -513,17 +603,18 @@ def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras=Non
     shader.uniform_block("params", ubo(bound))
     shader.uniform_sampler("instance_table", table)
     _bind_extras(shader, variant, extras or {})
+    numbering.bind(shader)
     base = 0
     for mesh, style, _o2v, object_to_clip, _info, mirrored in groups:
         count = len(object_to_clip)
         if style is not bound:
             bound = style
             shader.uniform_block("params", ubo(style))
-        if settings.use_backface_culling:
+        if settings.use_backface_culling and numbering.stage != RESOLVE:
             gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
         shader.uniform_int("instance_base", base)
         _bind_mesh(shader, variant, mesh)
-        mesh.batch.draw_instanced(shader, instance_start=0, instance_count=count)
+        numbering.draw(shader, mesh, mesh.batch, object_to_clip, instance_count=count)
         base += count * shaders.INSTANCE_TEXELS
         stats.objects_drawn += count
         stats.triangles_drawn += count * mesh.triangle_count

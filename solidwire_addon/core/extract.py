@@ -737,6 +737,40 @@ def read_corner_inputs(mesh) -> tuple[np.ndarray, np.ndarray]:
     return normals, materials
 
 
+def _triangle_corners(arrays: MeshArrays, polygons: np.ndarray, corner_vert: np.ndarray,
+                      face_offsets: np.ndarray) -> np.ndarray:
+    """(3T,) int64: for each corner of each drawn triangle the polygon corner
+    with that vertex (the first one, in corner order), -1 where none is.
+
+    Tris and quads compare the triangle's vertices with their polygon's (at
+    most four) corners directly: a few vectorised comparisons where a sort
+    of every corner took most of a first render's extraction. N-gon
+    triangles look theirs up in the sorted (polygon, vertex) keys."""
+    vertices = arrays.triangles[:, :3]
+    starts = face_offsets[polygons]
+    sizes = face_offsets[polygons + 1] - starts
+    corner = np.full(vertices.shape, -1, dtype=np.int64)
+    last = max(len(corner_vert) - 1, 0)
+    small = sizes <= 4
+    for k in range(4):
+        candidate = starts + k
+        at_k = corner_vert[np.minimum(candidate, last)]
+        match = ((k < sizes) & small)[:, None] & (at_k[:, None] == vertices) & (corner < 0)
+        np.copyto(corner, candidate[:, None], where=match)
+    rest = np.flatnonzero(sizes > 4)
+    if len(rest):
+        vertex_count = np.int64(max(arrays.vertex_count, 1))
+        all_sizes = np.diff(face_offsets)
+        corner_face = np.repeat(np.arange(len(all_sizes), dtype=np.int64), all_sizes)
+        keys = corner_face * vertex_count + corner_vert.astype(np.int64)
+        order = np.argsort(keys, kind="stable")
+        sorted_keys = keys[order]
+        wanted = (polygons[rest, None] * vertex_count + vertices[rest].astype(np.int64)).reshape(-1)
+        at = np.minimum(np.searchsorted(sorted_keys, wanted), len(sorted_keys) - 1)
+        corner[rest] = np.where(sorted_keys[at] == wanted, order[at], -1).reshape(-1, 3)
+    return corner.reshape(-1)
+
+
 def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray,
                  normals: np.ndarray, materials: np.ndarray) -> np.ndarray:
     """(3T, 4) float32: for each corner of each drawn triangle (the order of
@@ -751,18 +785,10 @@ def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     table = np.zeros((3 * count, 4), dtype=np.float32)
     if count == 0:
         return table
-    vertex_count = np.int64(max(arrays.vertex_count, 1))
-    sizes = np.diff(face_offsets).astype(np.int64)
-    corner_face = np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
-    keys = corner_face * vertex_count + corner_vert.astype(np.int64)
-    order = np.argsort(keys, kind="stable")
-    sorted_keys = keys[order]
     polygons = arrays.triangle_polygons.astype(np.int64)
-    wanted = (polygons[:, None] * vertex_count + arrays.triangles[:, :3].astype(np.int64)).reshape(-1)
-    at = np.minimum(np.searchsorted(sorted_keys, wanted), len(sorted_keys) - 1)
-    corner = order[at]
-    found = sorted_keys[at] == wanted
-    table[:, :3] = np.where(found[:, None], normals[corner], 0.0)
+    corner = _triangle_corners(arrays, polygons, np.asarray(corner_vert), np.asarray(face_offsets, dtype=np.int64))
+    found = corner >= 0
+    table[:, :3] = np.where(found[:, None], normals[np.where(found, corner, 0)], 0.0)
     material = materials[polygons] if len(materials) else np.zeros(count, np.int32)
     table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
     return table

@@ -22,9 +22,10 @@ from dataclasses import dataclass, replace
 import gpu
 import numpy as np
 
-from . import colors, edge_select
+from . import colors, edge_select, shaders
 from . import draw as draw_mod
 from . import silhouettes
+from .log import warn_once
 from .targets import BACKGROUND_DEPTH, read_texture, targets_for
 from .view import View
 
@@ -97,21 +98,8 @@ def render_passes(items, view: View, settings, *, cull: bool = True, extra_passe
     targets = targets_for(width, height)
     steps = plan(settings)
     stats = None
-    framebuffer = targets.framebuffer(aovs=aovs)
-    with framebuffer.bind():
-        # A clear honours the depth write mask, and GPU state lives per GL
-        # context: a previous frame drawn in this context may have left depth
-        # writes off, which left the old depth in place (wrong occlusion in
-        # the next render drawn in that context).
-        gpu.state.depth_mask_set(True)
-        gpu.state.color_mask_set(True, True, True, True)
-        gpu.state.blend_set("NONE")
-        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
-        gpu.state.viewport_set(0, 0, width, height)
-        stats = draw_mod.draw(items, view, steps[0].settings, write_view_depth=True, cull=cull,
-                              show_wire=steps[0].show_wire, write_aovs=aovs, linear_depth=True)
-        gpu.state.depth_test_set("NONE")
-        gpu.state.depth_mask_set(False)
+    surface = steps[0]
+    stats = draw_surface(targets, items, view, surface.settings, show_wire=surface.show_wire, aovs=aovs, cull=cull)
     blended = [step for step in steps[1:] if step.kind in (HIDDEN, WIRE)]
     if blended:
         # A framebuffer without the view-depth target: blended passes must
@@ -143,6 +131,80 @@ def render_passes(items, view: View, settings, *, cull: bool = True, extra_passe
     if any(step.kind == SILHOUETTES for step in steps):
         rgba = _composite_silhouettes(rgba, targets, items, view, settings)
     return rgba, depth, stats, {name: value for name, value in extra.items() if name in extra_passes}
+
+
+def _clear(framebuffer, width: int, height: int, depth: bool = True) -> None:
+    # A clear honours the depth write mask, and GPU state lives per GL
+    # context: a previous frame drawn in this context may have left depth
+    # writes off, which left the old depth in place (wrong occlusion in the
+    # next render drawn in that context).
+    gpu.state.depth_mask_set(depth)
+    gpu.state.color_mask_set(True, True, True, True)
+    gpu.state.blend_set("NONE")
+    if depth:
+        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+    else:
+        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0))
+    gpu.state.viewport_set(0, 0, width, height)
+
+
+# Off only to measure the direct surface pass against it (scripts/bench).
+use_deferred_surface = True
+
+
+def deferred_surface(items) -> bool:
+    """Whether the render's surface pass runs deferred (docs/image_model.md
+    §2.5): always, unless a number it records would not be exact in float32
+    (a mesh of 2^24 triangles or more, or as many instances or draws)."""
+    if not use_deferred_surface or not shaders.deferred_available():
+        return False
+    if len(items) >= draw_mod.DEFERRED_MAX:
+        return False
+    return all(item.mesh.triangle_count < draw_mod.DEFERRED_MAX for item in items)
+
+
+def draw_surface(targets, items, view: View, settings, *, show_wire: bool = True, aovs: bool = False,
+                 cull: bool = True):
+    """The surface pass into ``targets`` (cleared first): depth, the fill
+    and the visible wire, and the render passes' outputs with ``aovs``.
+    Deferred where it can be (deferred_surface), else drawn directly; the
+    same image either way. Returns the DrawStats."""
+    width, height = view.width, view.height
+    surface_args = {"cull": cull, "show_wire": show_wire, "write_aovs": aovs, "linear_depth": True}
+    if deferred_surface(items):
+        try:
+            return _deferred_surface(targets, items, view, settings, aovs, surface_args)
+        except shaders.DeferredUnavailable as exc:
+            shaders.disable_deferred()
+            warn_once(("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); "
+                                     "drawing directly")
+    framebuffer = targets.framebuffer(aovs=aovs)
+    with framebuffer.bind():
+        _clear(framebuffer, width, height)
+        stats = draw_mod.draw(items, view, settings, write_view_depth=True, **surface_args)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+    return stats
+
+
+def _deferred_surface(targets, items, view: View, settings, aovs: bool, surface_args: dict):
+    """The surface pass in two stages: which triangle each pixel shows
+    (depth test, no shading), then the exact fragment stage once per pixel
+    shown. Same depth, same image as the direct pass; the edge set-up runs
+    once per visible pixel instead of at every corner of every triangle."""
+    width, height = view.width, view.height
+    framebuffer = targets.visibility_framebuffer()
+    with framebuffer.bind():
+        _clear(framebuffer, width, height)
+        stats = draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY, **surface_args)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+    framebuffer = targets.resolve_framebuffer(aovs=aovs)
+    with framebuffer.bind():
+        _clear(framebuffer, width, height, depth=False)
+        draw_mod.draw(items, view, settings, stage=draw_mod.RESOLVE, visibility=targets.visible,
+                      write_view_depth=True, **surface_args)
+    return stats
 
 
 def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:

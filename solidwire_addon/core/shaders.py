@@ -102,6 +102,12 @@ class ShaderVariant:
     # (SETUP_TABLE, shaders/setup_comp.glsl) instead of setting it up at
     # every corner.
     setup_table: bool = False
+    # The deferred surface (docs/image_model.md §2.5): ``visibility`` is the
+    # pass that only records which triangle each pixel shows (it reads just
+    # ``instanced`` and ``linear_depth`` of the variant); ``resolve`` is the
+    # exact path's fragment stage run once per pixel over that record.
+    visibility: bool = False
+    resolve: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -205,8 +211,35 @@ def output_and_feature_defines(info, variant: ShaderVariant) -> None:
         info.define("USE_FADE", "1")
 
 
+class _Interface:
+    """The varyings of the exact path, declared once: handed to a
+    GPUStageInterfaceInfo for the two-stage program, or declared as plain
+    globals for the resolve pass, which runs both stages' code in one
+    fragment shader (resolve_frag.glsl)."""
+
+    def __init__(self):
+        self.entries = []  # (interpolation, type, name)
+
+    def flat(self, kind: str, name: str) -> None:
+        self.entries.append(("flat", kind, name))
+
+    def smooth(self, kind: str, name: str) -> None:
+        self.entries.append(("smooth", kind, name))
+
+    def stage_interface(self):
+        iface = gpu.types.GPUStageInterfaceInfo("solidwire_iface")
+        for interpolation, kind, name in self.entries:
+            getattr(iface, interpolation)(kind, name)
+        return iface
+
+    def globals_glsl(self) -> str:
+        return "".join(f"{kind.lower()} {name};\n" for _interpolation, kind, name in self.entries)
+
+
 def _create_info(variant: ShaderVariant):
-    iface = gpu.types.GPUStageInterfaceInfo("solidwire_iface")
+    if variant.visibility:
+        return _visibility_create_info(variant)
+    iface = _Interface()
     for i in range(EDGE_COUNT):
         iface.flat("VEC3", f"edge_line{i}")
         iface.flat("VEC2", f"edge_span{i}")
@@ -242,13 +275,25 @@ def _create_info(variant: ShaderVariant):
         info.define("SETUP_TABLE", "1")
         info.define("SETUP_TEXELS", str(SETUP_TEXELS))
         info.define("SETUP_ROW_TRIANGLES", str(SETUP_ROW_TRIANGLES))
-    info.vertex_in(0, "INT", "edge_flags")
-    info.vertex_out(iface)
+    if variant.resolve:
+        # One rectangle per draw; the triangle comes from the visibility
+        # record, its edge flags from a table (the batch's attribute is
+        # per corner, out of a fragment stage's reach).
+        info.vertex_in(0, "INT", "rect_corner")
+        info.push_constant("INT", "draw_number")
+        info.push_constant("VEC4", "resolve_rect")
+        info.sampler(RESOLVE_VISIBILITY_SLOT, "FLOAT_2D", "visibility")
+        info.sampler(RESOLVE_FLAGS_SLOT, "FLOAT_2D", "triangle_flag_table")
+        info.define("RESOLVE_PASS", "1")
+    else:
+        info.vertex_in(0, "INT", "edge_flags")
     output_and_feature_defines(info, variant)
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
     if variant.linear_depth:
+        if variant.resolve:
+            raise ValueError("the resolve pass writes no depth (the visibility pass did)")
         info.define("LINEAR_DEPTH", "1")
         compat.depth_write(info, "ANY")
     if variant.ngons:
@@ -269,7 +314,38 @@ def _create_info(variant: ShaderVariant):
         # replaces the one pulling_info set).
         info.typedef_source(schema.param_block_glsl() + (OBJECT_BLOCK_GLSL if variant.write_aovs else "")
                             + (CLIP_BLOCK_GLSL if variant.clip_planes else ""))
-    _add_sources(info, variant)
+    if not variant.resolve:
+        info.vertex_out(iface.stage_interface())  # last: the steps above add varyings
+    _add_sources(info, variant, iface)
+    return info
+
+
+def _visibility_create_info(variant: ShaderVariant):
+    """The visibility pass (visibility_vert.glsl): positions pulled as the
+    exact path pulls them, depth as it writes it, and per pixel the
+    triangle, instance and draw that won the depth test."""
+    iface = gpu.types.GPUStageInterfaceInfo("solidwire_visibility_iface")
+    iface.smooth("FLOAT", "view_depth")
+    info = pulling_info(push_matrices=not variant.instanced)
+    info.push_constant("INT", "draw_number")
+    if variant.instanced:
+        iface.flat("FLOAT", "visible_instance")
+        info.push_constant("INT", "instance_base")
+        info.sampler(3, "FLOAT_2D", "instance_table")
+    info.vertex_in(0, "VEC3", "position")
+    info.vertex_out(iface)
+    info.fragment_out(0, "VEC4", "frag_visible")
+    if not variant.linear_depth:
+        raise ValueError("the visibility pass is for the render's linear depth")
+    compat.depth_write(info, "ANY")
+    if variant.instanced:
+        info.define("SW_INSTANCED", "1")
+        prologue = (f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
+                    + read_source("instancing.glsl") + read_source("edge_geometry.glsl"))
+    else:
+        prologue = ""
+    info.vertex_source(prologue + read_source("visibility_vert.glsl"))
+    info.fragment_source(read_source("visibility_frag.glsl"))
     return info
 
 
@@ -339,21 +415,49 @@ def _add_render_pass_outputs(info, iface) -> None:
     iface.flat("VEC3", "face_normal")
 
 
-def _add_sources(info, variant: ShaderVariant) -> None:
-    """The GLSL files of the exact path, in the order each stage needs them."""
+def _add_sources(info, variant: ShaderVariant, iface: _Interface) -> None:
+    """The GLSL files of the exact path, in the order each stage needs them.
+    The SW_ names stand for the builtins a stage reads (resolve_frag.glsl
+    supplies its own)."""
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
     styles = read_source("line_style.glsl") + read_source("edge_styles.glsl")
     fill = read_source("fill_shading.glsl")
     if variant.instanced:
         instancing = read_source("instancing.glsl")
-        info.vertex_source(_INSTANCE_SLOT_VERT + instancing + common + styles + read_source("solidwire_vert.glsl"))
-        info.fragment_source(_INSTANCE_SLOT_FRAG + instancing + common + styles + fill + _display_source(variant)
-                             + read_source("solidwire_frag.glsl"))
+        vertex_head = _INSTANCE_SLOT_VERT + instancing
+        fragment_head = _INSTANCE_SLOT_FRAG + instancing
     else:
-        items = read_source("item_table.glsl") if variant.per_item else ""
-        info.vertex_source(items + common + styles + read_source("solidwire_vert.glsl"))
-        info.fragment_source(items + common + styles + fill + _display_source(variant)
-                             + read_source("solidwire_frag.glsl"))
+        vertex_head = fragment_head = read_source("item_table.glsl") if variant.per_item else ""
+    fragment_tail = fill + _display_source(variant) + read_source("solidwire_frag.glsl")
+    if variant.resolve:
+        instance_slot = (f"#define SW_INSTANCE_SLOT (instance_slot = instance_base + {INSTANCE_TEXELS} * sw_instance_id)\n"
+                         if variant.instanced else "")
+        info.vertex_source(read_source("resolve_vert.glsl"))
+        info.fragment_source(_RESOLVE_GLOBALS + iface.globals_glsl() + instance_slot
+                             + (instancing if variant.instanced else vertex_head) + common + styles
+                             + read_source("solidwire_vert.glsl") + fragment_tail + read_source("resolve_frag.glsl"))
+        return
+    info.vertex_source("#define SW_VERTEX_ID gl_VertexID\n" + vertex_head + common + styles
+                       + read_source("solidwire_vert.glsl"))
+    info.fragment_source("#define SW_FRONT_FACING gl_FrontFacing\n#define SW_INV_CLIP_W gl_FragCoord.w\n"
+                         + fragment_head + common + styles + fragment_tail)
+
+
+# The resolve pass's stand-ins for the vertex stage's inputs and the
+# fragment stage's builtins (set by resolve_frag.glsl before each call).
+_RESOLVE_GLOBALS = """int edge_flags;
+int sw_vertex_id;
+int sw_instance_id;
+bool sw_front_facing;
+float sw_inv_clip_w;
+mat3x4 sw_corner_clip;
+#define SW_VERTEX_ID sw_vertex_id
+#define SW_FRONT_FACING sw_front_facing
+#define SW_INV_CLIP_W sw_inv_clip_w
+"""
+# Sampler slots of the resolve pass, above the set-up table's.
+RESOLVE_VISIBILITY_SLOT = 10
+RESOLVE_FLAGS_SLOT = 11
 
 
 # Per-object values of the render passes (std140): the columns of the normal
@@ -381,13 +485,37 @@ _INSTANCE_SLOT_VERT = f"#define SW_INSTANCE_SLOT (instance_slot = instance_base 
 _INSTANCE_SLOT_FRAG = "#define SW_INSTANCE_SLOT instance_slot\n"
 
 
+class DeferredUnavailable(RuntimeError):
+    """A stage of the deferred surface does not compile here."""
+
+
 def get(variant: ShaderVariant):
     """The compiled shader for ``variant`` (compiled once, then cached)."""
     key = (_context, variant)
     shader = _cache.get(key)
     if shader is None:
-        shader = _keep(_cache, key, gpu.shader.create_from_info(_create_info(variant)))
+        try:
+            shader = _keep(_cache, key, gpu.shader.create_from_info(_create_info(variant)))
+        except Exception as exc:
+            if variant.visibility or variant.resolve:
+                raise DeferredUnavailable(str(exc)) from exc
+            raise
     return shader
+
+
+_deferred_support = [True]
+
+
+def deferred_available() -> bool:
+    """Whether the deferred surface is still in use in this process (see
+    disable_deferred)."""
+    return _deferred_support[0]
+
+
+def disable_deferred() -> None:
+    """Never use the deferred surface again in this process (a stage failed
+    to compile): the direct surface pass draws the same image."""
+    _deferred_support[0] = False
 
 
 _setup_support: list = []

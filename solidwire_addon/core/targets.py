@@ -36,6 +36,20 @@ class Targets:
         self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
         self.outer = self.outer_depth = None  # silhouette targets, made on first use
         self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
+        self.visible = None  # the deferred surface's visibility record, made on first use
+
+    def visibility_framebuffer(self):
+        """The deferred surface's first stage: the visibility record
+        (RGBA32F: triangle + 1, instance, draw number, view depth) over the
+        depth buffer."""
+        if self.visible is None:
+            self.visible = gpu.types.GPUTexture(self.size, format="RGBA32F")
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.visible,))
+
+    def resolve_framebuffer(self, aovs: bool = False):
+        """The deferred surface's second stage: the colour targets of
+        :meth:`framebuffer` without depth (the first stage wrote it)."""
+        return gpu.types.GPUFrameBuffer(color_slots=self._color_slots(aovs))
 
     def framebuffer(self, aovs: bool = False):
         """A framebuffer over the textures. Made per use: textures are shared
@@ -43,13 +57,16 @@ class Targets:
         engine's context differs from the one scripts draw in. With ``aovs``
         the render passes' two targets too (RGBA32F: d_real, I_vis, object
         index; world normal), created on first use."""
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self._color_slots(aovs))
+
+    def _color_slots(self, aovs: bool) -> tuple:
         slots = (self.color, self.view_depth)
         if aovs:
             if self.aov is None:
                 self.aov = gpu.types.GPUTexture(self.size, format="RGBA32F")
                 self.normal = gpu.types.GPUTexture(self.size, format="RGBA32F")
             slots += (self.aov, self.normal)
-        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=slots)
+        return slots
 
     def hidden_framebuffer(self):
         """The Hidden Wire pass's own colour target over the surface depth."""

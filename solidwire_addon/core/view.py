@@ -83,3 +83,21 @@ def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max) -> 
     x, y, z, w = np.moveaxis(clip, 2, 0)
     outside = (x > w).all(1) | (x < -w).all(1) | (y > w).all(1) | (y < -w).all(1) | (z > w).all(1) | (z < -w).all(1)
     return outside
+
+
+def window_rect(object_to_clip: np.ndarray, bounds_min, bounds_max) -> tuple:
+    """(x0, y0, x1, y1) in NDC: a rectangle holding every pixel the boxes of
+    (N, 4, 4) ``object_to_clip`` can cover, widened by a pixel's worth of
+    slack for rounding and clamped to the view; the whole view when a box
+    reaches behind the camera (no finite projection there)."""
+    lo, hi = np.asarray(bounds_min), np.asarray(bounds_max)
+    corners = _BOX_CORNERS.copy()
+    corners[:, :3] = lo + corners[:, :3] * (hi - lo)
+    clip = np.einsum("kj,nij->nki", corners, np.asarray(object_to_clip).reshape(-1, 4, 4)).reshape(-1, 4)
+    w = clip[:, 3]
+    if not len(w) or (w <= 1e-6 * np.abs(clip[:, :3]).max(initial=1.0)).any():
+        return (-1.0, -1.0, 1.0, 1.0)
+    ndc = clip[:, :2] / w[:, None]
+    x0, y0 = np.clip(ndc.min(axis=0) - 0.01, -1.0, 1.0)
+    x1, y1 = np.clip(ndc.max(axis=0) + 0.01, -1.0, 1.0)
+    return (float(x0), float(y0), float(x1), float(y1))

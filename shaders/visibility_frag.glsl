@@ -1,0 +1,15 @@
+/* Visibility pass (visibility_vert.glsl): depth exactly as the exact path
+ * writes it, and per pixel (triangle + 1, instance, draw number, view
+ * depth). Whole numbers below 2^24 are exact in float32; bigger meshes stay
+ * on the direct path (passes.deferred_surface). */
+
+void main()
+{
+  gl_FragDepth = view_depth * params.inv_clip_end; /* see LINEAR_DEPTH in solidwire_frag.glsl */
+#ifdef SW_INSTANCED
+  float instance = visible_instance;
+#else
+  float instance = 0.0;
+#endif
+  frag_visible = vec4(float(gl_PrimitiveID + 1), instance, float(draw_number), view_depth);
+}

@@ -1,0 +1,17 @@
+/* Visibility pass of the deferred surface (docs/image_model.md §2.5): the
+ * rasteriser only decides which triangle each pixel shows. An indexed batch
+ * (cache.GPUMesh.visibility_batch): each vertex is transformed once, with
+ * the exact path's own expression (so the same coverage and depth), and
+ * hands on nothing but the view depth (and its instance); gl_PrimitiveID
+ * numbers the triangle. The per-triangle edge set-up, which dominates a
+ * dense mesh's frame on a software rasteriser, moves to the resolve pass
+ * and runs once per pixel instead of at every corner. */
+
+void main()
+{
+  view_depth = -dot(object_to_view_z, vec4(position, 1.0));
+#ifdef SW_INSTANCED
+  visible_instance = float(gl_InstanceID);
+#endif
+  gl_Position = object_to_clip * vec4(position, 1.0); /* as vertex_clip() */
+}

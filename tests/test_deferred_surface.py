@@ -1,0 +1,153 @@
+"""The deferred surface pass (docs/image_model.md §2.5): the render first
+records which triangle each pixel shows, then runs the exact fragment stage
+once per recorded pixel. It must give the direct pass's image: the same
+depth to the bit (the same rasterisation), the same wire and fill up to
+float32 rounding (the flat inputs come from the same code; 1/w, facing and
+the smooth normal are computed from the triangle instead of interpolated by
+the rasteriser), and every render pass alike."""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+import pytest
+
+from solidwire_addon.core import draw, passes, shaders
+from tests.support import scenes
+from tests.test_render_passes import _enable_all
+
+# Colour and render passes: the same up to float32 rounding of the
+# analytically interpolated normal and 1/w (far below 1/255).
+COLOUR_TOLERANCE = 2e-5
+
+
+def _stages(monkeypatch):
+    """Record the stage of every draw.draw call."""
+    calls = []
+    real = draw.draw
+
+    def spy(*args, **kwargs):
+        calls.append(kwargs.get("stage"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(draw, "draw", spy)
+    return calls
+
+
+def _render_both(scene, path, monkeypatch):
+    """(direct channels, deferred channels) of one multilayer EXR render
+    each, and the stages the deferred render drew."""
+    calls = _stages(monkeypatch)
+    monkeypatch.setattr(passes, "use_deferred_surface", False)
+    direct = scenes.render_multilayer_exr(scene, path.with_name(path.stem + "_direct.exr"))
+    assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
+    calls.clear()
+    monkeypatch.setattr(passes, "use_deferred_surface", True)
+    deferred = scenes.render_multilayer_exr(scene, path.with_name(path.stem + "_deferred.exr"))
+    return direct, deferred, list(calls)
+
+
+def _assert_same(direct: dict, deferred: dict) -> None:
+    assert direct.keys() == deferred.keys()
+    for name, values in direct.items():
+        if name.endswith(".Z") or name.endswith(".Depth.Z") or "Depth" in name:
+            np.testing.assert_array_equal(deferred[name], values, err_msg=name)
+        else:
+            np.testing.assert_allclose(deferred[name], values, rtol=0.0, atol=COLOUR_TOLERANCE, err_msg=name)
+
+
+def _mixed_scene(scene):
+    """Tris, quads, n-gons, a mesh shared by a mirrored twin, edges through
+    the near plane, and enough copies of one mesh to be drawn instanced."""
+    scenes.near_plane_scene(scene)
+    shared = scenes.monkey(scene, "Left", location=(-1.5, 4.0, 0.8))
+    twin = shared.copy()
+    twin.name = "Right"
+    twin.location = (2.5, 5.0, 0.8)
+    twin.scale = (-1.0, 1.0, 1.0)
+    scene.collection.objects.link(twin)
+    hexagon = scenes.from_pydata(
+        scene, "Hexagon", [(np.cos(a), np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]],
+        [tuple(range(6))], location=(-2.0, 6.0, 2.0), rotation_euler=(1.2, 0.3, 0.0),
+    )
+    hexagon.data.materials.append(bpy.data.materials.new("Red"))
+    rng = np.random.default_rng(7)
+    box = scenes.cube(scene, "Box", size=0.3, location=(0.0, 6.0, 0.3))
+    for i in range(draw.INSTANCING_MIN + 2):
+        copy = bpy.data.objects.new(f"Box{i}", box.data)
+        scene.collection.objects.link(copy)
+        copy.location = (rng.uniform(-3.0, 3.0), rng.uniform(4.0, 9.0), rng.uniform(0.0, 2.5))
+        copy.rotation_euler = rng.uniform(0.0, 6.0, 3)
+        copy.scale = (1.0, -1.0 if i % 3 == 0 else 1.0, 1.0)
+
+
+LOOKS = {
+    "wire_only": {},
+    "studio_fill": dict(use_fill=True, fill_shading="STUDIO", diagonal_mode="DASHED"),
+    "matcap_materials": dict(use_fill=True, fill_shading="MATCAP", fill_color_source="MATERIAL",
+                             wire_color_source="RANDOM"),
+    "world_thickness_fade_culling": dict(thickness_mode="WORLD", use_fade=True, use_backface_culling=True,
+                                          use_fill=True),
+    "classes_density_angle": dict(use_boundary_edges=True, use_sharp_edges=True, use_density_fade=True,
+                                  edge_angle=20.0, use_fill=True),
+    "hidden_lines_silhouettes": dict(use_hidden_lines=True, use_silhouettes=True, use_fill=True),
+}
+
+
+@pytest.mark.parametrize("look", sorted(LOOKS))
+def test_deferred_surface_gives_the_direct_image(look, output_dir, monkeypatch):
+    scene = scenes.empty_scene(200, 150, **LOOKS[look])
+    _mixed_scene(scene)
+    _enable_all(scene.view_layers[0])
+    direct, deferred, stages = _render_both(scene, output_dir / f"deferred_{look}.exr", monkeypatch)
+    assert stages[:2] == [draw.VISIBILITY, draw.RESOLVE]
+    combined = next(name for name in direct if name.endswith("Combined.A"))
+    assert (direct[combined] > 0.0).sum() > 2000  # something was drawn
+    _assert_same(direct, deferred)
+
+
+def test_deferred_surface_with_an_orthographic_camera(output_dir, monkeypatch):
+    scene = scenes.empty_scene(160, 120, use_fill=True, fill_shading="STUDIO")
+    scenes.ortho_scene(scene)
+    direct, deferred, stages = _render_both(scene, output_dir / "deferred_ortho.exr", monkeypatch)
+    assert draw.RESOLVE in stages
+    _assert_same(direct, deferred)
+
+
+def test_a_deferred_stage_that_does_not_compile_falls_back_to_the_direct_pass(output_dir, monkeypatch, capsys):
+    """A backend whose compiler refuses a deferred stage draws the same image
+    with the direct pass, says so once, and does not try again."""
+    scene = scenes.empty_scene(120, 90, use_fill=True)
+    _mixed_scene(scene)
+    monkeypatch.setattr(passes, "use_deferred_surface", False)
+    expected = scenes.render_multilayer_exr(scene, output_dir / "deferred_fallback_expected.exr")
+    monkeypatch.setattr(passes, "use_deferred_surface", True)
+    real_get = shaders.get
+
+    def refuse_resolve(variant):
+        if variant.resolve:
+            raise shaders.DeferredUnavailable("resolve refused")
+        return real_get(variant)
+
+    monkeypatch.setattr(shaders, "get", refuse_resolve)
+    monkeypatch.setattr(shaders, "_deferred_support", [True])
+    got = scenes.render_multilayer_exr(scene, output_dir / "deferred_fallback.exr")
+    assert shaders.deferred_available() is False
+    assert "deferred surface pass is not available" in capsys.readouterr().err
+    for name, values in expected.items():
+        np.testing.assert_array_equal(got[name], values, err_msg=name)
+
+
+def test_numbers_beyond_float32_whole_numbers_keep_the_direct_pass(monkeypatch):
+    """Triangle, instance and draw numbers travel as float32 whole numbers:
+    an item set that would overflow them is drawn directly."""
+
+    class Mesh:
+        triangle_count = draw.DEFERRED_MAX
+
+    class Item:
+        mesh = Mesh()
+
+    assert passes.deferred_surface([Item()]) is False
+    Mesh.triangle_count = draw.DEFERRED_MAX - 1
+    assert passes.deferred_surface([Item()]) is True
