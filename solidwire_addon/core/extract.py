@@ -74,6 +74,9 @@ class MeshArrays:
     # (S, 4) float32 segment blocks of listed triangles (edge_select.py);
     # they follow ngon_corners in the GPU's outline table. None: no blocks.
     region_table: np.ndarray = None
+    # (3T,) int32 polygon corner of each triangle corner (-1: none), kept with
+    # ``corners`` so a moved mesh refills its table (fill_corner_table).
+    corner_rows: np.ndarray | None = None
     # Set when positions alone decide nothing but the quad diagonals (tris and
     # quads only, every vertex finite): the quads' vertex ids, their split
     # and a checksum of the face sizes, so that an edit that only moves
@@ -742,15 +745,25 @@ def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     """(3T, 4) float32: for each corner of each drawn triangle (the order of
     ``arrays.triangles``, which the vertex stage reads by gl_VertexID) the
     corner normal of that polygon corner and the polygon's material index.
+    Also keeps the corner lookup in ``arrays.corner_rows`` so that a mesh
+    that only moves can refill the table from new normals (see
+    :func:`fill_corner_table`)."""
+    arrays.corner_rows = corner_rows(arrays, corner_vert, face_offsets)
+    return fill_corner_table(arrays.corner_rows, arrays.triangle_polygons, normals, materials)
+
+
+def corner_rows(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray) -> np.ndarray:
+    """(3T,) int32: the polygon corner (loop) of each triangle corner of
+    ``arrays.triangles``, -1 where there is none. Depends on the faces and
+    triangles alone, never on positions.
 
     A triangle row holds vertex ids, not corners: the corner is found as the
     one of the triangle's polygon with that vertex (unique in any polygon
     that is not degenerate; a face that uses a vertex twice has zero-area
     triangles that never draw)."""
     count = arrays.triangle_count
-    table = np.zeros((3 * count, 4), dtype=np.float32)
-    if count == 0:
-        return table
+    if count == 0 or len(corner_vert) == 0:
+        return np.full(3 * count, -1, dtype=np.int32)
     vertex_count = np.int64(max(arrays.vertex_count, 1))
     sizes = np.diff(face_offsets).astype(np.int64)
     corner_face = np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
@@ -760,9 +773,23 @@ def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     polygons = arrays.triangle_polygons.astype(np.int64)
     wanted = (polygons[:, None] * vertex_count + arrays.triangles[:, :3].astype(np.int64)).reshape(-1)
     at = np.minimum(np.searchsorted(sorted_keys, wanted), len(sorted_keys) - 1)
-    corner = order[at]
-    found = sorted_keys[at] == wanted
-    table[:, :3] = np.where(found[:, None], normals[corner], 0.0)
-    material = materials[polygons] if len(materials) else np.zeros(count, np.int32)
+    return np.where(sorted_keys[at] == wanted, order[at], -1).astype(np.int32)
+
+
+def fill_corner_table(rows: np.ndarray, triangle_polygons: np.ndarray, normals: np.ndarray,
+                      materials: np.ndarray) -> np.ndarray:
+    """The corner table (see :func:`corner_table`) from the corner lookup
+    ``rows`` of :func:`corner_rows`: one gather of the corner normals and the
+    material index of each triangle's polygon."""
+    table = np.zeros((len(rows), 4), dtype=np.float32)
+    if len(rows) == 0:
+        return table
+    found = rows >= 0
+    if found.all():
+        table[:, :3] = normals[rows]
+    else:
+        table[found, :3] = normals[rows[found]]
+    count = len(triangle_polygons)
+    material = materials[triangle_polygons] if len(materials) else np.zeros(count, np.int32)
     table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
     return table
