@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 import bmesh
-import bpy
 import numpy as np
 import pytest
 
@@ -25,12 +24,8 @@ FRAMES = (1, 2, 3, 4)
 
 
 def default_look_scene(width=160, height=120):
-    """An empty scene with the add-on's own defaults for what the tests
-    otherwise switch off (scenes.CORE_LOOK): a Studio-shaded fill and cage
-    edges."""
-    scene = scenes.empty_scene(width, height)
-    for key in scenes.CORE_LOOK:
-        scene.solidwire.property_unset(key)
+    """An empty scene in the add-on's default look (shaded fill, cage edges)."""
+    scene = scenes.default_look(scenes.empty_scene(width, height))
     assert scene.solidwire.use_fill and scene.solidwire.fill_shading == "STUDIO" and scene.solidwire.use_cage_edges
     scene.solidwire.wire_color = (0.05, 0.05, 0.05, 1.0)
     return scene
@@ -42,25 +37,13 @@ def shape_key_monkey(scene):
     monkey = scenes.monkey(scene, "Shaped", subdivisions=1, rotation=(0.2, 0.0, 0.5))
     for poly in monkey.data.polygons:
         poly.use_smooth = poly.index % 3 != 0  # smooth and flat corners both
-    monkey.shape_key_add(name="Basis")
-    key = monkey.shape_key_add(name="Swell")
-    basis = np.array([v.co for v in monkey.data.vertices])
-    angle = 0.6 * basis[:, 2]
-    swollen = basis * (1.0 + 0.25 * basis[:, 2:3])
-    x, y = swollen[:, 0].copy(), swollen[:, 1].copy()
-    swollen[:, 0] = x * np.cos(angle) - y * np.sin(angle)
-    swollen[:, 1] = x * np.sin(angle) + y * np.cos(angle)
-    key.data.foreach_set("co", swollen.astype(np.float32).ravel())
-    for frame, value in ((FRAMES[0], 0.0), (FRAMES[-1], 1.0)):
-        key.value = value
-        key.keyframe_insert("value", frame=frame)
+    scenes.add_swell_shape_key(monkey, (FRAMES[0], FRAMES[-1]))
     scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0.0, 0.0, 0.0))
     return monkey
 
 
 def armature_tube(scene):
-    """A smooth tube of quads bent by a two-bone armature whose upper bone's
-    rotation is animated."""
+    """A smooth tube of quads bent by a two-bone armature."""
     tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
         bm, cap_ends=False, segments=16, radius1=0.5, radius2=0.5, depth=4.0))
     mesh = tube.data
@@ -73,30 +56,7 @@ def armature_tube(scene):
     bm.free()
     for poly in mesh.polygons:
         poly.use_smooth = True
-
-    armature = bpy.data.armatures.new("Rig")
-    rig = bpy.data.objects.new("Rig", armature)
-    scene.collection.objects.link(rig)
-    bpy.context.view_layer.objects.active = rig
-    bpy.ops.object.mode_set(mode="EDIT")
-    lower = armature.edit_bones.new("Lower")
-    lower.head, lower.tail = (0.0, 0.0, -2.0), (0.0, 0.0, 0.0)
-    upper = armature.edit_bones.new("Upper")
-    upper.head, upper.tail = (0.0, 0.0, 0.0), (0.0, 0.0, 2.0)
-    upper.parent = lower
-    bpy.ops.object.mode_set(mode="OBJECT")
-
-    groups = {name: tube.vertex_groups.new(name=name) for name in ("Lower", "Upper")}
-    for vertex in mesh.vertices:
-        t = min(max((vertex.co.z + 0.5) / 1.0, 0.0), 1.0)  # blended across the joint
-        groups["Upper"].add([vertex.index], t, "REPLACE")
-        groups["Lower"].add([vertex.index], 1.0 - t, "REPLACE")
-    tube.modifiers.new("Armature", "ARMATURE").object = rig
-    bone = rig.pose.bones["Upper"]
-    bone.rotation_mode = "XYZ"
-    for frame, angle in ((FRAMES[0], 0.0), (FRAMES[-1], math.radians(70.0))):
-        bone.rotation_euler = (angle, 0.0, 0.0)
-        bone.keyframe_insert("rotation_euler", frame=frame)
+    scenes.add_bend_rig(scene, tube, (FRAMES[0], FRAMES[-1]), angle_deg=70.0)
     scenes.add_camera(scene, location=(8.0, -3.0, 1.0), target=(0.0, 0.0, 0.5))
     return tube
 
