@@ -633,17 +633,28 @@ def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_of
     if old is None or old.shape != positions.shape:
         return None
     # Flat index arithmetic instead of reductions over the short axis of
-    # (N, 3) / (Q, 4) arrays, which numpy does slowly.
-    moved_ids = np.unique(np.flatnonzero(positions.ravel() != old.ravel()) // 3)
-    moved = np.zeros(len(positions), dtype=bool)
-    moved[moved_ids] = True
+    # (N, 3) / (Q, 4) arrays, which numpy does slowly; flatnonzero is sorted,
+    # so ids are made unique without sorting again.
+    moved_ids = _sorted_unique(np.flatnonzero(positions.ravel() != old.ravel()) // 3)
+    everything = len(moved_ids) == len(positions)  # a deformation moves every vertex
     if len(quads) and len(moved_ids):
         # Only quads with a moved corner can split differently.
-        touched = np.unique(np.flatnonzero(moved[quads.ravel()]) // 4)
-        if len(touched):
-            ids, corners = np.unique(quads[touched], return_inverse=True)
-            new_flip, undecided = quad_flip(positions[ids], corners.reshape(-1, 4).astype(np.int32))
-            if undecided.any() or not np.array_equal(new_flip, flip[touched]):
+        if everything:
+            touched, touched_quads = None, quads
+        else:
+            moved = np.zeros(len(positions), dtype=bool)
+            moved[moved_ids] = True
+            touched = _sorted_unique(np.flatnonzero(moved[quads.ravel()]) // 4)
+            touched_quads = quads[touched]
+        if len(touched_quads):
+            if 4 * len(touched_quads) >= len(positions):
+                # Many quads: gather from all positions (one transposed copy).
+                new_flip, undecided = quad_flip(positions, touched_quads)
+            else:
+                # A local edit: the few vertices involved, renumbered.
+                ids, corners = np.unique(touched_quads, return_inverse=True)
+                new_flip, undecided = quad_flip(positions[ids], corners.reshape(-1, 4).astype(np.int32))
+            if undecided.any() or not np.array_equal(new_flip, flip if touched is None else flip[touched]):
                 return None
     # The centre stays where it was (any nearby centre keeps float32
     # precision); the bounds grow to take in the moved vertices, never
@@ -651,12 +662,22 @@ def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_of
     centre = previous.centre
     bounds_min, bounds_max = previous.mesh_bounds
     if len(moved_ids):
-        moved_positions = positions[moved_ids].astype(np.float64)
-        bounds_min = np.minimum(bounds_min, moved_positions.min(axis=0))
-        bounds_max = np.maximum(bounds_max, moved_positions.max(axis=0))
+        columns = np.ascontiguousarray((positions if everything else positions[moved_ids]).T)
+        bounds_min = np.minimum(bounds_min, [float(c.min()) for c in columns])
+        bounds_max = np.maximum(bounds_max, [float(c.max()) for c in columns])
     local = np.empty_like(positions)
     np.subtract(positions, centre, out=local, dtype=np.float64, casting="unsafe")
     return local, centre, bounds_min, bounds_max, positions
+
+
+def _sorted_unique(ids: np.ndarray) -> np.ndarray:
+    """The distinct values of an already sorted array (np.unique sorts again)."""
+    if len(ids) < 2:
+        return ids
+    keep = np.empty(len(ids), dtype=bool)
+    keep[0] = True
+    np.not_equal(ids[1:], ids[:-1], out=keep[1:])
+    return ids[keep]
 
 
 def _ngon_tri_rows(tri_start, sizes, ngon_faces) -> np.ndarray:
@@ -785,10 +806,15 @@ def fill_corner_table(rows: np.ndarray, triangle_polygons: np.ndarray, normals: 
     if len(rows) == 0:
         return table
     found = rows >= 0
-    if found.all():
-        table[:, :3] = normals[rows]
-    else:
-        table[found, :3] = normals[rows[found]]
+    if not found.any():
+        return table
+    lost = not found.all()
+    safe = np.where(found, rows, 0) if lost else rows
+    # One 1-D gather per axis: ~2x faster than gathering (N, 3) rows.
+    for k, column in enumerate(np.ascontiguousarray(np.asarray(normals, np.float32).reshape(-1, 3).T)):
+        table[:, k] = column.take(safe)
+    if lost:
+        table[~found, :3] = 0.0
     count = len(triangle_polygons)
     material = materials[triangle_polygons] if len(materials) else np.zeros(count, np.int32)
     table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)

@@ -175,13 +175,16 @@ def add_bend_rig(scene, obj, frames: tuple, *, joint_z: float = 0.0, blend: floa
     upper.parent = lower
     bpy.ops.object.mode_set(mode="OBJECT")
 
-    # Weights in 21 steps: one vertex-group call per step, not per vertex.
-    steps = np.round(np.clip((z - joint_z + blend) / (2.0 * blend), 0.0, 1.0) * 20.0).astype(int)
+    # Weights in fine steps (one vertex-group call per step, not per vertex):
+    # coarse steps would shear the small faces they cut across, folding them.
+    levels = 2000
+    steps = np.round(np.clip((z - joint_z + blend) / (2.0 * blend), 0.0, 1.0) * levels).astype(int)
     groups = {name: obj.vertex_groups.new(name=name) for name in ("Lower", "Upper")}
-    for step in np.unique(steps):
-        ids = np.flatnonzero(steps == step).tolist()
-        groups["Upper"].add(ids, step / 20.0, "REPLACE")
-        groups["Lower"].add(ids, 1.0 - step / 20.0, "REPLACE")
+    order = np.argsort(steps, kind="stable")
+    values, first = np.unique(steps[order], return_index=True)
+    for step, ids in zip(values.tolist(), np.split(order, first[1:])):
+        groups["Upper"].add(ids.tolist(), step / levels, "REPLACE")
+        groups["Lower"].add(ids.tolist(), 1.0 - step / levels, "REPLACE")
     obj.modifiers.new("Armature", "ARMATURE").object = rig
     obj.modifiers.move(len(obj.modifiers) - 1, 0)  # before any subdivision
     bone = rig.pose.bones["Upper"]
