@@ -632,18 +632,18 @@ def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_of
     old = getattr(previous, "source_positions", None)
     if old is None or old.shape != positions.shape:
         return None
-    # Flat index arithmetic instead of reductions over the short axis of
-    # (N, 3) / (Q, 4) arrays, which numpy does slowly; flatnonzero is sorted,
-    # so ids are made unique without sorting again.
-    moved_ids = _sorted_unique(np.flatnonzero(positions.ravel() != old.ravel()) // 3)
-    everything = len(moved_ids) == len(positions)  # a deformation moves every vertex
-    if len(quads) and len(moved_ids):
+    # Column-wise ORs and flat index arithmetic instead of reductions over
+    # the short axis of (N, 3) / (Q, 4) arrays, which numpy does slowly.
+    changed = (positions != old).view(np.uint8)
+    moved = (changed[:, 0] | changed[:, 1] | changed[:, 2]).view(bool)
+    moved_count = int(np.count_nonzero(moved))
+    everything = moved_count == len(positions)  # a deformation moves every vertex
+    if len(quads) and moved_count:
         # Only quads with a moved corner can split differently.
         if everything:
             touched, touched_quads = None, quads
         else:
-            moved = np.zeros(len(positions), dtype=bool)
-            moved[moved_ids] = True
+            # flatnonzero is sorted: made unique without sorting again.
             touched = _sorted_unique(np.flatnonzero(moved[quads.ravel()]) // 4)
             touched_quads = quads[touched]
         if len(touched_quads):
@@ -661,8 +661,8 @@ def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_of
     # shrink (culling only needs them to enclose the mesh).
     centre = previous.centre
     bounds_min, bounds_max = previous.mesh_bounds
-    if len(moved_ids):
-        columns = np.ascontiguousarray((positions if everything else positions[moved_ids]).T)
+    if moved_count:
+        columns = np.ascontiguousarray((positions if everything else positions[moved]).T)
         bounds_min = np.minimum(bounds_min, [float(c.min()) for c in columns])
         bounds_max = np.maximum(bounds_max, [float(c.max()) for c in columns])
     local = np.empty_like(positions)
