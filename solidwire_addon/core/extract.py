@@ -805,6 +805,9 @@ def fill_corner_table(rows: np.ndarray, triangle_polygons: np.ndarray, normals: 
     table = np.zeros((len(rows), 4), dtype=np.float32)
     if len(rows) == 0:
         return table
+    count = len(triangle_polygons)
+    material = materials[triangle_polygons] if len(materials) else np.zeros(count, np.int32)
+    table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
     found = rows >= 0
     if not found.any():
         return table
@@ -815,7 +818,4 @@ def fill_corner_table(rows: np.ndarray, triangle_polygons: np.ndarray, normals: 
         table[:, k] = column.take(safe)
     if lost:
         table[~found, :3] = 0.0
-    count = len(triangle_polygons)
-    material = materials[triangle_polygons] if len(materials) else np.zeros(count, np.int32)
-    table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
     return table
