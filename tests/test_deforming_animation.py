@@ -15,7 +15,7 @@ import pytest
 
 import solidwire_addon
 from solidwire_addon.blender import runtime
-from solidwire_addon.core import draw, shaders
+from solidwire_addon.core import draw, extract, shaders
 from tests.support import accuracy
 from tests.support import reference
 from tests.support import scenes
@@ -42,8 +42,10 @@ def shape_key_monkey(scene):
     return monkey
 
 
-def armature_tube(scene):
-    """A smooth tube of quads bent by a two-bone armature."""
+def armature_tube(scene, collapse: bool = False):
+    """A smooth tube of quads bent by a two-bone armature; with ``collapse``,
+    one quad at the joint has an edge collapsed (two corners on one spot):
+    its split is too close to call in every frame."""
     tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
         bm, cap_ends=False, segments=16, radius1=0.5, radius2=0.5, depth=4.0))
     mesh = tube.data
@@ -56,9 +58,21 @@ def armature_tube(scene):
     bm.free()
     for poly in mesh.polygons:
         poly.use_smooth = True
+    if collapse:
+        poly = min(mesh.polygons, key=lambda p: abs(p.center.z - 0.1))
+        a, b = poly.vertices[0], poly.vertices[1]
+        mesh.vertices[b].co = mesh.vertices[a].co
+        mesh.update()
+        positions = extract.read_positions(mesh)
+        quads = extract.read_corner_verts(mesh).reshape(-1, 4)
+        assert extract.quad_flip(positions, quads)[1].any()
     scenes.add_bend_rig(scene, tube, (FRAMES[0], FRAMES[-1]), angle_deg=70.0)
     scenes.add_camera(scene, location=(8.0, -3.0, 1.0), target=(0.0, 0.0, 0.5))
     return tube
+
+
+def armature_tube_collapsed(scene):
+    return armature_tube(scene, collapse=True)
 
 
 def render(scene, path):
@@ -76,7 +90,8 @@ def difference_report(measured, expected) -> dict:
     (shape_key_monkey, draw.SETUP_TABLE_MIN),  # cage edges: an outline table, never the pre-pass
     (armature_tube, draw.SETUP_TABLE_MIN),
     (armature_tube, 1),
-], ids=["shape_key", "armature", "armature_setup_prepass"])
+    (armature_tube_collapsed, draw.SETUP_TABLE_MIN),  # a quad split Blender settles every frame
+], ids=["shape_key", "armature", "armature_setup_prepass", "armature_degenerate_quad"])
 def test_deformation_uploads_positions_and_normals_only(build, setup_min, monkeypatch, output_dir):
     # The set-up pre-pass (big tri/quad meshes; here forced on a small one)
     # keeps a per-mesh table that must follow the new positions.

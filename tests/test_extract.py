@@ -201,6 +201,34 @@ def test_reposition_of_a_deformation_is_a_full_extraction():
     assert extract.reposition(arrays, bent, corner_vert, offsets) is None
 
 
+def test_reposition_asks_blender_about_a_quad_too_close_to_call():
+    """A degenerate quad (an edge collapsed: two corners on one spot) is
+    undecided in every frame; its split comes from Blender's triangles, as at
+    extraction, instead of sending the whole mesh to a full extraction."""
+    positions, corner_vert, offsets = _quad_grid()
+    q = corner_vert[4 * 30: 4 * 31]
+    positions[q[2]] = positions[q[1]]
+
+    def blender_tris(flipped):
+        def lookup(tri_indices):  # the first triangle of each asked quad, as Blender splits it
+            face = np.asarray(tri_indices) // 2
+            corners = [0, 1, 3] if flipped else [0, 1, 2]
+            return 4 * face[:, None] + np.array(corners)
+        return lookup
+
+    arrays = extract.build_arrays_fast(positions, corner_vert, offsets, blender_tris=blender_tris(False))
+    bent = _bend(positions, 1.5)
+    assert extract.quad_flip(bent, arrays.quads)[1][30]  # still undecided
+    assert extract.reposition(arrays, bent, corner_vert, offsets) is None
+    assert extract.reposition(arrays, bent, corner_vert, offsets, blender_tris(True)) is None  # split changed
+    result = extract.reposition(arrays, bent, corner_vert, offsets, blender_tris(False))
+    assert result is not None
+    local, centre = result[:2]
+    full = extract.build_arrays_fast(bent, corner_vert, offsets, blender_tris=blender_tris(False))
+    np.testing.assert_array_equal(full.triangles, arrays.triangles)
+    np.testing.assert_allclose(local + centre, full.positions + full.centre, atol=1e-5)
+
+
 def test_corner_table_refilled_from_new_normals_equals_a_fresh_one():
     """The corner lookup kept at extraction refills the table of a moved mesh
     exactly as a fresh corner_table does (normals per loop, materials per face)."""

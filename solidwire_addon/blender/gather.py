@@ -441,7 +441,9 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
 
     def reposition(entry, context):
         positions, corner_vert, corner_inputs = context
-        moved = extract.reposition(entry, positions, corner_vert, extract.read_face_offsets(get_source()))
+        source_mesh = get_source()
+        moved = extract.reposition(entry, positions, corner_vert, extract.read_face_offsets(source_mesh),
+                                   extract.blender_triangles(source_mesh))
         if moved is None or not corners:
             return moved
         if entry.corner_rows is None:

@@ -609,12 +609,15 @@ def build_arrays_fast(
     return arrays
 
 
-def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_offsets: np.ndarray):
+def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_offsets: np.ndarray,
+               blender_tris: Callable[[np.ndarray], np.ndarray] | None = None):
     """(local positions, centre, bounds_min, bounds_max, source positions)
     for new vertex positions of a mesh whose faces are unchanged, or None when the new
-    positions change more than positions: a quad split differently (or too
-    close to call), a non-finite vertex, n-gons (their triangulation follows
-    the positions), other face sizes.
+    positions change more than positions: a quad split differently, a
+    non-finite vertex, n-gons (their triangulation follows the positions),
+    other face sizes. A moved quad too close to call (a degenerate one
+    stays so in every frame) is settled by ``blender_tris`` as in
+    :func:`build_arrays_fast`; without it, None.
 
     ``previous`` is what the last extraction kept (``quads``, ``quad_flip``,
     ``face_offsets_crc``, ``source_positions``, ``centre`` and
@@ -654,7 +657,17 @@ def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_of
                 # A local edit: the few vertices involved, renumbered.
                 ids, corners = np.unique(touched_quads, return_inverse=True)
                 new_flip, undecided = quad_flip(positions[ids], corners.reshape(-1, 4).astype(np.int32))
-            if undecided.any() or not np.array_equal(new_flip, flip if touched is None else flip[touched]):
+            if undecided.any():
+                if blender_tris is None:
+                    return None
+                asked = np.flatnonzero(undecided)
+                quad_index = asked if touched is None else touched[asked]
+                face = np.flatnonzero(np.diff(offsets) == 4)[quad_index]  # quads are the 4-corner faces in order
+                loop_start = offsets[face]
+                # Blender's first triangle of a flipped quad is (0, 1, 3).
+                first = np.asarray(blender_tris(loop_start - 2 * face), dtype=np.int32).reshape(-1, 3)
+                new_flip[asked] = first[:, 2] == loop_start + 3
+            if not np.array_equal(new_flip, flip if touched is None else flip[touched]):
                 return None
     # The centre stays where it was (any nearby centre keeps float32
     # precision); the bounds grow to take in the moved vertices, never
