@@ -20,13 +20,14 @@ Measured in one run, each against the path it replaces:
 7. the viewport overlay's redraw cost after one edit (``--part
    interactive`` runs only this): a vertex moved in Edit Mode on Suzanne
    level 5, one of 1000 objects moved, one vertex of one of them moved;
-8. a deforming 1M-triangle mesh (``--part animation_1m`` runs only this):
+8. a deforming 1M-triangle mesh (only with ``--part animation_1m``, apart
+   from the full run: a few minutes):
    Suzanne subdivided to level 5 and applied, bent by a two-bone armature
    and, apart, swollen by a shape key, ``--anim-1m-frames`` frames in the
    add-on's default look (Studio fill, cage edges) at 1280 x 720 (640 x 360
    with ``--quick``, Suzanne level 4): per-frame F12 time of SolidWire,
-   of SolidWire re-extracting every frame (the path before positions-only
-   uploads) and of Workbench (flat light, single colour, no AA, as in
+   of SolidWire re-extracting every frame (the default look's path before
+   deformations re-uploaded positions and corner normals alone) and of Workbench (flat light, single colour, no AA, as in
    scripts/bench_engines.py), engines taking turns frame by frame (a noisy
    machine hits them alike; the frame change itself is not timed), median
    of the frames after the first; SolidWire's extract and upload ms and
@@ -312,11 +313,11 @@ def bench_animation(static: int, frame_end: int) -> dict:
 # 8: a deforming 1M-triangle mesh against Workbench, frame by frame
 
 # (engine, cache emptied before each frame, label). The baseline empties the
-# cache (a full extraction, as before positions-only uploads) rather than
-# switching reposition off: with the engines taking turns, the frame's first
-# SolidWire render has already uploaded it.
+# cache (a full extraction) rather than switching reposition off: with the
+# engines taking turns, the frame's first SolidWire render has already
+# uploaded it, and a switched-off reposition would find nothing changed.
 ANIMATION_1M_RUNS = (
-    ("SOLIDWIRE", False, "SolidWire (positions-only uploads)"),
+    ("SOLIDWIRE", False, "SolidWire (positions and corner normals re-uploaded)"),
     ("SOLIDWIRE", True, "SolidWire, full re-extraction every frame (baseline)"),
     ("WORKBENCH_FLAT", False, "Workbench flat, single colour, no AA"),
 )
