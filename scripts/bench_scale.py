@@ -19,7 +19,19 @@ Measured in one run, each against the path it replaces:
    among 100 static ones, with reuse vs without;
 7. the viewport overlay's redraw cost after one edit (``--part
    interactive`` runs only this): a vertex moved in Edit Mode on Suzanne
-   level 5, one of 1000 objects moved, one vertex of one of them moved.
+   level 5, one of 1000 objects moved, one vertex of one of them moved;
+8. a deforming 1M-triangle mesh (only with ``--part animation_1m``, apart
+   from the full run: a few minutes):
+   Suzanne subdivided to level 5 and applied, bent by a two-bone armature
+   and, apart, swollen by a shape key, ``--anim-1m-frames`` frames in the
+   add-on's default look (Studio fill, cage edges) at 1280 x 720 (640 x 360
+   with ``--quick``, Suzanne level 4): per-frame F12 time of SolidWire,
+   of SolidWire re-extracting every frame (the default look's path before
+   deformations re-uploaded positions and corner normals alone) and of Workbench (flat light, single colour, no AA, as in
+   scripts/bench_engines.py), engines taking turns frame by frame (a noisy
+   machine hits them alike; the frame change itself is not timed), median
+   of the frames after the first; SolidWire's extract and upload ms and
+   meshes extracted / repositioned per frame.
 
 Frame times are the wall time of ``bpy.ops.render.render`` (Blender's
 depsgraph evaluation included) and SolidWire's own share (stats
@@ -27,6 +39,7 @@ depsgraph evaluation included) and SolidWire's own share (stats
 the table says which renderer ran, and draw times mean CPU time then.
 
     python -m scripts.bench_scale [--quick] [--out out/bench_scale.md]
+        [--part memory|interactive|animation_1m] [--anim-1m-frames 8]
 
 Prints a Markdown table and writes it (plus a .json) under out/.
 """
@@ -297,6 +310,85 @@ def bench_animation(static: int, frame_end: int) -> dict:
 
 
 # --------------------------------------------------------------------------
+# 8: a deforming 1M-triangle mesh against Workbench, frame by frame
+
+# (engine, cache emptied before each frame, label). The baseline empties the
+# cache (a full extraction) rather than switching reposition off: with the
+# engines taking turns, the frame's first SolidWire render has already
+# uploaded it, and a switched-off reposition would find nothing changed.
+ANIMATION_1M_RUNS = (
+    ("SOLIDWIRE", False, "SolidWire (positions and corner normals re-uploaded)"),
+    ("SOLIDWIRE", True, "SolidWire, full re-extraction every frame (baseline)"),
+    ("WORKBENCH_FLAT", False, "Workbench flat, single colour, no AA"),
+)
+
+
+def deforming_1m_scene(kind: str, level: int, size: tuple, frame_count: int):
+    """Suzanne subdivided ``level`` times and applied (the same mesh as
+    scripts/bench_engines.py), in the default look, deformed by ``kind``
+    ("armature" or "shape_key") from frame 1 to ``frame_count``."""
+    from scripts.bench_engines import applied_mesh_scene
+
+    scene, obj = applied_mesh_scene(*size, level)
+    scenes.default_look(scene)
+    frames = (1, frame_count)
+    if kind == "armature":
+        scenes.add_bend_rig(scene, obj, frames, joint_z=0.0, blend=0.4, angle_deg=35.0)
+    else:
+        scenes.add_swell_shape_key(obj, frames, strength=0.5)
+    scene.frame_start, scene.frame_end = frames
+    return scene, obj
+
+
+def bench_animation_1m(level: int, size: tuple, frame_count: int) -> dict:
+    from scripts.bench_engines import configure
+
+    out = {}
+    for kind in ("armature", "shape_key"):
+        scene, obj = deforming_1m_scene(kind, level, size, frame_count)
+        triangles = sum(len(p.vertices) - 2 for p in obj.data.polygons)
+        runtime.mesh_cache.clear()
+        samples = {label: [] for _engine, _reuse, label in ANIMATION_1M_RUNS}
+        for frame in range(1, frame_count + 1):
+            scene.frame_set(frame)
+            for engine, fresh, label in ANIMATION_1M_RUNS:
+                configure(scene, engine)
+                if fresh:
+                    runtime.mesh_cache.clear()
+                wall, stats = render_once(scene)
+                samples[label].append((wall, stats if engine == "SOLIDWIRE" else None))
+        result = {"triangles": triangles, "frames": frame_count}
+        for engine, _allow, label in ANIMATION_1M_RUNS:
+            later = samples[label][1:]
+            row = {"first_ms": samples[label][0][0], "ms_per_frame": statistics.median(w for w, _ in later)}
+            if engine == "SOLIDWIRE":
+                for key in ("ms_extract", "ms_upload", "ms_draw", "ms_total", "meshes_extracted",
+                            "meshes_repositioned"):
+                    row[key] = statistics.median(s.get(key, 0.0) for _, s in later)
+            result[label] = row
+        out[kind] = result
+    return out
+
+
+def animation_1m_table(r: dict, size: tuple) -> str:
+    lines = [
+        "| deforming mesh, %d x %d | per frame ms (median) | first frame ms | x Workbench | extract ms "
+        "| upload ms | draw ms | meshes extracted / repositioned per frame |" % size,
+        "|---|---:|---:|---:|---:|---:|---:|---|",
+    ]
+    for kind, result in r.items():
+        base = result[ANIMATION_1M_RUNS[-1][2]]["ms_per_frame"]
+        what = f"{kind.replace('_', ' ')}, {result['triangles']:,} tris, {result['frames']} frames"
+        for engine, _allow, label in ANIMATION_1M_RUNS:
+            row = result[label]
+            solidwire = engine == "SOLIDWIRE"
+            cells = (
+                f"{row['ms_extract']:.0f} | {row['ms_upload']:.0f} | {row['ms_draw']:.0f} | "
+                f"{row['meshes_extracted']:.0f} / {row['meshes_repositioned']:.0f}"
+            ) if solidwire else " | | | "
+            lines.append(f"| {what}: {label} | {row['ms_per_frame']:.0f} | {row['first_ms']:.0f} | "
+                         f"{row['ms_per_frame'] / base:.2f} | {cells} |")
+    return "\n".join(lines) + "\n"
 
 
 # --------------------------------------------------------------------------
@@ -480,8 +572,10 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="small sizes (a minute or so)")
     parser.add_argument("--out", default=str(ROOT / "out" / "bench_scale.md"))
-    parser.add_argument("--part", choices=["memory", "interactive"],
-                        help="run one part only (interactive: overlay redraw cost after an edit)")
+    parser.add_argument("--part", choices=["memory", "interactive", "animation_1m"],
+                        help="run one part only (interactive: overlay redraw cost after an edit; "
+                             "animation_1m: a deforming 1M-triangle mesh against Workbench)")
+    parser.add_argument("--anim-1m-frames", type=int, default=8, help="frames of --part animation_1m")
     args = parser.parse_args(argv)
     args.level = 4 if args.quick else 5
     args.repeat = 3 if args.quick else 5
@@ -509,6 +603,17 @@ def main(argv=None) -> int:
         out = Path(args.out).with_name("bench_interactive.md")
         out.parent.mkdir(parents=True, exist_ok=True)
         out.write_text(text, encoding="utf-8")
+        os._exit(0)
+    if args.part == "animation_1m":
+        size = (640, 360) if args.quick else (1280, 720)
+        results["animation_1m"] = bench_animation_1m(args.level, size, max(args.anim_1m_frames, 2))
+        text = (f"Renderer {results['renderer']}; {platform.machine()}, {os.cpu_count()} CPU cores; "
+                f"bpy {bpy.app.version_string}.\n\n" + animation_1m_table(results["animation_1m"], size))
+        print(text, flush=True)
+        out = Path(args.out).with_name("bench_animation_1m.md")
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(text, encoding="utf-8")
+        out.with_suffix(".json").write_text(json.dumps(results, indent=2), encoding="utf-8")
         os._exit(0)
     print("extraction ...", file=sys.stderr)
     results["extraction"] = bench_extraction(args.level, args.repeat)

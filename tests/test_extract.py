@@ -173,6 +173,82 @@ def test_reposition_is_a_full_extraction_of_the_moved_mesh():
     assert np.shares_memory(source, moved)  # kept as read, no copy
 
 
+def _bend(positions: np.ndarray, angle: float) -> np.ndarray:
+    """Every vertex moved: the grid rolled about the y axis (a deformation)."""
+    radius = float(positions[:, 0].max()) / angle
+    theta = positions[:, 0] / radius
+    r = radius - positions[:, 2]
+    return np.stack([r * np.sin(theta), positions[:, 1] + 0.25, radius - r * np.cos(theta)], axis=1).astype(np.float32)
+
+
+def test_reposition_of_a_deformation_is_a_full_extraction():
+    """Every vertex moved (the path a deforming animation takes): same
+    triangles, the world positions of a fresh extraction; a single quad
+    folded among them still refuses."""
+    positions, corner_vert, offsets = _quad_grid()
+    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
+    bent = _bend(positions, 1.5)
+    assert (bent != positions).any(axis=1).all()
+    result = extract.reposition(arrays, bent, corner_vert, offsets)
+    assert result is not None
+    local, centre, bounds_min, bounds_max, _source = result
+    full = extract.build_arrays_fast(bent, corner_vert, offsets)
+    np.testing.assert_array_equal(full.triangles, arrays.triangles)
+    np.testing.assert_allclose(local + centre, full.positions + full.centre, atol=1e-5)
+    assert (bounds_min <= full.bounds_min).all() and (bounds_max >= full.bounds_max).all()
+    q = arrays.quads[40]
+    bent[q[1]] = 0.9 * bent[q[3]] + 0.1 * bent[q[0]]
+    assert extract.reposition(arrays, bent, corner_vert, offsets) is None
+
+
+def test_reposition_asks_blender_about_a_quad_too_close_to_call():
+    """A degenerate quad (an edge collapsed: two corners on one spot) is
+    undecided in every frame; its split comes from Blender's triangles, as at
+    extraction, instead of sending the whole mesh to a full extraction."""
+    positions, corner_vert, offsets = _quad_grid()
+    q = corner_vert[4 * 30: 4 * 31]
+    positions[q[2]] = positions[q[1]]
+
+    def blender_tris(flipped):
+        def lookup(tri_indices):  # the first triangle of each asked quad, as Blender splits it
+            face = np.asarray(tri_indices) // 2
+            corners = [0, 1, 3] if flipped else [0, 1, 2]
+            return 4 * face[:, None] + np.array(corners)
+        return lookup
+
+    arrays = extract.build_arrays_fast(positions, corner_vert, offsets, blender_tris=blender_tris(False))
+    bent = _bend(positions, 1.5)
+    assert extract.quad_flip(bent, arrays.quads)[1][30]  # still undecided
+    assert extract.reposition(arrays, bent, corner_vert, offsets) is None
+    assert extract.reposition(arrays, bent, corner_vert, offsets, blender_tris(True)) is None  # split changed
+    result = extract.reposition(arrays, bent, corner_vert, offsets, blender_tris(False))
+    assert result is not None
+    local, centre = result[:2]
+    full = extract.build_arrays_fast(bent, corner_vert, offsets, blender_tris=blender_tris(False))
+    np.testing.assert_array_equal(full.triangles, arrays.triangles)
+    np.testing.assert_allclose(local + centre, full.positions + full.centre, atol=1e-5)
+
+
+def test_corner_table_refilled_from_new_normals_equals_a_fresh_one():
+    """The corner lookup kept at extraction refills the table of a moved mesh
+    exactly as a fresh corner_table does (normals per loop, materials per face)."""
+    positions, corner_vert, offsets = _quad_grid(6)
+    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
+    rng = np.random.default_rng(4)
+    materials = rng.integers(0, 3, len(offsets) - 1).astype(np.int32)
+    first = extract.corner_table(arrays, corner_vert, offsets, rng.normal(size=(len(corner_vert), 3)).astype(np.float32),
+                                 materials)
+    normals = rng.normal(size=(len(corner_vert), 3)).astype(np.float32)
+    refilled = extract.fill_corner_table(arrays.corner_rows, arrays.triangle_polygons, normals, materials)
+    fresh = extract.corner_table(extract.build_arrays_fast(positions, corner_vert, offsets), corner_vert, offsets,
+                                 normals, materials)
+    np.testing.assert_array_equal(refilled, fresh)
+    assert not np.array_equal(refilled, first)
+    # Each triangle corner carries the normal of its own polygon corner.
+    rows = arrays.corner_rows.reshape(-1, 3)
+    np.testing.assert_array_equal(corner_vert[rows], arrays.triangles[:, :3])
+
+
 def test_reposition_refuses_what_changes_the_triangles():
     positions, corner_vert, offsets = _quad_grid()
     arrays = extract.build_arrays_fast(positions, corner_vert, offsets)

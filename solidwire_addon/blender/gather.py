@@ -101,32 +101,39 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = ()):
     With ``corners`` (shaded fill), the corner normals and material indices
     too: sharp edges or materials can change without moving a vertex. With
     ``edge_classes``, the edge data of those classes (marking a seam moves
-    nothing either)."""
+    nothing either).
+
+    The fingerprint is ``(topology, shape)`` (see MeshCache.get_validated):
+    a deformation changes the shape part alone, and then positions and
+    corner normals may be uploaded again without a full extraction."""
     positions = extract.read_positions(mesh)
     corner_vert = extract.read_corner_verts(mesh)
-    # Topology first, the positions' checksum last (MeshCache.get_validated
-    # re-uploads positions alone when only the last element differs).
-    content = (
+    topology = (
         len(positions),
         len(mesh.edges),
         len(corner_vert),
         len(mesh.polygons),
-        zlib.crc32(memoryview(corner_vert).cast("B")),
+        _crc(corner_vert),
         *_edge_class_checksums(mesh, edge_classes),
-        zlib.crc32(memoryview(positions).cast("B")),
     )
+    shape = (_crc(positions),)
     corner_inputs = None
     if corners:
-        corner_inputs = extract.read_corner_inputs(mesh)
-        content += tuple(zlib.crc32(memoryview(np.ascontiguousarray(a)).cast("B")) for a in corner_inputs)
-    return content, (positions, corner_vert, corner_inputs)
+        normals, materials = corner_inputs = extract.read_corner_inputs(mesh)
+        topology += (_crc(materials),)
+        shape += (_crc(normals),)
+    return (topology, shape), (positions, corner_vert, corner_inputs)
+
+
+def _crc(array: np.ndarray) -> int:
+    return zlib.crc32(memoryview(np.ascontiguousarray(array)).cast("B"))
 
 
 def _edge_class_checksums(mesh, edge_classes: tuple) -> tuple:
     if not edge_classes:
         return ()
     bits = edge_select.read_edge_classes(mesh, edge_classes)
-    return (0,) if bits is None else (zlib.crc32(memoryview(np.ascontiguousarray(bits)).cast("B")),)
+    return (0,) if bits is None else (_crc(bits),)
 
 
 def item_source(obj) -> ItemSource:
@@ -433,17 +440,26 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
         return arrays
 
     def reposition(entry, context):
-        positions, corner_vert = context[:2]
-        return extract.reposition(entry, positions, corner_vert, extract.read_face_offsets(get_source()))
+        positions, corner_vert, corner_inputs = context
+        source_mesh = get_source()
+        moved = extract.reposition(entry, positions, corner_vert, extract.read_face_offsets(source_mesh),
+                                   extract.blender_triangles(source_mesh))
+        if moved is None or not corners:
+            return moved
+        if entry.corner_rows is None:
+            return None
+        # The corner normals follow the deformation; which corner each
+        # triangle corner is does not (same faces, same triangles).
+        normals, materials = corner_inputs
+        return (*moved, extract.fill_corner_table(entry.corner_rows, entry.triangle_polygons_cpu, normals, materials))
 
     try:
-        # Positions-only re-upload (reposition) only for meshes without a
-        # corner table or edge selection: corner normals and which edges are
-        # flat follow the positions, so those meshes are extracted again.
-        simple = not corners and not edges.active
+        # A deformation re-uploads positions (and corner normals) only, unless
+        # the edge selection follows the positions (edge angle): then which
+        # edges are drawn may change, and the mesh is extracted again.
         mesh, _extracted = cache.get_validated(
             key, fast, lambda: fingerprint(get_source(), corners, edges.classes),
-            make_arrays, reposition if simple else None
+            make_arrays, None if edges.follows_positions else reposition
         )
     finally:
         if in_edit_mode and source:

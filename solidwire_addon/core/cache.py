@@ -71,6 +71,7 @@ class GPUMesh:
         # Corner normals and material indices, one texel per triangle corner
         # (read by gl_VertexID); only for a shaded or per-material fill.
         self.corners = None if arrays.corners is None else table_texture(arrays.corners)
+        self.corner_rows = arrays.corner_rows  # to refill the corner table when the mesh moves
         # Kept (no copy) so the silhouette pass can derive its edge table on
         # first use without re-extracting; see silhouettes.py.
         self.triangles_cpu = arrays.triangles
@@ -144,13 +145,19 @@ class GPUMesh:
     def _visibility_bytes(self) -> int:
         return len(self._local_positions) * 12 + self.triangle_count * 12
 
-    def replace_positions(self, local: np.ndarray, centre, bounds_min, bounds_max, source_positions=None) -> None:
+    def replace_positions(self, local: np.ndarray, centre, bounds_min, bounds_max, source_positions=None,
+                          corners: np.ndarray | None = None) -> None:
         """New vertex positions, same faces and triangles: only the position
-        table is uploaded again (the triangle table, the edge-flag batch and
-        the silhouette edges depend on the faces alone)."""
+        table is uploaded again, and the corner table when ``corners`` (the
+        corner normals follow a deformation). The triangle and outline
+        tables, the edge-flag batch and the silhouette edges depend on the
+        faces and the edge selection alone; the set-up table is rewritten by
+        every draw from the position table."""
         positions = np.zeros((len(local), 4), dtype=np.float32)
         positions[:, :3] = local
         self.positions = table_texture(positions)
+        if corners is not None and self.corners is not None:
+            self.corners = table_texture(corners)
         if self._visibility_batch is not None:
             self.gpu_bytes -= self._visibility_bytes()
             self._visibility_batch = None  # made again from the new positions on first use
@@ -201,12 +208,13 @@ class MeshCache:
 
         ``fast`` is a token or None; ``fingerprint()`` computes the content
         fingerprint (called only when the fast token does not match) and
-        returns ``(fingerprint, context)``; the fingerprint is a tuple whose
-        last element is the positions' checksum and the rest the topology.
-        ``make_arrays(context)`` extracts (``context`` lets it reuse what the
-        fingerprint already read). When only the positions changed,
-        ``reposition(entry, context)`` may return the new (local positions,
-        centre, bounds_min, bounds_max, source positions) and only the position table is
+        returns ``(fingerprint, context)``; the fingerprint is a pair
+        ``(topology, shape)``: what decides the faces, triangles and edge
+        selection, and what a deformation changes (positions, corner
+        normals). ``make_arrays(context)`` extracts (``context`` lets it
+        reuse what the fingerprint already read). When only the shape
+        changed, ``reposition(entry, context)`` may return the arguments of
+        :meth:`GPUMesh.replace_positions` and only those tables are
         uploaded; None sends it through a full extraction.
         Returns ``(GPUMesh or None, extracted: bool)``."""
         entry = self._entries.get(key)
@@ -224,7 +232,7 @@ class MeshCache:
             and tokens is not None
             and reposition is not None
             and self.allow_reposition
-            and tokens[1][:-1] == content[:-1]
+            and tokens[1][0] == content[0]
         ):
             moved = reposition(entry, context)
             if moved is not None:

@@ -252,8 +252,6 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     flags[listed] = (flags[listed] & keep) | IN_REGION | (count[at].astype(np.int32) << NGON_SHIFT)
     flags[listed] &= ~(EDGE3_HIDDEN | EDGE4_HIDDEN)
     arrays.triangles[listed, 3] = base + TEXELS_PER_SEGMENT * first[at]
-    # Listed triangles no longer need (or have) the positions-only update.
-    arrays.quads = None
     stats.regions = int((walked_region & (np.arange(face_count) == label)).sum())
     stats.listed_triangles = int(listed.sum())
     stats.segments = int(len(seg_a))
@@ -403,6 +401,14 @@ class Selection:
     @property
     def active(self) -> bool:
         return self.edge_angle > 0.0 or bool(self.classes) or self.use_cage
+
+    @property
+    def follows_positions(self) -> bool:
+        """Whether moving vertices can change which edges are drawn: the
+        edge angle compares face normals. Classes (marks, boundary) and
+        cage edges depend on the topology alone, so the selection of a
+        deforming mesh stays as extracted."""
+        return self.edge_angle > 0.0
 
 
 def apply_to_mesh(arrays: MeshArrays, mesh, corner_vert: np.ndarray, face_offsets: np.ndarray, selection: Selection,

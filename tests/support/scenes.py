@@ -46,6 +46,14 @@ def empty_scene(width: int = 160, height: int = 120, *, transparent: bool = True
     return scene
 
 
+def default_look(scene):
+    """Back to the add-on's own defaults for what CORE_LOOK switches off (a
+    Studio-shaded fill, cage edges): the look a user starts from."""
+    for key in CORE_LOOK:
+        scene.solidwire.property_unset(key)
+    return scene
+
+
 def add_camera(
     scene,
     location=(7.0, -6.0, 5.0),
@@ -118,6 +126,73 @@ def grid(scene, name="Grid", x_segments=10, y_segments=10, size=10.0, **kwargs):
         lambda bm: bmesh.ops.create_grid(bm, x_segments=x_segments, y_segments=y_segments, size=size),
         **kwargs,
     )
+
+
+def add_swell_shape_key(obj, frames: tuple, strength: float = 1.0):
+    """A shape key that swells ``obj`` towards +z and twists it about z,
+    animated from 0 at ``frames[0]`` to 1 at ``frames[1]`` (every vertex
+    moves and the corner normals turn: a deforming animation)."""
+    obj.shape_key_add(name="Basis")
+    key = obj.shape_key_add(name="Swell")
+    count = len(obj.data.vertices)
+    basis = np.empty(count * 3, np.float32)
+    obj.data.vertices.foreach_get("co", basis)
+    basis = basis.reshape(-1, 3).astype(np.float64)
+    angle = 0.6 * strength * basis[:, 2]
+    swollen = basis * (1.0 + 0.25 * strength * basis[:, 2:3])
+    x, y = swollen[:, 0].copy(), swollen[:, 1].copy()
+    swollen[:, 0] = x * np.cos(angle) - y * np.sin(angle)
+    swollen[:, 1] = x * np.sin(angle) + y * np.cos(angle)
+    key.data.foreach_set("co", swollen.astype(np.float32).ravel())
+    for frame, value in zip(frames, (0.0, 1.0)):
+        key.value = value
+        key.keyframe_insert("value", frame=frame)
+    return key
+
+
+def add_bend_rig(scene, obj, frames: tuple, *, joint_z: float = 0.0, blend: float = 0.5, angle_deg: float = 60.0):
+    """A two-bone armature bending ``obj`` at height ``joint_z`` (its own
+    space): vertices above the joint follow the upper bone, below it the
+    lower one, blended over ``blend`` either side. The upper bone turns
+    about x from 0 at ``frames[0]`` to ``angle_deg`` at ``frames[1]``."""
+    mesh = obj.data
+    count = len(mesh.vertices)
+    co = np.empty(count * 3, np.float32)
+    mesh.vertices.foreach_get("co", co)
+    z = co.reshape(-1, 3)[:, 2].astype(np.float64)
+    low, high = float(z.min()), float(z.max())
+
+    armature = bpy.data.armatures.new(f"{obj.name}Rig")
+    rig = bpy.data.objects.new(f"{obj.name}Rig", armature)
+    scene.collection.objects.link(rig)
+    rig.matrix_world = obj.matrix_world  # the bones in the mesh's own space
+    bpy.context.view_layer.objects.active = rig
+    bpy.ops.object.mode_set(mode="EDIT")
+    lower = armature.edit_bones.new("Lower")
+    lower.head, lower.tail = (0.0, 0.0, low), (0.0, 0.0, joint_z)
+    upper = armature.edit_bones.new("Upper")
+    upper.head, upper.tail = (0.0, 0.0, joint_z), (0.0, 0.0, max(high, joint_z + 0.1))
+    upper.parent = lower
+    bpy.ops.object.mode_set(mode="OBJECT")
+
+    # Weights in fine steps (one vertex-group call per step, not per vertex):
+    # coarse steps would shear the small faces they cut across, folding them.
+    levels = 2000
+    steps = np.round(np.clip((z - joint_z + blend) / (2.0 * blend), 0.0, 1.0) * levels).astype(int)
+    groups = {name: obj.vertex_groups.new(name=name) for name in ("Lower", "Upper")}
+    order = np.argsort(steps, kind="stable")
+    values, first = np.unique(steps[order], return_index=True)
+    for step, ids in zip(values.tolist(), np.split(order, first[1:])):
+        groups["Upper"].add(ids.tolist(), step / levels, "REPLACE")
+        groups["Lower"].add(ids.tolist(), 1.0 - step / levels, "REPLACE")
+    obj.modifiers.new("Armature", "ARMATURE").object = rig
+    obj.modifiers.move(len(obj.modifiers) - 1, 0)  # before any subdivision
+    bone = rig.pose.bones["Upper"]
+    bone.rotation_mode = "XYZ"
+    for frame, angle in zip(frames, (0.0, math.radians(angle_deg))):
+        bone.rotation_euler = (angle, 0.0, 0.0)
+        bone.keyframe_insert("rotation_euler", frame=frame)
+    return rig
 
 
 def uv_sphere(scene, name="Sphere", segments=16, rings=8, radius=1.0, **kwargs):

@@ -1,0 +1,183 @@
+"""Deforming animation in the add-on's default look (shaded fill, cage edges):
+a frame that only moves vertices (shape keys, an armature) uploads positions
+and corner normals again without a full extraction, and draws what a fresh
+extraction of that frame draws; whatever changes the faces, the triangles,
+the edge marks or an edge selection that follows the positions (edge angle)
+still goes through a full extraction."""
+
+from __future__ import annotations
+
+import math
+
+import bmesh
+import numpy as np
+import pytest
+
+import solidwire_addon
+from solidwire_addon.blender import runtime
+from solidwire_addon.core import draw, extract, passes, shaders
+from tests.support import accuracy
+from tests.support import reference
+from tests.support import scenes
+
+FRAMES = (1, 2, 3, 4)
+
+
+def default_look_scene(width=160, height=120):
+    """An empty scene in the add-on's default look (shaded fill, cage edges)."""
+    scene = scenes.default_look(scenes.empty_scene(width, height))
+    assert scene.solidwire.use_fill and scene.solidwire.fill_shading == "STUDIO" and scene.solidwire.use_cage_edges
+    scene.solidwire.wire_color = (0.05, 0.05, 0.05, 1.0)
+    return scene
+
+
+def shape_key_monkey(scene):
+    """Suzanne with a subdivision modifier (cage edges count) and an animated
+    shape key that swells and twists her (the corner normals change)."""
+    monkey = scenes.monkey(scene, "Shaped", subdivisions=1, rotation=(0.2, 0.0, 0.5))
+    for poly in monkey.data.polygons:
+        poly.use_smooth = poly.index % 3 != 0  # smooth and flat corners both
+    scenes.add_swell_shape_key(monkey, (FRAMES[0], FRAMES[-1]))
+    scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0.0, 0.0, 0.0))
+    return monkey
+
+
+def armature_tube(scene, collapse: bool = False):
+    """A smooth tube of quads bent by a two-bone armature; with ``collapse``,
+    one quad at the joint has an edge collapsed (two corners on one spot):
+    its split is too close to call in every frame."""
+    tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
+        bm, cap_ends=False, segments=16, radius1=0.5, radius2=0.5, depth=4.0))
+    mesh = tube.data
+    # Rings of quads along z, so the bend shows on many faces.
+    bm = bmesh.new()
+    bm.from_mesh(mesh)
+    bmesh.ops.subdivide_edges(bm, edges=[e for e in bm.edges if abs(e.verts[0].co.z - e.verts[1].co.z) > 1.0],
+                              cuts=11, use_grid_fill=False)
+    bm.to_mesh(mesh)
+    bm.free()
+    for poly in mesh.polygons:
+        poly.use_smooth = True
+    if collapse:
+        poly = min(mesh.polygons, key=lambda p: abs(p.center.z - 0.1))
+        a, b = poly.vertices[0], poly.vertices[1]
+        mesh.vertices[b].co = mesh.vertices[a].co
+        mesh.update()
+        positions = extract.read_positions(mesh)
+        quads = extract.read_corner_verts(mesh).reshape(-1, 4)
+        assert extract.quad_flip(positions, quads)[1].any()
+    scenes.add_bend_rig(scene, tube, (FRAMES[0], FRAMES[-1]), angle_deg=70.0)
+    scenes.add_camera(scene, location=(8.0, -3.0, 1.0), target=(0.0, 0.0, 0.5))
+    return tube
+
+
+def armature_tube_collapsed(scene):
+    return armature_tube(scene, collapse=True)
+
+
+def render(scene, path):
+    rgba = scenes.render_to_file(scene, path)
+    return rgba, solidwire_addon.stats()
+
+
+def difference_report(measured, expected) -> dict:
+    """The accuracy statistics (reference._statistics, SPEC 1.5) of the
+    largest per-sample channel difference between two renders."""
+    return reference._statistics(np.abs(measured - expected).max(axis=-1).ravel())
+
+
+@pytest.mark.parametrize("build, setup_min", [
+    (shape_key_monkey, draw.SETUP_TABLE_MIN),  # cage edges: an outline table, never the pre-pass
+    (armature_tube, draw.SETUP_TABLE_MIN),
+    (armature_tube, 1),
+    (armature_tube_collapsed, draw.SETUP_TABLE_MIN),  # a quad split Blender settles every frame
+], ids=["shape_key", "armature", "armature_setup_prepass", "armature_degenerate_quad"])
+def test_deformation_uploads_positions_and_normals_only(build, setup_min, monkeypatch, output_dir):
+    # The set-up pre-pass (big tri/quad meshes in a direct draw; here forced
+    # on a small one, with the render's surface pass drawn directly) keeps a
+    # per-mesh table that must follow the new positions.
+    if setup_min == 1 and not shaders.setup_available():
+        pytest.skip("no compute shaders here")
+    monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
+    monkeypatch.setattr(passes, "use_deferred_surface", setup_min != 1)
+    setup_calls = []
+    real_setup = draw._run_setup
+    monkeypatch.setattr(draw, "_run_setup", lambda *args: (setup_calls.append(1), real_setup(*args)))
+    scene = default_look_scene()
+    obj = build(scene)
+    name = f"deform_{obj.name.lower()}_{setup_min}"
+    warm_images = []
+    for frame in FRAMES:  # one cache through the animation
+        scene.frame_set(frame)
+        warm, stats = render(scene, output_dir / f"{name}_{frame}_warm.png")
+        warm_images.append(warm)
+        if frame == FRAMES[0]:
+            assert stats["meshes_extracted"] == 1
+        else:
+            assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (0, 1), frame
+    cold_images = []
+    for frame, warm in zip(FRAMES, warm_images):  # each frame from an empty cache: a full extraction
+        scene.frame_set(frame)
+        runtime.mesh_cache.clear()
+        cold, stats = render(scene, output_dir / f"{name}_{frame}_cold.png")
+        assert stats["meshes_extracted"] == 1
+        accuracy.assert_accurate({**difference_report(warm, cold), "nan": int(np.isnan(warm).sum())})
+        cold_images.append(cold)
+    assert (len(setup_calls) > 0) == (setup_min == 1)
+    # The frames really differ (fill shading and lines): stale positions or
+    # normals would fail the comparisons above.
+    for frame, image in zip(FRAMES[1:], cold_images[1:]):
+        report = difference_report(image, cold_images[0])
+        assert report["max"] > 0.3 and report["over_2_255"] > 200, (frame, report)
+
+
+def test_repositioned_frame_matches_the_reference(output_dir):
+    """The last frame of the shape-key animation, drawn from uploads reused
+    since the first frame, against the float64 reference's shaded fill."""
+    scene = default_look_scene(200, 150)
+    shape_key_monkey(scene)
+    for frame in FRAMES:
+        scene.frame_set(frame)
+        rgba, stats = render(scene, output_dir / "deform_reference.png")
+    assert stats["meshes_repositioned"] == 1 and stats["meshes_extracted"] == 0
+    ref = reference.render_reference(scene)
+    expected = reference.expected_fill_rgb(ref, float(scene.solidwire.wire_color[3]))
+    accuracy.assert_accurate(reference.color_error_report(rgba, expected, ref))
+
+
+def test_topology_change_mid_animation_reextracts(output_dir):
+    """A Build modifier adds faces every frame: never a positions-only upload."""
+    scene = default_look_scene()
+    obj = shape_key_monkey(scene)
+    build = obj.modifiers.new("Build", "BUILD")
+    obj.modifiers.move(len(obj.modifiers) - 1, 0)  # before the subdivision
+    build.frame_start, build.frame_duration = FRAMES[0] - 2, 2 * len(FRAMES)  # some faces at the first frame
+    for frame in FRAMES:
+        scene.frame_set(frame)
+        _rgba, stats = render(scene, output_dir / "deform_build.png")
+        assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (1, 0), frame
+
+
+def test_edge_marks_and_edge_angle_reextract(output_dir):
+    """A sharp mark changes which edges carry a class without moving a
+    vertex; with an edge angle a deformation changes which edges are drawn.
+    Both need the full extraction."""
+    scene = default_look_scene()
+    scene.solidwire.use_sharp_edges = True
+    obj = shape_key_monkey(scene)
+    scene.frame_set(FRAMES[0])
+    render(scene, output_dir / "deform_marks.png")
+    obj.data.edges[5].use_edge_sharp = True
+    _rgba, stats = render(scene, output_dir / "deform_marks.png")
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (1, 0)
+    # The same deformation with no edge angle: positions only ...
+    scene.frame_set(FRAMES[1])
+    _rgba, stats = render(scene, output_dir / "deform_marks.png")
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (0, 1)
+    # ... with an edge angle: extracted again.
+    scene.solidwire.edge_angle = math.radians(20.0)
+    scene.frame_set(FRAMES[2])
+    render(scene, output_dir / "deform_marks.png")
+    scene.frame_set(FRAMES[3])
+    _rgba, stats = render(scene, output_dir / "deform_marks.png")
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (1, 0)
