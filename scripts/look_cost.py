@@ -5,7 +5,8 @@ a frame that finds the mesh cache empty (the corner table included).
 
     .venv/bin/python -m scripts.look_cost [--repeats 5]
 
-Prints a Markdown table (median milliseconds) for the README.
+Prints a Markdown table (median milliseconds) for the README; the render
+column is the deferred surface pass, with the direct one beside it.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from tests.support import scenes
 import solidwire_addon
 from solidwire_addon.blender import engine, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.core import passes
 
 SIZE = (1920, 1080)
 BASE = dict(use_fill=True, fill_shading="FLAT", fill_color_source="SINGLE", wire_color_source="SINGLE",
@@ -76,12 +78,15 @@ def first_frame_ms(scene, settings: dict) -> float:
     return stats["ms_extract"] + stats.get("ms_upload", 0.0)
 
 
-def warm_ms(scene, settings: dict) -> float:
+def warm_ms(scene, settings: dict, deferred: bool = True) -> float:
     apply(scene, settings)
+    passes.use_deferred_surface = deferred
     depsgraph = bpy.context.evaluated_depsgraph_get()
     start = time.perf_counter()
     engine.render_scene(depsgraph, SIZE)
-    return (time.perf_counter() - start) * 1000.0
+    elapsed = (time.perf_counter() - start) * 1000.0
+    passes.use_deferred_surface = True
+    return elapsed
 
 
 def main(argv=None) -> int:
@@ -95,23 +100,28 @@ def main(argv=None) -> int:
         triangles = sum(len(o.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
                         for o in scene.objects if o.type == "MESH")
         print(f"{SIZE[0]}x{SIZE[1]}, {triangles} triangles in 7 objects, median of {args.repeats} rounds\n")
-        print("| option | render, meshes cached (ms) | vs flat | extract + upload, first frame (ms) |")
-        print("|---|---:|---:|---:|")
+        print("| option | render, meshes cached (ms) | vs flat | direct surface pass (ms) | "
+              "extract + upload, first frame (ms) |")
+        print("|---|---:|---:|---:|---:|")
         for _label, settings in OPTIONS:  # compile every variant, fill the cache
-            warm_ms(scene, settings)
-            warm_ms(scene, settings)
+            for deferred in (True, False):
+                warm_ms(scene, settings, deferred)
+                warm_ms(scene, settings, deferred)
         # Rounds over all options, so a change in machine load hits them alike.
         warm = {label: [] for label, _settings in OPTIONS}
         cold = {label: [] for label, _settings in OPTIONS}
+        direct = {label: [] for label, _settings in OPTIONS}
         for _round in range(args.repeats):
             for label, settings in OPTIONS:
                 cold[label].append(first_frame_ms(scene, settings))
                 warm_ms(scene, settings)
                 warm[label].append(warm_ms(scene, settings))
+                direct[label].append(warm_ms(scene, settings, deferred=False))
         base = statistics.median(warm[OPTIONS[0][0]])
         for label, _settings in OPTIONS:
             w, c = statistics.median(warm[label]), statistics.median(cold[label])
-            print(f"| {label} | {w:.0f} | {w / base:.2f}x | {c:.0f} |")
+            d = statistics.median(direct[label])
+            print(f"| {label} | {w:.0f} | {w / base:.2f}x | {d:.0f} | {c:.0f} |")
     finally:
         solidwire_addon.unregister()
     return 0

@@ -185,6 +185,9 @@ void main()
              && (edge_flags & IN_REGION) == 0;
   }
   ngon_corner_start = int(ids.w);
+#  ifdef RESOLVE_PASS
+  sw_corner_clip = mat3x4(vertex_clip(ids.x), vertex_clip(ids.y), vertex_clip(ids.z));
+#  endif
 #else
 
   vec4 c0 = vertex_clip(ids.x);

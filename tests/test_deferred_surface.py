@@ -12,6 +12,7 @@ import bpy
 import numpy as np
 import pytest
 
+import solidwire_addon
 from solidwire_addon.core import draw, passes, shaders
 from tests.support import scenes
 from tests.test_render_passes import _enable_all
@@ -36,7 +37,9 @@ def _stages(monkeypatch):
 
 def _render_both(scene, path, monkeypatch):
     """(direct channels, deferred channels) of one multilayer EXR render
-    each, and the stages the deferred render drew."""
+    each, and the stages the deferred render drew (every mesh deferred,
+    however sparse on screen)."""
+    monkeypatch.setattr(draw, "DEFERRED_MIN_DENSITY", 0.0)
     calls = _stages(monkeypatch)
     monkeypatch.setattr(passes, "use_deferred_surface", False)
     direct = scenes.render_multilayer_exr(scene, path.with_name(path.stem + "_direct.exr"))
@@ -44,6 +47,9 @@ def _render_both(scene, path, monkeypatch):
     calls.clear()
     monkeypatch.setattr(passes, "use_deferred_surface", True)
     deferred = scenes.render_multilayer_exr(scene, path.with_name(path.stem + "_deferred.exr"))
+    # Every stage compiled (a refused one falls back to the direct image,
+    # which would hide it here).
+    assert shaders.deferred_available()
     return direct, deferred, list(calls)
 
 
@@ -92,15 +98,21 @@ LOOKS = {
                                   edge_angle=20.0, use_fill=True),
     "hidden_lines_silhouettes": dict(use_hidden_lines=True, use_silhouettes=True, use_fill=True),
 }
+INSTANCED_LOOKS = ("wire_only", "studio_fill")
 
 
 @pytest.mark.parametrize("look", sorted(LOOKS))
 def test_deferred_surface_gives_the_direct_image(look, output_dir, monkeypatch):
     scene = scenes.empty_scene(200, 150, **LOOKS[look])
     _mixed_scene(scene)
-    _enable_all(scene.view_layers[0])
+    # With render passes every object draws on its own; without them the
+    # boxes share one instanced draw (its own visibility and resolve code).
+    instanced = look in INSTANCED_LOOKS
+    if not instanced:
+        _enable_all(scene.view_layers[0])
     direct, deferred, stages = _render_both(scene, output_dir / f"deferred_{look}.exr", monkeypatch)
-    assert stages[:2] == [draw.VISIBILITY, draw.RESOLVE]
+    assert stages[:3] == [None, draw.VISIBILITY, draw.RESOLVE]
+    assert (solidwire_addon.stats().get("instanced_draws", 0) > 0) == instanced
     combined = next(name for name in direct if name.endswith("Combined.A"))
     assert (direct[combined] > 0.0).sum() > 2000  # something was drawn
     _assert_same(direct, deferred)
@@ -138,16 +150,79 @@ def test_a_deferred_stage_that_does_not_compile_falls_back_to_the_direct_pass(ou
         np.testing.assert_array_equal(got[name], values, err_msg=name)
 
 
-def test_numbers_beyond_float32_whole_numbers_keep_the_direct_pass(monkeypatch):
+def test_deferred_and_direct_meshes_share_one_surface(output_dir, monkeypatch):
+    """Meshes dense on screen are deferred, the rest drawn directly into the
+    same depth buffer first: the image is the all-direct one, occlusion
+    between the two kinds included."""
+    scene = scenes.empty_scene(200, 150, use_fill=True, fill_shading="STUDIO")
+    _mixed_scene(scene)
+    monkeypatch.setattr(passes, "use_deferred_surface", False)
+    direct = scenes.render_multilayer_exr(scene, output_dir / "deferred_mixed_direct.exr")
+    monkeypatch.setattr(passes, "use_deferred_surface", True)
+    real_split = draw.split_deferred
+    halves = []
+
+    def every_other_mesh(items, view):
+        deferred, rest = real_split(items, view)
+        everything = deferred + rest
+        meshes = sorted({id(item.mesh) for item in everything})
+        chosen = set(meshes[::2])
+        halves.append((len(chosen), len(meshes)))
+        return ([item for item in everything if id(item.mesh) in chosen],
+                [item for item in everything if id(item.mesh) not in chosen])
+
+    monkeypatch.setattr(draw, "split_deferred", every_other_mesh)
+    mixed = scenes.render_multilayer_exr(scene, output_dir / "deferred_mixed.exr")
+    assert halves and 0 < halves[0][0] < halves[0][1] and shaders.deferred_available()
+    _assert_same(direct, mixed)
+
+
+class _Mesh:
+    centre = np.zeros(3)
+    bounds_min = -np.ones(3)
+    bounds_max = np.ones(3)
+    has_ngons = False
+
+    def __init__(self, triangles):
+        self.triangle_count = triangles
+
+
+class _Item:
+    matrix = np.eye(4)
+
+    def __init__(self, mesh):
+        self.mesh = mesh
+
+
+def _camera_view():
+    from solidwire_addon.core.view import View
+
+    view_matrix = np.eye(4)
+    view_matrix[2, 3] = -10.0  # the unit box 10 units ahead
+    near, far = 0.1, 100.0
+    projection = np.array([[2.0, 0, 0, 0], [0, 2.0, 0, 0],
+                           [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1.0, 0]])
+    return View(view_matrix, projection, (0, 0, 1000, 1000))
+
+
+def test_dense_meshes_are_deferred_sparse_ones_direct():
+    """The split follows triangles per pixel of the meshes' window boxes
+    (the unit box here covers about 230 x 230 of 1000 x 1000 pixels)."""
+    view = _camera_view()
+    sparse, dense = _Item(_Mesh(100)), _Item(_Mesh(50_000))
+    deferred, direct = draw.split_deferred([sparse, dense], view)
+    assert deferred == [dense] and direct == [sparse]
+    plain, blocky = _Mesh(4_000), _Mesh(4_000)
+    blocky.has_ngons = True  # n-gon and region blocks make a triangle dearer to set up
+    deferred, direct = draw.split_deferred([_Item(plain), _Item(blocky)], view)
+    assert [item.mesh for item in deferred] == [blocky] and [item.mesh for item in direct] == [plain]
+
+
+def test_numbers_beyond_float32_whole_numbers_keep_the_direct_pass():
     """Triangle, instance and draw numbers travel as float32 whole numbers:
-    an item set that would overflow them is drawn directly."""
-
-    class Mesh:
-        triangle_count = draw.DEFERRED_MAX
-
-    class Item:
-        mesh = Mesh()
-
-    assert passes.deferred_surface([Item()]) is False
-    Mesh.triangle_count = draw.DEFERRED_MAX - 1
-    assert passes.deferred_surface([Item()]) is True
+    a mesh that would overflow them is drawn directly."""
+    view = _camera_view()
+    huge = _Item(_Mesh(draw.DEFERRED_MAX))
+    assert draw.split_deferred([huge], view) == ([], [huge])
+    huge.mesh.triangle_count = draw.DEFERRED_MAX - 1
+    assert draw.split_deferred([huge], view) == ([huge], [])

@@ -19,7 +19,7 @@ from .cache import table_texture
 from .edge_select import EDGE_CLASSES
 from .log import warn_once
 from .settings import pack_params
-from .view import DrawStats, View, outside_frustum_many, translation, window_rect
+from .view import DrawStats, View, box_pixels, outside_frustum_many, translation, window_boxes, window_rect
 
 
 def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0,
@@ -107,6 +107,36 @@ VISIBILITY, RESOLVE = "visibility", "resolve"
 # Triangle numbers, instances and draw numbers travel as float32 whole
 # numbers in the visibility record: exact below 2^24.
 DEFERRED_MAX = 1 << 24
+# The deferred surface pays for a mesh with at least this many triangles
+# per pixel of its window boxes (measured on llvmpipe: a resolved pixel
+# costs about twice a directly shaded fragment, while every triangle of a
+# direct draw sets itself up at three corners and shades every fragment,
+# hidden ones too; break-even near one triangle per two covered pixels).
+# A mesh whose triangles walk segment blocks (n-gons, regions, classes) has
+# a set-up several times dearer and counts DEFERRED_BLOCK_WEIGHT times.
+DEFERRED_MIN_DENSITY = 0.25
+DEFERRED_BLOCK_WEIGHT = 4.0
+
+
+def split_deferred(items, view: View) -> tuple[list, list]:
+    """(items to draw deferred, items to draw directly): a mesh is deferred
+    when its triangles are dense on screen (DEFERRED_MIN_DENSITY), counted
+    over all its items at once; numbers the visibility record cannot hold
+    exactly (DEFERRED_MAX) keep the direct draw."""
+    by_mesh: dict = {}
+    for item in items:
+        by_mesh.setdefault(id(item.mesh), []).append(item)
+    if len(by_mesh) >= DEFERRED_MAX or len(items) >= DEFERRED_MAX:
+        return [], list(items)
+    deferred, direct = [], []
+    for group in by_mesh.values():
+        mesh = group[0].mesh
+        to_clip = view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
+        pixels = float(box_pixels(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max), view).sum())
+        weight = DEFERRED_BLOCK_WEIGHT if mesh.has_ngons else 1.0
+        dense = weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels
+        (deferred if dense and mesh.triangle_count < DEFERRED_MAX else direct).extend(group)
+    return deferred, direct
 
 
 def styled(settings, style, show_wire: bool = True):
@@ -288,10 +318,11 @@ def draw(
         # Big tri/quad meshes take their edge set-up from the pre-pass.
         # Only a mesh drawn once in this pass: its table is then written
         # before its one draw and never rewritten while a draw may still read
-        # it (objects sharing a mesh keep the per-corner set-up).
-        # (The deferred stages set up each visible triangle once per pixel
-        # anyway: no pre-pass.)
-        setup_ok = stage is None and getattr(program, "supports_setup_table", False) and _setup_ready()
+        # it (objects sharing a mesh keep the per-corner set-up). The
+        # deferred resolve sets a triangle up once per pixel it shows, so
+        # there the pre-pass pays only where the draw's pixels outnumber its
+        # triangles (_setup_size).
+        setup_ok = getattr(program, "supports_setup_table", False) and _setup_ready()
         # Both deferred stages must split and number the draws alike:
         # instancing does not depend on the stage's variant.
         instancing = program.supports_instancing and not write_aovs
@@ -302,11 +333,13 @@ def draw(
         for with_ngons in (False, True):
             batch = [g for g in groups if (program.supports_ngons and g[0].has_ngons) == with_ngons]
             for setup_table in (False, True):
+                # (Both deferred stages split alike, so they number the
+                # draws alike; the visibility stage itself reads no table.)
                 part = [g for g in batch if (setup_ok and not with_ngons and draws_of[id(g[0])] == 1
-                                             and _setup_size(g[0])) == setup_table]
+                                             and _setup_size(g[0], stage, g[4], view)) == setup_table]
                 if part:
                     part_variant = replace(variant, ngons=with_ngons and not variant.visibility,
-                                           setup_table=setup_table)
+                                           setup_table=setup_table and not variant.visibility)
                     _draw_groups(part, part_variant, ubo, settings, program, flip, stats, extras, bases,
                                  instancing=instancing, numbering=numbering)
     finally:
@@ -432,6 +465,9 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
     resolving = numbering.stage == RESOLVE
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
+    # (A resolve that reads the set-up table and needs no barycentrics
+    # never transforms a vertex.)
+    uses_matrix = shaders.uses_uniform(shader, "object_to_clip")
     shader.bind()
     bound = None
     shader.uniform_block("params", ubo(bound))
@@ -476,6 +512,8 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
         for slot, (mesh, style, world, object_to_view, object_to_clip, _info, mirrored, pass_index,
                    materials) in enumerate(single):
             if variant.setup_table:
+                # (Before each draw: so a mesh is set up for the matrix of
+                # the one object drawing it.)
                 _run_setup(mesh, object_to_clip, ubo(style))
                 shader.bind()
                 bound = _UNBOUND  # the pre-pass bound its own block
@@ -488,7 +526,8 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             if variant.write_aovs:
                 object_block = _set_object_block(shader, object_block, world, bool(mirrored), pass_index)
                 shader.uniform_sampler("triangle_material", _material_table(mesh, materials, material_tables))
-            shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
+            if uses_matrix:
+                shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             if uses_view_depth:
                 shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
             if variant.per_item:
@@ -519,10 +558,20 @@ def _setup_ready() -> bool:
     return True
 
 
-def _setup_size(mesh) -> bool:
-    """Whether ``mesh`` is big enough for the set-up pre-pass (and its table
-    fits in a texture)."""
-    return SETUP_TABLE_MIN <= mesh.triangle_count <= shaders.SETUP_MAX_TRIANGLES
+def _setup_size(mesh, stage, object_to_clip, view: View) -> bool:
+    """Whether a draw of ``mesh`` gains from the set-up pre-pass (and its
+    table fits in a texture). A direct draw sets a triangle up at each of
+    its corners: the pre-pass pays from SETUP_TABLE_MIN triangles on. The
+    deferred resolve sets it up once per pixel it shows: the pre-pass pays
+    where the draw's window box holds more pixels than the mesh has
+    triangles (a pixel's set-up and a pre-pass invocation cost about the
+    same; a box is about half covered)."""
+    if mesh.triangle_count > shaders.SETUP_MAX_TRIANGLES:
+        return False
+    if stage is None:
+        return mesh.triangle_count >= SETUP_TABLE_MIN
+    pixels = box_pixels(window_boxes(object_to_clip, mesh.bounds_min, mesh.bounds_max), view).sum()
+    return 0.5 * pixels > mesh.triangle_count
 
 
 def _run_setup(mesh, object_to_clip, block) -> None:

@@ -152,56 +152,50 @@ def _clear(framebuffer, width: int, height: int, depth: bool = True) -> None:
 use_deferred_surface = True
 
 
-def deferred_surface(items) -> bool:
-    """Whether the render's surface pass runs deferred (docs/image_model.md
-    §2.5): always, unless a number it records would not be exact in float32
-    (a mesh of 2^24 triangles or more, or as many instances or draws)."""
-    if not use_deferred_surface or not shaders.deferred_available():
-        return False
-    if len(items) >= draw_mod.DEFERRED_MAX:
-        return False
-    return all(item.mesh.triangle_count < draw_mod.DEFERRED_MAX for item in items)
-
-
 def draw_surface(targets, items, view: View, settings, *, show_wire: bool = True, aovs: bool = False,
                  cull: bool = True):
     """The surface pass into ``targets`` (cleared first): depth, the fill
     and the visible wire, and the render passes' outputs with ``aovs``.
-    Deferred where it can be (deferred_surface), else drawn directly; the
+    Meshes dense on screen are drawn deferred (docs/image_model.md §2.5,
+    draw.split_deferred), the rest directly, into the same depth buffer; the
     same image either way. Returns the DrawStats."""
     width, height = view.width, view.height
     surface_args = {"cull": cull, "show_wire": show_wire, "write_aovs": aovs, "linear_depth": True}
-    if deferred_surface(items):
+    deferred, direct = ([], list(items))
+    if use_deferred_surface and shaders.deferred_available():
+        deferred, direct = draw_mod.split_deferred(items, view)
+    framebuffer = targets.framebuffer(aovs=aovs)
+    with framebuffer.bind():
+        _clear(framebuffer, width, height)
+        stats = draw_mod.draw(direct, view, settings, write_view_depth=True, **surface_args)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+    if deferred:
         try:
-            return _deferred_surface(targets, items, view, settings, aovs, surface_args)
+            stats.add(_deferred_surface(targets, deferred, view, settings, aovs, surface_args))
         except shaders.DeferredUnavailable as exc:
             shaders.disable_deferred()
             warn_once(("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); "
                                      "drawing directly")
-    framebuffer = targets.framebuffer(aovs=aovs)
-    with framebuffer.bind():
-        _clear(framebuffer, width, height)
-        stats = draw_mod.draw(items, view, settings, write_view_depth=True, **surface_args)
-        gpu.state.depth_test_set("NONE")
-        gpu.state.depth_mask_set(False)
+            return draw_surface(targets, items, view, settings, show_wire=show_wire, aovs=aovs, cull=cull)
     return stats
 
 
 def _deferred_surface(targets, items, view: View, settings, aovs: bool, surface_args: dict):
-    """The surface pass in two stages: which triangle each pixel shows
-    (depth test, no shading), then the exact fragment stage once per pixel
-    shown. Same depth, same image as the direct pass; the edge set-up runs
-    once per visible pixel instead of at every corner of every triangle."""
+    """The surface pass of ``items`` in two stages over the depth the direct
+    draws left: which triangle each pixel shows (depth test, no shading),
+    then the exact fragment stage once per pixel shown. Same depth, same
+    image as the direct pass; the edge set-up runs once per visible pixel
+    instead of at every corner of every triangle."""
     width, height = view.width, view.height
     framebuffer = targets.visibility_framebuffer()
     with framebuffer.bind():
-        _clear(framebuffer, width, height)
+        _clear(framebuffer, width, height, depth=False)  # keep the direct draws' depth
         stats = draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY, **surface_args)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
-    framebuffer = targets.resolve_framebuffer(aovs=aovs)
-    with framebuffer.bind():
-        _clear(framebuffer, width, height, depth=False)
+    with targets.resolve_framebuffer(aovs=aovs).bind():
+        gpu.state.viewport_set(0, 0, width, height)
         draw_mod.draw(items, view, settings, stage=draw_mod.RESOLVE, visibility=targets.visible,
                       write_view_depth=True, **surface_args)
     return stats

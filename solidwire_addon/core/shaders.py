@@ -341,7 +341,7 @@ def _visibility_create_info(variant: ShaderVariant):
     if variant.instanced:
         info.define("SW_INSTANCED", "1")
         prologue = (f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
-                    + read_source("instancing.glsl") + read_source("edge_geometry.glsl"))
+                    + read_source("instancing.glsl") + read_source("common.glsl") + read_source("edge_geometry.glsl"))
     else:
         prologue = ""
     info.vertex_source(prologue + read_source("visibility_vert.glsl"))

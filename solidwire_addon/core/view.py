@@ -63,6 +63,14 @@ class DrawStats:
     triangles_drawn: int = 0
     extra: dict = field(default_factory=dict)
 
+    def add(self, other: "DrawStats") -> None:
+        """Count ``other``'s draws in too (one pass drawn in parts)."""
+        self.objects_drawn += other.objects_drawn
+        self.objects_culled += other.objects_culled
+        self.triangles_drawn += other.triangles_drawn
+        for key, value in other.extra.items():
+            self.extra[key] = self.extra.get(key, 0) + value
+
 
 def translation(offset) -> np.ndarray:
     m = np.eye(4)
@@ -85,19 +93,33 @@ def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max) -> 
     return outside
 
 
-def window_rect(object_to_clip: np.ndarray, bounds_min, bounds_max) -> tuple:
-    """(x0, y0, x1, y1) in NDC: a rectangle holding every pixel the boxes of
-    (N, 4, 4) ``object_to_clip`` can cover, widened by a pixel's worth of
-    slack for rounding and clamped to the view; the whole view when a box
-    reaches behind the camera (no finite projection there)."""
+def window_boxes(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.ndarray:
+    """(N, 4) NDC rectangles (x0, y0, x1, y1), one per (N, 4, 4)
+    ``object_to_clip``, each holding every pixel its box can cover, widened
+    by a little slack for rounding and clamped to the view; the whole view
+    where a box reaches behind the camera (no finite projection there)."""
     lo, hi = np.asarray(bounds_min), np.asarray(bounds_max)
     corners = _BOX_CORNERS.copy()
     corners[:, :3] = lo + corners[:, :3] * (hi - lo)
-    clip = np.einsum("kj,nij->nki", corners, np.asarray(object_to_clip).reshape(-1, 4, 4)).reshape(-1, 4)
-    w = clip[:, 3]
-    if not len(w) or (w <= 1e-6 * np.abs(clip[:, :3]).max(initial=1.0)).any():
+    clip = np.einsum("kj,nij->nki", corners, np.asarray(object_to_clip).reshape(-1, 4, 4))  # (N, 8, 4)
+    w = clip[..., 3]
+    behind = (w <= 1e-6 * np.abs(clip[..., :3]).max(axis=(1, 2), initial=1.0)[:, None]).any(axis=1)
+    with np.errstate(all="ignore"):
+        ndc = clip[..., :2] / np.where(behind[:, None], 1.0, w)[..., None]
+    boxes = np.concatenate([ndc.min(axis=1) - 0.01, ndc.max(axis=1) + 0.01], axis=1)
+    boxes[behind] = (-1.0, -1.0, 1.0, 1.0)
+    return np.clip(boxes, -1.0, 1.0)
+
+
+def window_rect(object_to_clip: np.ndarray, bounds_min, bounds_max) -> tuple:
+    """One NDC rectangle (x0, y0, x1, y1) over the window_boxes of every
+    instance in ``object_to_clip``."""
+    boxes = window_boxes(object_to_clip, bounds_min, bounds_max)
+    if not len(boxes):
         return (-1.0, -1.0, 1.0, 1.0)
-    ndc = clip[:, :2] / w[:, None]
-    x0, y0 = np.clip(ndc.min(axis=0) - 0.01, -1.0, 1.0)
-    x1, y1 = np.clip(ndc.max(axis=0) + 0.01, -1.0, 1.0)
-    return (float(x0), float(y0), float(x1), float(y1))
+    return (float(boxes[:, 0].min()), float(boxes[:, 1].min()), float(boxes[:, 2].max()), float(boxes[:, 3].max()))
+
+
+def box_pixels(boxes: np.ndarray, view) -> np.ndarray:
+    """(N,) pixels inside NDC rectangles ``boxes`` of a ``view``."""
+    return 0.25 * (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1]) * view.width * view.height
