@@ -83,6 +83,11 @@ void line_through(vec2 window_a, vec2 window_b, out vec3 line, out vec2 span)
  * the cross product is the better-conditioned choice (see below). */
 void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
 {
+#ifdef ALL_IN_FRONT
+  /* The draw lies wholly in front of the near plane (shaders.py): no
+   * clipping code at all (a CPU rasteriser runs every side of a branch). */
+  line_through(window_point(a), window_point(b), line, span);
+#else
   float depth_a = a.z + a.w; /* >= 0 in front of the near plane */
   float depth_b = b.z + b.w;
   if (depth_a < 0.0 && depth_b < 0.0) {
@@ -120,6 +125,7 @@ void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
     dir = -dir;
   }
   span = vec2(dot(dir, wa), dot(dir, wb));
+#endif
 }
 
 /* Edges run from their lower vertex id: the two triangles sharing a diagonal
@@ -159,7 +165,11 @@ void triangle_edges(vec4 c0, vec4 c1, vec4 c2, vec4 c3, vec4 ids, bool quad, out
                     out vec3 line4, out vec2 span4, out vec2 w0, out vec2 w1, out vec2 w2, out bool in_front,
                     out bool convex)
 {
+#ifdef ALL_IN_FRONT
+  in_front = true;
+#else
   in_front = min(min(c0.z + c0.w, c1.z + c1.w), min(c2.z + c2.w, c3.z + c3.w)) >= 0.0;
+#endif
   convex = false;
   line3 = line4 = vec3(0.0, 0.0, NO_EDGE);
   span3 = span4 = vec2(0.0);
@@ -189,6 +199,7 @@ void triangle_edges(vec4 c0, vec4 c1, vec4 c2, vec4 c3, vec4 ids, bool quad, out
       convex = s1 * s3 < 0.0 && t0 * t2 < 0.0;
     }
   }
+#ifndef ALL_IN_FRONT
   else {
     edge_setup_from_lower(c0, c1, ids.x, ids.y, line0, span0);
     edge_setup_from_lower(c1, c2, ids.y, ids.z, line1, span1);
@@ -198,4 +209,5 @@ void triangle_edges(vec4 c0, vec4 c1, vec4 c2, vec4 c3, vec4 ids, bool quad, out
       edge_setup_from_lower(c3, c0, ids.w, ids.x, line4, span4);
     }
   }
+#endif
 }

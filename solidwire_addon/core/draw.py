@@ -19,7 +19,8 @@ from .cache import table_texture
 from .edge_select import EDGE_CLASSES
 from .log import warn_once
 from .settings import pack_params
-from .view import DrawStats, View, box_pixels, outside_frustum_many, translation, window_boxes, window_rect
+from .view import (DrawStats, View, box_pixels, outside_frustum_many, translation, wholly_in_front, window_boxes,
+                   window_rect)
 
 
 def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0,
@@ -330,18 +331,22 @@ def draw(
         draws_of = {}
         for g in groups:
             draws_of[id(g[0])] = draws_of.get(id(g[0]), 0) + len(g[2])
-        for with_ngons in (False, True):
-            batch = [g for g in groups if (program.supports_ngons and g[0].has_ngons) == with_ngons]
-            for setup_table in (False, True):
-                # (Both deferred stages split alike, so they number the
-                # draws alike; the visibility stage itself reads no table.)
-                part = [g for g in batch if (setup_ok and not with_ngons and draws_of[id(g[0])] == 1
-                                             and _setup_size(g[0], stage, g[4], view)) == setup_table]
-                if part:
-                    part_variant = replace(variant, ngons=with_ngons and not variant.visibility,
-                                           setup_table=setup_table and not variant.visibility)
-                    _draw_groups(part, part_variant, ubo, settings, program, flip, stats, extras, bases,
-                                 instancing=instancing, numbering=numbering)
+        # One variant per part; parts in a fixed order (both deferred stages
+        # must draw, and so number, alike; the visibility stage itself reads
+        # no table and sets nothing up).
+        parts: dict = {}
+        for g in groups:
+            mesh = g[0]
+            ngons = program.supports_ngons and mesh.has_ngons
+            table = (setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g[4], view))
+            in_front = wholly_in_front(g[4], mesh.bounds_min, mesh.bounds_max)
+            parts.setdefault((ngons, table, in_front), []).append(g)
+        for (ngons, table, in_front) in sorted(parts):
+            part_variant = replace(variant, ngons=ngons and not variant.visibility,
+                                   setup_table=table and not variant.visibility,
+                                   in_front=in_front and not variant.visibility)
+            _draw_groups(parts[(ngons, table, in_front)], part_variant, ubo, settings, program, flip, stats, extras,
+                         bases, instancing=instancing, numbering=numbering)
     finally:
         gpu.state.face_culling_set("NONE")
     return stats

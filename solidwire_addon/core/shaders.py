@@ -108,6 +108,11 @@ class ShaderVariant:
     # exact path's fragment stage run once per pixel over that record.
     visibility: bool = False
     resolve: bool = False
+    # Every triangle of the draw lies in front of the near plane (its box
+    # does, with a margin; view.wholly_in_front): the edge set-up compiles
+    # without its clipping code (ALL_IN_FRONT), which a CPU rasteriser
+    # would otherwise run for every triangle or pixel, branch or not.
+    in_front: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -289,6 +294,8 @@ def _create_info(variant: ShaderVariant):
         info.vertex_in(0, "INT", "edge_flags")
     output_and_feature_defines(info, variant)
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
+    if variant.in_front:
+        info.define("ALL_IN_FRONT", "1")
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
     if variant.linear_depth:

@@ -93,6 +93,19 @@ def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max) -> 
     return outside
 
 
+def wholly_in_front(object_to_clip: np.ndarray, bounds_min, bounds_max) -> bool:
+    """Whether every box of (N, 4, 4) ``object_to_clip`` lies in front of the
+    near plane (clip z + w > 0 at every corner) with a margin of 1e-4 of the
+    largest |w|, more than float32 rounding of a vertex inside can take
+    away (a vertex is a convex mix of the corners, z + w linear)."""
+    lo, hi = np.asarray(bounds_min), np.asarray(bounds_max)
+    corners = _BOX_CORNERS.copy()
+    corners[:, :3] = lo + corners[:, :3] * (hi - lo)
+    clip = np.einsum("kj,nij->nki", corners, np.asarray(object_to_clip).reshape(-1, 4, 4))
+    depth = clip[..., 2] + clip[..., 3]
+    return bool(len(clip)) and bool((depth > 1e-4 * np.abs(clip[..., 3]).max()).all())
+
+
 def window_boxes(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.ndarray:
     """(N, 4) NDC rectangles (x0, y0, x1, y1), one per (N, 4, 4)
     ``object_to_clip``, each holding every pixel its box can cover, widened
