@@ -40,8 +40,9 @@ void main()
   sw_front_facing = dot(h0, cross(h1, h2)) > 0.0;
   view_depth = visible.w;
 #ifdef USE_CORNERS
-  shading_normal = mu.x * corner_shading(3 * triangle).xyz + mu.y * corner_shading(3 * triangle + 1).xyz
-                   + mu.z * corner_shading(3 * triangle + 2).xyz;
+  vec4 ids = fetch_texel(triangle_vertices, triangle);
+  shading_normal = mu.x * corner_shading(triangle, 0, ids.x).xyz + mu.y * corner_shading(triangle, 1, ids.y).xyz
+                   + mu.z * corner_shading(triangle, 2, ids.z).xyz;
 #endif
   solidwire_fragment();
 }

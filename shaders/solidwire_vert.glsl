@@ -125,12 +125,15 @@ float line_reach(float w0, float w1, float w2)
 }
 #endif
 
-/* This corner's normal in view space (one texel per triangle corner, in
- * draw order; extract.corner_table), and its face's material in w. */
+/* Corner `corner` of `triangle` (vertex `vertex_id`): its normal in view
+ * space and its face's material in w, from the corner table's row for it
+ * (extract.corner_table: a row per vertex, triangle or triangle corner, as
+ * normal_domain says). */
 #ifdef USE_CORNERS
-vec4 corner_shading(int corner_index)
+vec4 corner_shading(int triangle, int corner, float vertex_id)
 {
-  vec4 corner_data = fetch_texel(corner_table, corner_index);
+  int row = (normal_domain == 0) ? int(vertex_id) : ((normal_domain == 1) ? triangle : 3 * triangle + corner);
+  vec4 corner_data = fetch_texel(corner_table, row);
   return vec4(mat3(normal_to_view) * corner_data.xyz, corner_data.w);
 }
 #endif
@@ -265,7 +268,7 @@ void main()
 #endif
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
 #ifdef USE_CORNERS
-  vec4 corner_data = corner_shading(SW_VERTEX_ID);
+  vec4 corner_data = corner_shading(triangle, corner, (corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z));
   shading_normal = corner_data.xyz;
 #endif
 #ifdef ITEM_COLORS

@@ -56,6 +56,38 @@ def test_fill_shading_matches_reference(shading, output_dir):
         assert spread > 0.1  # lit: the fill is not flat
 
 
+def test_every_normal_domain_matches_reference(output_dir):
+    """A mesh's normals are uploaded where they vary (extract.NORMALS_BY_*):
+    per vertex for smooth shading with one material, per triangle for flat
+    shading, per triangle corner otherwise (here: smooth with two
+    materials, so a vertex has no one material); each shades as Blender
+    does."""
+    from solidwire_addon.blender import runtime
+    from solidwire_addon.core import extract
+
+    scene = scenes.empty_scene(200, 150, use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.7, 0.6),
+                               fill_color_source="MATERIAL")
+    scene.solidwire.wire_color = (0.05, 0.05, 0.05, 1.0)
+    smooth = scenes.uv_sphere(scene, "Smooth", location=(-1.6, 0.0, 0.0), radius=0.7)
+    flat = scenes.monkey(scene, "Flat", subdivisions=1, location=(0.2, 0.0, 0.0), rotation=(0.2, 0.0, 0.5))
+    two = scenes.uv_sphere(scene, "TwoMaterials", location=(1.9, 0.3, 0.0), radius=0.6)
+    for obj, use_smooth in ((smooth, True), (flat, False), (two, True)):
+        for poly in obj.data.polygons:
+            poly.use_smooth = use_smooth
+    for name, colour in (("Red", (0.8, 0.2, 0.1, 1.0)), ("Blue", (0.1, 0.3, 0.8, 1.0))):
+        material = bpy.data.materials.new(name)
+        material.diffuse_color = colour
+        two.data.materials.append(material)
+        smooth.data.materials.append(material)  # one slot used: still one material
+    for poly in two.data.polygons:
+        poly.material_index = poly.index % 2
+    scenes.add_camera(scene, location=(0.5, -5.0, 1.5), target=(0.2, 0, 0))
+    report, _rgba, _ref = _measure(scene, "fill_normal_domains", output_dir)
+    accuracy.assert_accurate(report)
+    domains = sorted(entry.normal_domain for entry in runtime.mesh_cache.meshes() if entry.corners is not None)
+    assert domains == [extract.NORMALS_BY_VERTEX, extract.NORMALS_BY_TRIANGLE, extract.NORMALS_BY_CORNER]
+
+
 def test_matcap_is_chosen_by_name(output_dir):
     scene = _shading_scene(fill_shading="MATCAP", matcap="check_normal+y", fill_color=(1.0, 1.0, 1.0))
     report, _rgba, _ref = _measure(scene, "fill_matcap_check", output_dir)

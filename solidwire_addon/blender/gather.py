@@ -119,8 +119,8 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = ()):
     shape = (_crc(positions),)
     corner_inputs = None
     if corners:
-        normals, materials = corner_inputs = extract.read_corner_inputs(mesh)
-        topology += (_crc(materials),)
+        normals, materials, domain = corner_inputs = extract.read_corner_inputs(mesh)
+        topology += (_crc(materials), domain)
         shape += (_crc(normals),)
     return (topology, shape), (positions, corner_vert, corner_inputs)
 
@@ -446,12 +446,14 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
                                    extract.blender_triangles(source_mesh))
         if moved is None or not corners:
             return moved
-        if entry.corner_rows is None:
+        normals, materials, domain = corner_inputs
+        if domain == extract.NORMALS_BY_CORNER and entry.corner_rows is None:
             return None
-        # The corner normals follow the deformation; which corner each
-        # triangle corner is does not (same faces, same triangles).
-        normals, materials = corner_inputs
-        return (*moved, extract.fill_corner_table(entry.corner_rows, entry.triangle_polygons_cpu, normals, materials))
+        # The normals follow the deformation; which corner each triangle
+        # corner is does not (same faces, same triangles; the domain is part
+        # of the fingerprint's topology).
+        return (*moved, extract.fill_corner_table(entry.corner_rows, entry.triangle_polygons_cpu, normals, materials,
+                                                  domain))
 
     try:
         # A deformation re-uploads positions (and corner normals) only, unless

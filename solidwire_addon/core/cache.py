@@ -68,10 +68,12 @@ class GPUMesh:
         ngon[len(arrays.ngon_corners) : outline_rows] = region
         self.ngon_corners = table_texture(ngon)
         self.has_ngons = outline_rows > 0
-        # Corner normals and material indices, one texel per triangle corner
-        # (read by gl_VertexID); only for a shaded or per-material fill.
+        # Shading normals and material indices, a texel per vertex, triangle
+        # or triangle corner (normal_domain); only for a shaded or
+        # per-material fill.
         self.corners = None if arrays.corners is None else table_texture(arrays.corners)
         self.corner_rows = arrays.corner_rows  # to refill the corner table when the mesh moves
+        self.normal_domain = arrays.normal_domain  # what a row of the corner table is for
         # Kept (no copy) so the silhouette pass can derive its edge table on
         # first use without re-extracting; see silhouettes.py.
         self.triangles_cpu = arrays.triangles
@@ -196,6 +198,10 @@ class MeshCache:
         self.allow_reposition = True
         self.culled = 0  # instances culled before their mesh was ever extracted
         self.ms_upload = 0.0
+
+    def meshes(self) -> list:
+        """The GPU meshes held now (statistics and tests)."""
+        return list(self._entries.values())
 
     def __len__(self) -> int:
         return len(self._entries)

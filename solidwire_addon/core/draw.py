@@ -401,6 +401,7 @@ def _bind_mesh(shader, variant, mesh) -> None:
         shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
     if variant.uses_corners:
         shader.uniform_sampler("corner_table", mesh.corners)
+        shader.uniform_int("normal_domain", mesh.normal_domain)
 
 
 class _DrawNumbers:

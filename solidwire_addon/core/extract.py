@@ -75,8 +75,11 @@ class MeshArrays:
     # they follow ngon_corners in the GPU's outline table. None: no blocks.
     region_table: np.ndarray = None
     # (3T,) int32 polygon corner of each triangle corner (-1: none), kept with
-    # ``corners`` so a moved mesh refills its table (fill_corner_table).
+    # ``corners`` so a moved mesh refills its table (fill_corner_table);
+    # only for normals by corner.
     corner_rows: np.ndarray | None = None
+    # What one row of ``corners`` is for (NORMALS_BY_*).
+    normal_domain: int = 2
     # Set when positions alone decide nothing but the quad diagonals (tris and
     # quads only, every vertex finite): the quads' vertex ids, their split
     # and a checksum of the face sizes, so that an edit that only moves
@@ -742,7 +745,7 @@ def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> Mes
     ``positions`` / ``corner_vert`` may be passed when the caller has just
     read them (the GPU cache reads them for its change fingerprint).
     ``corners``: also build the corner table (shaded fill, material colours);
-    True, or the (normals, materials) of :func:`read_corner_inputs` when the
+    True, or the (normals, materials, domain) of :func:`read_corner_inputs` when the
     caller has them already."""
     data = read_mesh_fast(mesh) if positions is None else {
         "positions": positions,
@@ -752,8 +755,8 @@ def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> Mes
     }
     arrays = build_arrays_fast(**data)
     if corners:
-        normals, materials = read_corner_inputs(mesh) if corners is True else corners
-        arrays.corners = corner_table(arrays, data["corner_vert"], data["face_offsets"], normals, materials)
+        normals, materials, domain = read_corner_inputs(mesh) if corners is True else corners
+        arrays.corners = corner_table(arrays, data["corner_vert"], data["face_offsets"], normals, materials, domain)
     return arrays
 
 
@@ -762,28 +765,47 @@ def extract_mesh_naive(mesh) -> MeshArrays:
     return build_arrays(**read_mesh(mesh))
 
 
-def read_corner_inputs(mesh) -> tuple[np.ndarray, np.ndarray]:
-    """(corner normals (L, 3) float32, material index per face (P,) int32):
-    what :func:`corner_table` needs. The normals are Blender's own
-    (``Mesh.corner_normals``: smooth, flat, sharp edges and custom normals as
-    the mesh defines them), so the fill is shaded as Blender shades it."""
-    normals = _read(mesh.corner_normals, "vector", len(mesh.loops), np.float32, 3)
+# Where the shading normals of a mesh live, so where its corner table has a
+# row: per vertex (smooth shading without sharp edges or custom normals), per
+# triangle (flat shading: its face's normal) or per triangle corner. The
+# first two are Blender's own normals on a smaller domain: a third or less
+# of the rows, no corner lookup, and what a deformation uploads again.
+NORMALS_BY_VERTEX, NORMALS_BY_TRIANGLE, NORMALS_BY_CORNER = 0, 1, 2
+
+
+def read_corner_inputs(mesh) -> tuple[np.ndarray, np.ndarray, int]:
+    """(normals (N, 3) float32, material index per face (P,) int32, domain
+    NORMALS_BY_*): what :func:`corner_table` needs. The normals are Blender's
+    own (smooth, flat, sharp edges and custom normals as the mesh defines
+    them; ``Mesh.normals_domain`` says where they vary), so the fill is
+    shaded as Blender shades it. Per vertex only with a single material (a
+    vertex has no material of its own)."""
     materials = _read_attribute(mesh, "material_index", "value", len(mesh.polygons), np.int32)
     if materials is None:
         materials = np.zeros(len(mesh.polygons), dtype=np.int32)
-    return normals, materials
+    domain = getattr(mesh, "normals_domain", "CORNER")  # Blender 4.1+
+    if domain == "POINT" and (len(materials) == 0 or bool((materials == materials[0]).all())):
+        return _read(mesh.vertex_normals, "vector", len(mesh.vertices), np.float32, 3), materials, NORMALS_BY_VERTEX
+    if domain == "FACE":
+        return (_read(mesh.polygon_normals, "vector", len(mesh.polygons), np.float32, 3), materials,
+                NORMALS_BY_TRIANGLE)
+    return _read(mesh.corner_normals, "vector", len(mesh.loops), np.float32, 3), materials, NORMALS_BY_CORNER
 
 
 def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray,
-                 normals: np.ndarray, materials: np.ndarray) -> np.ndarray:
-    """(3T, 4) float32: for each corner of each drawn triangle (the order of
-    ``arrays.triangles``, which the vertex stage reads by gl_VertexID) the
-    corner normal of that polygon corner and the polygon's material index.
-    Also keeps the corner lookup in ``arrays.corner_rows`` so that a mesh
-    that only moves can refill the table from new normals (see
+                 normals: np.ndarray, materials: np.ndarray, domain: int = NORMALS_BY_CORNER) -> np.ndarray:
+    """(R, 4) float32: a normal and a material index per row, the rows by
+    ``domain`` (NORMALS_BY_*): one per vertex (the single material), one per
+    drawn triangle (its face's normal and material), or one per corner of
+    each drawn triangle (the order of ``arrays.triangles``, which the vertex
+    stage reads by gl_VertexID: the normal of that polygon corner). By
+    corner, also keeps the corner lookup in ``arrays.corner_rows`` so that a
+    mesh that only moves can refill the table from new normals (see
     :func:`fill_corner_table`)."""
-    arrays.corner_rows = corner_rows(arrays, corner_vert, face_offsets)
-    return fill_corner_table(arrays.corner_rows, arrays.triangle_polygons, normals, materials)
+    arrays.normal_domain = domain
+    if domain == NORMALS_BY_CORNER:
+        arrays.corner_rows = corner_rows(arrays, corner_vert, face_offsets)
+    return fill_corner_table(arrays.corner_rows, arrays.triangle_polygons, normals, materials, domain)
 
 
 def corner_rows(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray) -> np.ndarray:
@@ -830,11 +852,25 @@ def corner_rows(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.nd
     return corner.reshape(-1).astype(np.int32)
 
 
-def fill_corner_table(rows: np.ndarray, triangle_polygons: np.ndarray, normals: np.ndarray,
-                      materials: np.ndarray) -> np.ndarray:
-    """The corner table (see :func:`corner_table`) from the corner lookup
-    ``rows`` of :func:`corner_rows`: one gather of the corner normals and the
-    material index of each triangle's polygon."""
+def fill_corner_table(rows, triangle_polygons: np.ndarray, normals: np.ndarray,
+                      materials: np.ndarray, domain: int = NORMALS_BY_CORNER) -> np.ndarray:
+    """The corner table (see :func:`corner_table`) of ``domain``: by
+    corner from the corner lookup ``rows`` of :func:`corner_rows` (one
+    gather of the corner normals and the material index of each triangle's
+    polygon); by triangle from its face; by vertex the normals themselves."""
+    normals = np.asarray(normals, np.float32).reshape(-1, 3)
+    if domain == NORMALS_BY_VERTEX:
+        table = np.zeros((len(normals), 4), dtype=np.float32)
+        table[:, :3] = normals
+        table[:, 3] = np.clip(materials[0], 0, 32767) if len(materials) else 0
+        return table
+    if domain == NORMALS_BY_TRIANGLE:
+        table = np.zeros((len(triangle_polygons), 4), dtype=np.float32)
+        if len(normals):
+            table[:, :3] = normals[triangle_polygons]
+        if len(materials):
+            table[:, 3] = np.clip(materials[triangle_polygons], 0, 32767)
+        return table
     table = np.zeros((len(rows), 4), dtype=np.float32)
     if len(rows) == 0:
         return table
@@ -847,7 +883,7 @@ def fill_corner_table(rows: np.ndarray, triangle_polygons: np.ndarray, normals: 
     lost = not found.all()
     safe = np.where(found, rows, 0) if lost else rows
     # One 1-D gather per axis: ~2x faster than gathering (N, 3) rows.
-    for k, column in enumerate(np.ascontiguousarray(np.asarray(normals, np.float32).reshape(-1, 3).T)):
+    for k, column in enumerate(np.ascontiguousarray(normals.T)):
         table[:, k] = column.take(safe)
     if lost:
         table[~found, :3] = 0.0

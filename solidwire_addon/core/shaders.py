@@ -376,6 +376,9 @@ def _add_fill_and_colours(info, iface, variant: ShaderVariant) -> None:
         info.define("PER_ITEM", "1")
     if variant.uses_corners:
         info.sampler(4, "FLOAT_2D", "corner_table")
+        # Where the mesh's normals live (extract.NORMALS_BY_*): a row of the
+        # corner table per vertex, triangle or triangle corner.
+        info.push_constant("INT", "normal_domain")
         info.define("USE_CORNERS", "1")
         iface.smooth("VEC3", "shading_normal")
     info.define("SHADING", str(variant.shading))
