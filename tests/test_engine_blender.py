@@ -136,7 +136,7 @@ def test_blenders_generic_panels_offer_solidwire():
 
 @pytest.mark.parametrize("use_region", [False, True])
 def test_tiled_frames_equal_the_frame_drawn_in_one_piece(tmp_path, region_scene, monkeypatch, use_region):
-    """Big frames are drawn tile by tile (engine.TILE_SIZE); with tiny tiles
+    """Big frames are drawn tile by tile (engine.TILE_PIXELS); with tiny tiles
     the image equals the one-piece render (each tile is an exact window of
     the frame's projection)."""
     region_scene.solidwire.use_silhouettes = True  # the fin pass is tiled too
@@ -146,7 +146,7 @@ def test_tiled_frames_equal_the_frame_drawn_in_one_piece(tmp_path, region_scene,
         render.use_border, render.use_crop_to_border = True, True
         render.border_min_x, render.border_max_x, render.border_min_y, render.border_max_y = 0.1, 0.9, 0.2, 0.95
     whole = scenes.render_to_file(region_scene, tmp_path / "whole.png")
-    monkeypatch.setattr(engine, "TILE_SIZE", 17)
+    monkeypatch.setattr(engine, "TILE_PIXELS", 17 * 13)
     tiles = list(engine.tiles_of(engine.region_of(region_scene, 80, 60)))
     assert len(tiles) > 6 and len({(w, h) for _x, _y, w, h in tiles}) > 1  # uneven edge tiles too
     tiled = scenes.render_to_file(region_scene, tmp_path / "tiled.png")

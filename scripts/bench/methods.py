@@ -247,6 +247,7 @@ class Renderer:
         framebuffer = target.framebuffer()
         with framebuffer.bind():
             framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+            target.clear_view_depth()
             gpu.state.viewport_set(0, 0, tw, th)
             stats = draw_method(
                 items, draw_view, settings, self.method, write_view_depth=True, cull=cull, line_width=float(self.factor)

@@ -53,20 +53,34 @@ def region_of(scene, width: int, height: int) -> tuple[int, int, int, int]:
     return x0, y0, x1 - x0, y1 - y0
 
 
-# Frames larger than this many pixels a side are drawn and handed to Blender
-# tile by tile (RenderEngine.begin_result on a sub-rectangle), so SolidWire's
-# own float targets and readback stay at one tile (~0.2 GiB at 2048^2) however
-# big the frame: peak memory is Blender's result plus one tile.
-TILE_SIZE = 2048
+# Frames of more than this many pixels are drawn and handed to Blender tile
+# by tile (RenderEngine.begin_result on a sub-rectangle), so SolidWire's own
+# float targets and readback stay at one tile (~0.3 GiB at this size) however
+# big the frame: peak memory is Blender's result plus one tile. A 4K UHD
+# frame (3840 x 2160, 8.3 Mpx) is one piece: every tile draws every mesh
+# again, and on a dense mesh that per-triangle work is most of a frame.
+TILE_PIXELS = 2 * 2048 * 2048
+TILE_SIDE = 8192  # and no tile side longer than this (GPU texture limits)
 
 
-def tiles_of(region, tile_size: int | None = None):
-    """(x0, y0, w, h) tiles covering ``region`` (frame pixels), rows from the bottom."""
+def tiles_of(region, tile_pixels: int | None = None):
+    """(x0, y0, w, h) tiles covering ``region`` (frame pixels), rows from the
+    bottom: the fewest columns and rows whose tiles hold at most
+    ``tile_pixels`` (default TILE_PIXELS), all of one size but the last
+    column and row, so consecutive tiles reuse one set of targets."""
     x0, y0, w, h = region
-    size = tile_size or TILE_SIZE
-    for ty in range(y0, y0 + h, size):
-        for tx in range(x0, x0 + w, size):
-            yield tx, ty, min(size, x0 + w - tx), min(size, y0 + h - ty)
+    budget = max(int(tile_pixels or TILE_PIXELS), 1)
+    columns, rows = -(-w // TILE_SIDE), -(-h // TILE_SIDE)
+    while -(-w // columns) * -(-h // rows) > budget:
+        # Split the longer side of the tile: tiles stay near square.
+        if -(-w // columns) >= -(-h // rows):
+            columns += 1
+        else:
+            rows += 1
+    tile_w, tile_h = -(-w // columns), -(-h // rows)
+    for ty in range(y0, y0 + h, tile_h):
+        for tx in range(x0, x0 + w, tile_w):
+            yield tx, ty, min(tile_w, x0 + w - tx), min(tile_h, y0 + h - ty)
 
 
 class PreparedFrame:

@@ -167,6 +167,7 @@ def draw_surface(targets, items, view: View, settings, *, show_wire: bool = True
     framebuffer = targets.framebuffer(aovs=aovs)
     with framebuffer.bind():
         _clear(framebuffer, width, height)
+        targets.clear_view_depth()
         stats = draw_mod.draw(direct, view, settings, write_view_depth=True, **surface_args)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)

@@ -88,17 +88,20 @@ class Targets:
             self.outer_depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self.outer_depth, color_slots=(self.outer,))
 
+    def clear_view_depth(self) -> None:
+        """The view-depth target to BACKGROUND_DEPTH: where no surface is
+        drawn it then already holds what the Depth pass wants there, and
+        :meth:`read` needs no depth-buffer read to tell background apart.
+        (Through a framebuffer of its own, bound and restored here: a
+        texture clear may rebind the one in use.)"""
+        framebuffer = gpu.types.GPUFrameBuffer(color_slots=(self.view_depth,))
+        with framebuffer.bind():
+            framebuffer.clear(color=(BACKGROUND_DEPTH, 0.0, 0.0, 0.0))
+
     def read(self):
         """(rgba premultiplied (H, W, 4), view depth (H, W) with
-        BACKGROUND_DEPTH where nothing was drawn)."""
-        rgba = read_texture(self.color, 4)
-        depth = read_texture(self.view_depth, 1)[..., 0]
-        covered = self.covered()
-        return rgba, np.where(covered, depth, BACKGROUND_DEPTH)
-
-    def covered(self) -> np.ndarray:
-        """(H, W) bool: a surface was drawn there."""
-        return read_texture(self.depth, 1)[..., 0] < 1.0
+        BACKGROUND_DEPTH where nothing was drawn; see clear_view_depth)."""
+        return read_texture(self.color, 4), read_texture(self.view_depth, 1)[..., 0]
 
 
 _targets: Targets | None = None
