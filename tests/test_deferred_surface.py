@@ -208,11 +208,18 @@ def _camera_view():
 def test_dense_meshes_are_deferred_sparse_ones_direct():
     """The split follows triangles per pixel of the meshes' window boxes
     (the unit box here covers about 230 x 230 of 1000 x 1000 pixels)."""
+    from solidwire_addon.core.view import box_pixels, window_boxes
+
     view = _camera_view()
-    sparse, dense = _Item(_Mesh(100)), _Item(_Mesh(50_000))
+    to_clip = view.projection @ view.view_matrix
+    pixels = float(box_pixels(window_boxes(to_clip[None], -np.ones(3), np.ones(3)), view)[0])
+    assert 40_000 < pixels < 70_000
+    threshold = draw.DEFERRED_MIN_DENSITY * pixels  # triangles from which a plain mesh is deferred
+    sparse, dense = _Item(_Mesh(int(0.9 * threshold))), _Item(_Mesh(int(1.1 * threshold)))
     deferred, direct = draw.split_deferred([sparse, dense], view)
     assert deferred == [dense] and direct == [sparse]
-    plain, blocky = _Mesh(4_000), _Mesh(4_000)
+    count = int(1.5 * threshold / draw.DEFERRED_BLOCK_WEIGHT)
+    plain, blocky = _Mesh(count), _Mesh(count)
     blocky.has_ngons = True  # n-gon and region blocks make a triangle dearer to set up
     deferred, direct = draw.split_deferred([_Item(plain), _Item(blocky)], view)
     assert [item.mesh for item in deferred] == [blocky] and [item.mesh for item in direct] == [plain]
