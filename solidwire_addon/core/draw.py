@@ -118,7 +118,7 @@ DEFERRED_MAX = 1 << 24
 # A mesh whose triangles walk segment blocks (n-gons, regions, classes) has
 # a set-up several times dearer and counts DEFERRED_BLOCK_WEIGHT times.
 DEFERRED_MIN_DENSITY = 0.4
-DEFERRED_BLOCK_WEIGHT = 4.0
+DEFERRED_BLOCK_WEIGHT = 8.0
 
 
 def split_deferred(items, view: View) -> tuple[list, list]:
