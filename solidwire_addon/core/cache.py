@@ -120,9 +120,9 @@ class GPUMesh:
             width, height = table_shape(self.triangle_count)
             buf = gpu.types.Buffer("FLOAT", width * height * 2)
             view = np.asarray(buf).reshape(-1, 2)
-            flags = np.asarray(self.edge_flags_cpu, dtype=np.int64)
-            view[: self.triangle_count, 0] = flags & 0xFFF
-            view[: self.triangle_count, 1] = flags >> 12
+            flags = np.asarray(self.edge_flags_cpu, dtype=np.int32)
+            np.bitwise_and(flags, 0xFFF, out=view[: self.triangle_count, 0], casting="unsafe")
+            np.right_shift(flags, 12, out=view[: self.triangle_count, 1], casting="unsafe")
             view[self.triangle_count :] = 0.0
             self._flag_table = gpu.types.GPUTexture((width, height), format="RG32F", data=buf)
             self.gpu_bytes += width * height * 8

@@ -77,7 +77,6 @@ class ExactProgram:
     supports_ngons = True
     supports_instancing = True
     supports_setup_table = True
-    supports_deferred = True
 
     def shader(self, variant):
         return shaders.get(variant)
@@ -101,7 +100,7 @@ INSTANCING_MIN = 16
 SETUP_TABLE_MIN = 50_000
 
 # The two stages of the deferred surface (docs/image_model.md §2.5; see
-# passes.render_passes): VISIBILITY records which triangle of which draw
+# passes.draw_surface): VISIBILITY records which triangle of which draw
 # each pixel shows, RESOLVE runs the exact fragment stage once per pixel of
 # that record. ``stage=None`` draws directly (one pass, every fragment).
 VISIBILITY, RESOLVE = "visibility", "resolve"
@@ -247,7 +246,7 @@ def draw(
     viewport overlay only): the colour leaves through the scene's colour
     management (image model §9). ``stage`` VISIBILITY or RESOLVE (with
     ``visibility``, the texture the first wrote): one half of the deferred
-    surface, see passes.render_passes; both halves must be called with the
+    surface, see passes.draw_surface; both halves must be called with the
     same items, view and settings so that they number the draws alike."""
     stats = DrawStats()
     if not items:
