@@ -233,3 +233,5 @@ def test_numbers_beyond_float32_whole_numbers_keep_the_direct_pass():
     assert draw.split_deferred([huge], view) == ([], [huge])
     huge.mesh.triangle_count = draw.DEFERRED_MAX - 1
     assert draw.split_deferred([huge], view) == ([huge], [])
+    empty = _Item(_Mesh(0))  # nothing to rasterise: never an empty index buffer
+    assert draw.split_deferred([empty], view) == ([], [empty])

@@ -137,7 +137,7 @@ def split_deferred(items, view: View) -> tuple[list, list]:
         pixels = float(box_pixels(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max), view).sum())
         weight = DEFERRED_BLOCK_WEIGHT if mesh.has_ngons else 1.0
         dense = weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels
-        (deferred if dense and mesh.triangle_count < DEFERRED_MAX else direct).extend(group)
+        (deferred if dense and 0 < mesh.triangle_count < DEFERRED_MAX else direct).extend(group)
     return deferred, direct
 
 
