@@ -95,19 +95,28 @@ class GPUMesh:
         self.source_positions = arrays.source_positions
         self.mesh_bounds = (arrays.bounds_min, arrays.bounds_max)  # mesh space
 
-        fmt = gpu.types.GPUVertFormat()
-        fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
-        vbo = gpu.types.GPUVertBuf(fmt, 3 * self.triangle_count)
-        vbo.attr_fill("edge_flags", np.repeat(arrays.edge_flags, 3))
-        self.batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+        self._batch = None  # batch, made on first use
         self.gpu_bytes = (
             self.positions.width * self.positions.height * 16
             + self.triangles.width * self.triangles.height * 16
-            + 3 * self.triangle_count * 4
             + self.ngon_corners.width * self.ngon_corners.height * 16
             + (0 if self.corners is None else self.corners.width * self.corners.height * 16)
         )
 
+
+    @property
+    def batch(self):
+        """The direct draw's non-indexed triangle list, whose only attribute
+        is the per-corner edge-flag word (the vertex stage pulls the rest).
+        Made on first use: a mesh only ever drawn deferred never needs it."""
+        if self._batch is None:
+            fmt = gpu.types.GPUVertFormat()
+            fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
+            vbo = gpu.types.GPUVertBuf(fmt, 3 * self.triangle_count)
+            vbo.attr_fill("edge_flags", np.repeat(self.edge_flags_cpu, 3))
+            self._batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+            self.gpu_bytes += 3 * self.triangle_count * 4
+        return self._batch
 
     def flag_table(self):
         """The edge-flag word of every triangle, as an RG32F texture

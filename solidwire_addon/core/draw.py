@@ -419,8 +419,11 @@ class _DrawNumbers:
         if self.stage == RESOLVE:
             shader.uniform_sampler("visibility", self.extras["visibility"])
 
-    def draw(self, shader, mesh, batch, object_to_clip, instance_count: int = 0) -> None:
+    def draw(self, shader, mesh, batch_of, object_to_clip, instance_count: int = 0) -> None:
+        """One draw call of ``mesh``; ``batch_of()`` gives the direct draw's
+        batch (asked for only when drawing directly)."""
         if self.stage is None:
+            batch = batch_of()
             if instance_count:
                 batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
             else:
@@ -540,7 +543,7 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             if variant.per_item:
                 shader.uniform_int("item_slot", slot)
             _bind_mesh(shader, variant, mesh)
-            numbering.draw(shader, mesh, program.batch(mesh), object_to_clip)
+            numbering.draw(shader, mesh, lambda: program.batch(mesh), object_to_clip)
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
@@ -670,7 +673,7 @@ def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras, nu
             gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
         shader.uniform_int("instance_base", base)
         _bind_mesh(shader, variant, mesh)
-        numbering.draw(shader, mesh, mesh.batch, object_to_clip, instance_count=count)
+        numbering.draw(shader, mesh, lambda: mesh.batch, object_to_clip, instance_count=count)
         base += count * shaders.INSTANCE_TEXELS
         stats.objects_drawn += count
         stats.triangles_drawn += count * mesh.triangle_count
