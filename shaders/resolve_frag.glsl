@@ -41,8 +41,10 @@ void main()
   view_depth = visible.w;
 #ifdef USE_CORNERS
   vec4 ids = fetch_texel(triangle_vertices, triangle);
-  shading_normal = mu.x * corner_shading(triangle, 0, ids.x).xyz + mu.y * corner_shading(triangle, 1, ids.y).xyz
-                   + mu.z * corner_shading(triangle, 2, ids.z).xyz;
+  /* Interpolated in object space, then turned once (the map is linear). */
+  shading_normal = mat3(normal_to_view) * (mu.x * corner_row(triangle, 0, ids.x).xyz
+                                           + mu.y * corner_row(triangle, 1, ids.y).xyz
+                                           + mu.z * corner_row(triangle, 2, ids.z).xyz);
 #endif
   solidwire_fragment();
 }

@@ -125,15 +125,20 @@ float line_reach(float w0, float w1, float w2)
 }
 #endif
 
-/* Corner `corner` of `triangle` (vertex `vertex_id`): its normal in view
- * space and its face's material in w, from the corner table's row for it
- * (extract.corner_table: a row per vertex, triangle or triangle corner, as
- * normal_domain says). */
+/* Corner `corner` of `triangle` (vertex `vertex_id`): the corner table's
+ * row for it (extract.corner_table: a row per vertex, triangle or triangle
+ * corner, as normal_domain says), and from it the corner's normal in view
+ * space with its face's material in w. */
 #ifdef USE_CORNERS
-vec4 corner_shading(int triangle, int corner, float vertex_id)
+vec4 corner_row(int triangle, int corner, float vertex_id)
 {
   int row = (normal_domain == 0) ? int(vertex_id) : ((normal_domain == 1) ? triangle : 3 * triangle + corner);
-  vec4 corner_data = fetch_texel(corner_table, row);
+  return fetch_texel(corner_table, row);
+}
+
+vec4 corner_shading(int triangle, int corner, float vertex_id)
+{
+  vec4 corner_data = corner_row(triangle, corner, vertex_id);
   return vec4(mat3(normal_to_view) * corner_data.xyz, corner_data.w);
 }
 #endif
