@@ -4,13 +4,15 @@
  * own edges once per corner; the fragment stage uses the same code for the
  * boundary of an n-gon, which no fixed number of varyings can carry. */
 
-/* Texel `index` of a table: every table is a power of two texels wide
- * (core/cache.py, table_shape), so a shift and a mask find it; an integer
- * division would run lane by lane on a CPU rasteriser. */
+/* Texel `index` of a table. A table longer than TABLE_WIDTH (4096) texels
+ * is 4096 wide, a shorter one is a single row (core/cache.py, table_shape),
+ * so texel i is at (i & 4095, i >> 12) in every table: no size query and no
+ * integer division (a CPU rasteriser runs those lane by lane), with GLSL
+ * every Blender backend translates. */
+#define TABLE_ROW_SHIFT 12
 vec4 fetch_texel(sampler2D table, int index)
 {
-  int shift = findMSB(textureSize(table, 0).x);
-  return texelFetch(table, ivec2(index & ((1 << shift) - 1), index >> shift), 0);
+  return texelFetch(table, ivec2(index & ((1 << TABLE_ROW_SHIFT) - 1), index >> TABLE_ROW_SHIFT), 0);
 }
 
 vec4 vertex_clip(float vertex_index)

@@ -29,7 +29,7 @@ void main()
   sw_vertex_id = 3 * triangle + 2;
   solidwire_corner();
 
-  vec4 c0 = sw_corner_clip[0], c1 = sw_corner_clip[1], c2 = sw_corner_clip[2];
+  vec4 c0 = sw_corner_clip0, c1 = sw_corner_clip1, c2 = sw_corner_clip2;
   vec2 ndc = (gl_FragCoord.xy - params.viewport.xy) / params.viewport.zw * 2.0 - 1.0;
   vec3 r = vec3(ndc, 1.0);
   vec3 h0 = c0.xyw, h1 = c1.xyw, h2 = c2.xyw;

@@ -194,7 +194,9 @@ void main()
   }
   ngon_corner_start = int(ids.w);
 #  ifdef RESOLVE_PASS
-  sw_corner_clip = mat3x4(vertex_clip(ids.x), vertex_clip(ids.y), vertex_clip(ids.z));
+  sw_corner_clip0 = vertex_clip(ids.x);
+  sw_corner_clip1 = vertex_clip(ids.y);
+  sw_corner_clip2 = vertex_clip(ids.z);
 #  endif
 #else
 
@@ -207,7 +209,10 @@ void main()
    * `ngon_corners`. */
   vec4 c3 = is_quad ? vertex_clip(ids.w) : c2;
 #  ifdef RESOLVE_PASS
-  sw_corner_clip = mat3x4(c0, c1, c2); /* the resolve pass's barycentrics */
+  /* The resolve pass's barycentrics. */
+  sw_corner_clip0 = c0;
+  sw_corner_clip1 = c1;
+  sw_corner_clip2 = c2;
 #  endif
   ngon_corner_start = int(ids.w);
   vec2 w0, w1, w2;

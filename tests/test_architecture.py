@@ -171,3 +171,21 @@ def test_a_new_setting_needs_only_a_schema_entry(monkeypatch):
     args = cli.build_parser().parse_args(["--example-width", "3"])
     assert args.example_width == 3.0
     assert any(m.glsl == "example_width" for m in schema._param_block())
+
+
+def test_every_table_is_laid_out_as_fetch_texel_reads_it():
+    """fetch_texel (shaders/edge_geometry.glsl) finds texel i at
+    (i & (2^TABLE_ROW_SHIFT - 1), i >> TABLE_ROW_SHIFT) without asking the
+    texture's size: every table (cache.table_shape) is TABLE_WIDTH wide, or
+    a single row when shorter."""
+    from solidwire_addon.core import cache
+
+    source = (shaders.SHADER_DIR / "edge_geometry.glsl").read_text(encoding="utf-8")
+    shift = int(re.search(r"#define TABLE_ROW_SHIFT (\d+)", source).group(1))
+    assert cache.TABLE_WIDTH == 1 << shift
+    for count in (0, 1, 7, 2048, 4095, 4096, 4097, 123_457, 10_000_000):
+        width, height = cache.table_shape(count)
+        assert width * height >= max(count, 1)
+        assert width == cache.TABLE_WIDTH or height == 1
+        last = max(count, 1) - 1
+        assert (last & (width - 1) if width == cache.TABLE_WIDTH else last) < width and (last >> shift) < height

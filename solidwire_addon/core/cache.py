@@ -21,14 +21,13 @@ TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up
 
 
 def table_shape(count: int) -> tuple[int, int]:
-    """(width, height) of a table of ``count`` texels: row-major, TABLE_WIDTH
-    texels a row, or the next power of two for a shorter table. Always a
-    power of two wide, so that a shader finds texel i with a shift and a mask
-    (fetch_texel in shaders/edge_geometry.glsl): an integer division runs
-    lane by lane on a CPU rasteriser, ten of them per pixel in the resolve
-    pass."""
+    """(width, height) of a table of ``count`` texels: TABLE_WIDTH texels a
+    row, or one row of ``count`` for a shorter table. Every shader finds
+    texel i at (i % TABLE_WIDTH, i // TABLE_WIDTH) with a mask and a shift
+    (fetch_texel in shaders/edge_geometry.glsl, TABLE_ROW_SHIFT): no integer
+    division, which a CPU rasteriser runs lane by lane."""
     count = max(count, 1)
-    width = min(1 << (count - 1).bit_length(), TABLE_WIDTH)
+    width = min(count, TABLE_WIDTH)
     return width, -(-count // width)
 
 
