@@ -40,7 +40,7 @@ void main()
   sw_front_facing = dot(h0, cross(h1, h2)) > 0.0;
   view_depth = visible.w;
 #ifdef USE_CORNERS
-  vec4 ids = fetch_texel(triangle_vertices, triangle);
+  vec4 ids = sw_triangle_ids; /* fetched by solidwire_corner() */
   /* Interpolated in object space, then turned once (the map is linear). */
   shading_normal = mat3(normal_to_view) * (mu.x * corner_row(triangle, 0, ids.x).xyz
                                            + mu.y * corner_row(triangle, 1, ids.y).xyz

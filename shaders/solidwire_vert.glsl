@@ -194,6 +194,7 @@ void main()
   }
   ngon_corner_start = int(ids.w);
 #  ifdef RESOLVE_PASS
+  sw_triangle_ids = ids;
   sw_corner_clip0 = vertex_clip(ids.x);
   sw_corner_clip1 = vertex_clip(ids.y);
   sw_corner_clip2 = vertex_clip(ids.z);
@@ -209,7 +210,8 @@ void main()
    * `ngon_corners`. */
   vec4 c3 = is_quad ? vertex_clip(ids.w) : c2;
 #  ifdef RESOLVE_PASS
-  /* The resolve pass's barycentrics. */
+  /* The resolve pass's barycentrics and corner normals. */
+  sw_triangle_ids = ids;
   sw_corner_clip0 = c0;
   sw_corner_clip1 = c1;
   sw_corner_clip2 = c2;

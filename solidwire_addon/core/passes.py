@@ -210,8 +210,7 @@ def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:
     in alpha."""
     framebuffer = targets.hidden_framebuffer()
     with framebuffer.bind():
-        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0))  # the surface depth stays
-        gpu.state.viewport_set(0, 0, view.width, view.height)
+        _clear(framebuffer, view.width, view.height, depth=False)  # the surface depth stays
         gpu.state.blend_set("ALPHA_PREMULT")
         try:
             draw_mod.draw_hidden_lines(items, view, replace(settings, use_fill=False), cull=cull, linear_depth=True)
@@ -227,9 +226,7 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
     with the wire colour ("over", premultiplied)."""
     framebuffer = targets.silhouette_framebuffer()
     with framebuffer.bind():
-        gpu.state.depth_mask_set(True)  # see render(): the clear honours the mask
-        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
-        gpu.state.viewport_set(0, 0, view.width, view.height)
+        _clear(framebuffer, view.width, view.height)
         silhouettes.draw_silhouettes(items, view, settings, targets.depth, linear_depth=True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)

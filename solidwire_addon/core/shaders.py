@@ -461,6 +461,7 @@ int sw_instance_id;
 bool sw_front_facing;
 float sw_inv_clip_w;
 vec4 sw_corner_clip0, sw_corner_clip1, sw_corner_clip2;
+vec4 sw_triangle_ids;
 #define SW_VERTEX_ID sw_vertex_id
 #define SW_FRONT_FACING sw_front_facing
 #define SW_INV_CLIP_W sw_inv_clip_w

@@ -81,13 +81,20 @@ def translation(offset) -> np.ndarray:
 _BOX_CORNERS = np.array([[x, y, z, 1.0] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
 
 
-def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.ndarray:
-    """(N,) bool: the box lies wholly outside one clip plane (conservative),
-    for (N, 4, 4) matrices at once (one einsum, no Python call per instance)."""
+def box_clip_corners(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.ndarray:
+    """(N, 8, 4): the eight corners of the box in clip space under each of
+    the (N, 4, 4) (or one (4, 4)) ``object_to_clip`` (one einsum, no Python
+    call per instance)."""
     lo, hi = np.asarray(bounds_min), np.asarray(bounds_max)
     corners = _BOX_CORNERS.copy()
     corners[:, :3] = lo + corners[:, :3] * (hi - lo)
-    clip = np.einsum("kj,nij->nki", corners, object_to_clip)  # (N, 8, 4)
+    return np.einsum("kj,nij->nki", corners, np.asarray(object_to_clip).reshape(-1, 4, 4))
+
+
+def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.ndarray:
+    """(N,) bool: the box lies wholly outside one clip plane (conservative),
+    for (N, 4, 4) matrices at once."""
+    clip = box_clip_corners(object_to_clip, bounds_min, bounds_max)
     x, y, z, w = np.moveaxis(clip, 2, 0)
     outside = (x > w).all(1) | (x < -w).all(1) | (y > w).all(1) | (y < -w).all(1) | (z > w).all(1) | (z < -w).all(1)
     return outside
@@ -98,10 +105,7 @@ def wholly_in_front(object_to_clip: np.ndarray, bounds_min, bounds_max) -> bool:
     near plane (clip z + w > 0 at every corner) with a margin of 1e-4 of the
     largest |w|, more than float32 rounding of a vertex inside can take
     away (a vertex is a convex mix of the corners, z + w linear)."""
-    lo, hi = np.asarray(bounds_min), np.asarray(bounds_max)
-    corners = _BOX_CORNERS.copy()
-    corners[:, :3] = lo + corners[:, :3] * (hi - lo)
-    clip = np.einsum("kj,nij->nki", corners, np.asarray(object_to_clip).reshape(-1, 4, 4))
+    clip = box_clip_corners(object_to_clip, bounds_min, bounds_max)
     depth = clip[..., 2] + clip[..., 3]
     return bool(len(clip)) and bool((depth > 1e-4 * np.abs(clip[..., 3]).max()).all())
 
@@ -111,10 +115,7 @@ def window_boxes(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.ndarr
     ``object_to_clip``, each holding every pixel its box can cover, widened
     by a little slack for rounding and clamped to the view; the whole view
     where a box reaches behind the camera (no finite projection there)."""
-    lo, hi = np.asarray(bounds_min), np.asarray(bounds_max)
-    corners = _BOX_CORNERS.copy()
-    corners[:, :3] = lo + corners[:, :3] * (hi - lo)
-    clip = np.einsum("kj,nij->nki", corners, np.asarray(object_to_clip).reshape(-1, 4, 4))  # (N, 8, 4)
+    clip = box_clip_corners(object_to_clip, bounds_min, bounds_max)
     w = clip[..., 3]
     behind = (w <= 1e-6 * np.abs(clip[..., :3]).max(axis=(1, 2), initial=1.0)[:, None]).any(axis=1)
     with np.errstate(all="ignore"):
