@@ -28,6 +28,9 @@ import solidwire_addon  # noqa: E402
 from solidwire_addon.core import passes, schema  # noqa: E402
 from tests.support import scenes  # noqa: E402
 
+# The world colour of Blender's startup file.
+FACTORY_WORLD_COLOR = (0.0509, 0.0509, 0.0509)
+
 ENGINES = (
     ("SOLIDWIRE", "SolidWire (default look)"),
     ("SOLIDWIRE_DIRECT", "SolidWire, direct surface pass (before the deferred surface)"),
@@ -39,7 +42,11 @@ ENGINES = (
 def applied_mesh_scene(width: int, height: int, subdivisions: int):
     """Suzanne subdivided and applied (no modifier left), framed by the camera."""
     # The default look (Studio-lit fill, cage edges), as a plain F12 gets it.
-    scene = scenes.empty_scene(width, height)
+    # An opaque film over the factory world colour, as a new file renders:
+    # every engine composites the background.
+    scene = scenes.empty_scene(width, height, transparent=False)
+    scene.world = bpy.data.worlds.new("World")
+    scene.world.color = FACTORY_WORLD_COLOR
     for setting in schema.settings_in("SCENE"):
         if setting.name in scenes.CORE_LOOK:
             setattr(scene.solidwire, setting.name, setting.default)

@@ -14,7 +14,7 @@ import time
 import bpy
 import numpy as np
 
-from ..core import passes, shaders
+from ..core import compositing, passes, shaders
 from ..core.ids import ENGINE_ID
 from . import gather, runtime
 from .gpu_context import ensure_gpu, is_init_scene
@@ -30,14 +30,11 @@ def world_color(scene) -> tuple[float, float, float]:
 
 
 def composite_film(rgba: np.ndarray, scene) -> np.ndarray:
-    """Premultiplied image over the film: transparent, or the world colour."""
-    if scene.render.film_transparent:
-        return rgba
-    out = rgba.copy()
-    background = np.asarray(world_color(scene), dtype=np.float32)
-    out[..., :3] += (1.0 - rgba[..., 3:4]) * background
-    out[..., 3] = 1.0
-    return out
+    """Premultiplied image over the film (transparent, or the world colour),
+    in place: ``rgba`` is the frame just read back, which nobody else holds."""
+    if not scene.render.film_transparent:
+        compositing.over_film(rgba, world_color(scene))
+    return rgba
 
 
 def region_of(scene, width: int, height: int) -> tuple[int, int, int, int]:

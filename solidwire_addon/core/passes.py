@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import gpu
 import numpy as np
 
-from . import colors, edge_select, shaders
+from . import colors, compositing, edge_select, shaders
 from . import draw as draw_mod
 from . import silhouettes
 from .log import warn_once
@@ -230,11 +230,8 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
         silhouettes.draw_silhouettes(items, view, settings, targets.depth, linear_depth=True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
-    outer = read_texture(targets.outer, 1)[..., 0:1]
-    wire = np.asarray(settings.wire_color, dtype=np.float32)
-    alpha = outer * wire[3]
-    over = np.concatenate([wire[:3] * alpha, alpha], axis=-1)
-    return over + (1.0 - alpha) * rgba
+    compositing.color_over(rgba, settings.wire_color, read_texture(targets.outer, 1)[..., 0])
+    return rgba
 
 
 # NDC depth bias of the viewport overlay (2^-18: 32 steps of a 24-bit depth
