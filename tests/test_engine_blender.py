@@ -170,3 +170,22 @@ def test_a_render_after_the_window_context_drew_is_right(tmp_path):
     scenes.add_camera(scene, location=(2.5, -4.0, 1.8), target=(0.0, 0.0, 0.0))
     f12 = scenes.render_to_file(scene, tmp_path / "f12.png")
     assert np.abs(f12[..., 3] - window_rgba[..., 3]).max() <= 1.5 / 65535
+
+
+def test_kept_readback_equals_a_fresh_one_and_is_reused(region_scene):
+    """The render engine reads each tile into buffers the targets keep
+    (core.targets.Targets.read): the same pixels as a fresh readback, and the
+    next tile of that size lands in the same memory."""
+    region_scene.render.film_transparent = False  # the film is composited in place, into the kept buffer
+    frame = engine.PreparedFrame(bpy.context.evaluated_depsgraph_get(), (80, 60))
+    try:
+        fresh_rgba, fresh_depth, _extra = frame.draw((0, 0, 80, 60))
+        kept_rgba, kept_depth, _extra = frame.draw((0, 0, 80, 60), keep_readback=True)
+        assert np.array_equal(kept_rgba, fresh_rgba) and np.array_equal(kept_depth, fresh_depth)
+        assert fresh_rgba[..., 3].min() == 1.0 and (fresh_depth < 1e9).sum() > 300
+        first = kept_rgba.copy()
+        shifted_rgba, _depth, _extra = frame.draw((20, 10, 80, 60), keep_readback=True)
+        assert np.shares_memory(shifted_rgba, kept_rgba) and not np.shares_memory(fresh_rgba, kept_rgba)
+        assert not np.array_equal(shifted_rgba, first)  # another window of the frame, in the same buffer
+    finally:
+        frame.finish()

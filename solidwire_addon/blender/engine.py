@@ -106,15 +106,17 @@ class PreparedFrame:
         self.draw_stats = None
         self.ms_draw = 0.0
 
-    def draw(self, region):
+    def draw(self, region, *, keep_readback: bool = False):
         """(rgba premultiplied over the film, view depth, {extra pass: values})
         of ``region`` (x0, y0, w, h in frame pixels), pixel for pixel as in
-        the whole frame."""
+        the whole frame. ``keep_readback``: rgba and depth are views of
+        buffers reused by the next draw (core.targets.Targets.read), for a
+        caller that hands them on at once."""
         width, height = self.view.width, self.view.height
         view = self.view if tuple(region) == (0, 0, width, height) else sub_view(self.view, region)
         start = time.perf_counter()
         rgba, depth, stats, extra = passes.render_passes(self.items, view, self.settings,
-                                                         extra_passes=self.extra_passes)
+                                                         extra_passes=self.extra_passes, keep_readback=keep_readback)
         self.ms_draw += (time.perf_counter() - start) * 1000.0
         if self.draw_stats is None:
             self.draw_stats = stats
@@ -232,7 +234,9 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
             self.update_stats("SolidWire", f"{layer_name} | drawing {len(frame.items)} objects"
                               + (f", tile {number} of {len(tiles)}" if len(tiles) > 1 else ""))
             self.update_progress(0.1 + 0.9 * (number - 1) / len(tiles))
-            rgba, depth, extra = frame.draw(tile)
+            # The tile goes into Blender's result before the next is drawn,
+            # so its readback can live in buffers that are reused.
+            rgba, depth, extra = frame.draw(tile, keep_readback=True)
             self._write(tile, region, layer_name, rgba, depth, extra)
         frame.finish()
 

@@ -15,11 +15,19 @@ import numpy as np
 BACKGROUND_DEPTH = 1.0e10
 
 
-def read_texture(texture, channels: int) -> np.ndarray:
-    """(H, W, channels) float32 copy of a float texture, bottom row first."""
-    buf = texture.read()
-    # A multi-dimensional gpu Buffer exports wrong strides to numpy: flatten first.
-    buf.dimensions = texture.width * texture.height * channels
+def read_texture(texture, channels: int, into=None) -> np.ndarray:
+    """(H, W, channels) float32 copy of a float texture, bottom row first:
+    a new array, or a view of ``into`` (a flat FLOAT ``gpu.types.Buffer`` of
+    W * H * channels values, see :meth:`Targets.read`), which is filled."""
+    if into is None:
+        buf = texture.read()
+        # A multi-dimensional gpu Buffer exports wrong strides to numpy: flatten first.
+        buf.dimensions = texture.width * texture.height * channels
+    else:
+        buf = into
+        framebuffer = gpu.types.GPUFrameBuffer(color_slots=(texture,))
+        with framebuffer.bind():
+            framebuffer.read_color(0, 0, texture.width, texture.height, channels, 0, "FLOAT", data=buf)
     # A view of the Buffer's memory, not a copy (the array keeps the Buffer
     # alive; nobody else holds it). np.array(buf) would copy it again:
     # ~17 ms per RGBA read at 1280x720, 40-80 ms at 3840x2160.
@@ -37,6 +45,7 @@ class Targets:
         self.outer = self.outer_depth = None  # silhouette targets, made on first use
         self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
         self.visible = None  # the deferred surface's visibility record, made on first use
+        self.kept_readback = None  # (colour, view depth) gpu Buffers, made on first read(keep=True)
 
     def visibility_framebuffer(self):
         """The deferred surface's first stage: the visibility record
@@ -98,10 +107,24 @@ class Targets:
         with framebuffer.bind():
             framebuffer.clear(color=(BACKGROUND_DEPTH, 0.0, 0.0, 0.0))
 
-    def read(self):
+    def read(self, *, keep: bool = False):
         """(rgba premultiplied (H, W, 4), view depth (H, W) with
-        BACKGROUND_DEPTH where nothing was drawn; see clear_view_depth)."""
-        return read_texture(self.color, 4), read_texture(self.view_depth, 1)[..., 0]
+        BACKGROUND_DEPTH where nothing was drawn; see clear_view_depth).
+
+        ``keep``: read into two buffers these targets keep instead of new
+        arrays, and return views of them. A new frame-sized array is fresh
+        memory the kernel faults in page by page (~50 ms of a 4K frame on a
+        2-core machine); kept buffers are faulted in once. The views are
+        overwritten by the next ``read(keep=True)``, so the caller hands them
+        on first (the render engine copies them into Blender's result)."""
+        if not keep:
+            return read_texture(self.color, 4), read_texture(self.view_depth, 1)[..., 0]
+        width, height = self.size
+        if self.kept_readback is None:
+            self.kept_readback = (gpu.types.Buffer("FLOAT", width * height * 4),
+                                  gpu.types.Buffer("FLOAT", width * height))
+        color, depth = self.kept_readback
+        return read_texture(self.color, 4, color), read_texture(self.view_depth, 1, depth)[..., 0]
 
 
 _targets: Targets | None = None
