@@ -1,7 +1,7 @@
 """F12 against Blender's own engines: SolidWire vs Workbench flat vs
 Workbench wireframe (and Freestyle over Cycles at 1 sample), the whole
 ``bpy.ops.render.render`` of the same applied mesh and camera, plus the
-per-stage breakdown of a SolidWire frame.
+per-stage breakdown of a SolidWire frame (scripts/frame_stages.py).
 
     .venv/bin/python -m scripts.bench_engines [--size 1280x720] [--size 3840x2160]
         [--subdivisions 5] [--repeats 3] [--freestyle]
@@ -15,6 +15,7 @@ Prints a Markdown table.
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import statistics
 import tempfile
@@ -26,6 +27,7 @@ import bpy  # noqa: E402
 
 import solidwire_addon  # noqa: E402
 from solidwire_addon.core import passes, schema  # noqa: E402
+from scripts import frame_stages  # noqa: E402
 from tests.support import scenes  # noqa: E402
 
 # The world colour of Blender's startup file.
@@ -87,7 +89,6 @@ def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
     triangles = sum(len(p.vertices) - 2 for p in obj.data.polygons)
     engines = list(ENGINES)
     first, times = {}, {name: [] for name, _label in engines}
-    stages = []
     for turn in range(repeats + 1):
         for name, _label in engines:
             configure(scene, name)
@@ -96,16 +97,13 @@ def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
                 first[name] = seconds
             else:
                 times[name].append(seconds)
-                if name == "SOLIDWIRE":
-                    stages.append(solidwire_addon.stats())
     if freestyle:
         scene.render.engine = "CYCLES"
         scene.cycles.samples = 1
         cycles_alone = time_render(scene)
-        scene.render.use_freestyle = True
-        scene.view_layers[0].use_freestyle = True
+        scenes.enable_freestyle(scene)
         with_freestyle = time_render(scene)
-        scene.render.use_freestyle = False
+        scenes.enable_freestyle(scene, False)
         engines.append(("FREESTYLE", "Freestyle (Cycles 1 spp + Freestyle - Cycles alone)"))
         times["FREESTYLE"] = [with_freestyle - cycles_alone]
         first["FREESTYLE"] = float("nan")
@@ -118,18 +116,17 @@ def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
     ]
     for name, label in engines:
         median = statistics.median(times[name])
-        lines.append(f"| {label} | {median:.3f} | {first[name]:.3f} | {median / base:.2f} |")
-    stage = {key: statistics.median(s[key] for s in stages) for key in ("ms_extract", "ms_upload", "ms_draw", "ms_total")}
-    total_ms = statistics.median(times["SOLIDWIRE"]) * 1000.0
-    lines += [
-        "",
-        "SolidWire frame by stage (median ms): "
-        f"extract/validate {stage['ms_extract']:.1f}, upload {stage['ms_upload']:.1f}, "
-        f"draw + readback {stage['ms_draw']:.1f}, SolidWire total {stage['ms_total']:.1f}; "
-        f"the rest of the {total_ms:.0f} ms F12 (depsgraph, result hand-over, Blender's own work) "
-        f"{total_ms - stage['ms_total']:.0f}.",
-        "",
-    ]
+        first_text = "–" if math.isnan(first[name]) else f"{first[name]:.3f}"
+        lines.append(f"| {label} | {median:.3f} | {first_text} | {median / base:.2f} |")
+    lines += ["", f"SolidWire's steady frame by stage ({repeats} more renders with a sync after each GPU stage; "
+                  "scripts/frame_stages.py):", ""]
+    configure(scene, "SOLIDWIRE")
+    with frame_stages.StageProbe() as probe:
+        for _ in range(repeats):
+            seconds = time_render(scene)
+            probe.end_frame(seconds * 1000.0, solidwire_addon.stats())
+    lines += probe.table(statistics.median(times["SOLIDWIRE"]) * 1000.0)
+    lines.append("")
     return lines
 
 

@@ -154,9 +154,8 @@ def render_engine_peer(scene, engine: str, shading: str | None, repeats: int, ou
         scene.cycles.samples = 1
         scene.cycles.device = "CPU"
         scene.cycles.use_denoising = False
-    scene.render.use_freestyle = freestyle
+    scenes.enable_freestyle(scene, freestyle)
     if freestyle:
-        scene.view_layers[0].use_freestyle = True
         scene.render.line_thickness_mode = "ABSOLUTE"
         scene.render.line_thickness = 1.0
     path = out_dir / f"peer_{engine}_{shading or 'freestyle'}.png"
@@ -171,7 +170,7 @@ def render_engine_peer(scene, engine: str, shading: str | None, repeats: int, ou
         times.append((time.perf_counter() - start) * 1000.0)
     alpha = scenes.load_png(path)[..., 3]
     scene.render.engine = "SOLIDWIRE"
-    scene.render.use_freestyle = False
+    scenes.enable_freestyle(scene, False)
     return times, alpha
 
 

@@ -204,6 +204,21 @@ def uv_sphere(scene, name="Sphere", segments=16, rings=8, radius=1.0, **kwargs):
     )
 
 
+def enable_freestyle(scene, on: bool = True) -> None:
+    """Freestyle on (or off) for the scene and its first view layer. An empty
+    factory file's line set has no line style, and Freestyle then draws
+    nothing (an error inside its own script): it gets a new default one."""
+    scene.render.use_freestyle = on
+    if not on:
+        return
+    view_layer = scene.view_layers[0]
+    view_layer.use_freestyle = True
+    settings = view_layer.freestyle_settings
+    lineset = settings.linesets.active or settings.linesets.new("LineSet")
+    if lineset.linestyle is None:
+        lineset.linestyle = bpy.data.linestyles.new("LineStyle")
+
+
 def render_still(scene, path: Path, **image_settings) -> Path:
     """Render ``scene`` through the real engine with write_still to ``path``
     (its folder made), with these image settings applied in order."""
