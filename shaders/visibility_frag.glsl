@@ -11,5 +11,10 @@ void main()
 #else
   float instance = 0.0;
 #endif
-  frag_visible = vec4(float(gl_PrimitiveID + 1), instance, float(draw_number), view_depth);
+#ifdef SW_TRIANGLE_BY_VERTEX
+  float triangle_number = visible_triangle; /* triangle + 1 */
+#else
+  float triangle_number = float(gl_PrimitiveID + 1);
+#endif
+  frag_visible = vec4(triangle_number, instance, float(draw_number), view_depth);
 }

@@ -3,13 +3,19 @@
  * (cache.GPUMesh.visibility_batch): each vertex is transformed once, with
  * the exact path's own expression (so the same coverage and depth), and
  * hands on nothing but the view depth (and its instance); gl_PrimitiveID
- * numbers the triangle. The per-triangle edge set-up, which dominates a
+ * numbers the triangle, or on a software rasteriser the provoking vertex
+ * does (SW_TRIANGLE_BY_VERTEX, shaders.triangle_ids_by_vertex). The per-triangle edge set-up, which dominates a
  * dense mesh's frame on a software rasteriser, moves to the resolve pass
  * and runs once per pixel instead of at every corner. */
 
 void main()
 {
   view_depth = -dot(object_to_view_z, vec4(position, 1.0));
+#ifdef SW_TRIANGLE_BY_VERTEX
+  /* Only the provoking (last) corner's value reaches the fragments: the
+   * batch gives every triangle a last corner of its own. */
+  visible_triangle = triangle;
+#endif
 #ifdef SW_INSTANCED
   visible_instance = float(gl_InstanceID);
 #endif

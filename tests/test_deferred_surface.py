@@ -235,3 +235,41 @@ def test_numbers_beyond_float32_whole_numbers_keep_the_direct_pass():
     assert draw.split_deferred([huge], view) == ([huge], [])
     empty = _Item(_Mesh(0))  # nothing to rasterise: never an empty index buffer
     assert draw.split_deferred([empty], view) == ([], [empty])
+
+
+@pytest.mark.parametrize("look", sorted(INSTANCED_LOOKS))
+def test_both_triangle_numberings_give_the_same_frame(look, output_dir, monkeypatch):
+    """The visibility pass numbers triangles with gl_PrimitiveID or, on a
+    software rasteriser, by their provoking vertex
+    (shaders.triangle_ids_by_vertex): the same frame to the bit either way,
+    instanced draws included."""
+    scene = scenes.empty_scene(200, 150, **LOOKS[look])
+    _mixed_scene(scene)
+    monkeypatch.setattr(draw, "DEFERRED_MIN_DENSITY", 0.0)
+    frames = {}
+    for by_vertex in (False, True):
+        monkeypatch.setattr(shaders, "TRIANGLE_IDS_BY_VERTEX", by_vertex)
+        frames[by_vertex] = scenes.render_multilayer_exr(scene, output_dir / f"numbering_{look}_{by_vertex}.exr")
+        assert shaders.deferred_available()
+    assert solidwire_addon.stats().get("instanced_draws", 0) > 0
+    for name, values in frames[False].items():
+        np.testing.assert_array_equal(frames[True][name], values, err_msg=name)
+    combined = next(name for name in frames[False] if name.endswith("Combined.A"))
+    assert (frames[False][combined] > 0.0).sum() > 2000
+
+
+def test_provoking_vertex_numbering_keeps_every_triangle():
+    """Every triangle's last corner carries its number; copies keep the
+    position, and the corners stay in order (so the same rasterisation)."""
+    from solidwire_addon.core.cache import _provoking_triangle_numbers
+
+    rng = np.random.default_rng(3)
+    positions = rng.random((50, 3)).astype(np.float32)
+    triangles = rng.integers(0, 40, size=(300, 3)).astype(np.int32)  # vertices 40..49 end no triangle
+    out_positions, numbers, out_triangles = _provoking_triangle_numbers(positions, triangles)
+    np.testing.assert_array_equal(out_positions[:50], positions)
+    np.testing.assert_array_equal(out_triangles[:, :2], triangles[:, :2])
+    np.testing.assert_array_equal(out_positions[out_triangles], positions[triangles])
+    np.testing.assert_array_equal(numbers[out_triangles[:, 2]], np.arange(1, 301))
+    # One triangle per distinct last vertex keeps it; the rest are copies.
+    assert len(out_positions) == 50 + 300 - len(np.unique(triangles[:, 2]))

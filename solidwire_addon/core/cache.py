@@ -43,6 +43,29 @@ def table_texture(rows4: np.ndarray):
     return gpu.types.GPUTexture((width, height), format="RGBA32F", data=buf)
 
 
+def _provoking_triangle_numbers(positions: np.ndarray, triangles: np.ndarray):
+    """(positions, triangle number + 1 per vertex, index triangles) for a
+    visibility batch whose triangles are numbered by their last corner (see
+    GPUMesh.visibility_batch). One triangle ending at a vertex keeps the
+    vertex (whichever wrote it last below: any one will do); every other
+    gets a copy appended after the original vertices. Corners keep their
+    order, so each triangle is rasterised exactly as before."""
+    count = len(triangles)
+    last = triangles[:, 2]
+    rows = np.arange(count, dtype=np.int32)
+    owner = np.zeros(len(positions), dtype=np.int32)
+    owner[last] = rows  # repeated vertices: one of their triangles wins
+    keeps = owner[last] == rows
+    copied = np.flatnonzero(~keeps)
+    out_positions = np.concatenate([positions, positions[last[copied]]]).astype(np.float32, copy=False)
+    numbers = np.zeros(len(out_positions), dtype=np.float32)
+    numbers[last[keeps]] = rows[keeps] + 1
+    numbers[len(positions):] = copied + 1
+    out_triangles = triangles.copy()
+    out_triangles[copied, 2] = len(positions) + np.arange(len(copied), dtype=np.int32)
+    return out_positions, numbers, out_triangles
+
+
 class GPUMesh:
     """GPU resources of one extracted mesh."""
 
@@ -85,6 +108,7 @@ class GPUMesh:
         self.setup_table = None
         self._flag_table = None  # flag_table(), made on first use
         self._visibility_batch = None  # visibility_batch(), made on first use
+        self._visibility_layout = None  # (by_vertex, bytes) of that batch
         self._local_positions = positions[:, :3]  # for visibility_batch()
         # What reposition() needs to tell a move of vertices from a new shape.
         self.vertex_count = arrays.vertex_count
@@ -136,24 +160,45 @@ class GPUMesh:
             self.gpu_bytes += width * height * 8
         return self._flag_table
 
-    def visibility_batch(self):
-        """An indexed triangle batch (positions as a vertex attribute, the
-        triangle table as the index buffer) for the deferred surface's
-        visibility pass: each vertex is transformed once, not once per
-        corner, and gl_PrimitiveID numbers the triangles as the triangle
-        table does. Made on first use."""
+    def visibility_batch(self, by_vertex: bool = False):
+        """An indexed triangle batch (the triangle table as index buffer)
+        for the deferred surface's visibility pass: each vertex is
+        transformed once, not once per corner. Made on first use.
+
+        The pass numbers the triangles as the triangle table does, either
+        with gl_PrimitiveID (the batch holds the positions alone) or, with
+        ``by_vertex``, with a "triangle" attribute that each triangle's last
+        corner (OpenGL's provoking vertex, whose value a flat output takes)
+        carries for it. A vertex can carry that for one triangle only, so
+        every other triangle ending at it gets a copy of the vertex as its
+        last corner: same position, so the same coverage and depth. This
+        costs ~16 bytes per triangle and saves a software rasteriser its
+        primitive-ID bookkeeping (shaders.triangle_ids_by_vertex)."""
+        if self._visibility_batch is not None and self._visibility_layout[0] != by_vertex:
+            self._drop_visibility_batch()
         if self._visibility_batch is None:
+            triangles = np.ascontiguousarray(self.triangles_cpu[:, :3], dtype=np.int32)
+            positions = self._local_positions
             fmt = gpu.types.GPUVertFormat()
             fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
-            vbo = gpu.types.GPUVertBuf(fmt, len(self._local_positions))
-            vbo.attr_fill("position", self._local_positions)
-            ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=np.ascontiguousarray(self.triangles_cpu[:, :3], dtype=np.int32))
+            if by_vertex:
+                fmt.attr_add(id="triangle", comp_type="F32", len=1, fetch_mode="FLOAT")
+                positions, numbers, triangles = _provoking_triangle_numbers(positions, triangles)
+            vbo = gpu.types.GPUVertBuf(fmt, len(positions))
+            vbo.attr_fill("position", positions)
+            if by_vertex:
+                vbo.attr_fill("triangle", numbers)
+            ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=triangles)
             self._visibility_batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)
-            self.gpu_bytes += self._visibility_bytes()
+            size = len(positions) * (16 if by_vertex else 12) + self.triangle_count * 12
+            self._visibility_layout = (by_vertex, size)
+            self.gpu_bytes += size
         return self._visibility_batch
 
-    def _visibility_bytes(self) -> int:
-        return len(self._local_positions) * 12 + self.triangle_count * 12
+    def _drop_visibility_batch(self) -> None:
+        if self._visibility_batch is not None:
+            self.gpu_bytes -= self._visibility_layout[1]
+            self._visibility_batch = self._visibility_layout = None
 
     def replace_positions(self, local: np.ndarray, centre, bounds_min, bounds_max, source_positions=None,
                           corners: np.ndarray | None = None) -> None:
@@ -168,9 +213,7 @@ class GPUMesh:
         self.positions = table_texture(positions)
         if corners is not None and self.corners is not None:
             self.corners = table_texture(corners)
-        if self._visibility_batch is not None:
-            self.gpu_bytes -= self._visibility_bytes()
-            self._visibility_batch = None  # made again from the new positions on first use
+        self._drop_visibility_batch()  # made again from the new positions on first use
         self._local_positions = positions[:, :3]
         self.centre = centre
         self.bounds_min = bounds_min - centre

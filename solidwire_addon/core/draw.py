@@ -261,7 +261,8 @@ def draw(
     if stage == RESOLVE:
         variant = replace(variant, resolve=True, linear_depth=False)
     elif stage == VISIBILITY:
-        variant = shaders.ShaderVariant(visibility=True, linear_depth=linear_depth)
+        variant = shaders.ShaderVariant(visibility=True, linear_depth=linear_depth,
+                                        triangle_ids_by_vertex=shaders.triangle_ids_by_vertex())
     clip_rows = None
     if clip_planes is not None:
         variant = replace(variant, clip_planes=True)
@@ -328,7 +329,7 @@ def draw(
         # Both deferred stages must split and number the draws alike:
         # instancing does not depend on the stage's variant.
         instancing = program.supports_instancing and not write_aovs
-        numbering = _DrawNumbers(stage, extras)
+        numbering = _DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex)
         draws_of = {}
         for g in groups:
             draws_of[id(g[0])] = draws_of.get(id(g[0]), 0) + len(g[2])
@@ -412,8 +413,9 @@ class _DrawNumbers:
     rectangle over the draw's window box. A direct draw (stage None) just
     draws the batch."""
 
-    def __init__(self, stage, extras):
+    def __init__(self, stage, extras, by_vertex: bool = False):
         self.stage, self.extras, self.count = stage, extras, 0
+        self.by_vertex = by_vertex  # the visibility batch's numbering (ShaderVariant.triangle_ids_by_vertex)
 
     def bind(self, shader) -> None:
         if self.stage == RESOLVE:
@@ -432,7 +434,7 @@ class _DrawNumbers:
         self.count += 1
         shader.uniform_int("draw_number", self.count)
         if self.stage == VISIBILITY:
-            batch = mesh.visibility_batch()
+            batch = mesh.visibility_batch(by_vertex=self.by_vertex)
             if instance_count:
                 batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
             else:
