@@ -259,6 +259,11 @@ def plot(results, path: Path, meta):
                     color=colour, s=46, edgecolors="black", linewidths=0.4,
                 )
         ax.set_xscale("log")
+        # Ticks at 1, 2, 5 x 10^k in plain numbers: over less than two
+        # decades matplotlib's own minor labels run into each other.
+        ax.xaxis.set_major_locator(plt.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        ax.xaxis.set_major_formatter(plt.FuncFormatter(lambda value, _pos: f"{value:g}"))
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())
         ax.set_yscale("log")
         ax.set_xlabel("ms per frame (median; CPU timings, Mesa llvmpipe)")
         ax.set_ylabel(f"{label} vs float64 reference (floored at {floor:g})")
