@@ -15,7 +15,7 @@ import pytest
 
 import solidwire_addon
 from solidwire_addon.blender import runtime
-from solidwire_addon.core import draw, extract, passes, shaders
+from solidwire_addon.core import cache, draw, extract, passes, shaders
 from tests.support import accuracy
 from tests.support import reference
 from tests.support import scenes
@@ -129,6 +129,38 @@ def test_deformation_uploads_positions_and_normals_only(build, setup_min, monkey
     for frame, image in zip(FRAMES[1:], cold_images[1:]):
         report = difference_report(image, cold_images[0])
         assert report["max"] > 0.3 and report["over_2_255"] > 200, (frame, report)
+
+
+@pytest.mark.parametrize("by_vertex", [False, True], ids=["primitive_id", "by_vertex"])
+def test_deferred_deformation_keeps_the_index_buffer(by_vertex, monkeypatch, output_dir):
+    """Drawn deferred, a frame that only moves vertices uploads the
+    visibility batch's vertex buffer again but keeps its index buffer (and,
+    numbered by vertex, which corners are copied): those depend on the
+    triangles alone. Each frame still equals a fresh extraction's."""
+    monkeypatch.setattr(draw, "DEFERRED_MIN_DENSITY", 0.0)
+    monkeypatch.setattr(shaders, "TRIANGLE_IDS_BY_VERTEX", by_vertex)
+    index_buffers = []
+    real_index_buffer = cache.gpu.types.GPUIndexBuf
+
+    def counting_index_buffer(*args, **kwargs):
+        index_buffers.append(kwargs.get("type"))
+        return real_index_buffer(*args, **kwargs)
+
+    monkeypatch.setattr(cache.gpu.types, "GPUIndexBuf", counting_index_buffer)
+    scene = default_look_scene()
+    armature_tube(scene)
+    warm_images = []
+    for frame in FRAMES:
+        scene.frame_set(frame)
+        image, _stats = render(scene, output_dir / f"deferred_move_{by_vertex}_{frame}.png")
+        warm_images.append(image)
+    assert shaders.deferred_available()
+    assert index_buffers == ["TRIS"]  # made once, at the first frame
+    runtime.mesh_cache.clear()
+    cold, _stats = render(scene, output_dir / f"deferred_move_{by_vertex}_cold.png")
+    accuracy.assert_accurate({**difference_report(warm_images[-1], cold), "nan": int(np.isnan(cold).sum())})
+    assert len(index_buffers) == 2
+    assert difference_report(warm_images[-1], warm_images[0])["over_2_255"] > 200  # the frames really differ
 
 
 def test_repositioned_frame_matches_the_reference(output_dir):

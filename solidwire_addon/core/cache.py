@@ -43,27 +43,29 @@ def table_texture(rows4: np.ndarray):
     return gpu.types.GPUTexture((width, height), format="RGBA32F", data=buf)
 
 
-def _provoking_triangle_numbers(positions: np.ndarray, triangles: np.ndarray):
-    """(positions, triangle number + 1 per vertex, index triangles) for a
-    visibility batch whose triangles are numbered by their last corner (see
-    GPUMesh.visibility_batch). One triangle ending at a vertex keeps the
+def _provoking_triangle_numbers(vertex_count: int, triangles: np.ndarray):
+    """(copied vertices, triangle number + 1 per vertex, index triangles)
+    of a visibility batch whose triangles are numbered by their last corner
+    (see GPUMesh.visibility_batch). One triangle ending at a vertex keeps the
     vertex (whichever wrote it last below: any one will do); every other
-    gets a copy appended after the original vertices. Corners keep their
-    order, so each triangle is rasterised exactly as before."""
+    gets a copy of it, appended after the original vertices in the order of
+    ``copied vertices``. Corners keep their order, so each triangle is
+    rasterised exactly as before. Depends on the triangles alone, so a mesh
+    that only moves keeps it (the positions are appended again)."""
     count = len(triangles)
     last = triangles[:, 2]
     rows = np.arange(count, dtype=np.int32)
-    owner = np.zeros(len(positions), dtype=np.int32)
+    owner = np.zeros(vertex_count, dtype=np.int32)
     owner[last] = rows  # repeated vertices: one of their triangles wins
     keeps = owner[last] == rows
     copied = np.flatnonzero(~keeps)
-    out_positions = np.concatenate([positions, positions[last[copied]]]).astype(np.float32, copy=False)
-    numbers = np.zeros(len(out_positions), dtype=np.float32)
+    copied_vertices = last[copied]
+    numbers = np.zeros(vertex_count + len(copied), dtype=np.float32)
     numbers[last[keeps]] = rows[keeps] + 1
-    numbers[len(positions):] = copied + 1
+    numbers[vertex_count:] = copied + 1
     out_triangles = triangles.copy()
-    out_triangles[copied, 2] = len(positions) + np.arange(len(copied), dtype=np.int32)
-    return out_positions, numbers, out_triangles
+    out_triangles[copied, 2] = vertex_count + np.arange(len(copied), dtype=np.int32)
+    return copied_vertices, numbers, out_triangles
 
 
 class GPUMesh:
@@ -109,6 +111,7 @@ class GPUMesh:
         self._flag_table = None  # flag_table(), made on first use
         self._visibility_batch = None  # visibility_batch(), made on first use
         self._visibility_layout = None  # (by_vertex, bytes) of that batch
+        self._visibility_index = None  # (by_vertex, index buffer, copied vertices, numbers), kept across moves
         self._local_positions = positions[:, :3]  # for visibility_batch()
         # What reposition() needs to tell a move of vertices from a new shape.
         self.vertex_count = arrays.vertex_count
@@ -177,20 +180,32 @@ class GPUMesh:
         if self._visibility_batch is not None and self._visibility_layout[0] != by_vertex:
             self._drop_visibility_batch()
         if self._visibility_batch is None:
-            triangles = np.ascontiguousarray(self.triangles_cpu[:, :3], dtype=np.int32)
+            index = self._visibility_index
+            if index is None or index[0] != by_vertex:
+                # The index buffer (and by vertex, which vertices are copied)
+                # depends on the triangles alone: kept when the mesh moves.
+                triangles = np.ascontiguousarray(self.triangles_cpu[:, :3], dtype=np.int32)
+                copied = numbers = None
+                if by_vertex:
+                    copied, numbers, triangles = _provoking_triangle_numbers(len(self._local_positions), triangles)
+                if index is not None:
+                    self.gpu_bytes -= self.triangle_count * 12  # the other numbering's index buffer
+                index = self._visibility_index = (by_vertex, gpu.types.GPUIndexBuf(type="TRIS", seq=triangles),
+                                                  copied, numbers)
+                self.gpu_bytes += self.triangle_count * 12
+            _by_vertex, ibo, copied, numbers = index
             positions = self._local_positions
             fmt = gpu.types.GPUVertFormat()
             fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
             if by_vertex:
                 fmt.attr_add(id="triangle", comp_type="F32", len=1, fetch_mode="FLOAT")
-                positions, numbers, triangles = _provoking_triangle_numbers(positions, triangles)
+                positions = np.concatenate([positions, positions[copied]])
             vbo = gpu.types.GPUVertBuf(fmt, len(positions))
             vbo.attr_fill("position", positions)
             if by_vertex:
                 vbo.attr_fill("triangle", numbers)
-            ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=triangles)
             self._visibility_batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)
-            size = len(positions) * (16 if by_vertex else 12) + self.triangle_count * 12
+            size = len(positions) * (16 if by_vertex else 12)  # the vertex buffer; the index buffer is counted above
             self._visibility_layout = (by_vertex, size)
             self.gpu_bytes += size
         return self._visibility_batch
