@@ -118,6 +118,10 @@ def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
         median = statistics.median(times[name])
         first_text = "–" if math.isnan(first[name]) else f"{first[name]:.3f}"
         lines.append(f"| {label} | {median:.3f} | {first_text} | {median / base:.2f} |")
+    # What any engine pays to draw these triangles at all, in the same run.
+    floor_ms, _covered = frame_stages.bare_draw(scene, obj, size, repeats)
+    lines.append(f"| floor: bare indexed draw of the same triangles (no shading, no readback; "
+                 f"scripts/frame_stages.bare_draw) | {floor_ms / 1000.0:.3f} | – | {floor_ms / 1000.0 / base:.2f} |")
     lines += ["", f"SolidWire's steady frame by stage ({repeats} more renders with a sync after each GPU stage; "
                   "scripts/frame_stages.py):", ""]
     configure(scene, "SOLIDWIRE")

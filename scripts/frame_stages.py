@@ -135,3 +135,55 @@ class StageProbe:
         lines.append(f"| **probed frame** (stages synchronised) | {total:.0f} | |")
         lines.append(f"| unprobed frame (median F12 above) | {unprobed_ms:.0f} | |")
         return lines
+
+
+def bare_draw(scene, obj, size, repeats: int = 5) -> tuple[float, int]:
+    """(median ms, pixels covered) of the cheapest draw of ``obj``'s triangles a rasteriser
+    can do: one indexed batch of the evaluated mesh's positions with
+    Blender's built-in uniform-colour shader (no varying, no shading), depth
+    tested into an 8-bit target of the frame's size from the scene camera,
+    synchronised by a 1-pixel read. Every engine that draws the mesh pays at
+    least this; on a software rasteriser it is the floor of a frame."""
+    import bpy
+    import numpy as np
+    from gpu_extras.batch import batch_for_shader
+    from mathutils import Matrix
+
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+    from solidwire_addon.blender.views import camera_view
+
+    ensure_gpu()
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    mesh = obj.evaluated_get(depsgraph).data
+    mesh.calc_loop_triangles()
+    positions = np.empty((len(mesh.vertices), 3), dtype=np.float32)
+    mesh.vertices.foreach_get("co", positions.reshape(-1))
+    triangles = np.empty((len(mesh.loop_triangles), 3), dtype=np.int32)
+    mesh.loop_triangles.foreach_get("vertices", triangles.reshape(-1))
+    view = camera_view(scene, depsgraph, size)
+    object_to_clip = view.projection @ view.view_matrix @ np.array(obj.matrix_world, dtype=np.float64)
+    shader = gpu.shader.from_builtin("UNIFORM_COLOR")
+    batch = batch_for_shader(shader, "TRIS", {"pos": positions}, indices=triangles)
+    offscreen = gpu.types.GPUOffScreen(size[0], size[1], format="RGBA8")
+    times = []
+    try:
+        with offscreen.bind():
+            framebuffer = gpu.state.active_framebuffer_get()
+            gpu.matrix.load_matrix(Matrix.Identity(4))
+            gpu.matrix.load_projection_matrix(Matrix(object_to_clip.tolist()))
+            gpu.state.depth_test_set("LESS_EQUAL")
+            gpu.state.depth_mask_set(True)
+            shader.uniform_float("color", (0.8, 0.8, 0.8, 1.0))
+            for turn in range(repeats + 1):
+                start = time.perf_counter()
+                framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+                batch.draw(shader)
+                _sync()
+                if turn:  # the first draw compiles
+                    times.append((time.perf_counter() - start) * 1000.0)
+            depth = np.asarray(framebuffer.read_depth(0, 0, size[0], size[1]).to_list(), dtype=np.float32)
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+    finally:
+        offscreen.free()
+    return statistics.median(times), int((depth < 1.0).sum())

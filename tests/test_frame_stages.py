@@ -32,3 +32,34 @@ def test_probe_times_every_stage_and_restores_the_add_on(tmp_path):
     assert abs(sum(frame.values()) - 1000.0) < 1e-6  # "the rest" closes the frame
     rows = probe.table(900.0)
     assert rows[-1].startswith("| unprobed frame") and any(frame_stages.READBACK in row for row in rows)
+
+
+def test_bare_draw_covers_what_solidwire_draws(tmp_path):
+    """The benchmark's floor (frame_stages.bare_draw): the same triangles
+    from the same camera, so the same pixels up to float32 rounding of the
+    matrices at the silhouette."""
+    scene = scenes.empty_scene(96, 72)
+    obj = scenes.monkey(scene, subdivisions=2)
+    scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0.0, 0.0, 0.0))
+    rgba = scenes.render_to_file(scene, tmp_path / "solidwire.png")
+    covered = int((rgba[..., 3] > 0.0).sum())
+    milliseconds, bare_covered = frame_stages.bare_draw(scene, obj, (96, 72), repeats=2)
+    assert milliseconds > 0.0
+    assert covered > 1000
+    assert abs(bare_covered - covered) <= 0.01 * covered, (bare_covered, covered)
+
+
+def test_engines_table_lists_every_engine_the_floor_and_the_stages():
+    """scripts.bench_engines (also ``python -m scripts.bench --engines``):
+    one row per engine with a steady time, the bare-draw floor, then
+    SolidWire's frame stage by stage."""
+    from scripts import bench_engines
+
+    lines = bench_engines.run((64, 48), subdivisions=1, repeats=1, freestyle=False)
+    rows = {line.split(" | ")[0].lstrip("| "): line for line in lines if line.startswith("| ")}
+    for _name, label in bench_engines.ENGINES:
+        cells = rows[label].strip("| ").split(" | ")
+        assert float(cells[1]) > 0.0 and float(cells[3]) > 0.0, rows[label]
+    assert any(label.startswith("floor: bare indexed draw") for label in rows)
+    assert any(frame_stages.READBACK in line for line in lines)
+    assert lines[-2].startswith("| unprobed frame")

@@ -26,6 +26,12 @@ exact). matplotlib is needed for the pictures only (requirements-bench.txt).
 
     python -m scripts.bench [--quick] [--method exact --method nvidia2007 ...]
                             [--scene teapot ...] [--frames 20] [--no-peers]
+                            [--engines 1280x720 --engines 3840x2160]
+
+``--engines WxH`` adds the F12 table of scripts/bench_engines.py at that
+size (SolidWire against Workbench flat and wireframe, Freestyle unless
+``--no-peers``, and the floor: a bare draw of the same triangles), with
+SolidWire's frame stage by stage, to the output and to results.md.
 
 Run scripts/fetch_meshes.py first for the teapot and bunny (optional: their
 scenes are skipped when the meshes are missing).
@@ -341,6 +347,9 @@ def main(argv=None):
     parser.add_argument("--no-peers", action="store_true", help="skip Workbench and Freestyle")
     parser.add_argument("--out", default=str(ROOT / "out" / "bench"))
     parser.add_argument("--docs", metavar="DIR", help="also copy the two pictures there (e.g. docs/, for the README)")
+    parser.add_argument("--engines", action="append", metavar="WxH",
+                        help="also time F12 against Blender's own engines at this size, with the SolidWire frame "
+                        "stage by stage (scripts/bench_engines.py; repeatable)")
     args = parser.parse_args(argv)
 
     width, height = (int(v) for v in args.size.lower().split("x"))
@@ -438,11 +447,24 @@ def main(argv=None):
 
     summary = targets_summary(results)
     data = {"meta": meta, "results": results, "targets": summary, "skipped": skipped}
+    engine_lines = []
+    for text in args.engines or ():
+        from scripts import bench_engines
+
+        engine_size = tuple(int(v) for v in text.lower().split("x"))
+        engine_lines += bench_engines.run(engine_size, subdivisions=5, repeats=2 if args.quick else 5,
+                                          freestyle=not args.no_peers)
+        print("\n".join(engine_lines), flush=True)
+    if engine_lines:
+        data["engines_markdown"] = engine_lines
     if crop_images:
         extras["crop_window"] = crops(crop_images, out_dir / "near_plane_crops.png")
         data["crop_window"] = extras["crop_window"]
     (out_dir / "results.json").write_text(json.dumps(data, indent=1), encoding="utf-8")
     write_markdown(results, meta, out_dir / "results.md")
+    if engine_lines:
+        with (out_dir / "results.md").open("a", encoding="utf-8") as markdown:
+            markdown.write("\n## Against Blender's own engines (F12)\n\n" + "\n".join(engine_lines) + "\n")
     plot(results, out_dir / "time_vs_error.png", meta)
     if args.docs:
         import shutil
