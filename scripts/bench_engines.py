@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import resource
 import statistics
 import tempfile
 import time
@@ -24,6 +25,7 @@ import time
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
 
 import bpy  # noqa: E402
+import numpy as np  # noqa: E402
 
 import solidwire_addon  # noqa: E402
 from solidwire_addon.core import passes, schema  # noqa: E402
@@ -83,16 +85,40 @@ def time_render(scene) -> float:
     return time.perf_counter() - start
 
 
+def touched_mib() -> float:
+    """MiB of memory this process has touched for the first time so far
+    (minor page faults: a page the kernel had to map on first use)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_minflt * resource.getpagesize() / 2.0**20
+
+
+def first_touch_ms_per_mib(mib: int = 64) -> float:
+    """What touching new memory costs on this machine: ms per MiB of a
+    ``mib`` MiB fill the first time in the process, less the same fill
+    again (reused memory). Meaningful at the start of a process only."""
+    times = []
+    for _ in range(2):
+        start = time.perf_counter()
+        block = np.ones(mib * 2**18, dtype=np.float32)
+        times.append((time.perf_counter() - start) * 1000.0)
+        del block
+    return max(times[0] - times[1], 0.0) / mib
+
+
 def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
     width, height = size
     scene, obj = applied_mesh_scene(width, height, subdivisions)
     triangles = sum(len(p.vertices) - 2 for p in obj.data.polygons)
     engines = list(ENGINES)
-    first, times = {}, {name: [] for name, _label in engines}
+    first, times, touched, first_stats = {}, {name: [] for name, _label in engines}, {}, {}
     for turn in range(repeats + 1):
         for name, _label in engines:
             configure(scene, name)
+            before = touched_mib()
             seconds = time_render(scene)
+            if name == "SOLIDWIRE":
+                touched[turn] = touched_mib() - before
+                if turn == 0:
+                    first_stats = solidwire_addon.stats()
             if turn == 0:
                 first[name] = seconds
             else:
@@ -122,6 +148,11 @@ def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
     floor_ms, _covered = frame_stages.bare_draw(scene, obj, size, repeats)
     lines.append(f"| floor: bare indexed draw of the same triangles (no shading, no readback; "
                  f"scripts/frame_stages.bare_draw) | {floor_ms / 1000.0:.3f} | – | {floor_ms / 1000.0 / base:.2f} |")
+    steady_touched = statistics.median(touched[turn] for turn in range(1, repeats + 1))
+    lines += ["", f"SolidWire's first render: {first['SOLIDWIRE']:.3f} s against {statistics.median(times['SOLIDWIRE']):.3f} s "
+                  f"steady; extraction {first_stats.get('ms_extract', 0.0):.0f} ms, upload "
+                  f"{first_stats.get('ms_upload', 0.0):.0f} ms; {touched[0]:.0f} MiB of memory touched for the first "
+                  f"time (minor page faults; {steady_touched:.0f} MiB in a steady render)."]
     lines += ["", f"SolidWire's steady frame by stage ({repeats} more renders with a sync after each GPU stage; "
                   "scripts/frame_stages.py):", ""]
     configure(scene, "SOLIDWIRE")
@@ -141,6 +172,9 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--freestyle", action="store_true")
     args = parser.parse_args()
+    cost = first_touch_ms_per_mib()  # before anything else has touched memory
+    print(f"Touching new memory here costs {cost:.2f} ms per MiB (a 64 MiB fill, first time in the process "
+          "against again).\n", flush=True)
     solidwire_addon.register()
     try:
         for text in args.size or ["1280x720"]:

@@ -61,5 +61,6 @@ def test_engines_table_lists_every_engine_the_floor_and_the_stages():
         cells = rows[label].strip("| ").split(" | ")
         assert float(cells[1]) > 0.0 and float(cells[3]) > 0.0, rows[label]
     assert any(label.startswith("floor: bare indexed draw") for label in rows)
+    assert any(line.startswith("SolidWire's first render:") and "MiB of memory touched" in line for line in lines)
     assert any(frame_stages.READBACK in line for line in lines)
     assert lines[-2].startswith("| unprobed frame")
