@@ -249,6 +249,40 @@ def test_corner_table_refilled_from_new_normals_equals_a_fresh_one():
     np.testing.assert_array_equal(corner_vert[rows], arrays.triangles[:, :3])
 
 
+@pytest.mark.parametrize("domain", [extract.NORMALS_BY_VERTEX, extract.NORMALS_BY_TRIANGLE, extract.NORMALS_BY_CORNER])
+def test_corner_table_rows_hold_their_normal_and_material(domain):
+    """Every row of the corner table, by each domain, is the normal of its
+    vertex / face / polygon corner and the material of its face (clamped to
+    0..32767), NaN normals passed on as they are; a triangle corner with no
+    polygon corner (-1) gets a zero normal."""
+    rng = np.random.default_rng(7)
+    faces, triangles = 40, 80
+    triangle_polygons = np.repeat(np.arange(faces, dtype=np.int32), 2)
+    materials = rng.integers(-2, 40000, faces).astype(np.int32)
+    if domain == extract.NORMALS_BY_VERTEX:
+        materials[:] = 5
+        count = 30
+    else:
+        count = faces if domain == extract.NORMALS_BY_TRIANGLE else 4 * faces
+    normals = rng.normal(size=(count, 3)).astype(np.float32)
+    normals[3, 1] = np.nan
+    rows = rng.integers(0, count, 3 * triangles).astype(np.int32)
+    rows[[5, 17]] = -1
+    table = extract.fill_corner_table(rows, triangle_polygons, normals, materials, domain)
+    clamped = np.clip(materials, 0, 32767).astype(np.float32)
+    if domain == extract.NORMALS_BY_VERTEX:
+        expected_normals, expected_materials = normals, np.full(count, 5.0, np.float32)
+    elif domain == extract.NORMALS_BY_TRIANGLE:
+        expected_normals, expected_materials = normals[triangle_polygons], clamped[triangle_polygons]
+    else:
+        expected_normals = np.where((rows >= 0)[:, None], normals[np.maximum(rows, 0)], 0.0)
+        expected_materials = np.repeat(clamped[triangle_polygons], 3)
+    assert table.shape == (len(expected_normals), 4) and table.dtype == np.float32
+    np.testing.assert_array_equal(table[:, :3], expected_normals)
+    np.testing.assert_array_equal(table[:, 3], expected_materials)
+    assert np.isnan(table[:, 1]).any()
+
+
 def test_reposition_refuses_what_changes_the_triangles():
     positions, corner_vert, offsets = _quad_grid()
     arrays = extract.build_arrays_fast(positions, corner_vert, offsets)

@@ -53,15 +53,16 @@ def _provoking_triangle_numbers(vertex_count: int, triangles: np.ndarray):
     rasterised exactly as before. Depends on the triangles alone, so a mesh
     that only moves keeps it (the positions are appended again)."""
     count = len(triangles)
-    last = triangles[:, 2]
+    last = np.ascontiguousarray(triangles[:, 2])
     rows = np.arange(count, dtype=np.int32)
-    owner = np.zeros(vertex_count, dtype=np.int32)
+    owner = np.full(vertex_count, -1, dtype=np.int32)
     owner[last] = rows  # repeated vertices: one of their triangles wins
-    keeps = owner[last] == rows
-    copied = np.flatnonzero(~keeps)
+    copied = np.flatnonzero(owner[last] != rows)
     copied_vertices = last[copied]
-    numbers = np.zeros(vertex_count + len(copied), dtype=np.float32)
-    numbers[last[keeps]] = rows[keeps] + 1
+    numbers = np.empty(vertex_count + len(copied), dtype=np.float32)
+    # A vertex keeps the number of the triangle that won it, 0 (none) where
+    # it ends no triangle: owner + 1 either way.
+    np.add(owner, 1, out=numbers[:vertex_count], casting="unsafe")
     numbers[vertex_count:] = copied + 1
     out_triangles = triangles.copy()
     out_triangles[copied, 2] = vertex_count + np.arange(len(copied), dtype=np.int32)

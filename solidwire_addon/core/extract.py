@@ -865,26 +865,38 @@ def fill_corner_table(rows, triangle_polygons: np.ndarray, normals: np.ndarray,
         table[:, 3] = np.clip(materials[0], 0, 32767) if len(materials) else 0
         return table
     if domain == NORMALS_BY_TRIANGLE:
-        table = np.zeros((len(triangle_polygons), 4), dtype=np.float32)
-        if len(normals):
-            table[:, :3] = normals[triangle_polygons]
+        if len(normals) == 0 or len(triangle_polygons) == 0:
+            table = np.zeros((len(triangle_polygons), 4), dtype=np.float32)
+            if len(materials):
+                table[:, 3] = np.clip(materials[triangle_polygons], 0, 32767)
+            return table
+        # A face's row (normal, material), then one gather of whole rows.
+        face = np.zeros((len(normals), 4), dtype=np.float32)
+        face[:, :3] = normals
         if len(materials):
-            table[:, 3] = np.clip(materials[triangle_polygons], 0, 32767)
-        return table
+            face[:, 3] = np.clip(materials, 0, 32767)
+        return _take_rows(face, triangle_polygons)
     table = np.zeros((len(rows), 4), dtype=np.float32)
     if len(rows) == 0:
         return table
     count = len(triangle_polygons)
     material = materials[triangle_polygons] if len(materials) else np.zeros(count, np.int32)
-    table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
     found = rows >= 0
-    if not found.any():
-        return table
-    lost = not found.all()
-    safe = np.where(found, rows, 0) if lost else rows
-    # One 1-D gather per axis: ~2x faster than gathering (N, 3) rows.
-    for k, column in enumerate(np.ascontiguousarray(normals.T)):
-        table[:, k] = column.take(safe)
-    if lost:
-        table[~found, :3] = 0.0
+    if found.any():
+        lost = not found.all()
+        padded = np.zeros((len(normals), 4), dtype=np.float32)
+        padded[:, :3] = normals
+        table = _take_rows(padded, np.where(found, rows, 0) if lost else rows)
+        if lost:
+            table[~found, :3] = 0.0
+    table[:, 3] = np.repeat(np.clip(material, 0, 32767), 3)
     return table
+
+
+def _take_rows(table: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """``table[indices]`` for a C-contiguous (N, 4) float32 table, 2-3x
+    faster: each row is gathered as one 16-byte item (a complex128 view,
+    whose copy moves the bytes as they are, NaN payloads included) instead
+    of four float32 elements."""
+    rows = table.view(np.complex128).reshape(-1)
+    return rows.take(indices).view(np.float32).reshape(-1, 4)
