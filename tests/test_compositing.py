@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
+import pytest
 
 from solidwire_addon.blender import engine
 from solidwire_addon.core import compositing
@@ -23,7 +24,14 @@ def _frame(seed: int, height: int = 37, width: int = 53) -> np.ndarray:
     return np.concatenate([colour, alpha[..., None]], axis=-1)
 
 
-def test_over_film_is_premultiplied_over_an_opaque_colour():
+# One block for the whole frame, then blocks of 1 and 3 rows (the last one
+# shorter): the frame is composited block by block (compositing.BLOCK_PIXELS).
+BLOCKS = [compositing.BLOCK_PIXELS, 53, 160]
+
+
+@pytest.mark.parametrize("block_pixels", BLOCKS)
+def test_over_film_is_premultiplied_over_an_opaque_colour(block_pixels, monkeypatch):
+    monkeypatch.setattr(compositing, "BLOCK_PIXELS", block_pixels)
     frame = _frame(1)
     film = (0.2, 0.45, 0.7)
     expected = frame.astype(np.float64)
@@ -32,6 +40,11 @@ def test_over_film_is_premultiplied_over_an_opaque_colour():
     result = frame.copy()
     compositing.over_film(result, film)
     assert np.abs(result - expected).max() < 1e-6
+    # The same bits as the float32 one-liner (see compositing's docstring).
+    one_liner = frame.copy()
+    one_liner[..., :3] += (np.float32(1.0) - frame[..., 3:4]) * np.asarray(film, dtype=np.float32)
+    one_liner[..., 3] = 1.0
+    assert np.array_equal(result, one_liner)
     # Opaque pixels keep their colour exactly; empty ones become the film.
     opaque, empty = frame[..., 3] == 1.0, frame[..., 3] == 0.0
     assert opaque.any() and empty.any()
@@ -39,7 +52,9 @@ def test_over_film_is_premultiplied_over_an_opaque_colour():
     assert np.allclose(result[empty][:, :3], np.asarray(film, dtype=np.float32))
 
 
-def test_colour_over_blends_by_coverage_and_alpha():
+@pytest.mark.parametrize("block_pixels", BLOCKS)
+def test_colour_over_blends_by_coverage_and_alpha(block_pixels, monkeypatch):
+    monkeypatch.setattr(compositing, "BLOCK_PIXELS", block_pixels)
     frame = _frame(2)
     coverage = np.random.default_rng(3).choice([0.0, 1.0, 0.3], size=frame.shape[:2]).astype(np.float32)
     wire = (0.9, 0.1, 0.3, 0.8)
