@@ -33,9 +33,10 @@ def _render(scene, path, setup_min, monkeypatch):
     real = draw._run_setup
     monkeypatch.setattr(passes, "use_deferred_surface", False)
     monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
-    monkeypatch.setattr(draw, "_run_setup", lambda *args: (calls.append(1), real(*args)))
+    # Per pre-pass run: whether it ran without its clipping code (in_front).
+    monkeypatch.setattr(draw, "_run_setup", lambda *args: (calls.append(args[3:4] == (True,)), real(*args)))
     channels = scenes.render_multilayer_exr(scene, path)
-    return channels, len(calls)
+    return channels, calls
 
 
 @pytest.mark.parametrize("fill", [False, True])
@@ -44,12 +45,15 @@ def test_setup_table_gives_the_same_image(fill, output_dir, monkeypatch):
         pytest.skip("no compute shaders here")
     scene = scenes.empty_scene(200, 150, use_fill=fill)
     _quads_tris_mirrored_shared(scene)
-    per_corner, calls = _render(scene, output_dir / f"setup_off_{fill}.exr", 10**12, monkeypatch)
-    assert calls == 0
-    table, calls = _render(scene, output_dir / f"setup_on_{fill}.exr", 1, monkeypatch)
+    per_corner, runs = _render(scene, output_dir / f"setup_off_{fill}.exr", 10**12, monkeypatch)
+    assert runs == []
+    table, runs = _render(scene, output_dir / f"setup_on_{fill}.exr", 1, monkeypatch)
     # Floor, wall, box and the mirrored monkey with its own mesh; the two
     # objects that share a mesh keep the per-corner set-up.
-    assert calls >= 4
+    assert len(runs) >= 4
+    # Both pre-pass variants ran: the floor and wall cross the near plane,
+    # the monkeys and the box lie wholly in front of it (ALL_IN_FRONT).
+    assert True in runs and False in runs
     assert per_corner.keys() == table.keys()
     for name, values in per_corner.items():
         np.testing.assert_array_equal(table[name], values, err_msg=name)
@@ -62,14 +66,14 @@ def test_a_failing_pre_pass_falls_back_to_the_per_corner_set_up(output_dir, monk
         pytest.skip("no compute shaders here")
     scene = scenes.empty_scene(120, 90)
     _quads_tris_mirrored_shared(scene)
-    expected, _calls = _render(scene, output_dir / "setup_fallback_expected.exr", 10**12, monkeypatch)
+    expected, _runs = _render(scene, output_dir / "setup_fallback_expected.exr", 10**12, monkeypatch)
 
-    def refuse():
+    def refuse(*_variant):
         raise RuntimeError("compute shader refused")
 
     monkeypatch.setattr(shaders, "get_setup", refuse)
     monkeypatch.setattr(shaders, "_setup_support", [True])
-    got, calls = _render(scene, output_dir / "setup_fallback.exr", 1, monkeypatch)
-    assert calls == 0 and shaders.setup_available() is False
+    got, runs = _render(scene, output_dir / "setup_fallback.exr", 1, monkeypatch)
+    assert runs == [] and shaders.setup_available() is False
     for name, values in expected.items():
         np.testing.assert_array_equal(got[name], values, err_msg=name)

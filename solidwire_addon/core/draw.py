@@ -526,7 +526,7 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             if variant.setup_table:
                 # (Before each draw: so a mesh is set up for the matrix of
                 # the one object drawing it.)
-                _run_setup(mesh, object_to_clip, ubo(style))
+                _run_setup(mesh, object_to_clip, ubo(style), variant.in_front)
                 shader.bind()
                 bound = _UNBOUND  # the pre-pass bound its own block
                 shader.uniform_sampler("setup_table", mesh.setup_table)
@@ -586,18 +586,20 @@ def _setup_size(mesh, stage, object_to_clip, view: View) -> bool:
     return 0.5 * pixels > mesh.triangle_count
 
 
-def _run_setup(mesh, object_to_clip, block) -> None:
+def _run_setup(mesh, object_to_clip, block, in_front: bool = False) -> None:
     """The set-up pre-pass of one draw: every triangle's edge set-up into
     ``mesh.setup_table`` (allocated on first use, rewritten for each pass
     that draws the mesh; gpu.compute.dispatch ends with the barrier that
-    makes the writes visible to the draw's texture fetches)."""
+    makes the writes visible to the draw's texture fetches). ``in_front``:
+    the draw lies wholly in front of the near plane (view.wholly_in_front),
+    so the pre-pass runs without its clipping code."""
     count = mesh.triangle_count
     if getattr(mesh, "setup_table", None) is None:
         rows = -(-count // shaders.SETUP_ROW_TRIANGLES)
         mesh.setup_table = gpu.types.GPUTexture((shaders.SETUP_ROW_TRIANGLES * shaders.SETUP_TEXELS, rows),
                                                 format="RGBA32F")
         mesh.gpu_bytes += mesh.setup_table.width * mesh.setup_table.height * 16
-    setup = shaders.get_setup()
+    setup = shaders.get_setup(in_front)
     setup.bind()
     setup.uniform_block("params", block)
     setup.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())

@@ -583,13 +583,17 @@ def disable_setup() -> None:
     _setup_support[:] = [False]
 
 
-def get_setup():
+def get_setup(in_front: bool = False):
     """The set-up pre-pass (shaders/setup_comp.glsl): one invocation per
-    triangle writes its SETUP_TEXELS texels of edge set-up."""
-    key = (_context, "setup")
+    triangle writes its SETUP_TEXELS texels of edge set-up. ``in_front``:
+    for a draw wholly in front of the near plane, compiled without the
+    clipping code (ALL_IN_FRONT, as ShaderVariant.in_front)."""
+    key = (_context, "setup", bool(in_front))
     shader = _cache.get(key)
     if shader is None:
         info = pulling_info()
+        if in_front:
+            info.define("ALL_IN_FRONT", "1")
         info.push_constant("INT", "triangle_count")
         info.sampler(1, "FLOAT_2D", "triangle_vertices")
         info.image(0, "RGBA32F", "FLOAT_2D", "setup_table", qualifiers={"WRITE"})
