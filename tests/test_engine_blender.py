@@ -189,3 +189,32 @@ def test_kept_readback_equals_a_fresh_one_and_is_reused(region_scene):
         assert not np.array_equal(shifted_rgba, first)  # another window of the frame, in the same buffer
     finally:
         frame.finish()
+
+
+def test_a_frame_without_a_depth_pass_reads_no_view_depth(region_scene, tmp_path, monkeypatch):
+    """The render engine reads back only what the view layer's passes need:
+    without the Depth pass the view depth stays on the GPU, and Combined is
+    the same as with it."""
+    from solidwire_addon.core import targets
+
+    asked = []
+    real_read = targets.Targets.read
+
+    def spy(self, **kwargs):
+        asked.append(kwargs.get("depth", True))
+        return real_read(self, **kwargs)
+
+    monkeypatch.setattr(targets.Targets, "read", spy)
+    layer = region_scene.view_layers[0]
+    channels = {}
+    for use_pass_z in (True, False):
+        layer.use_pass_z = use_pass_z
+        asked.clear()
+        channels[use_pass_z] = _multilayer_render(region_scene, tmp_path / f"depth_{use_pass_z}.exr")
+        assert asked == [use_pass_z]
+    with_depth, without_depth = channels[True], channels[False]
+    depth_names = [name for name in with_depth if "Depth" in name]
+    assert depth_names and not any("Depth" in name for name in without_depth)
+    assert (with_depth[depth_names[0]] < 1e9).sum() > 300
+    for name, values in without_depth.items():
+        np.testing.assert_array_equal(values, with_depth[name], err_msg=name)

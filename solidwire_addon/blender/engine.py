@@ -106,17 +106,19 @@ class PreparedFrame:
         self.draw_stats = None
         self.ms_draw = 0.0
 
-    def draw(self, region, *, keep_readback: bool = False):
+    def draw(self, region, *, keep_readback: bool = False, read_depth: bool = True):
         """(rgba premultiplied over the film, view depth, {extra pass: values})
         of ``region`` (x0, y0, w, h in frame pixels), pixel for pixel as in
-        the whole frame. ``keep_readback``: rgba and depth are views of
+        the whole frame; the view depth is None with ``read_depth`` False
+        (a frame without a Depth pass). ``keep_readback``: rgba and depth are views of
         buffers reused by the next draw (core.targets.Targets.read), for a
         caller that hands them on at once."""
         width, height = self.view.width, self.view.height
         view = self.view if tuple(region) == (0, 0, width, height) else sub_view(self.view, region)
         start = time.perf_counter()
         rgba, depth, stats, extra = passes.render_passes(self.items, view, self.settings,
-                                                         extra_passes=self.extra_passes, keep_readback=keep_readback)
+                                                         extra_passes=self.extra_passes, keep_readback=keep_readback,
+                                                         read_depth=read_depth)
         self.ms_draw += (time.perf_counter() - start) * 1000.0
         if self.draw_stats is None:
             self.draw_stats = stats
@@ -236,7 +238,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
             self.update_progress(0.1 + 0.9 * (number - 1) / len(tiles))
             # The tile goes into Blender's result before the next is drawn,
             # so its readback can live in buffers that are reused.
-            rgba, depth, extra = frame.draw(tile, keep_readback=True)
+            rgba, depth, extra = frame.draw(tile, keep_readback=True, read_depth=depsgraph.view_layer.use_pass_z)
             self._write(tile, region, layer_name, rgba, depth, extra)
         frame.finish()
 
@@ -252,7 +254,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
             layer = result.layers[0]
             write_pass(layer.passes["Combined"], rgba)
             depth_pass = layer.passes.find("Depth")
-            if depth_pass != -1:
+            if depth_pass != -1 and depth is not None:
                 write_pass(layer.passes[depth_pass], depth)
             for name, values in extra.items():
                 index = layer.passes.find(name)

@@ -86,14 +86,16 @@ def render(items, view: View, settings, *, cull: bool = True):
     return rgba, depth, stats
 
 
-def render_passes(items, view: View, settings, *, cull: bool = True, extra_passes=(), keep_readback: bool = False):
+def render_passes(items, view: View, settings, *, cull: bool = True, extra_passes=(), keep_readback: bool = False,
+                  read_depth: bool = True):
     """:func:`render` plus the render passes named in ``extra_passes`` (of
     EXTRA_PASSES): (rgba, view_depth, stats, {name: (H, W, channels)}).
     A pass that is not asked for costs nothing: the surface pass gets its
     extra outputs only when one of them is wanted, Hidden Wire its own pass
-    only when asked for. ``keep_readback``: rgba and view_depth are views of
-    buffers the targets keep, valid until the next such frame
-    (:meth:`Targets.read`)."""
+    only when asked for, and with ``read_depth`` False (no Depth pass) the
+    view depth is not read back (None). ``keep_readback``: rgba and
+    view_depth are views of buffers the targets keep, valid until the next
+    such frame (:meth:`Targets.read`)."""
     extra_passes = frozenset(extra_passes)
     aovs = bool(extra_passes & _SURFACE_AOVS)
     width, height = view.width, view.height
@@ -121,7 +123,8 @@ def render_passes(items, view: View, settings, *, cull: bool = True, extra_passe
     extra = {}
     if HIDDEN_WIRE_PASS in extra_passes:
         extra[HIDDEN_WIRE_PASS] = _hidden_wire(targets, items, view, settings, cull)
-    rgba, depth = targets.read(keep=keep_readback)
+    # The surface passes' outputs need the coverage that the view depth holds.
+    rgba, depth = targets.read(keep=keep_readback, depth=read_depth or aovs)
     if aovs:
         covered = depth < BACKGROUND_DEPTH
         aov = read_texture(targets.aov, 4)

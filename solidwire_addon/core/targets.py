@@ -45,7 +45,7 @@ class Targets:
         self.outer = self.outer_depth = None  # silhouette targets, made on first use
         self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
         self.visible = None  # the deferred surface's visibility record, made on first use
-        self.kept_readback = None  # (colour, view depth) gpu Buffers, made on first read(keep=True)
+        self.kept_readback = None  # [colour, view depth] gpu Buffers, made on first read(keep=True)
 
     def visibility_framebuffer(self):
         """The deferred surface's first stage: the visibility record
@@ -107,9 +107,11 @@ class Targets:
         with framebuffer.bind():
             framebuffer.clear(color=(BACKGROUND_DEPTH, 0.0, 0.0, 0.0))
 
-    def read(self, *, keep: bool = False):
+    def read(self, *, keep: bool = False, depth: bool = True):
         """(rgba premultiplied (H, W, 4), view depth (H, W) with
         BACKGROUND_DEPTH where nothing was drawn; see clear_view_depth).
+        ``depth`` False: the view depth is not read back (None), for a
+        frame without a Depth pass.
 
         ``keep``: read into two buffers these targets keep instead of new
         arrays, and return views of them. A new frame-sized array is fresh
@@ -118,13 +120,14 @@ class Targets:
         overwritten by the next ``read(keep=True)``, so the caller hands them
         on first (the render engine copies them into Blender's result)."""
         if not keep:
-            return read_texture(self.color, 4), read_texture(self.view_depth, 1)[..., 0]
+            return read_texture(self.color, 4), read_texture(self.view_depth, 1)[..., 0] if depth else None
         width, height = self.size
         if self.kept_readback is None:
-            self.kept_readback = (gpu.types.Buffer("FLOAT", width * height * 4),
-                                  gpu.types.Buffer("FLOAT", width * height))
-        color, depth = self.kept_readback
-        return read_texture(self.color, 4, color), read_texture(self.view_depth, 1, depth)[..., 0]
+            self.kept_readback = [gpu.types.Buffer("FLOAT", width * height * 4), None]
+        if depth and self.kept_readback[1] is None:
+            self.kept_readback[1] = gpu.types.Buffer("FLOAT", width * height)
+        color, view_depth = self.kept_readback
+        return read_texture(self.color, 4, color), read_texture(self.view_depth, 1, view_depth)[..., 0] if depth else None
 
 
 _targets: Targets | None = None
