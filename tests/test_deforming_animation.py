@@ -213,3 +213,51 @@ def test_edge_marks_and_edge_angle_reextract(output_dir):
     scene.frame_set(FRAMES[3])
     _rgba, stats = render(scene, output_dir / "deform_marks.png")
     assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (1, 0)
+
+
+def test_normals_that_follow_the_positions_are_not_checksummed(monkeypatch, output_dir):
+    """Flat (per face) and plain smooth (per vertex) normals follow from the
+    positions and faces, which the fingerprint covers: a render validating an
+    unchanged mesh reads no normals, a moved mesh reads them once to be
+    shaded anew, and a change of where the normals live (flat to smooth,
+    then a sharp edge) still re-extracts."""
+    reads = []
+    real_read_normals = extract.read_normals
+    monkeypatch.setattr(extract, "read_normals", lambda mesh, domain: (reads.append(domain),
+                                                                       real_read_normals(mesh, domain))[1])
+    scene = default_look_scene()
+    monkey = scenes.monkey(scene, "Flat", subdivisions=1, rotation=(0.2, 0.0, 0.5))
+    scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0.0, 0.0, 0.0))
+    mesh = monkey.data
+    mesh.polygons.foreach_set("use_smooth", [False] * len(mesh.polygons))
+    mesh.update()
+    _image, stats = render(scene, output_dir / "derived_first.png")
+    assert stats["meshes_extracted"] == 1 and reads == [extract.NORMALS_BY_TRIANGLE]
+
+    reads.clear()
+    _image, stats = render(scene, output_dir / "derived_again.png")
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"], reads) == (0, 0, [])
+
+    positions = extract.read_positions(mesh)
+    positions[:, 2] *= 1.3
+    mesh.vertices.foreach_set("co", positions.reshape(-1))
+    mesh.update()
+    reads.clear()
+    moved, stats = render(scene, output_dir / "derived_moved.png")
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (0, 1)
+    assert reads == [extract.NORMALS_BY_TRIANGLE]
+    runtime.mesh_cache.clear()
+    cold, _stats = render(scene, output_dir / "derived_moved_cold.png")
+    accuracy.assert_accurate({**difference_report(moved, cold), "nan": int(np.isnan(moved).sum())})
+
+    mesh.polygons.foreach_set("use_smooth", [True] * len(mesh.polygons))
+    mesh.update()
+    smooth, stats = render(scene, output_dir / "derived_smooth.png")
+    assert stats["meshes_extracted"] == 1
+    assert difference_report(smooth, cold)["over_2_255"] > 200  # shaded anew
+
+    mesh.edges[0].use_edge_sharp = True
+    mesh.update()
+    reads.clear()
+    _image, stats = render(scene, output_dir / "derived_sharp.png")
+    assert stats["meshes_extracted"] == 1 and extract.NORMALS_BY_CORNER in reads

@@ -98,10 +98,14 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = ()):
 
     Counts plus CRC32 of the vertex positions and corner vertices (~4 GB/s),
     read with the same bulk reads extraction needs, which then reuses them.
-    With ``corners`` (shaded fill), the corner normals and material indices
-    too: sharp edges or materials can change without moving a vertex. With
-    ``edge_classes``, the edge data of those classes (marking a seam moves
-    nothing either).
+    With ``corners`` (shaded fill), the material indices and where the
+    normals live too, and the corner normals themselves where they can
+    change without moving a vertex (sharp edges, custom normals); normals
+    per face or per vertex follow from the positions and faces
+    (extract.normals_follow_geometry), so they are neither read nor
+    checksummed here (None in the context: read when the mesh is extracted
+    or moved). With ``edge_classes``, the edge data of those classes
+    (marking a seam moves nothing either).
 
     The fingerprint is ``(topology, shape)`` (see MeshCache.get_validated):
     a deformation changes the shape part alone, and then positions and
@@ -119,9 +123,13 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = ()):
     shape = (_crc(positions),)
     corner_inputs = None
     if corners:
-        normals, materials, domain = corner_inputs = extract.read_corner_inputs(mesh)
+        materials, domain = extract.read_corner_domain(mesh)
         topology += (_crc(materials), domain)
-        shape += (_crc(normals),)
+        normals = None
+        if not extract.normals_follow_geometry(domain):
+            normals = extract.read_normals(mesh, domain)
+            shape += (_crc(normals),)
+        corner_inputs = (normals, materials, domain)
     return (topology, shape), (positions, corner_vert, corner_inputs)
 
 
@@ -449,6 +457,8 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
         normals, materials, domain = corner_inputs
         if domain == extract.NORMALS_BY_CORNER and entry.corner_rows is None:
             return None
+        if normals is None:  # not read by the fingerprint (they follow the positions)
+            normals = extract.read_normals(source_mesh, domain)
         # The normals follow the deformation; which corner each triangle
         # corner is does not (same faces, same triangles; the domain is part
         # of the fingerprint's topology).

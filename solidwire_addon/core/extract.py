@@ -746,7 +746,7 @@ def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> Mes
     read them (the GPU cache reads them for its change fingerprint).
     ``corners``: also build the corner table (shaded fill, material colours);
     True, or the (normals, materials, domain) of :func:`read_corner_inputs` when the
-    caller has them already."""
+    caller has them already (normals None: read here)."""
     data = read_mesh_fast(mesh) if positions is None else {
         "positions": positions,
         "corner_vert": corner_vert if corner_vert is not None else read_corner_verts(mesh),
@@ -756,6 +756,8 @@ def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> Mes
     arrays = build_arrays_fast(**data)
     if corners:
         normals, materials, domain = read_corner_inputs(mesh) if corners is True else corners
+        if normals is None:
+            normals = read_normals(mesh, domain)
         arrays.corners = corner_table(arrays, data["corner_vert"], data["face_offsets"], normals, materials, domain)
     return arrays
 
@@ -778,18 +780,42 @@ def read_corner_inputs(mesh) -> tuple[np.ndarray, np.ndarray, int]:
     NORMALS_BY_*): what :func:`corner_table` needs. The normals are Blender's
     own (smooth, flat, sharp edges and custom normals as the mesh defines
     them; ``Mesh.normals_domain`` says where they vary), so the fill is
-    shaded as Blender shades it. Per vertex only with a single material (a
-    vertex has no material of its own)."""
+    shaded as Blender shades it."""
+    materials, domain = read_corner_domain(mesh)
+    return read_normals(mesh, domain), materials, domain
+
+
+def read_corner_domain(mesh) -> tuple[np.ndarray, int]:
+    """(material index per face (P,) int32, domain NORMALS_BY_*) of
+    :func:`read_corner_inputs`, without the normals. Per vertex only with a
+    single material (a vertex has no material of its own)."""
     materials = _read_attribute(mesh, "material_index", "value", len(mesh.polygons), np.int32)
     if materials is None:
         materials = np.zeros(len(mesh.polygons), dtype=np.int32)
     domain = getattr(mesh, "normals_domain", "CORNER")  # Blender 4.1+
     if domain == "POINT" and (len(materials) == 0 or bool((materials == materials[0]).all())):
-        return _read(mesh.vertex_normals, "vector", len(mesh.vertices), np.float32, 3), materials, NORMALS_BY_VERTEX
+        return materials, NORMALS_BY_VERTEX
     if domain == "FACE":
-        return (_read(mesh.polygon_normals, "vector", len(mesh.polygons), np.float32, 3), materials,
-                NORMALS_BY_TRIANGLE)
-    return _read(mesh.corner_normals, "vector", len(mesh.loops), np.float32, 3), materials, NORMALS_BY_CORNER
+        return materials, NORMALS_BY_TRIANGLE
+    return materials, NORMALS_BY_CORNER
+
+
+def read_normals(mesh, domain: int) -> np.ndarray:
+    """Blender's normals of ``mesh`` on ``domain`` (NORMALS_BY_*), (N, 3) float32."""
+    if domain == NORMALS_BY_VERTEX:
+        return _read(mesh.vertex_normals, "vector", len(mesh.vertices), np.float32, 3)
+    if domain == NORMALS_BY_TRIANGLE:
+        return _read(mesh.polygon_normals, "vector", len(mesh.polygons), np.float32, 3)
+    return _read(mesh.corner_normals, "vector", len(mesh.loops), np.float32, 3)
+
+
+def normals_follow_geometry(domain: int) -> bool:
+    """Whether normals on ``domain`` are a function of the positions and the
+    faces alone: per face (Newell's normal) and per vertex (smooth shading
+    without sharp edges or custom normals). Per corner they may also carry
+    sharp edges, custom normals, or a material split (a vertex normal per
+    corner; conservatively treated alike)."""
+    return domain != NORMALS_BY_CORNER
 
 
 def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray,
