@@ -18,9 +18,15 @@ import statistics
 import time
 from collections import defaultdict
 
+import bpy
 import gpu
+import numpy as np
+from gpu_extras.batch import batch_for_shader
+from mathutils import Matrix
 
 from solidwire_addon.blender import engine
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.blender.views import camera_view
 from solidwire_addon.core import draw as draw_mod
 from solidwire_addon.core import passes, silhouettes, targets
 
@@ -144,14 +150,6 @@ def bare_draw(scene, obj, size, repeats: int = 5) -> tuple[float, int]:
     tested into an 8-bit target of the frame's size from the scene camera,
     synchronised by a 1-pixel read. Every engine that draws the mesh pays at
     least this; on a software rasteriser it is the floor of a frame."""
-    import bpy
-    import numpy as np
-    from gpu_extras.batch import batch_for_shader
-    from mathutils import Matrix
-
-    from solidwire_addon.blender.gpu_context import ensure_gpu
-    from solidwire_addon.blender.views import camera_view
-
     ensure_gpu()
     depsgraph = bpy.context.evaluated_depsgraph_get()
     mesh = obj.evaluated_get(depsgraph).data

@@ -119,15 +119,16 @@ class Targets:
         2-core machine); kept buffers are faulted in once. The views are
         overwritten by the next ``read(keep=True)``, so the caller hands them
         on first (the render engine copies them into Blender's result)."""
-        if not keep:
-            return read_texture(self.color, 4), read_texture(self.view_depth, 1)[..., 0] if depth else None
-        width, height = self.size
-        if self.kept_readback is None:
-            self.kept_readback = [gpu.types.Buffer("FLOAT", width * height * 4), None]
-        if depth and self.kept_readback[1] is None:
-            self.kept_readback[1] = gpu.types.Buffer("FLOAT", width * height)
-        color, view_depth = self.kept_readback
-        return read_texture(self.color, 4, color), read_texture(self.view_depth, 1, view_depth)[..., 0] if depth else None
+        color_buffer = depth_buffer = None  # None: read_texture makes new arrays
+        if keep:
+            width, height = self.size
+            if self.kept_readback is None:
+                self.kept_readback = [gpu.types.Buffer("FLOAT", width * height * 4), None]
+            if depth and self.kept_readback[1] is None:
+                self.kept_readback[1] = gpu.types.Buffer("FLOAT", width * height)
+            color_buffer, depth_buffer = self.kept_readback
+        rgba = read_texture(self.color, 4, color_buffer)
+        return rgba, read_texture(self.view_depth, 1, depth_buffer)[..., 0] if depth else None
 
 
 _targets: Targets | None = None
