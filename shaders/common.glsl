@@ -14,7 +14,7 @@
 #define EDGE2_REAL 4  /* edge p2-p0 */
 #define HAS_QUAD_CORNER 8 /* p3 is the 4th corner of a quad: p2-p3, p3-p0 are real */
 #define IS_NGON 16 /* part of a polygon with more than 4 corners; see NGON_SHIFT */
-#define NGON_SHIFT 12 /* edge_flags >> NGON_SHIFT: the n-gon's corner count, or a block's segment count */
+#define NGON_SHIFT 13 /* edge_flags >> NGON_SHIFT: the n-gon's corner count, or a block's segment count */
 #define EDGE3_HIDDEN 64 /* a quad's p2-p3 is not drawn (edge angle, cage): no line, no diagonal */
 #define EDGE4_HIDDEN 128 /* a quad's p3-p0 likewise */
 #define EDGE0_HIDDEN 256 /* the triangle's own edge k is a polygon edge that is not drawn: 256 << k */
@@ -22,6 +22,9 @@
  * with its line style, and the diagonals of n-gons in it) starting at
  * ngon_corner_start; see core/edge_select.py. */
 #define IN_REGION 2048
+/* The triangle's lines come from the region-lines pass where one ran
+ * (REGION_LINES variant); its block then starts with its diagonals. */
+#define REGION_LINES 4096
 #define SEGMENT_TEXELS 2 /* (lower id, upper id, style, 0), (chain end, chain end, 0, 0) */
 #define DIAGONAL_STYLE 15
 /* Set by the vertex stage: the whole triangle (and a quad's 4th corner) is in

@@ -10,7 +10,7 @@ const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
 void main()
 {
   int edge = gl_VertexID / 6;
-  int corner = fin_corner;
+  int corner = quad_corner;
   vec4 ids = fetch_texel(silhouette_edges, edge);
   vec4 a = vertex_clip(ids.x);
   vec4 b = vertex_clip(ids.y);

@@ -51,11 +51,16 @@ void keep_segment(int style, float d, vec3 line, vec2 span, inout float d_style[
   keep_nearest(true, d, line, span, d_style[k], line_style[k], span_style[k]);
 }
 
-#ifdef USE_DENSITY_FADE
-/* With the density fade each line has a fade of its own, so a style's
- * intensity is the largest P(d) m(t) g(l) over its lines, not that of the
- * nearest line alone (which would jump where two edges of different length
- * meet; docs/image_model.md §3.7). `chain`: the fade's length l. */
+/* A style's intensity is the largest P(d) m(t) g(l) over its lines
+ * (docs/image_model.md §3.6-§3.7), not that of its nearest line alone: with
+ * the density fade each line has a fade of its own (the nearest line's
+ * would jump where two edges of different length meet), and a patterned
+ * class style keeps its strongest dash where two of its edges meet, as the
+ * region-lines pass's per-pixel maximum does. `chain`: the fade's length l. */
+#if defined(USE_DENSITY_FADE) || STYLE_COUNT > 1
+#  define USE_LINE_MAXIMUM
+#endif
+#ifdef USE_LINE_MAXIMUM
 float faded_line(int style, float d_sq, vec3 line, vec2 span, vec2 p, float wire_half, float chain)
 {
   float value = line_profile(sqrt(d_sq), style_half_thickness(style, wire_half));
@@ -74,7 +79,10 @@ float faded_line(int style, float d_sq, vec3 line, vec2 span, vec2 p, float wire
     float along = dot(vec2(-line.y, line.x), p);
     value *= pattern_mask(abs(along - span.x), params.pattern_period, duty);
   }
-  return value * density_fade(chain);
+#  ifdef USE_DENSITY_FADE
+  value *= density_fade(chain);
+#  endif
+  return value;
 }
 
 void offer_faded(int style, float d_sq, vec3 line, vec2 span, vec2 p, float wire_half, float chain,
@@ -164,7 +172,7 @@ void main()
    * edges then only give diagonals. Polygon edges that are not drawn are
    * neither. A quad's edges p2-p3, p3-p0 are NO_EDGE unless it has them. */
   float half_thickness = half_thickness_at(view_depth, SW_INV_CLIP_W);
-#ifdef USE_DENSITY_FADE
+#ifdef USE_LINE_MAXIMUM
   float faded[STYLE_COUNT];
   for (int k = 0; k < STYLE_COUNT; k++) {
     faded[k] = 0.0;
@@ -172,6 +180,13 @@ void main()
   float faded_diagonal = 0.0;
 #endif
   bool listed = (triangle_flags & IN_REGION) != 0;
+#ifdef REGION_LINE_IMAGE
+  /* The region-lines pass measured this triangle's lines (image model
+   * §2.6): the strongest line at this pixel and its style. */
+  bool lines_from_image = (triangle_flags & REGION_LINES) != 0;
+#else
+  const bool lines_from_image = false;
+#endif
   bool real0 = (triangle_flags & EDGE0_REAL) != 0;
   bool real1 = (triangle_flags & EDGE1_REAL) != 0;
   bool real2 = (triangle_flags & EDGE2_REAL) != 0;
@@ -194,7 +209,7 @@ void main()
   keep_nearest(real0 && !listed, d0, edge_line0, edge_span0, d_style[0], line_style[0], span_style[0]);
   keep_nearest(real1 && !listed, d1, edge_line1, edge_span1, d_style[0], line_style[0], span_style[0]);
   keep_nearest(real2 && !listed, d2, edge_line2, edge_span2, d_style[0], line_style[0], span_style[0]);
-#ifdef USE_DENSITY_FADE
+#ifdef USE_LINE_MAXIMUM
   if (!listed) {
     if (real0) OFFER(0, d0, edge_line0, edge_span0, edge_span0.y - edge_span0.x);
     if (real1) OFFER(0, d1, edge_line1, edge_span1, edge_span1.y - edge_span1.x);
@@ -205,7 +220,7 @@ void main()
   bool real4 = (triangle_flags & EDGE4_HIDDEN) == 0;
   keep_nearest(real3, d3, edge_line3, edge_span3, d_style[0], line_style[0], span_style[0]);
   keep_nearest(real4, d4, edge_line4, edge_span4, d_style[0], line_style[0], span_style[0]);
-#ifdef USE_DENSITY_FADE
+#ifdef USE_LINE_MAXIMUM
   if (real3) OFFER(0, d3, edge_line3, edge_span3, edge_span3.y - edge_span3.x);
   if (real4) OFFER(0, d4, edge_line4, edge_span4, edge_span4.y - edge_span4.x);
 #endif
@@ -218,7 +233,7 @@ void main()
   keep_nearest(diag0, d0, edge_line0, edge_span0, d_diag, diag_line, diag_span);
   keep_nearest(diag1, d1, edge_line1, edge_span1, d_diag, diag_line, diag_span);
   keep_nearest(diag2, d2, edge_line2, edge_span2, d_diag, diag_line, diag_span);
-#  ifdef USE_DENSITY_FADE
+#  ifdef USE_LINE_MAXIMUM
   if (diag0) OFFER(DIAGONAL_STYLE, d0, edge_line0, edge_span0, edge_span0.y - edge_span0.x);
   if (diag1) OFFER(DIAGONAL_STYLE, d1, edge_line1, edge_span1, edge_span1.y - edge_span1.x);
   if (diag2) OFFER(DIAGONAL_STYLE, d2, edge_line2, edge_span2, edge_span2.y - edge_span2.x);
@@ -261,6 +276,9 @@ void main()
     for (int k = 0; k < block_size; k++) {
       int texel = ngon_corner_start + SEGMENT_TEXELS * k;
       vec4 segment = fetch_texel(ngon_corners, texel);
+      if (lines_from_image && int(segment.z) != DIAGONAL_STYLE) {
+        break; /* the block's diagonals come first; its lines are in the image */
+      }
       vec3 line;
       vec2 span;
       /* Stored lower id first: patterns run from the lower-id end. */
@@ -269,6 +287,8 @@ void main()
       int style = int(segment.z);
 #  ifdef USE_DENSITY_FADE
       OFFER(style, d, line, span, chain_length(texel + 1, span));
+#  else
+      OFFER(style, d, line, span, 0.0);
 #  endif
       keep_segment(style, d, line, span, d_style, line_style, span_style, d_diag, diag_line, diag_span);
     }
@@ -331,23 +351,25 @@ void main()
   float intensity = 0.0;
   int winner = 0;
   for (int k = 0; k < styles; k++) {
-#  ifdef USE_DENSITY_FADE
+#  ifdef USE_LINE_MAXIMUM
     float value = faded[k];
 #  else
     float value = line_profile(sqrt(d_style[k]), style_half_thickness(k, half_thickness));
-#  endif
-#  if STYLE_COUNT > 1 && !defined(USE_DENSITY_FADE)
-    float duty = style_duty(k);
-    if (duty < 1.0) {
-      float along = dot(vec2(-line_style[k].y, line_style[k].x), p);
-      value *= pattern_mask(abs(along - span_style[k].x), params.pattern_period, duty);
-    }
 #  endif
     if (value > intensity) {
       intensity = value;
       winner = k;
     }
   }
+#  ifdef REGION_LINE_IMAGE
+  if (lines_from_image) {
+    vec2 line = texelFetch(region_line_image, ivec2(gl_FragCoord.xy), 0).xy;
+    if (line.x > intensity) {
+      intensity = line.x;
+      winner = int(line.y);
+    }
+  }
+#  endif
 #  if DIAGONALS >= 1
   d_diag = sqrt(d_diag);
   float diag_intensity = line_profile(d_diag, half_thickness);

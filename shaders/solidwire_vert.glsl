@@ -248,7 +248,16 @@ void main()
    * selection; other backends may provoke from the first, so both ends
    * select (PROVOKING_CORNERS, core/shaders.py). */
   bool provoking = (corner == 2) || (PROVOKING_CORNERS == 2 && corner == 0);
-  if ((edge_flags & IN_REGION) != 0 && provoking) {
+#  ifdef REGION_LINE_IMAGE
+  /* Lines from the region-lines pass: only the block's diagonals are walked. */
+  bool lines_elsewhere = (edge_flags & REGION_LINES) != 0;
+#  else
+  const bool lines_elsewhere = false;
+#  endif
+  if (lines_elsewhere) {
+    segment_count = -1;
+  }
+  else if ((edge_flags & IN_REGION) != 0 && provoking) {
     /* Behind the near plane a corner has no window position: walk. */
     segment_count = in_front ? select_segments(t0, t1, t2, line_reach(c0.w, c1.w, c2.w)) : -1;
   }

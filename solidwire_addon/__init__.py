@@ -16,7 +16,7 @@ import atexit
 import bpy
 
 from .blender import cli, color_management, engine, matcap_files, ops, ops_composite, overlay, properties, runtime, ui
-from .core import draw, log, matcaps, silhouettes, targets
+from .core import draw, log, matcaps, targets
 
 _classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
 _registered = False
@@ -67,12 +67,11 @@ def _at_exit() -> None:
 
 
 def release_gpu() -> None:
-    """Free the GPU objects the add-on holds (targets, meshes, fin batches,
+    """Free the GPU objects the add-on holds (targets, meshes, quad batches,
     display LUTs). Compiled shader programs are the exception: they live
     until interpreter exit (core/shaders.py says why)."""
     targets.release()
     runtime.release()
-    silhouettes.release()
     draw.release_rectangle()
     matcaps.clear()
     color_management.release()

@@ -60,17 +60,35 @@ def test_a_region_walks_every_drawn_edge_around_it():
     assert hidden == [(1, 5), (1, 5)]
 
 
-def test_a_region_over_the_limit_keeps_each_face_to_its_own_edges():
+def test_a_large_region_is_one_block_and_its_lines_one_table():
     arrays, corner_vert, offsets, corner_edge, verts, index = _strip(40)
     drawn = np.ones(len(verts), bool)
     for x in range(1, 40):
         drawn[index[(x, 41 + x)]] = False  # one region of 40 quads, 82 drawn edges
-    stats = edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn),
-                                     max_region_edges=64)
-    assert stats.large_regions == 1 and stats.listed_triangles == 0
-    assert ((arrays.edge_flags & extract.IN_REGION) == 0).all()
-    assert ((arrays.edge_flags & (extract.EDGE0_HIDDEN | extract.EDGE0_HIDDEN << 1 | extract.EDGE0_HIDDEN << 2
-                                  | extract.EDGE3_HIDDEN | extract.EDGE4_HIDDEN)) != 0).all()
+    stats = edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    # No size limit: every triangle walks the region's whole block ...
+    assert stats.regions == 1 and stats.listed_triangles == arrays.triangle_count
+    assert ((arrays.edge_flags >> extract.NGON_SHIFT) == 82).all()
+    # ... and the region-lines table holds each of its 82 drawn edges once,
+    # with the region (face 0's label) on one side and nothing on the other.
+    lines = arrays.region_lines.reshape(-1, 2, 4)
+    assert stats.region_lines == len(lines) == 82
+    ends = {(int(a), int(b)) for a, b in lines[:, 0, :2]}
+    assert ends == {tuple(sorted(map(int, verts[e]))) for e in range(len(verts)) if drawn[e]}
+    assert (lines[:, 0, 3] == 0).all() and (lines[:, 1, 2] == edge_select.NO_REGION).all()
+    assert (arrays.triangle_regions == 0).all()
+
+
+def test_an_edge_between_two_regions_is_one_line_naming_both():
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(4)
+    drawn = np.ones(len(verts), bool)
+    drawn[index[(1, 6)]] = False  # quads 0 + 1 form a region, 2 + 3 another
+    drawn[index[(3, 8)]] = False
+    edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    lines = arrays.region_lines.reshape(-1, 2, 4)
+    shared = [row for row in lines if (int(row[0, 0]), int(row[0, 1])) == (2, 7)]
+    assert len(shared) == 1 and sorted((shared[0][0, 3], shared[0][1, 2])) == [0.0, 2.0]
+    assert sorted(set(arrays.triangle_regions.tolist())) == [0.0, 2.0]
 
 
 def test_an_edge_of_several_classes_gets_a_segment_per_class():

@@ -106,6 +106,11 @@ class GPUMesh:
         self.triangle_polygons_cpu = arrays.triangle_polygons
         self.edge_flags_cpu = arrays.edge_flags
         self.silhouette_edges = None  # (texture, count), built lazily
+        # The lines of multi-face regions and each triangle's region
+        # (edge_select._region_lines), uploaded on first use (region_tables).
+        self._region_lines_cpu = arrays.region_lines
+        self._triangle_regions_cpu = arrays.triangle_regions
+        self._region_tables = None
         # The set-up pre-pass's output for big meshes (draw._run_setup), made
         # on first use and rewritten by every draw of the mesh.
         self.setup_table = None
@@ -163,6 +168,22 @@ class GPUMesh:
             self._flag_table = gpu.types.GPUTexture((width, height), format="RG32F", data=buf)
             self.gpu_bytes += width * height * 8
         return self._flag_table
+
+    @property
+    def region_line_count(self) -> int:
+        """Entries of the region-lines table (0: no multi-face region)."""
+        lines = self._region_lines_cpu
+        return 0 if lines is None else len(lines) // 2
+
+    def region_tables(self):
+        """(region-lines table, per-triangle region table) as textures (see
+        region_lines.py), made on first use."""
+        if self._region_tables is None:
+            regions = np.zeros((self.triangle_count, 4), np.float32)
+            regions[:, 0] = self._triangle_regions_cpu
+            self._region_tables = (table_texture(self._region_lines_cpu), table_texture(regions))
+            self.gpu_bytes += sum(t.width * t.height * 16 for t in self._region_tables)
+        return self._region_tables
 
     def visibility_batch(self, by_vertex: bool = False):
         """An indexed triangle batch (the triangle table as index buffer)

@@ -104,6 +104,9 @@ SETUP_TABLE_MIN = 50_000
 # each pixel shows, RESOLVE runs the exact fragment stage once per pixel of
 # that record. ``stage=None`` draws directly (one pass, every fragment).
 VISIBILITY, RESOLVE = "visibility", "resolve"
+# Between the two: the lines of multi-face regions drawn over the
+# visibility record (region_lines.py, docs/image_model.md §2.6).
+LINES = "lines"
 # Triangle numbers, instances and draw numbers travel as float32 whole
 # numbers in the visibility record: exact below 2^24.
 DEFERRED_MAX = 1 << 24
@@ -136,7 +139,10 @@ def split_deferred(items, view: View) -> tuple[list, list]:
         to_clip = view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
         pixels = float(box_pixels(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max), view).sum())
         weight = DEFERRED_BLOCK_WEIGHT if mesh.has_ngons else 1.0
-        dense = weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels
+        # Multi-face regions draw their lines over the visibility record
+        # (region_lines.py), so such a mesh is always deferred.
+        dense = (weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels
+                 or mesh.region_line_count > 0)
         (deferred if dense and 0 < mesh.triangle_count < DEFERRED_MAX else direct).extend(group)
     return deferred, direct
 
@@ -234,6 +240,7 @@ def draw(
     program=EXACT,
     stage=None,
     visibility=None,
+    region_lines=None,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
 
@@ -247,7 +254,10 @@ def draw(
     management (image model §9). ``stage`` VISIBILITY or RESOLVE (with
     ``visibility``, the texture the first wrote): one half of the deferred
     surface, see passes.draw_surface; both halves must be called with the
-    same items, view and settings so that they number the draws alike."""
+    same items, view and settings so that they number the draws alike.
+    ``stage`` LINES (between the two, with ``visibility``) draws the lines
+    of multi-face regions into the bound region-lines target; a RESOLVE
+    given that target (``region_lines``) reads them from it."""
     stats = DrawStats()
     if not items:
         return stats
@@ -263,11 +273,17 @@ def draw(
     elif stage == VISIBILITY:
         variant = shaders.ShaderVariant(visibility=True, linear_depth=linear_depth,
                                         triangle_ids_by_vertex=shaders.triangle_ids_by_vertex())
+    elif stage == LINES:
+        variant = shaders.ShaderVariant(region_lines_pass=True, thickness_mode=variant.thickness_mode,
+                                        edge_classes=variant.edge_classes, density_fade=variant.density_fade)
     clip_rows = None
     if clip_planes is not None:
         variant = replace(variant, clip_planes=True)
         clip_rows = clip_space_planes(clip_planes, view)
     extras = {}
+    if region_lines is not None:
+        variant = replace(variant, region_lines=True)
+        extras["region_line_image"] = region_lines
     if display is not None:
         variant = replace(variant, display_transform=True)
         extras["display"] = display
@@ -329,7 +345,7 @@ def draw(
         # Both deferred stages must split and number the draws alike:
         # instancing does not depend on the stage's variant.
         instancing = program.supports_instancing and not write_aovs
-        numbering = _DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex)
+        numbering = _DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view)
         draws_of = {}
         for g in groups:
             draws_of[id(g[0])] = draws_of.get(id(g[0]), 0) + len(g[2])
@@ -343,9 +359,11 @@ def draw(
             table = (setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g[4], view))
             in_front = wholly_in_front(g[4], mesh.bounds_min, mesh.bounds_max)
             parts.setdefault((ngons, table, in_front), []).append(g)
+        # The visibility and region-lines passes read neither n-gon
+        # outlines nor the set-up table.
+        plain_stage = variant.visibility or variant.region_lines_pass
         for (ngons, table, in_front) in sorted(parts):
-            part_variant = replace(variant, ngons=ngons and not variant.visibility,
-                                   setup_table=table and not variant.visibility,
+            part_variant = replace(variant, ngons=ngons and not plain_stage, setup_table=table and not plain_stage,
                                    in_front=in_front and not variant.visibility)
             _draw_groups(parts[(ngons, table, in_front)], part_variant, ubo, settings, program, flip, stats, extras,
                          bases, instancing=instancing, numbering=numbering)
@@ -386,6 +404,8 @@ def _bind_extras(shader, variant, extras) -> None:
         _set_clip_planes(shader, extras["clip_block"])
     if variant.display_transform:
         bind_display_transform(shader, extras["display"])
+    if variant.region_lines:
+        shader.uniform_sampler("region_line_image", extras["region_line_image"])
 
 
 def bind_display_transform(shader, display) -> None:
@@ -413,13 +433,25 @@ class _DrawNumbers:
     rectangle over the draw's window box. A direct draw (stage None) just
     draws the batch."""
 
-    def __init__(self, stage, extras, by_vertex: bool = False):
+    def __init__(self, stage, extras, by_vertex: bool = False, view: View | None = None):
         self.stage, self.extras, self.count = stage, extras, 0
         self.by_vertex = by_vertex  # the visibility batch's numbering (ShaderVariant.triangle_ids_by_vertex)
+        self.view = view
+
+    @property
+    def draws_over_record(self) -> bool:
+        """A stage that draws over the visibility record: no face culling
+        (its triangles are not the mesh's)."""
+        return self.stage in (RESOLVE, LINES)
 
     def bind(self, shader) -> None:
-        if self.stage == RESOLVE:
+        if self.stage in (RESOLVE, LINES):
             shader.uniform_sampler("visibility", self.extras["visibility"])
+        if self.stage == LINES and shaders.uses_uniform(shader, "clip_w_of_depth"):
+            # (Read only for widths in scene units.) Clip w at a view depth z: w = -P[3][2] z + P[3][3] (z for a
+            # perspective camera, 1 for an orthographic one).
+            row = self.view.projection[3]
+            shader.uniform_float("clip_w_of_depth", (float(-row[2]), float(row[3])))
 
     def draw(self, shader, mesh, batch_of, object_to_clip, instance_count: int = 0) -> None:
         """One draw call of ``mesh``; ``batch_of()`` gives the direct draw's
@@ -432,6 +464,20 @@ class _DrawNumbers:
                 batch.draw(shader)
             return
         self.count += 1
+        if self.stage == LINES:
+            count = mesh.region_line_count
+            if count:
+                shader.uniform_int("draw_number", self.count)
+                lines, regions = mesh.region_tables()
+                shader.uniform_sampler("region_lines", lines)
+                shader.uniform_sampler("triangle_regions", regions)
+                shader.uniform_int("line_count", count)
+                batch = quad_batch(count)
+                if instance_count:
+                    batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
+                else:
+                    batch.draw_range(shader, elem_start=0, elem_count=6 * count)
+            return
         shader.uniform_int("draw_number", self.count)
         if self.stage == VISIBILITY:
             batch = mesh.visibility_batch(by_vertex=self.by_vertex)
@@ -443,6 +489,25 @@ class _DrawNumbers:
         shader.uniform_float("resolve_rect", window_rect(object_to_clip, mesh.bounds_min, mesh.bounds_max))
         shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
         _rectangle().draw(shader)
+
+
+_quad_batches: dict[int, object] = {}
+
+
+def quad_batch(count: int):
+    """Six corners (two triangles, ``quad_corner`` 0..5) for each of at
+    least ``count`` screen-space quads whose shader pulls everything else:
+    the silhouette fins and the region lines. Shared by every draw of the
+    same size class (the next power of two)."""
+    size = 1 << max(int(count - 1).bit_length(), 6)
+    batch = _quad_batches.get(size)
+    if batch is None:
+        fmt = gpu.types.GPUVertFormat()
+        fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
+        vbo = gpu.types.GPUVertBuf(fmt, 6 * size)
+        vbo.attr_fill("quad_corner", np.tile(np.arange(6, dtype=np.int32), size))
+        batch = _quad_batches[size] = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+    return batch
 
 
 _rectangles: list = []
@@ -461,8 +526,10 @@ def _rectangle():
 
 
 def release_rectangle() -> None:
-    """Drop the resolve pass's rectangle (add-on unregister frees every GPU object)."""
+    """Drop the resolve pass's rectangle and the quad batches (add-on
+    unregister frees every GPU object)."""
     _rectangles.clear()
+    _quad_batches.clear()
 
 
 def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats, extras=None,
@@ -474,7 +541,7 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
     (_DrawNumbers)."""
     extras = extras or {}
     numbering = numbering or _DrawNumbers(None, extras)
-    resolving = numbering.stage == RESOLVE
+    resolving = numbering.draws_over_record
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
     # (A resolve that reads the set-up table and needs no barycentrics
@@ -673,7 +740,7 @@ def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras, nu
         if style is not bound:
             bound = style
             shader.uniform_block("params", ubo(style))
-        if settings.use_backface_culling and numbering.stage != RESOLVE:
+        if settings.use_backface_culling and not numbering.draws_over_record:
             gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
         shader.uniform_int("instance_base", base)
         _bind_mesh(shader, variant, mesh)

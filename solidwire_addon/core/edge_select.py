@@ -13,11 +13,16 @@ image: a face whose edges are all drawn and carry no class ("plain") draws
 from its own edges as before. Every other face is *listed*: its triangles
 walk a block of segments (the drawn edges of its region, each with its
 style, plus the diagonals of n-gons in it) in a table the fragment stage
-reads (``region_table``). A region whose boundary has more than
-``MAX_REGION_EDGES`` drawn edges is not walked as a whole (every fragment
-would loop over all of them): its faces keep their own edges, and a line
-may then stop short by up to h + 2s px at a hidden edge (the documented
-limit, §3.4).
+reads (``region_table``). Regions have no size limit.
+
+A fragment that walked a region of thousands of edges would pay for all of
+them, so the render draws the lines of multi-face regions another way
+(``region_lines``, docs/image_model.md §2.6): each drawn edge bounding such
+a region is a screen-space quad whose fragments measure the exact distance
+and keep the strongest line per pixel where the visible triangle lies in
+one of the edge's regions (``triangle_regions``). The block walk stays for
+what needs the distance beyond a line's reach (the Edge Distance pass) and
+for hidden lines.
 
 Plain numpy on arrays; no Blender.
 """
@@ -30,7 +35,7 @@ import numpy as np
 
 from .extract import (
     EDGE0_HIDDEN, EDGE0_REAL, EDGE1_REAL, EDGE2_REAL, EDGE3_HIDDEN, EDGE4_HIDDEN, HAS_QUAD_CORNER, IN_REGION,
-    IS_NGON, NGON_SHIFT, MeshArrays, read_face_normals,
+    IS_NGON, NGON_SHIFT, REGION_LINES, MeshArrays, read_face_normals,
 )
 
 # Edge classes, in style order: style k + 1 is class k (style 0 is the
@@ -39,12 +44,13 @@ EDGE_CLASSES = ("boundary", "sharp", "crease", "seam", "freestyle")
 CLASS_BIT = {name: 1 << k for k, name in enumerate(EDGE_CLASSES)}
 # Style of a diagonal segment in a region block (n-gon diagonals).
 DIAGONAL_STYLE = 15
-# Above this many drawn edges a region is not walked as a whole (see above).
-# 64 covers a quad cage face subdivided four times (4 * 2^4 edges).
-MAX_REGION_EDGES = 64
 # Texels per segment in the region table: (lower id, upper id, style, 0)
 # and (chain end, chain end, 0, 0) for the density fade.
 TEXELS_PER_SEGMENT = 2
+# Texels per region line (shaders/region_lines_vert.glsl): (lower id, upper
+# id, style, region) and (chain end, chain end, other region or NO_REGION, 0).
+TEXELS_PER_REGION_LINE = 2
+NO_REGION = -1.0
 
 
 @dataclass
@@ -76,7 +82,7 @@ class SelectionStats:
     regions: int = 0  # regions of more than one face walked as a whole
     listed_triangles: int = 0
     segments: int = 0
-    large_regions: int = 0  # regions over MAX_REGION_EDGES (own edges only)
+    region_lines: int = 0  # entries of the region-lines table
 
 
 def _face_of_corner(sizes: np.ndarray) -> np.ndarray:
@@ -127,7 +133,7 @@ def _chain_ends(verts: np.ndarray, chain: np.ndarray | None) -> np.ndarray:
 
 
 def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray,
-                 inputs: EdgeInputs, max_region_edges: int = MAX_REGION_EDGES) -> SelectionStats:
+                 inputs: EdgeInputs) -> SelectionStats:
     """Apply ``inputs`` to ``arrays`` in place (edge flags, column 3 of
     listed triangles, ``region_table``) and say what it did."""
     stats = SelectionStats()
@@ -162,9 +168,7 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     # Drawn edges of each region (unique (label, edge) pairs).
     drawn_corner = drawn[corner_edge]
     pairs = np.unique(np.stack([label[corner_face[drawn_corner]], corner_edge[drawn_corner]], axis=1), axis=0)
-    region_edges = np.bincount(pairs[:, 0], minlength=face_count) if len(pairs) else np.zeros(face_count, np.int64)
-    walked_region = (region_size > 1) & (region_edges <= max_region_edges)
-    stats.large_regions = int(((region_size > 1) & ~walked_region & (np.arange(face_count) == label)).sum())
+    walked_region = region_size > 1
     styled_face = np.bincount(corner_face, weights=(classes[corner_edge] != 0), minlength=face_count) > 0
     walked = walked_region[label]
     ngon_face = sizes > 4
@@ -204,15 +208,7 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     seg_edge = np.concatenate([seg_edge, own[:, 1]])
     # One segment per class of the edge (an edge with no class: one
     # ordinary segment).
-    bits = classes[seg_edge]
-    popcount = np.array([bin(b).count("1") for b in range(1 << len(EDGE_CLASSES))])
-    per_edge = np.maximum(popcount[bits], 1)
-    seg_owner, seg_edge, bits = np.repeat(seg_owner, per_edge), np.repeat(seg_edge, per_edge), np.repeat(bits, per_edge)
-    rank = np.arange(len(bits)) - np.repeat(np.cumsum(per_edge) - per_edge, per_edge)
-    seg_style = np.zeros(len(bits), np.int64)
-    for k in range(len(EDGE_CLASSES)):  # the rank-th set bit of each edge's classes
-        below = popcount[bits & ((1 << k) - 1)]
-        seg_style = np.where(((bits >> k) & 1 == 1) & (below == rank), k + 1, seg_style)
+    seg_style, (seg_owner, seg_edge) = _one_per_class(classes[seg_edge], seg_owner, seg_edge)
     ends = _chain_ends(verts, inputs.chain)
     seg_a = np.minimum(verts[seg_edge, 0], verts[seg_edge, 1])
     seg_b = np.maximum(verts[seg_edge, 0], verts[seg_edge, 1])
@@ -227,7 +223,9 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     chain_b = np.concatenate([chain_b, diag_b])
     seg_style = np.concatenate([seg_style, np.full(len(diag_a), DIAGONAL_STYLE)])
 
-    order = np.argsort(seg_owner, kind="stable")
+    # Diagonals first in each block: a triangle whose lines come from the
+    # region-lines pass walks only that prefix (solidwire_frag.glsl).
+    order = np.lexsort((seg_style != DIAGONAL_STYLE, seg_owner))
     seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style = (
         x[order] for x in (seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style))
     owners, first, count = np.unique(seg_owner, return_index=True, return_counts=True)
@@ -248,14 +246,68 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     listed = tri_owner >= 0
     at = np.searchsorted(owners, tri_owner[listed])
     flags = arrays.edge_flags
-    keep = ~(HAS_QUAD_CORNER | IS_NGON | (-1 << NGON_SHIFT))
+    keep = ~(HAS_QUAD_CORNER | IS_NGON | REGION_LINES | (-1 << NGON_SHIFT))
     flags[listed] = (flags[listed] & keep) | IN_REGION | (count[at].astype(np.int32) << NGON_SHIFT)
+    flags[listed & walked[arrays.triangle_polygons]] |= REGION_LINES
     flags[listed] &= ~(EDGE3_HIDDEN | EDGE4_HIDDEN)
     arrays.triangles[listed, 3] = base + TEXELS_PER_SEGMENT * first[at]
     stats.regions = int((walked_region & (np.arange(face_count) == label)).sum())
     stats.listed_triangles = int(listed.sum())
     stats.segments = int(len(seg_a))
+    _region_lines(arrays, verts, classes, ends, label, walked, pairs, stats)
     return stats
+
+
+def _one_per_class(bits: np.ndarray, *columns: np.ndarray):
+    """(style, columns repeated): one row per class bit set in ``bits`` (its
+    style k + 1 for class k), one row of style 0 where no bit is set."""
+    popcount = np.array([bin(b).count("1") for b in range(1 << len(EDGE_CLASSES))])
+    per_row = np.maximum(popcount[bits], 1)
+    bits = np.repeat(bits, per_row)
+    rank = np.arange(len(bits)) - np.repeat(np.cumsum(per_row) - per_row, per_row)
+    style = np.zeros(len(bits), np.int64)
+    for k in range(len(EDGE_CLASSES)):  # the rank-th set bit of each row's classes
+        below = popcount[bits & ((1 << k) - 1)]
+        style = np.where(((bits >> k) & 1 == 1) & (below == rank), k + 1, style)
+    return style, tuple(np.repeat(column, per_row) for column in columns)
+
+
+def _region_lines(arrays: MeshArrays, verts, classes, ends, label, walked, pairs, stats: SelectionStats) -> None:
+    """The lines of multi-face regions as a table of their own
+    (``region_lines``, TEXELS_PER_REGION_LINE texels per entry) and each
+    triangle's region (``triangle_regions``, NO_REGION outside one). An edge
+    bounding two regions is one entry naming both; a non-manifold edge
+    bounding more is one entry per pair; an edge in several classes is one
+    entry per class."""
+    region_of_face = np.where(walked, label, -1)
+    arrays.triangle_regions = region_of_face[arrays.triangle_polygons].astype(np.float32)
+    keep = walked[pairs[:, 0]] if len(pairs) else np.zeros(0, bool)
+    pairs = pairs[keep]
+    if not len(pairs):
+        arrays.region_lines = None
+        return
+    pairs = pairs[np.lexsort((pairs[:, 0], pairs[:, 1]))]  # by edge, then region
+    edge, region = pairs[:, 1], pairs[:, 0]
+    start = np.ones(len(edge), bool)
+    start[1:] = edge[1:] != edge[:-1]
+    first = np.flatnonzero(start)
+    rank = np.arange(len(edge)) - np.repeat(first, np.diff(np.append(first, len(edge))))
+    # Ranks 0 and 1 of an edge share an entry, then 2 and 3, ...
+    head = rank % 2 == 0
+    has_partner = np.append(~start[1:], False) & head
+    partner = np.where(has_partner, np.append(region[1:], -1), -1)
+    edge, region, partner = edge[head], region[head], partner[head]
+    # One entry per class of the edge (an edge with no class: one entry).
+    style, (edge, region, partner) = _one_per_class(classes[edge], edge, region, partner)
+    table = np.zeros((TEXELS_PER_REGION_LINE * len(edge), 4), np.float32)
+    table[0::2, 0] = np.minimum(verts[edge, 0], verts[edge, 1])
+    table[0::2, 1] = np.maximum(verts[edge, 0], verts[edge, 1])
+    table[0::2, 2] = style
+    table[0::2, 3] = region
+    table[1::2, 0], table[1::2, 1] = ends[edge, 0], ends[edge, 1]
+    table[1::2, 2] = np.where(partner >= 0, partner, NO_REGION)
+    arrays.region_lines = table
+    stats.region_lines = len(edge)
 
 
 def _mark_own_edges(arrays: MeshArrays, verts: np.ndarray, drawn: np.ndarray) -> None:

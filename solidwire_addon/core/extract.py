@@ -35,7 +35,11 @@ EDGE0_HIDDEN = 256  # << k for edges 1 and 2
 # edge_select.py) that starts at column 3; edge_flags >> NGON_SHIFT is the
 # segment count.
 IN_REGION = 2048
-NGON_SHIFT = 12  # edge_flags >> NGON_SHIFT is an n-gon's corner count
+# The triangle lies in a region of several faces: where the render draws the
+# region lines as a pass of their own (region_lines.py), its lines come from
+# that pass and it walks only the diagonals at the head of its block.
+REGION_LINES = 4096
+NGON_SHIFT = 13  # edge_flags >> NGON_SHIFT is an n-gon's corner count
 
 # Vertex ids travel to the GPU as float32 texels: exact below 2**24.
 MAX_VERTICES = 1 << 24
@@ -74,6 +78,11 @@ class MeshArrays:
     # (S, 4) float32 segment blocks of listed triangles (edge_select.py);
     # they follow ngon_corners in the GPU's outline table. None: no blocks.
     region_table: np.ndarray = None
+    # The lines of multi-face regions (edge_select._region_lines): (2N, 4)
+    # float32, and each triangle's region (NO_REGION outside one). None:
+    # no multi-face region.
+    region_lines: np.ndarray = None
+    triangle_regions: np.ndarray = None
     # (3T,) int32 polygon corner of each triangle corner (-1: none), kept with
     # ``corners`` so a moved mesh refills its table (fill_corner_table);
     # only for normals by corner.

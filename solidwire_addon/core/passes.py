@@ -200,10 +200,25 @@ def _deferred_surface(targets, items, view: View, settings, aovs: bool, surface_
         stats = draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY, **surface_args)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
+    # The lines of multi-face regions as quads over the record, so that no
+    # pixel walks a region's edges (docs/image_model.md §2.6). The Edge
+    # Distance pass needs d beyond a line's reach, so with the render
+    # passes' outputs the resolve walks the regions instead; a pass with
+    # the wire switched off needs no lines.
+    lines = None
+    if not aovs and surface_args["show_wire"] and any(item.mesh.region_line_count for item in items):
+        framebuffer = targets.region_lines_framebuffer()
+        with framebuffer.bind():
+            _clear(framebuffer, width, height)
+            draw_mod.draw(items, view, settings, stage=draw_mod.LINES, visibility=targets.visible, **surface_args)
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+        lines = targets.lines
+        stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
     with targets.resolve_framebuffer(aovs=aovs).bind():
         gpu.state.viewport_set(0, 0, width, height)
         draw_mod.draw(items, view, settings, stage=draw_mod.RESOLVE, visibility=targets.visible,
-                      write_view_depth=True, **surface_args)
+                      write_view_depth=True, region_lines=lines, **surface_args)
     return stats
 
 

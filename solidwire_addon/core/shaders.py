@@ -117,6 +117,13 @@ class ShaderVariant:
     # without its clipping code (ALL_IN_FRONT), which a CPU rasteriser
     # would otherwise run for every triangle or pixel, branch or not.
     in_front: bool = False
+    # Region lines (docs/image_model.md §2.6): ``region_lines_pass`` is the
+    # pass that draws the lines of multi-face regions as screen-space quads
+    # over the visibility record (it reads only thickness_mode,
+    # edge_classes, density_fade and instanced); ``region_lines`` is a
+    # resolve that reads that pass's image for those regions' triangles.
+    region_lines_pass: bool = False
+    region_lines: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -248,6 +255,8 @@ class _Interface:
 def _create_info(variant: ShaderVariant):
     if variant.visibility:
         return _visibility_create_info(variant)
+    if variant.region_lines_pass:
+        return _region_lines_create_info(variant)
     iface = _Interface()
     for i in range(EDGE_COUNT):
         iface.flat("VEC3", f"edge_line{i}")
@@ -294,6 +303,9 @@ def _create_info(variant: ShaderVariant):
         info.sampler(RESOLVE_VISIBILITY_SLOT, "FLOAT_2D", "visibility")
         info.sampler(RESOLVE_FLAGS_SLOT, "FLOAT_2D", "triangle_flag_table")
         info.define("RESOLVE_PASS", "1")
+        if variant.region_lines:
+            info.sampler(REGION_LINE_IMAGE_SLOT, "FLOAT_2D", "region_line_image")
+            info.define("REGION_LINE_IMAGE", "1")
     else:
         info.vertex_in(0, "INT", "edge_flags")
     output_and_feature_defines(info, variant)
@@ -361,6 +373,50 @@ def _visibility_create_info(variant: ShaderVariant):
         prologue = ""
     info.vertex_source(prologue + read_source("visibility_vert.glsl"))
     info.fragment_source(read_source("visibility_frag.glsl"))
+    return info
+
+
+def _region_lines_create_info(variant: ShaderVariant):
+    """The region-lines pass (region_lines_vert/frag.glsl): a quad per
+    entry of the mesh's region-lines table, the exact distance per
+    fragment, the strongest line per pixel kept through the depth test."""
+    iface = gpu.types.GPUStageInterfaceInfo("solidwire_region_lines_iface")
+    iface.flat("VEC3", "line_equation")
+    iface.flat("VEC2", "line_span")
+    iface.flat("INT", "line_style")
+    iface.flat("VEC2", "line_regions")
+    iface.flat("FLOAT", "line_chain")
+    info = pulling_info(push_matrices=not variant.instanced)
+    info.sampler(1, "FLOAT_2D", "triangle_vertices")  # bound with every mesh (draw._bind_mesh), unread
+    info.sampler(2, "FLOAT_2D", "region_lines")
+    info.sampler(4, "FLOAT_2D", "triangle_regions")
+    info.sampler(RESOLVE_VISIBILITY_SLOT, "FLOAT_2D", "visibility")
+    info.push_constant("INT", "draw_number")
+    info.push_constant("INT", "line_count")
+    info.push_constant("VEC2", "clip_w_of_depth")
+    prologue = ""
+    if variant.instanced:
+        iface.flat("FLOAT", "line_instance")
+        info.push_constant("INT", "instance_base")
+        info.sampler(3, "FLOAT_2D", "instance_table")
+        info.define("SW_INSTANCED", "1")
+        prologue = (f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
+                    + read_source("instancing.glsl"))
+    info.vertex_in(0, "INT", "quad_corner")
+    info.vertex_out(iface)
+    info.fragment_out(0, "VEC2", "frag_line")
+    compat.depth_write(info, "ANY")
+    info.define("THICKNESS_MODE", str(variant.thickness_mode))
+    info.define("STYLE_COUNT", "6" if variant.edge_classes else "1")
+    if variant.density_fade:
+        info.define("USE_DENSITY_FADE", "1")
+    if variant.in_front:
+        info.define("ALL_IN_FRONT", "1")
+    body = (read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("line_style.glsl")
+            + read_source("edge_styles.glsl"))
+    info.vertex_source(prologue + body + read_source("region_lines_vert.glsl"))
+    fragment_prologue = prologue.replace("gl_InstanceID", "0")  # the fragment stage transforms nothing
+    info.fragment_source(fragment_prologue + body + read_source("region_lines_frag.glsl"))
     return info
 
 
@@ -497,6 +553,7 @@ vec4 sw_triangle_ids;
 # Sampler slots of the resolve pass, above the set-up table's.
 RESOLVE_VISIBILITY_SLOT = 10
 RESOLVE_FLAGS_SLOT = 11
+REGION_LINE_IMAGE_SLOT = 12
 
 
 # Per-object values of the render passes (std140): the columns of the normal
@@ -536,7 +593,7 @@ def get(variant: ShaderVariant):
         try:
             shader = _keep(_cache, key, gpu.shader.create_from_info(_create_info(variant)))
         except Exception as exc:
-            if variant.visibility or variant.resolve:
+            if variant.visibility or variant.resolve or variant.region_lines_pass:
                 raise DeferredUnavailable(str(exc)) from exc
             raise
     return shader
@@ -636,7 +693,7 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         info.push_constant("INT", "edge_count")
         info.sampler(1, "FLOAT_2D", "silhouette_edges")
         info.sampler(2, "DEPTH_2D", "scene_depth")
-        info.vertex_in(0, "INT", "fin_corner")
+        info.vertex_in(0, "INT", "quad_corner")
         info.vertex_out(iface)
         if key.depth_bias:
             info.fragment_out(0, "VEC4", "frag_color")

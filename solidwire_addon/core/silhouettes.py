@@ -35,7 +35,7 @@ import numpy as np
 
 from . import shaders
 from .cache import table_texture
-from .draw import bind_display_transform, shader_variant
+from .draw import bind_display_transform, quad_batch, shader_variant
 from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
 from .settings import pack_params
 from .view import translation
@@ -83,28 +83,6 @@ def edge_table(mesh):
     return mesh.silhouette_edges
 
 
-_fin_batches: dict[int, object] = {}
-
-
-def _fin_batch(edge_count: int):
-    """A vertex-less-in-spirit batch of 6 vertices per edge (two triangles);
-    shared by all meshes of the same edge count class (next power of two)."""
-    size = 1 << max(int(edge_count - 1).bit_length(), 6)
-    batch = _fin_batches.get(size)
-    if batch is None:
-        fmt = gpu.types.GPUVertFormat()
-        fmt.attr_add(id="fin_corner", comp_type="I32", len=1, fetch_mode="INT")
-        vbo = gpu.types.GPUVertBuf(fmt, 6 * size)
-        vbo.attr_fill("fin_corner", np.tile(np.arange(6, dtype=np.int32), size))
-        batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
-        _fin_batches[size] = batch
-    return batch
-
-
-def release() -> None:
-    _fin_batches.clear()
-
-
 def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay_bias: float = 0.0,
                      linear_depth: bool = False, display=None) -> None:
     """Draw the outer halves into the bound framebuffer.
@@ -146,4 +124,4 @@ def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay
         shader.uniform_sampler("vertex_positions", mesh.positions)
         shader.uniform_sampler("silhouette_edges", table)
         shader.uniform_int("edge_count", count)
-        _fin_batch(count).draw_range(shader, elem_start=0, elem_count=6 * count)
+        quad_batch(count).draw_range(shader, elem_start=0, elem_count=6 * count)

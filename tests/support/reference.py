@@ -167,9 +167,6 @@ def _flat_edges(mesh, loop_poly, real_a, real_b, angle) -> set:
 EDGE_CLASSES = ("boundary", "sharp", "crease", "seam", "freestyle")
 _CLASS_ATTRIBUTES = {"sharp": ("sharp_edge",), "crease": ("crease_edge",), "seam": ("uv_seam", ".uv_seam"),
                      "freestyle": ("freestyle_edge",)}
-# A region with more drawn edges than this measures per face (image model
-# §3.5: the documented bound of the implementation).
-REGION_EDGE_LIMIT = 64
 PATTERN_DUTY = {"SOLID": 1.0, "DOTTED": 0.25, "DASHED": 0.5}
 
 
@@ -291,8 +288,7 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
             region_edges.setdefault(int(label[f]), set()).add(int(e))
             face_edges.setdefault(f, set()).add(int(e))
     size = np.bincount(label, minlength=npoly)
-    walked = np.array([size[label[f]] > 1 and len(region_edges.get(int(label[f]), ())) <= REGION_EDGE_LIMIT
-                       for f in range(npoly)], bool)
+    walked = size[label] > 1  # regions have no size limit (image model §3.4)
     key = np.where(walked, label, np.arange(npoly))
     entries = []  # (owner key, edge)
     for owner in sorted(set(key.tolist())):
@@ -893,15 +889,14 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
         pattern = getattr(s, f"{name}_pattern") if name else "SOLID"
         style_ties = {}
         d, along, index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
-                                                  want_along=pattern != "SOLID", want_index=True, ties=style_ties)
-        if pattern != "SOLID" and not use_density:
-            tied |= style_ties["tied"]
+                                                  want_along=False, want_index=True, ties=style_ties)
         d_real = np.minimum(d_real, d)
         width_px = float(getattr(s, f"{name}_thickness")) if name else thickness
         duty = PATTERN_DUTY[pattern]
-        if use_density:
-            # Each line fades on its own: the style's intensity is its
-            # strongest faded line (§3.7), not its nearest line's.
+        if use_density or duty < 1.0:
+            # The style's intensity is its strongest line (§3.6-§3.7), not
+            # its nearest line's: each line fades on its own, and each
+            # edge's pattern runs along that edge.
             def faded(pair_pix, pair_edge, d_pair, along_pair, width_px=width_px, duty=duty):
                 w = width_px if np.isscalar(width_px) else width_px[pair_pix]
                 v = profile(d_pair, w, softness) * density(pair_edge)
@@ -909,8 +904,6 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
             v = _max_value_per_pixel(keys, pix_xy, geo, wa, wb, valid, select, faded)
         else:
             v = profile(d, width_px, softness)
-            if pattern != "SOLID":
-                v *= pattern_mask(np.abs(along), float(s.pattern_period), duty)
         wins = v > value
         winner[wins] = style
         value = np.maximum(value, v)

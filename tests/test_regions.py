@@ -1,0 +1,140 @@
+"""Regions of any size (image model §3.4, §2.6): the lines of a region come
+from every drawn edge around it, however many, at every subdivision level,
+for n-gon cages and large flat areas under the angle threshold, with edge
+classes; faces smaller than a pixel included. Renders through the engine
+are compared with the float64 reference, which walks each region whole."""
+
+from __future__ import annotations
+
+import math
+
+import bmesh
+import numpy as np
+import pytest
+
+import solidwire_addon
+from solidwire_addon.core import exr
+from tests.support import accuracy, reference, scenes
+
+
+def _subdivided(obj, levels: int, *, optimal_display: bool = True):
+    modifier = obj.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = modifier.render_levels = levels
+    modifier.show_only_control_edges = optimal_display
+    return modifier
+
+
+def _assert_region_lines_drawn():
+    """The render drew the lines of its multi-face regions as their own pass."""
+    assert solidwire_addon.stats().get("region_line_entries", 0) > 0
+
+
+@pytest.mark.parametrize("level", [1, 2, 3, 4, 5])
+def test_cage_edges_of_a_cube_at_every_level(level, output_dir):
+    scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5)
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    _subdivided(cube, level)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    report = accuracy.measure(scene, f"regions_cube_level{level}", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+    # Each cage face is one region: its interior is free of lines, whatever
+    # the level (the reference's own count of line pixels stays put).
+    ref = reference.render_reference(scene)
+    assert (ref.intensity > 0.5).sum() < 0.35 * (ref.face >= 0).sum()
+
+
+def test_faces_smaller_than_a_pixel(output_dir):
+    """A level-5 cube a few dozen pixels across: each quad is under a pixel,
+    each cage face one region of 128 drawn edges."""
+    scene = scenes.empty_scene(96, 72, use_cage_edges=True, thickness=1.0)
+    cube = scenes.cube(scene, rotation=(0.5, 0.2, 0.4))
+    _subdivided(cube, 5)
+    scenes.add_camera(scene, location=(6.0, -9.0, 5.0), target=(0, 0, 0))
+    report = accuracy.measure(scene, "regions_subpixel", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+
+
+@pytest.mark.parametrize("level", [2, 4])
+def test_an_ngon_cage_keeps_its_whole_outline(level, output_dir):
+    """A cylinder's 16-gon caps under subdivision: each cap is one region of
+    16 * 2^level drawn edges around a fan of child faces."""
+    scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5, diagonal_mode="SOLID")
+    tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
+        bm, cap_ends=True, cap_tris=False, segments=16, radius1=1.0, radius2=1.0, depth=1.6))
+    _subdivided(tube, level)
+    scenes.add_camera(scene, location=(2.2, -3.4, 3.0), target=(0, 0, 0))
+    report = accuracy.measure(scene, f"regions_ngon_cap_level{level}", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+    # The cap's outline is drawn all the way round: the rim's pixels are lit.
+    ref = reference.render_reference(scene)
+    assert (ref.intensity > 0.99).sum() > 100
+
+
+def test_the_angle_threshold_on_a_large_creased_region(output_dir):
+    """A 40 x 40 grid folded once: under the angle threshold each half is one
+    flat region of about 120 drawn edges."""
+    scene = scenes.empty_scene(220, 160, edge_angle=math.radians(10.0), thickness=2.0)
+    grid = scenes.grid(scene, x_segments=40, y_segments=40, size=4.0)
+    for vertex in grid.data.vertices:
+        if vertex.co.x > 0.0:
+            vertex.co.z = 0.6 * vertex.co.x
+    grid.data.update()
+    scenes.add_camera(scene, location=(0.8, -4.4, 3.6), target=(0, 0, 0.3))
+    report = accuracy.measure(scene, "regions_creased_grid", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+    # Lines only along the outline and the fold: far fewer than every edge.
+    ref = reference.render_reference(scene)
+    every_edge = reference.render_reference(scene, settings=reference.SettingsWith(scene.solidwire, edge_angle=0.0))
+    assert ref.intensity.sum() < 0.25 * every_edge.intensity.sum()
+
+
+@pytest.mark.parametrize("case", ["cage", "angle"])
+def test_edge_classes_on_large_regions(case, output_dir):
+    """Edge classes with their own width, colour and pattern on regions of
+    more than a hundred edges: the strongest line per pixel decides the
+    style, with each class's pattern running along its own edges."""
+    look = dict(use_sharp_edges=True, sharp_thickness=3.0, sharp_pattern="DASHED",
+                use_boundary_edges=True, boundary_thickness=2.5, thickness=1.0)
+    if case == "cage":
+        scene = scenes.empty_scene(200, 150, use_cage_edges=True, **look)
+        obj = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+        for edge in obj.data.edges[:4]:
+            edge.use_edge_sharp = True
+        _subdivided(obj, 4)
+        scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    else:
+        scene = scenes.empty_scene(200, 150, edge_angle=math.radians(10.0), **look)
+        obj = scenes.grid(scene, x_segments=24, y_segments=24, size=4.0)
+        for edge in obj.data.edges:
+            a, b = (obj.data.vertices[v].co for v in edge.vertices)
+            edge.use_edge_sharp = abs(a.x - b.x) < 1e-6 and abs(a.x) < 1e-6  # a line across the middle
+        scenes.add_camera(scene, location=(0.8, -4.4, 3.6), target=(0, 0, 0))
+    report = accuracy.measure(scene, f"regions_classes_{case}", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+
+
+def test_the_edge_distance_pass_walks_regions_whole(output_dir):
+    """The Edge Distance pass needs d_real itself, not a line's intensity:
+    with it the resolve walks the region (no region-lines pass)."""
+    scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    _subdivided(cube, 3)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    scene.view_layers[0].solidwire.use_pass_edge_distance = True
+    passes = scenes.render_multilayer_exr(scene, output_dir / "regions_edge_distance.exr")
+    ref = reference.render_reference(scene)
+    distance = exr.exr_pass(passes, scene.view_layers[0].name, "Edge Distance", "X")[..., 0]
+    covered = (ref.face >= 0) & ~ref.on_silhouette
+    # Exact within a line's reach (h + 2s), where lines are drawn; beyond
+    # it no edge can change a pixel, and the pass says "at least that far".
+    reach = 0.5 * 1.5 + 2.0 * 1.0
+    near = covered & (ref.d_real <= reach)
+    assert near.sum() > 200 and (covered & ~near).sum() > 200
+    assert np.abs(distance[near] - ref.d_real[near]).max() <= 2e-3
+    assert (distance[covered & ~near] >= reach - 2e-3).all()
+    assert "region_line_entries" not in solidwire_addon.stats()
