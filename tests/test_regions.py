@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import bmesh
+import bpy
 import numpy as np
 import pytest
 
@@ -56,11 +57,11 @@ def test_faces_smaller_than_a_pixel(output_dir):
     _assert_region_lines_drawn()
 
 
-@pytest.mark.parametrize("level", [2, 4])
-def test_an_ngon_cage_keeps_its_whole_outline(level, output_dir):
+@pytest.mark.parametrize("level, diagonals", [(2, "SOLID"), (4, "HIDDEN")])
+def test_an_ngon_cage_keeps_its_whole_outline(level, diagonals, output_dir):
     """A cylinder's 16-gon caps under subdivision: each cap is one region of
     16 * 2^level drawn edges around a fan of child faces."""
-    scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5, diagonal_mode="SOLID")
+    scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5, diagonal_mode=diagonals)
     tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
         bm, cap_ends=True, cap_tris=False, segments=16, radius1=1.0, radius2=1.0, depth=1.6))
     _subdivided(tube, level)
@@ -90,6 +91,27 @@ def test_the_angle_threshold_on_a_large_creased_region(output_dir):
     ref = reference.render_reference(scene)
     every_edge = reference.render_reference(scene, settings=reference.SettingsWith(scene.solidwire, edge_angle=0.0))
     assert ref.intensity.sum() < 0.25 * every_edge.intensity.sum()
+
+
+def _grid_with_ngon(bm):
+    bmesh.ops.create_grid(bm, x_segments=8, y_segments=8, size=2.0)
+    block = [f for f in bm.faces if all(abs(v.co.x) < 0.6 and abs(v.co.y) < 0.6 for v in f.verts)]
+    bmesh.ops.dissolve_faces(bm, faces=block)
+
+
+@pytest.mark.parametrize("diagonals", ["SOLID", "DASHED"])
+def test_an_ngon_inside_a_region_keeps_its_own_diagonals(diagonals, output_dir):
+    """A flat grid with an n-gon in it is one region under the angle
+    threshold; the n-gon's diagonals are its own (image model §3.4), walked
+    at the head of its block while the region's lines come from their pass."""
+    scene = scenes.empty_scene(200, 150, edge_angle=math.radians(5.0), thickness=1.5, diagonal_mode=diagonals)
+    scenes.mesh_object(scene, "Holey", _grid_with_ngon, rotation=(0.4, 0.0, 0.3))
+    scenes.add_camera(scene, location=(0.5, -3.0, 2.6), target=(0, 0, 0))
+    report = accuracy.measure(scene, f"regions_ngon_in_region_{diagonals.lower()}", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+    ref = reference.render_reference(scene)
+    assert (ref.intensity > 0.5).sum() > 50  # the outline and the n-gon's diagonals
 
 
 @pytest.mark.parametrize("case", ["cage", "angle"])
@@ -138,3 +160,36 @@ def test_the_edge_distance_pass_walks_regions_whole(output_dir):
     assert np.abs(distance[near] - ref.d_real[near]).max() <= 2e-3
     assert (distance[covered & ~near] >= reach - 2e-3).all()
     assert "region_line_entries" not in solidwire_addon.stats()
+
+
+@pytest.mark.parametrize("look", [dict(), dict(use_sharp_edges=True, sharp_pattern="DASHED", sharp_thickness=3.0),
+                                  dict(use_hidden_lines=True)])
+def test_the_overlay_draws_region_lines_as_the_render_does(look, output_dir):
+    """The viewport overlay draws the same region lines over the viewport's
+    own depth, compared with the engine's image as the overlay tests do."""
+    from solidwire_addon.blender import engine
+    from solidwire_addon.blender.views import camera_view
+    from tests.test_overlay import FakeViewport, silhouette_mask
+
+    width, height = 200, 150
+    scene = scenes.empty_scene(width, height, use_cage_edges=True, thickness=1.5, **look)
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    for edge in cube.data.edges[:4]:
+        edge.use_edge_sharp = True
+    _subdivided(cube, 3)
+    tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
+        bm, cap_ends=True, cap_tris=False, segments=12, radius1=0.6, radius2=0.6, depth=1.0), location=(1.6, 0.4, 0))
+    _subdivided(tube, 2)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0.5, 0, 0))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    rgba_engine, depth_engine = engine.render_scene(depsgraph, (width, height))
+    view = camera_view(scene, depsgraph, (width, height))
+    viewport = FakeViewport(width, height)
+    viewport.depth_pass(depsgraph, view, [cube, tube])
+    stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
+    assert stats.get("region_line_entries", 0) > 0
+    diff = np.abs(viewport.rgba()[..., 3] - rgba_engine[..., 3])
+    off = ~silhouette_mask(depth_engine)
+    assert rgba_engine[..., 3].max() > 0.9
+    assert np.percentile(diff[off], 99.9) <= 2.0 / 255.0 + 1e-9
+    assert diff[off].max() <= 0.1

@@ -202,24 +202,52 @@ def _deferred_surface(targets, items, view: View, settings, aovs: bool, surface_
         gpu.state.depth_mask_set(False)
     # The lines of multi-face regions as quads over the record, so that no
     # pixel walks a region's edges (docs/image_model.md §2.6). The Edge
-    # Distance pass needs d beyond a line's reach, so with the render
-    # passes' outputs the resolve walks the regions instead; a pass with
-    # the wire switched off needs no lines.
+    # Distance pass needs d itself, so with the render passes' outputs the
+    # resolve walks the regions instead; a pass with the wire switched off
+    # needs no lines.
     lines = None
-    if not aovs and surface_args["show_wire"] and any(item.mesh.region_line_count for item in items):
-        framebuffer = targets.region_lines_framebuffer()
-        with framebuffer.bind():
-            _clear(framebuffer, width, height)
-            draw_mod.draw(items, view, settings, stage=draw_mod.LINES, visibility=targets.visible, **surface_args)
-            gpu.state.depth_test_set("NONE")
-            gpu.state.depth_mask_set(False)
-        lines = targets.lines
-        stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
+    if not aovs and surface_args["show_wire"] and _has_region_lines(items):
+        lines = _draw_region_lines(targets, items, view, settings, surface_args, stats)
     with targets.resolve_framebuffer(aovs=aovs).bind():
         gpu.state.viewport_set(0, 0, width, height)
         draw_mod.draw(items, view, settings, stage=draw_mod.RESOLVE, visibility=targets.visible,
                       write_view_depth=True, region_lines=lines, **surface_args)
     return stats
+
+
+def _has_region_lines(items) -> bool:
+    return any(item.mesh.region_line_count for item in items)
+
+
+def _draw_region_lines(targets, items, view: View, settings, draw_args: dict, stats):
+    """The region-lines pass over ``targets.visible`` (the visibility
+    record of ``items``, numbered as draw() numbers them): the strongest
+    line per pixel into ``targets.lines``, which it returns."""
+    framebuffer = targets.region_lines_framebuffer()
+    with framebuffer.bind():
+        _clear(framebuffer, view.width, view.height)
+        draw_mod.draw(items, view, settings, stage=draw_mod.LINES, visibility=targets.visible, **draw_args)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+    stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
+    return targets.lines
+
+
+def _overlay_region_lines(items, view: View, settings, stats):
+    """The viewport overlay's region lines: a visibility record of our own
+    surfaces at the region's size (own depth: Blender's depth buffer cannot
+    be read back here), then the region-lines pass over it. The overlay's
+    surface pass reads the result where its depth test lets a region's
+    triangle through, which is where the record has it: our own depth
+    pre-pass makes our nearest surface the only one that passes."""
+    targets = targets_for(view.width, view.height)
+    framebuffer = targets.visibility_framebuffer()
+    with framebuffer.bind():
+        _clear(framebuffer, view.width, view.height)
+        draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY, linear_depth=True)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+    return _draw_region_lines(targets, items, view, settings, {"linear_depth": True}, stats)
 
 
 def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:
@@ -291,6 +319,15 @@ def draw_over_viewport(
     # too: with the LUT its variant, and so its compiled program, is the
     # surface pass's).
     options = {"display": display} if clip_planes is None else {"clip_planes": clip_planes, "display": display}
+    line_stats = draw_mod.DrawStats()
+    if clip_planes is None and _has_region_lines(items):
+        # (Inside a clipping region the record would keep clipped-away
+        # surfaces: there the regions are walked.)
+        saved_viewport = gpu.state.viewport_get()
+        try:
+            options["region_lines"] = _overlay_region_lines(items, view, settings, line_stats)
+        finally:
+            gpu.state.viewport_set(*saved_viewport)
     try:
         if not scene_depth:
             gpu.state.depth_mask_set(True)
@@ -309,7 +346,8 @@ def draw_over_viewport(
                                               show_wire=step.show_wire, **options)
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
-                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias, **options)
+                walk = {name: value for name, value in options.items() if name != "region_lines"}
+                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias, **walk)
             elif step.kind == WIRE:
                 stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **options)
             elif step.kind == SILHOUETTES:
@@ -319,4 +357,6 @@ def draw_over_viewport(
         gpu.state.blend_set(saved_blend)
         gpu.state.depth_test_set(saved_depth_test)
         gpu.state.depth_mask_set(saved_depth_mask)
-    return stats if stats is not None else draw_mod.DrawStats()
+    stats = stats if stats is not None else draw_mod.DrawStats()
+    stats.extra.update(line_stats.extra)
+    return stats

@@ -121,7 +121,8 @@ class ShaderVariant:
     # pass that draws the lines of multi-face regions as screen-space quads
     # over the visibility record (it reads only thickness_mode,
     # edge_classes, density_fade and instanced); ``region_lines`` is a
-    # resolve that reads that pass's image for those regions' triangles.
+    # surface pass (resolve, or the overlay's direct draw) that reads that
+    # pass's image for those regions' triangles.
     region_lines_pass: bool = False
     region_lines: bool = False
 
@@ -303,11 +304,11 @@ def _create_info(variant: ShaderVariant):
         info.sampler(RESOLVE_VISIBILITY_SLOT, "FLOAT_2D", "visibility")
         info.sampler(RESOLVE_FLAGS_SLOT, "FLOAT_2D", "triangle_flag_table")
         info.define("RESOLVE_PASS", "1")
-        if variant.region_lines:
-            info.sampler(REGION_LINE_IMAGE_SLOT, "FLOAT_2D", "region_line_image")
-            info.define("REGION_LINE_IMAGE", "1")
     else:
         info.vertex_in(0, "INT", "edge_flags")
+    if variant.region_lines:
+        info.sampler(REGION_LINE_IMAGE_SLOT, "FLOAT_2D", "region_line_image")
+        info.define("REGION_LINE_IMAGE", "1")
     output_and_feature_defines(info, variant)
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     if variant.in_front:

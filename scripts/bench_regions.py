@@ -1,0 +1,185 @@
+"""What the cage look and the other edge selections cost against drawing
+every edge of the same mesh: F12 (a warm render), the viewport overlay (a
+static redraw and a redraw after one vertex moved) and the first render's
+extraction, for Suzanne under a Subdivision Surface modifier at levels 2-5;
+then the angle threshold and edge classes against a plain frame.
+
+    .venv/bin/python -m scripts.bench_regions [--size 1280x720] [--repeats 3] [--levels 2 3 4 5]
+
+Every ratio is taken within one process, rounds alternating between the two
+looks so that a change in machine load hits both alike; the table gives the
+best of the rounds (Markdown, for the README).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+
+import bpy
+import gpu
+
+import solidwire_addon
+from solidwire_addon.blender import engine, overlay, runtime
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.blender.views import camera_view
+from tests.support import scenes
+
+PLAIN = dict(use_fill=True, use_cage_edges=False, edge_angle=0.0, use_density_fade=False, diagonal_mode="HIDDEN",
+             use_boundary_edges=False, use_sharp_edges=False, use_seam_edges=False, use_crease_edges=False,
+             use_freestyle_edges=False)
+
+
+def build_scene(size, level: int):
+    scene = scenes.empty_scene(*size, transparent=False)
+    monkey = scenes.monkey(scene, rotation=(0.0, 0.0, 0.5))
+    for edge in monkey.data.edges[:80]:  # marked edges for the edge classes
+        edge.use_seam = edge.index % 2 == 0
+        edge.use_edge_sharp = edge.index % 2 == 1
+    modifier = monkey.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = modifier.render_levels = level
+    scenes.add_camera(scene, location=(1.2, -3.4, 1.0), target=(0.0, 0.0, 0.0), lens=45.0)
+    return scene, monkey
+
+
+def apply(scene, look: dict) -> None:
+    for name, value in {**PLAIN, **look}.items():
+        setattr(scene.solidwire, name, value)
+
+
+def f12_ms(scene, size) -> float:
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    start = time.perf_counter()
+    engine.render_scene(depsgraph, size)
+    return (time.perf_counter() - start) * 1000.0
+
+
+class Viewport:
+    """An offscreen standing in for a 3D viewport (colour + depth), drawn
+    into by the overlay as its POST_VIEW handler would."""
+
+    def __init__(self, size):
+        self.size = size
+        self.offscreen = gpu.types.GPUOffScreen(*size, format="RGBA8")
+
+    def redraw_ms(self, scene) -> float:
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        view = camera_view(scene, depsgraph, self.size)
+        start = time.perf_counter()
+        with self.offscreen.bind():
+            fb = gpu.state.active_framebuffer_get()
+            fb.clear(color=(0.2, 0.2, 0.2, 1.0), depth=1.0)
+            gpu.state.viewport_set(0, 0, *self.size)
+            overlay.draw_scene_overlay(depsgraph, view, scene.solidwire.snapshot())
+            fb.read_color(0, 0, 1, 1, 4, 0, "UBYTE")  # waits for the GPU
+        return (time.perf_counter() - start) * 1000.0
+
+
+def nudge(obj, step: int) -> None:
+    vertex = obj.data.vertices[step % len(obj.data.vertices)]
+    vertex.co.z += 1e-3 * (1 if step % 2 else -1)
+    obj.data.update()
+
+
+def first_extract_ms(scene, size) -> float:
+    runtime.mesh_cache.clear()
+    engine.render_scene(bpy.context.evaluated_depsgraph_get(), size)
+    return solidwire_addon.stats()["ms_extract"]
+
+
+def compare(scene, monkey, size, looks, repeats: int, viewport: Viewport | None):
+    """{look: {measure: best ms}} over alternating rounds."""
+    best: dict = {name: {} for name in looks}
+
+    def keep(name, key, value):
+        best[name][key] = min(best[name].get(key, math.inf), value)
+
+    for name, look in looks.items():  # compile every variant, fill the cache
+        apply(scene, look)
+        f12_ms(scene, size)
+        if viewport:
+            viewport.redraw_ms(scene)
+    for round_ in range(repeats):
+        for name, look in looks.items():
+            apply(scene, look)
+            f12_ms(scene, size)
+            keep(name, "f12", f12_ms(scene, size))
+            if viewport:
+                viewport.redraw_ms(scene)
+                keep(name, "redraw", viewport.redraw_ms(scene))
+                nudge(monkey, round_)
+                keep(name, "edit", viewport.redraw_ms(scene))
+            keep(name, "extract", first_extract_ms(scene, size))
+    return best
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", default="1280x720")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--levels", type=int, nargs="+", default=[2, 3, 4, 5])
+    args = parser.parse_args(argv)
+    size = tuple(int(v) for v in args.size.split("x"))
+    solidwire_addon.register()
+    try:
+        ensure_gpu()
+        viewport = Viewport(size)
+        print(f"{size[0]}x{size[1]}, best of {args.repeats} alternating rounds; ratio = cage / every edge\n")
+        print("| level | triangles | F12 every edge (ms) | F12 cage | ratio | overlay redraw every edge | cage | ratio |"
+              " edit redraw every edge | cage | ratio | first extraction every edge | cage | ratio |")
+        print("|---:|---:|" + "---:|" * 12)
+        for level in args.levels:
+            bpy.ops.wm.read_factory_settings(use_empty=True)
+            solidwire_addon.register()
+            scene, monkey = build_scene(size, level)
+            triangles = len(monkey.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
+            best = compare(scene, monkey, size, {"all": {}, "cage": dict(use_cage_edges=True)}, args.repeats,
+                           viewport)
+            cells = []
+            for key in ("f12", "redraw", "edit", "extract"):
+                a, c = best["all"][key], best["cage"][key]
+                cells += [f"{a:.0f}", f"{c:.0f}", f"{c / a:.2f}x"]
+            print(f"| {level} | {triangles:,} | " + " | ".join(cells) + " |", flush=True)
+
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        solidwire_addon.register()
+        scene, monkey = build_scene(size, 2)
+        looks = {"plain": {}, "angle": dict(edge_angle=math.radians(20.0)),
+                 "classes": dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True),
+                 "angle + classes": dict(edge_angle=math.radians(20.0), use_sharp_edges=True, use_seam_edges=True)}
+        modifier = monkey.modifiers[0]
+        modifier.show_viewport = modifier.show_render = False
+        bpy.ops.object.select_all(action="DESELECT")
+        apply_subdivision(monkey, 3)
+        best = compare(scene, monkey, size, looks, args.repeats, viewport)
+        print("\nSuzanne subdivided 3 times and applied "
+              f"({len(monkey.data.loop_triangles):,} triangles); ratio against the plain frame\n")
+        print("| look | F12 (ms) | ratio | overlay redraw (ms) | ratio |")
+        print("|---|---:|---:|---:|---:|")
+        for name in looks:
+            f, r = best[name]["f12"], best[name]["redraw"]
+            print(f"| {name} | {f:.0f} | {f / best['plain']['f12']:.2f}x | {r:.0f} | {r / best['plain']['redraw']:.2f}x |")
+    finally:
+        solidwire_addon.unregister()
+    return 0
+
+
+def apply_subdivision(obj, levels: int) -> None:
+    """Subdivide the mesh itself (no modifier): a dense mesh whose regions
+    come from the angle threshold alone."""
+    import bmesh
+
+    mesh = obj.data
+    bm = bmesh.new()
+    bm.from_mesh(mesh)
+    for _ in range(levels):
+        bmesh.ops.subdivide_edges(bm, edges=bm.edges[:], cuts=1, use_grid_fill=True, smooth=1.0)
+    bm.to_mesh(mesh)
+    bm.free()
+    mesh.calc_loop_triangles()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
