@@ -1,5 +1,5 @@
 """Error of the exact path against the float64 reference (SPEC 1.5) on the
-core test scenes, as a Markdown table for the README.
+core test scenes, as a Markdown table for the manual (docs/dev/accuracy.md).
 
     .venv/bin/python -m scripts.accuracy_report [--size 200x150] [--edges]
 

@@ -1,5 +1,5 @@
 """Render which edges are drawn on one subdivided model and write a sheet for
-the README (docs/edges.png): top row every evaluated edge, cage edges (the
+the manual (docs/edges.png): top row every evaluated edge, cage edges (the
 default), cage edges with an edge angle; bottom row edge classes (boundary,
 sharp, seam), density fade on a dense distant grid, both together.
 

@@ -5,7 +5,7 @@ a frame that finds the mesh cache empty (the corner table included).
 
     .venv/bin/python -m scripts.look_cost [--repeats 5]
 
-Prints a Markdown table (median milliseconds) for the README; the render
+Prints a Markdown table (median milliseconds) for the manual (docs/dev/benchmarks.md); the render
 column is the deferred surface pass, with the direct one beside it.
 """
 

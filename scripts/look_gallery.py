@@ -1,6 +1,6 @@
 """Render the fill shadings (FLAT, STUDIO, MATCAP) and the colour sources
 (object, material, random) on one small scene and write a sheet for the
-README (docs/looks.png): top row Flat, Studio, MatCap; bottom row fill from
+manual (docs/looks.png): top row Flat, Studio, MatCap; bottom row fill from
 Object colour, from Material colour, Random per object (wire too).
 
     .venv/bin/python -m scripts.look_gallery [-o docs/looks.png]

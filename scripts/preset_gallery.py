@@ -126,7 +126,7 @@ def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS, cell=CEL
     for c in range(1, columns):  # thin separators between columns
         draw.line([(c * width, 0), (c * width, image.height)], fill=LABEL_BACKGROUND, width=2)
     # An adaptive 256-colour palette keeps the anti-aliased lines smooth and
-    # the file small enough for a README.
+    # the file small enough for the README and the manual.
     image.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE).save(path, optimize=True)
 
 

@@ -1,4 +1,4 @@
-"""Gallery images of the wire pass over a shaded Cycles render (README,
+"""Gallery images of the wire pass over a shaded Cycles render (docs/user/wire-over.md,
 "Wire over EEVEE / Cycles renders"):
 
     .venv/bin/python -m scripts.wire_over_gallery [--out docs] [--samples 48]

@@ -189,3 +189,19 @@ def test_every_table_is_laid_out_as_fetch_texel_reads_it():
         assert width == cache.TABLE_WIDTH or height == 1
         last = max(count, 1) - 1
         assert (last & (width - 1) if width == cache.TABLE_WIDTH else last) < width and (last >> shift) < height
+
+
+MODULE_MAP = ROOT / "docs" / "dev" / "architecture.md"
+
+
+def test_the_module_map_lists_every_module():
+    """docs/dev/architecture.md is the one module map (the package docstrings
+    point to it): every module under solidwire_addon/ has a row there, named
+    by its path inside the package (``core/passes.py``), and the map names no
+    module that is gone."""
+    text = MODULE_MAP.read_text(encoding="utf-8")
+    modules = {p.relative_to(PACKAGE).as_posix() for p in PACKAGE.rglob("*.py") if p.name != "__init__.py"}
+    missing = sorted(m for m in modules if f"`{m}`" not in text)
+    assert not missing, f"modules missing from {MODULE_MAP.relative_to(ROOT)}: {missing}"
+    named = set(re.findall(r"`((?:core|blender)/\w+\.py)`", text))
+    assert not named - modules, f"the module map names modules that do not exist: {sorted(named - modules)}"

@@ -4,7 +4,7 @@ Flamenco runs job scripts inside its Manager; here Node runs them instead,
 through tests/flamenco_harness.js, which gives the script stand-ins for
 Flamenco's ``author`` API and records the tasks and commands it authors. The
 tests check those against the command lines the job type promises (see the
-script's header and README.md ("Render farm")). Nothing here needs Blender or the
+script's header and docs/user/render-farm.md). Nothing here needs Blender or the
 add-on.
 """
 

@@ -1,13 +1,13 @@
 """The viewport overlay in every shading mode and viewport state, headless.
 
-Each state of the README table ("The viewport overlay", states) is turned
+Each state of the table in docs/user/overlay.md ("Viewport states") is turned
 into the plain inputs the draw handler reads (``core/overlay_state.py``:
 ``ViewportState`` / ``ObjectState``), planned by the same pure function the
 handler calls, and drawn by ``blender/overlay.py::draw_scene_overlay`` (and so
 ``core/passes.py::draw_over_viewport``) into the offscreen sRGB target of
 tests/test_overlay.py, with or without a Blender-like scene depth. The image
 is checked against the float64 reference (tests/support/reference.py) or
-against the rule the README states for that state.
+against the rule that table states for that state.
 """
 
 from __future__ import annotations

@@ -346,7 +346,7 @@ def main(argv=None):
     parser.add_argument("--ref-row-step", type=int, default=None, help="reference on every N-th window row")
     parser.add_argument("--no-peers", action="store_true", help="skip Workbench and Freestyle")
     parser.add_argument("--out", default=str(ROOT / "out" / "bench"))
-    parser.add_argument("--docs", metavar="DIR", help="also copy the two pictures there (e.g. docs/, for the README)")
+    parser.add_argument("--docs", metavar="DIR", help="also copy the two pictures there (e.g. docs/, for the manual)")
     parser.add_argument("--engines", action="append", metavar="WxH",
                         help="also time F12 against Blender's own engines at this size, with the SolidWire frame "
                         "stage by stage (scripts/bench_engines.py; repeatable)")

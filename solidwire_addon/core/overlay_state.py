@@ -6,7 +6,7 @@ The draw handler (``blender/overlay.py``) only reads ``bpy.context`` into a
 decision is made here, so tests can call it with any state a real window
 could be in (X-ray, Rendered shading, clipping region, HiDPI, Edit Mode...).
 
-Rules (README "Viewport overlay", table of states):
+Rules (docs/user/overlay.md, "Viewport states"):
 
 * Nothing is drawn when this viewport's SolidWire toggle is off or the
   viewport's own Overlays switch is off.
