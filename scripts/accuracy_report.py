@@ -21,11 +21,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
 
-from tests.support import accuracy  # noqa: E402
-from tests.support import scenes  # noqa: E402
-import solidwire_addon  # noqa: E402
-from tests import test_edge_selection as selection  # noqa: E402
-from tests import test_render_reference as cases  # noqa: E402
+import solidwire_addon
+from tests import test_edge_selection as selection
+from tests import test_render_reference as cases
+from tests.support import (
+    accuracy,
+    scenes,
+)
 
 # The edge-selection looks: (name, settings, scene builder).
 EDGE_CASES = (

@@ -20,14 +20,13 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
+import bpy
+import numpy as np
 
-from tests.support import scenes  # noqa: E402  (tests/support/scenes.py: scene builders shared with the tests)
-import solidwire_addon  # noqa: E402
-from solidwire_addon.blender import engine
-from solidwire_addon.blender import presets
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
+import solidwire_addon
+from solidwire_addon.blender import engine, presets
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from tests.support import scenes
 
 CELL = (460, 345)
 COLUMNS = 3

@@ -16,11 +16,11 @@ from pathlib import Path
 # Must be set before bpy is imported.
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
 
-import bpy  # noqa: E402,F401
-import pytest  # noqa: E402
+import bpy  # noqa: F401  (first, once BLENDER_USER_RESOURCES is set)
+import pytest
 
-import solidwire_addon  # noqa: E402
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
+import solidwire_addon
+from solidwire_addon.blender.gpu_context import ensure_gpu
 
 ROOT = Path(__file__).resolve().parent.parent
 OUTPUT_DIR = ROOT / "tests" / "output"

@@ -126,7 +126,7 @@ def test_no_private_name_is_used_across_modules():
 
 def test_the_parameter_block_is_the_schemas():
     glsl = schema.param_block_glsl()
-    members = re.findall(r"^\s*(vec4|float) (\w+);", glsl, re.M)
+    members = re.findall(r"^\s*(vec4|float) (\w+);", glsl, re.MULTILINE)
     assert [name for _kind, name in members] == [m.glsl for m in schema.PARAM_BLOCK]
     floats = sum(4 if kind == "vec4" else 1 for kind, _name in members)
     assert floats == schema.PARAM_FLOATS and floats % 4 == 0  # std140: whole vec4s

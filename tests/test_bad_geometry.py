@@ -16,12 +16,8 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import robustness
-from tests.support import scenes
-from solidwire_addon.core import extract
-from solidwire_addon.core import log
+from solidwire_addon.core import extract, log
+from tests.support import accuracy, reference, robustness, scenes
 
 W, H = 96, 64
 NAN, INF = math.nan, math.inf

@@ -17,9 +17,9 @@ import bpy
 import numpy as np
 import pytest
 
+from solidwire_addon.blender import composite
 from solidwire_addon.core import compat
 from tests.support import scenes
-from solidwire_addon.blender import composite
 
 ROOT = Path(__file__).resolve().parent.parent
 W, H = 96, 72
@@ -418,7 +418,7 @@ def test_sidebar_menu_lists_the_engines():
 
 def _cli(*args):
     return subprocess.run([sys.executable, str(ROOT / "scripts" / "render.py"), *args],
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=300, check=False)
 
 
 def test_cli_over(tmp_path):

@@ -16,7 +16,7 @@ import math
 import bpy
 import pytest
 
-from tests.support import accuracy, reference, scenes
+from tests.support import accuracy, scenes
 
 DISTANCE = 25.0
 GAP = 1e-4 * DISTANCE

@@ -9,8 +9,8 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.support import scenes
 from solidwire_addon.core import extract
+from tests.support import scenes
 
 FIELDS = ("positions", "centre", "triangles", "edge_flags", "triangle_polygons", "bounds_min", "bounds_max", "ngon_corners")
 

@@ -48,6 +48,7 @@ def _harness(action: str, job: dict | None = None) -> dict:
         [NODE, str(HARNESS), str(SCRIPT), action],
         input=json.dumps(job) if job is not None else "",
         capture_output=True, text=True, timeout=TIMEOUT_S, env=env,
+        check=False,
     )
     assert proc.returncode == 0, f"harness failed ({proc.returncode}):\n{proc.stderr}"
     return json.loads(proc.stdout)
@@ -93,12 +94,12 @@ def frame_runs(task: dict) -> list[tuple[int, int]]:
 
 
 def test_script_parses():
-    proc = subprocess.run([NODE, "--check", str(SCRIPT)], capture_output=True, text=True, timeout=TIMEOUT_S)
+    proc = subprocess.run([NODE, "--check", str(SCRIPT)], capture_output=True, text=True, timeout=TIMEOUT_S, check=False)
     assert proc.returncode == 0, proc.stderr
 
 
 def test_harness_parses():
-    proc = subprocess.run([NODE, "--check", str(HARNESS)], capture_output=True, text=True, timeout=TIMEOUT_S)
+    proc = subprocess.run([NODE, "--check", str(HARNESS)], capture_output=True, text=True, timeout=TIMEOUT_S, check=False)
     assert proc.returncode == 0, proc.stderr
 
 

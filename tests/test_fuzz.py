@@ -18,11 +18,8 @@ import numpy as np
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import robustness
-from tests.support import scenes
 from solidwire_addon.core import log
+from tests.support import accuracy, reference, robustness, scenes
 
 W, H = 48, 36
 LONG_RUN = int(os.environ.get("SOLIDWIRE_FUZZ_EXAMPLES", "0") or 0)

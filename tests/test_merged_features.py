@@ -54,7 +54,7 @@ def test_override_fill_is_shaded_and_passes_are_written():
     plain.pass_index, styled.pass_index = 3, 7
     depsgraph = bpy.context.evaluated_depsgraph_get()
     extra: dict = {}
-    rgba, depth = engine.render_scene(depsgraph, (WIDTH, HEIGHT), extra_passes=("IndexOB", "Normal"),
+    rgba, _depth = engine.render_scene(depsgraph, (WIDTH, HEIGHT), extra_passes=("IndexOB", "Normal"),
                                       extra_out=extra)
     index = extra["IndexOB"][..., 0]
     on_plain, on_styled = index == 3, index == 7

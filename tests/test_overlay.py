@@ -16,18 +16,14 @@ import numpy as np
 import pytest
 from mathutils import Matrix
 
-from tests.support import scenes
-from solidwire_addon.core import draw
-from solidwire_addon.blender import engine
-from solidwire_addon.core import log
-from solidwire_addon.blender import overlay
-from solidwire_addon.blender import runtime
+from solidwire_addon.blender import engine, overlay, runtime
 from solidwire_addon.blender.gather import gather
 from solidwire_addon.blender.gpu_context import ensure_gpu
-from solidwire_addon.core.targets import BACKGROUND_DEPTH
 from solidwire_addon.blender.views import camera_view
-from solidwire_addon.core import passes
+from solidwire_addon.core import draw, log, passes
+from solidwire_addon.core.targets import BACKGROUND_DEPTH
 from solidwire_addon.core.view import View
+from tests.support import scenes
 
 WIDTH, HEIGHT = 200, 150
 

@@ -18,9 +18,8 @@ import os
 import bpy
 import pytest
 
-from tests.support import robustness
-from tests.support import scenes
 import solidwire_addon
+from tests.support import robustness, scenes
 
 FRAMES = int(os.environ.get("SOLIDWIRE_SOAK_FRAMES", "1000"))
 WARMUP = min(100, FRAMES // 5)  # allocator and caches settle first

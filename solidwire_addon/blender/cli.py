@@ -131,8 +131,6 @@ def _frame_range(text: str) -> tuple[int, int]:
     return first, last
 
 
-
-
 def _frame_list(text: str) -> list[int]:
     """Blender's -f syntax: 'N', 'A..B', or a comma list of those."""
     frames: list[int] = []
@@ -256,8 +254,6 @@ def open_blend(path: Path) -> None:
         raise UsageError(f"cannot open '{path}': {_one_line(exc)}") from None
 
 
-
-
 def load_scene(args, build_demo=None):
     """Open what is to be rendered and return its scene. ``build_demo``
     (scripts/render.py --demo) builds a scene instead of opening a file."""
@@ -359,7 +355,6 @@ def apply_options(scene, args) -> None:
         render.resolution_y = _checked_rna(render, "resolution_y", args.height, "--height")
     if args.percentage is not None:
         render.resolution_percentage = _checked_rna(render, "resolution_percentage", args.percentage, "--percentage")
-
 
 
 def frames_to_render(scene, args) -> list[int]:
@@ -592,7 +587,7 @@ def main(arguments: list[str], **kwargs) -> int:
     except RenderFailed as exc:
         print(f"solidwire: error: render failed: {exc}", file=sys.stderr, flush=True)
         return EXIT_FAILURE
-    except Exception:  # a bug: keep the traceback, but never exit 0
+    except Exception:  # noqa: BLE001  (a bug: keep the traceback, but never exit 0)
         traceback.print_exc()
         print("solidwire: error: unexpected failure (traceback above)", file=sys.stderr, flush=True)
         return EXIT_FAILURE

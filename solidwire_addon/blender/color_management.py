@@ -268,7 +268,7 @@ def _build_requested():
             built = _build_and_store(scene, key) is not None or built
     if built:
         runtime.redraw_viewports()
-    return None  # once
+    # once
 
 
 def release() -> None:

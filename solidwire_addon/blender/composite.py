@@ -33,8 +33,8 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-import sys
 import shutil
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,7 +44,6 @@ import numpy as np
 from ..core import compat, output
 from ..core.exr import ExrError, exr_pass, read_exr
 from ..core.ids import ENGINE_ID
-
 
 # Friendly and older names of Blender's engines (EEVEE was BLENDER_EEVEE_NEXT
 # in Blender 4.2 to 4.4 and is BLENDER_EEVEE again from 5.0).

@@ -16,9 +16,9 @@ import numpy as np
 
 from ..core import compositing, passes, shaders
 from ..core.ids import ENGINE_ID
+from ..core.view import DrawStats, View
 from . import gather, runtime
 from .gpu_context import ensure_gpu, is_init_scene
-from ..core.view import DrawStats, View
 from .views import NoCameraError, camera_view, render_size
 
 
@@ -219,7 +219,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
                 self._render_frame(depsgraph, (width, height), region, layer_name)
         except NoCameraError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
-        except Exception as exc:  # never take the render (or Blender) down
+        except Exception as exc:  # noqa: BLE001  (never take the render, or Blender, down)
             self.report({"ERROR"}, f"SolidWire render failed: {type(exc).__name__}: {exc}")
         else:
             self.update_progress(1.0)
@@ -261,7 +261,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
                 if index != -1:
                     write_pass(layer.passes[index], values)
             cancel = False
-        except Exception as exc:
+        except Exception as exc:  # noqa: BLE001  (any failure to fill the result is one render error)
             raise RuntimeError(f"could not write the result: {type(exc).__name__}: {exc}") from None
         finally:
             self.end_result(result, cancel=cancel)

@@ -154,9 +154,14 @@ def item_source(obj) -> ItemSource:
     return ItemSource(obj.name, tuple(float(c) for c in obj.color[:3]), tuple(materials))
 
 
+# The default edge selection (every option off); Selection is frozen, so one
+# instance serves every call.
+NO_SELECTION = edge_select.Selection()
+
+
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
            should_stop=None, corners: bool = False, colors: bool = False,
-           edges: edge_select.Selection = edge_select.Selection(),
+           edges: edge_select.Selection = NO_SELECTION,
            object_settings: ObjectSettings | None = None, materials: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
@@ -400,7 +405,7 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
 
 
 def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False,
-              edges: edge_select.Selection = edge_select.Selection(), render: bool = False):
+              edges: edge_select.Selection = NO_SELECTION, render: bool = False):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
     obj_orig = obj.original
     fast = None

@@ -121,9 +121,7 @@ def keep_object(plan: OverlayPlan, obj: ObjectState) -> bool:
         return False
     if plan.only_selected and not obj.selected:
         return False
-    if obj.in_edit_mode and not plan.draw_edit_mode:
-        return False
-    return True
+    return not (obj.in_edit_mode and not plan.draw_edit_mode)
 
 
 PIXEL_SETTINGS = tuple(s.name for s in schema.SETTINGS if s.kind == schema.FLOAT and s.subtype == "PIXEL" and s.in_snapshot)

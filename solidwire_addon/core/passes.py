@@ -22,9 +22,8 @@ from dataclasses import dataclass, replace
 import gpu
 import numpy as np
 
-from . import colors, compositing, edge_select, shaders
+from . import colors, compositing, edge_select, shaders, silhouettes
 from . import draw as draw_mod
-from . import silhouettes
 from .log import warn_once
 from .targets import BACKGROUND_DEPTH, read_texture, targets_for
 from .view import View
@@ -101,7 +100,6 @@ def render_passes(items, view: View, settings, *, cull: bool = True, extra_passe
     width, height = view.width, view.height
     targets = targets_for(width, height)
     steps = plan(settings)
-    stats = None
     surface = steps[0]
     stats = draw_surface(targets, items, view, surface.settings, show_wire=surface.show_wire, aovs=aovs, cull=cull)
     blended = [step for step in steps[1:] if step.kind in (HIDDEN, WIRE)]

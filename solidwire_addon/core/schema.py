@@ -21,8 +21,8 @@ This module imports nothing from Blender: it is plain data.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 # Where a setting lives in Blender: ``scene.solidwire``, ``object.solidwire``
 # or ``view_layer.solidwire``.
@@ -179,7 +179,7 @@ PATTERN_DUTY = {"SOLID": 1.0, "DOTTED": 0.25, "DASHED": 0.5}
 
 def edge_class_settings(name, label, what, color, width, pattern) -> tuple:
     """The four settings of one edge class: on/off, colour, width, pattern."""
-    active = lambda p, flag=f"use_{name}_edges": getattr(p, flag)  # noqa: E731
+    active = lambda p, flag=f"use_{name}_edges": getattr(p, flag)
     return (
         Setting(
             f"use_{name}_edges", BOOL, False, f"{label} Edges",
@@ -450,7 +450,7 @@ SETTINGS: tuple[Setting, ...] = (
 # Not part of the scene's snapshot, presets or command line: gather() reads
 # them per drawn instance. The override's three values share their names with
 # the scene settings they replace (scope tells them apart).
-_OVERRIDE_ACTIVE = lambda p: p.use_override  # noqa: E731
+_OVERRIDE_ACTIVE = lambda p: p.use_override
 OBJECT_SETTINGS: tuple[Setting, ...] = (
     Setting(
         "show_in_viewport", BOOL, True, "Show in Viewport",

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tests.support import reference
-from tests.support import scenes
+from tests.support import reference, scenes
 
 # Core thresholds of the exact path (issue 2 / SPEC 1.5).
 P999_LIMIT = 2.0 / 255.0

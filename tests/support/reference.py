@@ -36,11 +36,10 @@ Method:
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import bpy
-import warnings
-
 import numpy as np
 
 SILHOUETTE_OFFSET = 0.01  # px, SPEC 1.5
@@ -305,7 +304,7 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
     members: dict = {}
     for e in range(ne):
         members.setdefault(int(chain[e]), []).append(e)
-    for c, es in members.items():
+    for es in members.values():
         count: dict = {}
         for e in es:
             for v in ev[e]:
@@ -325,7 +324,7 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
             ca.append(chain_ends[e][0])
             cb.append(chain_ends[e][1])
     hidden = {(int(min(ev[e])), int(max(ev[e]))) for e in np.flatnonzero(~drawn)}
-    as_array = lambda x: np.array(x, np.int64)  # noqa: E731
+    as_array = lambda x: np.array(x, np.int64)
     return {"key": key, "owner": as_array(owner), "a": as_array(a), "b": as_array(b), "style": as_array(style),
             "chain_a": as_array(ca), "chain_b": as_array(cb), "hidden": hidden}
 
@@ -892,7 +891,7 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
         name = EDGE_CLASSES[style - 1] if style else None
         pattern = getattr(s, f"{name}_pattern") if name else "SOLID"
         style_ties = {}
-        d, along, index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
+        d, along, _index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
                                                   want_along=pattern != "SOLID", want_index=True, ties=style_ties)
         if pattern != "SOLID" and not use_density:
             tied |= style_ties["tied"]
@@ -1147,7 +1146,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         mode = s.diagonal_mode
         if mode != "HIDDEN":
             diag_ties = {}
-            d_diag, along, index = _min_distance_per_pixel(
+            d_diag, along, _index = _min_distance_per_pixel(
                 pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, want_along=(mode in ("DOTTED", "DASHED")),
                 want_index=True, ties=diag_ties,
             )

@@ -11,9 +11,9 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from tests.support import scenes
 from solidwire_addon.blender import overlay
 from solidwire_addon.blender.views import camera_view
+from tests.support import scenes
 
 # Opt-in suites (soak, large frames, compat): `SOLIDWIRE_SLOW=1 pytest ...`
 # or `pytest --run-slow` (see conftest.py); default CI skips them.
