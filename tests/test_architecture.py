@@ -205,3 +205,21 @@ def test_the_module_map_lists_every_module():
     assert not missing, f"modules missing from {MODULE_MAP.relative_to(ROOT)}: {missing}"
     named = set(re.findall(r"`((?:core|blender)/\w+\.py)`", text))
     assert not named - modules, f"the module map names modules that do not exist: {sorted(named - modules)}"
+
+
+def test_errors_are_made_one_line_by_one_function():
+    """core.log.one_line is the one formatter of an exception as one line:
+    its whitespace folded, its type's name when it has no text. No other
+    module folds an exception's text by hand, and none puts an exception's
+    raw text (which may span lines) after its type's name in a message."""
+    from solidwire_addon.core.log import one_line
+
+    assert one_line(OSError("cannot open\n  the file:\tdenied ")) == "cannot open the file: denied"
+    assert one_line(KeyError()) == "KeyError"
+    assert one_line(RuntimeError("  \n")) == "RuntimeError"
+    by_hand = re.compile(r"""["']\s["']\.join\(str\(\w+\)\.split\(\)\)|__name__\}: \{(exc|error|e)\}""")
+    for path in PACKAGE.rglob("*.py"):
+        if path.name == "log.py" and path.parent.name == "core":
+            continue
+        source = path.read_text(encoding="utf-8")
+        assert not by_hand.search(source), f"{path.relative_to(ROOT)} formats an error by hand: use core.log.one_line"

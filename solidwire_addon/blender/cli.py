@@ -37,6 +37,7 @@ import bpy
 
 from ..core import compat, output, schema
 from ..core.ids import ENGINE_ID, EXTENSION_ID
+from ..core.log import one_line
 from . import composite, ops, presets, runtime
 
 EXIT_USAGE = 2
@@ -251,7 +252,7 @@ def open_blend(path: Path) -> None:
     try:
         bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     except RuntimeError as exc:
-        raise UsageError(f"cannot open '{path}': {_one_line(exc)}") from None
+        raise UsageError(f"cannot open '{path}': {one_line(exc)}") from None
 
 
 def load_scene(args, build_demo=None):
@@ -458,10 +459,6 @@ def set_file_format(scene, path: Path, color_depth: str | None) -> None:
 # -- rendering -----------------------------------------------------------------
 
 
-def _one_line(exc: BaseException) -> str:
-    return " ".join(str(exc).split()) or type(exc).__name__
-
-
 def _seconds(value: float) -> str:
     return f"{value:.2f} s"
 
@@ -508,7 +505,7 @@ def render_frames(scene, paths: dict, args, over=None) -> None:
             else:
                 over(scene, path)
         except RuntimeError as exc:
-            raise RenderFailed(f"frame {frame}: {_one_line(exc)}") from None
+            raise RenderFailed(f"frame {frame}: {one_line(exc)}") from None
         seconds = time.perf_counter() - start
         if not path.is_file() or path.stat().st_size == 0:
             raise RenderFailed(f"frame {frame}: no image was written to '{path}'")

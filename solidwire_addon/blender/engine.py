@@ -16,6 +16,7 @@ import numpy as np
 
 from ..core import compositing, passes, shaders
 from ..core.ids import ENGINE_ID
+from ..core.log import one_line
 from ..core.view import DrawStats, View
 from . import gather, runtime
 from .gpu_context import ensure_gpu, is_init_scene
@@ -220,7 +221,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         except NoCameraError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
         except Exception as exc:  # noqa: BLE001  (never take the render, or Blender, down)
-            self.report({"ERROR"}, f"SolidWire render failed: {type(exc).__name__}: {exc}")
+            self.report({"ERROR"}, f"SolidWire render failed: {type(exc).__name__}: {one_line(exc)}")
         else:
             self.update_progress(1.0)
 
@@ -262,7 +263,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
                     write_pass(layer.passes[index], values)
             cancel = False
         except Exception as exc:  # noqa: BLE001  (any failure to fill the result is one render error)
-            raise RuntimeError(f"could not write the result: {type(exc).__name__}: {exc}") from None
+            raise RuntimeError(f"could not write the result: {type(exc).__name__}: {one_line(exc)}") from None
         finally:
             self.end_result(result, cancel=cancel)
 

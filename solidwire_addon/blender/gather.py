@@ -27,7 +27,7 @@ import numpy as np
 from ..core import edge_select, extract
 from ..core.cache import MeshCache
 from ..core.colors import ItemSource
-from ..core.log import warn_once
+from ..core.log import one_line, warn_once
 from ..core.view import DrawItem, Style, outside_frustum_many
 from . import cage, runtime
 
@@ -283,7 +283,7 @@ class _FrameGather:
                 try:
                     key, uids = self._key(obj, pointer, parent)
                 except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
-                    warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
+                    warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
                     key = None
                 if key is not None:
                     if self.view_projection is not None and key not in self.cache:
@@ -316,7 +316,7 @@ class _FrameGather:
             mesh, ms = _mesh_for(obj, data, pointer, key, uids, self.cache, self.trust, self.versions,
                                  self.corners, self._edges_for(obj)[0], self.mode == "RENDER")
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
-            warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
+            warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
             return None
         self.ms_extract += ms
         return mesh
