@@ -223,3 +223,44 @@ def test_errors_are_made_one_line_by_one_function():
             continue
         source = path.read_text(encoding="utf-8")
         assert not by_hand.search(source), f"{path.relative_to(ROOT)} formats an error by hand: use core.log.one_line"
+
+
+def test_render_passes_come_from_one_table():
+    """core.schema.RENDER_PASSES is the one list of render passes: the
+    engine's pass layout and switches, the panel's Blender switches, the pass
+    names core/passes.py draws and the view layer settings all derive from it,
+    and no other module spells a pass name out."""
+    from types import SimpleNamespace
+
+    import bpy
+
+    from solidwire_addon.blender import engine, ui
+    from solidwire_addon.core import passes
+
+    table = schema.RENDER_PASSES
+    names = tuple(p.name for p in table)
+    assert len(set(names)) == len(names) and len({p.switch for p in table}) == len(table)
+    assert engine.PASS_LAYOUT == {p.name: (p.channels, p.channel_ids, p.kind) for p in table}
+    assert all(len(p.channel_ids) == p.channels for p in table)
+    # SolidWire's own switches are exactly the view layer settings, in order.
+    assert [s.name for s in schema.settings_in(schema.VIEW_LAYER)] == [p.switch for p in table if p.own]
+    # Blender's own switches exist on a view layer, and the panel shows them all.
+    assert ui.BLENDER_PASSES == tuple(p.switch for p in table if not p.own)
+    assert set(ui.BLENDER_PASSES) <= set(bpy.types.ViewLayer.bl_rna.properties.keys())
+    assert schema.EXTRA_PASSES == tuple(n for n in names if n != schema.DEPTH_PASS)
+    for constant in ("WIRE_PASS", "HIDDEN_WIRE_PASS", "EDGE_DISTANCE_PASS", "NORMAL_PASS", "OBJECT_INDEX_PASS",
+                     "MATERIAL_INDEX_PASS"):
+        assert getattr(passes, constant) == getattr(schema, constant)
+    # What a view layer asks for, read through the table.
+    every = SimpleNamespace(**{p.switch: True for p in table if not p.own},
+                            solidwire=SimpleNamespace(**{p.switch: True for p in table if p.own}))
+    assert engine.passes_of(every) == names
+    assert engine.extra_passes_of(every) == schema.EXTRA_PASSES
+    none = SimpleNamespace(**{p.switch: False for p in table if not p.own})  # no SolidWire settings at all
+    assert engine.passes_of(none) == ()
+    # Nobody else spells a pass name out.
+    spelled = set(names)
+    for module in ("blender/engine.py", "blender/ui.py", "core/passes.py"):
+        tree = ast.parse((PACKAGE / module).read_text(encoding="utf-8"))
+        literals = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
+        assert not literals & spelled, f"{module} spells out {sorted(literals & spelled)}: use core.schema"
