@@ -104,12 +104,13 @@ bench-scale: $(VENV_STAMP) check-system
 bench-engines: $(VENV_STAMP) check-system
 	$(VENV_PYTHON) -m scripts.bench_engines --size 1280x720 --size 3840x2160 --repeats 5 --freestyle $(BENCH_ARGS)
 
-# Opt-in robustness runs (not part of `make test` / CI); see docs/dev/robustness.md.
+# Opt-in robustness runs (not part of `make test` / CI; pytest markers, see
+# pytest.ini); see docs/dev/robustness.md.
 test-slow: $(VENV_STAMP) check-system
-	SOLIDWIRE_SLOW=1 $(VENV_PYTHON) -m pytest tests
+	$(VENV_PYTHON) -m pytest tests --run-slow
 
 soak: $(VENV_STAMP) check-system
-	SOLIDWIRE_SLOW=1 $(VENV_PYTHON) -m pytest tests/test_soak.py -s
+	$(VENV_PYTHON) -m pytest tests/test_soak.py --run-slow -s
 
 fuzz: $(VENV_STAMP) check-system
 	SOLIDWIRE_FUZZ_EXAMPLES=$(or $(FUZZ_EXAMPLES),500) $(VENV_PYTHON) -m pytest tests/test_fuzz.py -s

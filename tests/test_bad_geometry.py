@@ -1,4 +1,4 @@
-"""Bad geometry never takes a render down (issue 6, item 1).
+"""Bad geometry never takes a render down.
 
 Each faulty object sits beside a good one, out of its way in the picture.
 Every case checks, through the real engine and a float EXR file (which keeps

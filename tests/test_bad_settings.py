@@ -1,4 +1,4 @@
-"""Bad settings, files and render set-ups (issue 6, item 2): a correct image
+"""Bad settings, files and render set-ups: a correct image
 or one clear message, never a crash, a NaN pixel or a silent black frame."""
 
 from __future__ import annotations
@@ -191,7 +191,7 @@ def test_large_frame_2048(output_dir):
     _large_frame(2048, output_dir)
 
 
-@pytest.mark.skipif(not robustness.SLOW, reason="opt-in: SOLIDWIRE_SLOW=1 (about 1 min and 6 GB on llvmpipe)")
+@pytest.mark.slow  # about 1 min and 6 GB on llvmpipe
 def test_large_frame_8192(output_dir):
     _large_frame(8192, output_dir)
 

@@ -1,4 +1,4 @@
-"""Fast extraction (issue 5): the triangles we build for tris and quads are
+"""Fast extraction: the triangles we build for tris and quads are
 exactly Blender's own (``loop_triangles``), including its quad split rule on
 concave, non-planar and degenerate quads; the whole MeshArrays of the fast
 path equals the reference path's, byte for byte."""

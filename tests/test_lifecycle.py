@@ -1,4 +1,4 @@
-"""Lifecycle (issue 6, item 3): register/unregister leaves nothing behind
+"""Lifecycle: register/unregister leaves nothing behind
 (measured: classes, properties, handlers, draw handler, keymaps, timers,
 panel appends, exit hooks, GPU objects); the add-on keeps no Blender data; the
 overlay survives file load, undo, deletion, scene switch and renders."""

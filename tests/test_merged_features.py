@@ -1,6 +1,6 @@
-"""Features of two lines of work used together (merge of issue11/16 into
-issue12): shaded fill and colour sources with per-object overrides, render
-passes and the viewport clipping region. Each alone is tested elsewhere;
+"""Features that were built apart, used together: shaded fill and colour
+sources with per-object overrides, render passes and the viewport clipping
+region. Each alone is tested elsewhere;
 these check that the shader variants combine (samplers, blocks, push
 constants) and that an override shows through the colour table."""
 

@@ -434,7 +434,7 @@ def test_redraws_reuse_meshes_and_see_edits():
     ids=["hidden_lines", "silhouettes", "hidden_lines_fill"],
 )
 def test_overlay_matches_render_engine_with_line_styles(features, output_dir):
-    """Hidden-line style and full-width silhouettes (issue 7) look the same in
+    """Hidden-line style and full-width silhouettes look the same in
     the viewport as in the render. Silhouette fins blend "over" in the
     viewport (the render keeps the exact maximum), so only the corner pixels
     where two fins overlap may differ; they are few and bounded."""

@@ -1,4 +1,4 @@
-"""Scale (issue 5), asserted through ``solidwire_addon.stats()``: the GPU
+"""Scale, asserted through ``solidwire_addon.stats()``: the GPU
 cache reuses what did not change, shares one upload between duplicates and
 instances, frees what is gone; culling and instanced drawing."""
 

@@ -1,4 +1,4 @@
-"""Security (issue 6, item 6): no network, no undeclared permissions, writes
+"""Security: no network, no undeclared permissions, writes
 only where the user asked (render output) and in its own user directory,
 presets are data that is validated, never code that is run."""
 

@@ -23,6 +23,8 @@ from solidwire_addon.core.cache import MeshCache
 from solidwire_addon.core.settings import DrawSettings
 from tests.support import accuracy, reference, scenes
 
+pytestmark = pytest.mark.stress
+
 SIZE = (1280, 720)
 ROW_STEP = 8
 # The SPEC defaults, and the benchmark's settings: the papers' prefiltered

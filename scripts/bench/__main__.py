@@ -208,7 +208,7 @@ def write_markdown(results, meta, path: Path):
 
 
 def targets_summary(results):
-    """The issue's targets, measured: exact / fill_only ratio on the mesh
+    """The benchmark's targets, measured: exact / fill_only ratio on the mesh
     scenes; lowest error and Pareto front per scene."""
     summary = {}
     for scene_name, rows in results.items():

@@ -75,7 +75,7 @@ class _Geometry:
     edge_face: np.ndarray  # (E,) global face id
     edge_real: np.ndarray  # (E,) bool: a drawn line (else a diagonal)
     edge_origin_first: np.ndarray  # (E,) bool: pattern measured from endpoint 0
-    # Silhouette candidates (issue 7): real edges with one or two faces.
+    # Silhouette candidates (image model §5.5): real edges with one or two faces.
     sil_edges: np.ndarray = None  # (S, 2, 3) view-space endpoints
     sil_third: np.ndarray = None  # (S, 2, 3) third vertex of the face on each side (NaN: none)
     # Fill shading and colour sources (image model §5.8).
@@ -945,8 +945,8 @@ def _eye(proj):
 
 
 def _outer_half(s, geo, proj, width, height, rows, depth):
-    """Outer-half intensity per pixel of ``rows`` (issue 7 definition, see
-    solidwire_addon/silhouettes.py): max over silhouette edges whose outer
+    """Outer-half intensity per pixel of ``rows`` (image model §5.5; see
+    solidwire_addon/core/silhouettes.py): max over silhouette edges whose outer
     side holds the sample and whose nearest point q is not behind the
     visible surface there, of P(d) * fade with thickness and fade at q."""
     out = np.zeros(len(rows) * width)
@@ -1059,7 +1059,7 @@ def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj) 
 
 def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha,
                           undecided=None):
-    """Alpha of the hidden-line layer per pixel (issue 7 definition): every
+    """Alpha of the hidden-line layer per pixel (image model §5.4): every
     face hit behind the visible surface contributes
     a_k = wire_alpha * hidden_alpha * P(d_real) * dash(t) * fade(z_k), with
     t measured along its nearest real edge from that edge's lower-id end;
