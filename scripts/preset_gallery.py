@@ -8,7 +8,9 @@ the same view (a Workbench render), which is how an artist sees them in the
 viewport; fill presets are opaque and replace it. The "Fade into Distance"
 cell uses the range that "Fade Range from Visible Objects" sets, as an artist
 would. Labels need Pillow; without it the grid is written unlabelled through
-Blender's image API.
+Blender's image API, with a warning that names the tiles. The last tile is
+not a preset: it is Blender's Solid shading alone, the reference the overlay
+presets are drawn over.
 """
 
 from __future__ import annotations
@@ -108,6 +110,11 @@ def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS, cell=CEL
     try:
         from PIL import Image, ImageDraw, ImageFont
     except ImportError:
+        # Without labels a sheet is easy to misread (the last tile of the
+        # preset sheet, Blender's Solid shading with no overlay, passed for a
+        # preset that draws no wire), so say so and name the tiles.
+        print(f"warning: Pillow is not installed, so {path.name} has empty label strips; its tiles, "
+              f"left to right, top to bottom: {'; '.join(label for label, _linear in cells)}", file=sys.stderr)
         _write_with_blender(sheet, path)
         return
     image = Image.fromarray(sheet)
