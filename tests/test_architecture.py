@@ -1,7 +1,8 @@
 """The package's layering, read from its source: no import cycles (module- or
 function-level imports alike), nothing in ``core`` that faces Blender's UI or
-context, no private names used across modules, and a shader parameter block
-that is exactly the schema's.
+context, no private names used across modules, a shader parameter block
+that is exactly the schema's, one module map in the manual that lists every
+module, one formatter for errors as one line, and one table of render passes.
 """
 
 from __future__ import annotations
