@@ -175,7 +175,8 @@ def passes_of(view_layer) -> tuple:
 
 
 def extra_passes_of(view_layer) -> tuple:
-    """:func:`passes_of` less Depth, which every frame draws anyway."""
+    """:func:`passes_of` less Depth, which a frame reads back on its own
+    (``read_depth``) rather than drawing it as an extra pass."""
     return tuple(name for name in passes_of(view_layer) if name != schema.DEPTH_PASS)
 
 
