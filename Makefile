@@ -1,6 +1,7 @@
 # Set-up, demo and tests. `make demo` and `make test` are the two commands in
 # the README; both create the project venv first (once; a stamp file records
-# that requirements-dev.txt has been installed).
+# that requirements-dev.txt has been installed). `make docs` and `make lint`
+# add their own tools to the same venv, each with its own stamp.
 
 # bpy 5.0.1 is built for Python 3.11: prefer python3.11, else python3.
 PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
@@ -18,7 +19,7 @@ BLENDER_TAGS = $(VENV_PYTHON) -c "import importlib.util, os; \
 	print(os.path.join(importlib.util.find_spec('bpy').submodule_search_locations[0], \
 	'5.0', 'scripts', 'modules', '_bpy_internal', 'extensions', 'tags.py'))"
 
-.PHONY: demo test test-newest venv venv-newest zip check-system clean bench bench-scale bench-engines fetch-meshes test-slow soak fuzz compat
+.PHONY: demo test docs lint test-newest venv venv-newest zip check-system clean bench bench-scale bench-engines fetch-meshes test-slow soak fuzz compat
 
 venv: $(VENV_STAMP)
 
@@ -29,6 +30,27 @@ $(VENV_STAMP): requirements-dev.txt
 	$(PYTHON) -m venv $(VENV)
 	$(VENV_PYTHON) -m pip install --disable-pip-version-check -r requirements-dev.txt
 	touch $(VENV_STAMP)
+
+# The manual's and the linter's tools, on top of the project venv.
+DOCS_STAMP := $(VENV)/.solidwire-docs-installed
+LINT_STAMP := $(VENV)/.solidwire-lint-installed
+
+$(DOCS_STAMP): requirements-docs.txt $(VENV_STAMP)
+	$(VENV_PYTHON) -m pip install --disable-pip-version-check -r requirements-docs.txt
+	touch $(DOCS_STAMP)
+
+$(LINT_STAMP): requirements-lint.txt $(VENV_STAMP)
+	$(VENV_PYTHON) -m pip install --disable-pip-version-check -r requirements-lint.txt
+	touch $(LINT_STAMP)
+
+# The manual (mkdocs.yml: docs/ -> build/site/), strict: a broken link or
+# anchor fails the build.
+docs: $(DOCS_STAMP)
+	$(VENV_PYTHON) -m mkdocs build --strict --site-dir build/site
+
+# `ruff check` only; the tree is not reformatted yet (pyproject.toml says why).
+lint: $(LINT_STAMP)
+	$(VENV_PYTHON) -m ruff check .
 
 # bpy renders through EGL (Mesa's llvmpipe without a GPU); warn early instead
 # of failing later with an obscure import error.
@@ -67,7 +89,7 @@ zip: $(VENV_STAMP)
 	mkdir -p $(DIST_DIR)
 	$(VENV_PYTHON) "$$($(BLENDER_EXT))" build --valid-tags "$$($(BLENDER_TAGS))" --source-dir . --output-dir $(DIST_DIR)
 
-# Benchmarks (numbers in the README; matplotlib is a benchmark-only dependency).
+# Benchmarks (numbers in docs/dev/benchmarks.md; matplotlib is a benchmark-only dependency).
 fetch-meshes: $(VENV_STAMP)
 	$(VENV_PYTHON) scripts/fetch_meshes.py
 
@@ -82,12 +104,13 @@ bench-scale: $(VENV_STAMP) check-system
 bench-engines: $(VENV_STAMP) check-system
 	$(VENV_PYTHON) -m scripts.bench_engines --size 1280x720 --size 3840x2160 --repeats 5 --freestyle $(BENCH_ARGS)
 
-# Opt-in robustness runs (not part of `make test` / CI); see README "Robustness".
+# Opt-in robustness runs (not part of `make test` / CI; pytest markers, see
+# pytest.ini); see docs/dev/robustness.md.
 test-slow: $(VENV_STAMP) check-system
-	SOLIDWIRE_SLOW=1 $(VENV_PYTHON) -m pytest tests
+	$(VENV_PYTHON) -m pytest tests --run-slow
 
 soak: $(VENV_STAMP) check-system
-	SOLIDWIRE_SLOW=1 $(VENV_PYTHON) -m pytest tests/test_soak.py -s
+	$(VENV_PYTHON) -m pytest tests/test_soak.py --run-slow -s
 
 fuzz: $(VENV_STAMP) check-system
 	SOLIDWIRE_FUZZ_EXAMPLES=$(or $(FUZZ_EXAMPLES),500) $(VENV_PYTHON) -m pytest tests/test_fuzz.py -s
@@ -96,4 +119,4 @@ compat: check-system
 	scripts/compat.sh $(COMPAT_VERSIONS)
 
 clean:
-	rm -rf out $(DIST_DIR) tests/output
+	rm -rf out $(DIST_DIR) tests/output build/site

@@ -4,4 +4,4 @@
 # it as a plain module (pytest collecting a checkout whose folder name is not
 # a Python name) do so without failing on the relative import.
 if __package__:
-    from .solidwire_addon import register, stats, unregister  # noqa: F401
+    from .solidwire_addon import register, stats, unregister  # noqa: F401  (the extension's entry points, re-exported)

@@ -1,5 +1,5 @@
 """Error of the exact path against the float64 reference (SPEC 1.5) on the
-core test scenes, as a Markdown table for the README.
+core test scenes, as a Markdown table for the manual (docs/dev/accuracy.md).
 
     .venv/bin/python -m scripts.accuracy_report [--size 200x150] [--edges]
 
@@ -21,11 +21,13 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
 
-from tests.support import accuracy  # noqa: E402
-from tests.support import scenes  # noqa: E402
-import solidwire_addon  # noqa: E402
-from tests import test_edge_selection as selection  # noqa: E402
-from tests import test_render_reference as cases  # noqa: E402
+import solidwire_addon
+from tests import test_edge_selection as selection
+from tests import test_render_reference as cases
+from tests.support import (
+    accuracy,
+    scenes,
+)
 
 # The edge-selection looks: (name, settings, scene builder).
 EDGE_CASES = (

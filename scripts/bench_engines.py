@@ -24,13 +24,13 @@ import time
 
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
+import bpy
+import numpy as np
 
-import solidwire_addon  # noqa: E402
-from solidwire_addon.core import passes, schema  # noqa: E402
-from scripts import frame_stages  # noqa: E402
-from tests.support import scenes  # noqa: E402
+import solidwire_addon
+from scripts import frame_stages
+from solidwire_addon.core import passes, schema
+from tests.support import scenes
 
 # The world colour of Blender's startup file.
 FACTORY_WORLD_COLOR = (0.0509, 0.0509, 0.0509)
@@ -149,12 +149,12 @@ def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
     lines.append(f"| floor: bare indexed draw of the same triangles (no shading, no readback; "
                  f"scripts/frame_stages.bare_draw) | {floor_ms / 1000.0:.3f} | – | {floor_ms / 1000.0 / base:.2f} |")
     steady_touched = statistics.median(touched[turn] for turn in range(1, repeats + 1))
-    lines += ["", f"SolidWire's first render: {first['SOLIDWIRE']:.3f} s against {statistics.median(times['SOLIDWIRE']):.3f} s "
+    lines += ["", (f"SolidWire's first render: {first['SOLIDWIRE']:.3f} s against {statistics.median(times['SOLIDWIRE']):.3f} s "
                   f"steady; extraction {first_stats.get('ms_extract', 0.0):.0f} ms, upload "
                   f"{first_stats.get('ms_upload', 0.0):.0f} ms; {touched[0]:.0f} MiB of memory touched for the first "
-                  f"time (minor page faults; {steady_touched:.0f} MiB in a steady render)."]
-    lines += ["", f"SolidWire's steady frame by stage ({repeats} more renders with a sync after each GPU stage; "
-                  "scripts/frame_stages.py):", ""]
+                  f"time (minor page faults; {steady_touched:.0f} MiB in a steady render).")]
+    lines += ["", (f"SolidWire's steady frame by stage ({repeats} more renders with a sync after each GPU stage; "
+                  "scripts/frame_stages.py):"), ""]
     configure(scene, "SOLIDWIRE")
     with frame_stages.StageProbe() as probe:
         for _ in range(repeats):

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Scale benchmark: what SolidWire costs as scenes grow.
 
 Measured in one run, each against the path it replaces:
@@ -61,15 +60,14 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-bench-"))
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
+import bpy
+import numpy as np
 
-from tests.support import scenes  # noqa: E402
-import solidwire_addon  # noqa: E402
-from solidwire_addon.core import draw
-from solidwire_addon.core import extract
+import solidwire_addon
 from solidwire_addon.blender import runtime
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.core import draw, extract
+from tests.support import scenes
 
 
 def rss_mib() -> float:
@@ -372,8 +370,8 @@ def bench_animation_1m(level: int, size: tuple, frame_count: int) -> dict:
 
 def animation_1m_table(r: dict, size: tuple) -> str:
     lines = [
-        "| deforming mesh, %d x %d | per frame ms (median) | first frame ms | x Workbench | extract ms "
-        "| upload ms | draw ms | meshes extracted / repositioned per frame |" % size,
+        (f"| deforming mesh, {size[0]} x {size[1]} | per frame ms (median) | first frame ms | x Workbench | extract ms "
+        "| upload ms | draw ms | meshes extracted / repositioned per frame |"),
         "|---|---:|---:|---:|---:|---:|---:|---|",
     ]
     for kind, result in r.items():
@@ -504,8 +502,8 @@ def interactive_table(r: dict, args) -> str:
 
     big = f"Suzanne L{args.level} ({r['big_triangles']:,.0f} tris) in Edit Mode"
     lines = [
-        "| overlay redraw, 640 x 360 (median) | total ms | depsgraph ms | extract ms | upload ms | draw ms "
-        "| meshes re-extracted | positions re-uploaded |",
+        ("| overlay redraw, 640 x 360 (median) | total ms | depsgraph ms | extract ms | upload ms | draw ms "
+        "| meshes re-extracted | positions re-uploaded |"),
         "|---|---|---|---|---|---|---|---|",
         row(f"{big}: nothing changed", r["big_steady"]),
         row(f"{big}: one vertex moved", r["big_edit_vertex"]),
@@ -526,7 +524,7 @@ def table(results: dict, args) -> str:
     m = results["memory"]
     a = results["animation"]
     rows = [
-        ("Extraction, Suzanne L%d (%s tris), ms per M tris" % (args.level, f"{e['triangles']:,}"),
+        (f"Extraction, Suzanne L{args.level} ({e['triangles']:,} tris), ms per M tris",
          f"{e['fast_ms_per_mtri']:.0f}", f"{e['naive_ms_per_mtri']:.0f} (loop_triangles)"),
         ("GPU bytes per triangle", f"{e['gpu_bytes_per_triangle']:.1f}", ""),
         (f"{args.objects} objects (own mesh each, {o['reuse']['triangles_drawn']:,} tris drawn): first frame, ms (SolidWire share)",
@@ -628,6 +626,7 @@ def main(argv=None) -> int:
     child = subprocess.run(
         [sys.executable, __file__, "--part", "memory"] + (["--quick"] if args.quick else []),
         capture_output=True, text=True,
+        check=False,
     )
     lines = [line for line in child.stdout.splitlines() if line.startswith("{")]
     if not lines:

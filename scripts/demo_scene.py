@@ -17,7 +17,7 @@ import math
 
 import bmesh
 import bpy
-from mathutils import Matrix, Vector
+from mathutils import Vector
 
 SCENE_NAME = "SolidWire Demo"
 RESOLUTION = (960, 540)

@@ -1,5 +1,5 @@
 """Render which edges are drawn on one subdivided model and write a sheet for
-the README (docs/edges.png): top row every evaluated edge, cage edges (the
+the manual (docs/edges.png): top row every evaluated edge, cage edges (the
 default), cage edges with an edge angle; bottom row edge classes (boundary,
 sharp, seam), density fade on a dense distant grid, both together.
 
@@ -16,8 +16,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
-from scripts import preset_gallery  # noqa: E402  (the same sheet layout as the presets gallery)
-from tests.support import scenes  # noqa: E402
+from scripts import preset_gallery
 
 CELL = (360, 270)
 LOOK = dict(use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0),

@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Fetch the benchmark's real meshes into cache/meshes/ (optional step).
 
 Nothing here is installed system-wide and nothing is committed: Debian
@@ -140,7 +139,8 @@ def main(argv=None) -> int:
     print(f"fetch_meshes: {teapot} ({len(patches)} patches, {len(vertices)} vertices, {len(triangles)} triangles)")
 
     shutil.copyfile(root / BUNNY_OBJ, bunny)
-    faces = sum(1 for line in open(bunny, encoding="ascii", errors="replace") if line.startswith("f "))
+    with open(bunny, encoding="ascii", errors="replace") as obj_file:
+        faces = sum(1 for line in obj_file if line.startswith("f "))
     print(f"fetch_meshes: {bunny} ({faces} triangles, from Debian glmark2-data)")
     return 0
 

@@ -13,7 +13,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 
 
-from scripts import preset_gallery  # noqa: E402  (compose/write: the same sheet layout as the presets gallery)
+from scripts import preset_gallery
 
 CELL = preset_gallery.CELL
 PAPER = (0.93, 0.92, 0.88)

@@ -5,7 +5,7 @@ a frame that finds the mesh cache empty (the corner table included).
 
     .venv/bin/python -m scripts.look_cost [--repeats 5]
 
-Prints a Markdown table (median milliseconds) for the README; the render
+Prints a Markdown table (median milliseconds) for the manual (docs/dev/benchmarks.md); the render
 column is the deferred surface pass, with the direct one beside it.
 """
 
@@ -18,11 +18,11 @@ import time
 
 import bpy
 
-from tests.support import scenes
 import solidwire_addon
 from solidwire_addon.blender import engine, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.core import passes
+from tests.support import scenes
 
 SIZE = (1920, 1080)
 BASE = dict(use_fill=True, fill_shading="FLAT", fill_color_source="SINGLE", wire_color_source="SINGLE",

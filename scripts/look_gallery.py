@@ -1,6 +1,6 @@
 """Render the fill shadings (FLAT, STUDIO, MATCAP) and the colour sources
 (object, material, random) on one small scene and write a sheet for the
-README (docs/looks.png): top row Flat, Studio, MatCap; bottom row fill from
+manual (docs/looks.png): top row Flat, Studio, MatCap; bottom row fill from
 Object colour, from Material colour, Random per object (wire too).
 
     .venv/bin/python -m scripts.look_gallery [-o docs/looks.png]
@@ -15,9 +15,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
-import bpy  # noqa: E402
+import bpy
 
-from scripts import preset_gallery  # noqa: E402  (compose/write: the same sheet layout as the presets gallery)
+from scripts import preset_gallery
 
 CELL = (360, 270)
 LOOK = dict(use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0),

@@ -8,7 +8,9 @@ the same view (a Workbench render), which is how an artist sees them in the
 viewport; fill presets are opaque and replace it. The "Fade into Distance"
 cell uses the range that "Fade Range from Visible Objects" sets, as an artist
 would. Labels need Pillow; without it the grid is written unlabelled through
-Blender's image API.
+Blender's image API, with a warning that names the tiles. The last tile is
+not a preset: it is Blender's Solid shading alone, the reference the overlay
+presets are drawn over.
 """
 
 from __future__ import annotations
@@ -20,14 +22,13 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
+import bpy
+import numpy as np
 
-from tests.support import scenes  # noqa: E402  (tests/support/scenes.py: scene builders shared with the tests)
-import solidwire_addon  # noqa: E402
-from solidwire_addon.blender import engine
-from solidwire_addon.blender import presets
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
+import solidwire_addon
+from solidwire_addon.blender import engine, presets
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from tests.support import scenes
 
 CELL = (460, 345)
 COLUMNS = 3
@@ -109,6 +110,11 @@ def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS, cell=CEL
     try:
         from PIL import Image, ImageDraw, ImageFont
     except ImportError:
+        # Without labels a sheet is easy to misread (the last tile of the
+        # preset sheet, Blender's Solid shading with no overlay, passed for a
+        # preset that draws no wire), so say so and name the tiles.
+        print(f"warning: Pillow is not installed, so {path.name} has empty label strips; its tiles, "
+              f"left to right, top to bottom: {'; '.join(label for label, _linear in cells)}", file=sys.stderr)
         _write_with_blender(sheet, path)
         return
     image = Image.fromarray(sheet)
@@ -126,7 +132,7 @@ def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS, cell=CEL
     for c in range(1, columns):  # thin separators between columns
         draw.line([(c * width, 0), (c * width, image.height)], fill=LABEL_BACKGROUND, width=2)
     # An adaptive 256-colour palette keeps the anti-aliased lines smooth and
-    # the file small enough for a README.
+    # the file small enough for the README and the manual.
     image.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE).save(path, optimize=True)
 
 

@@ -1,4 +1,4 @@
-"""Gallery images of the wire pass over a shaded Cycles render (README,
+"""Gallery images of the wire pass over a shaded Cycles render (docs/user/wire-over.md,
 "Wire over EEVEE / Cycles renders"):
 
     .venv/bin/python -m scripts.wire_over_gallery [--out docs] [--samples 48]
@@ -21,13 +21,13 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Vector  # noqa: E402
+import bpy
+import numpy as np
+from mathutils import Vector
 
-from tests.support import scenes  # noqa: E402  (tests/support/scenes.py: scene builders)
-import solidwire_addon  # noqa: E402
+import solidwire_addon
 from solidwire_addon.blender import composite
+from tests.support import scenes
 
 SIZE = (640, 400)
 

@@ -78,5 +78,5 @@ def release_gpu() -> None:
 
 
 def stats() -> dict:
-    """Statistics of the last drawn frame (see README, "Command line")."""
+    """Statistics of the last drawn frame (see docs/user/command-line.md)."""
     return runtime.stats()

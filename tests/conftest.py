@@ -16,14 +16,38 @@ from pathlib import Path
 # Must be set before bpy is imported.
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-user-"))
 
-import bpy  # noqa: E402,F401
-import pytest  # noqa: E402
+import bpy  # noqa: F401  (first, once BLENDER_USER_RESOURCES is set)
+import pytest
 
-import solidwire_addon  # noqa: E402
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
+import solidwire_addon
+from solidwire_addon.blender.gpu_context import ensure_gpu
 
 ROOT = Path(__file__).resolve().parent.parent
 OUTPUT_DIR = ROOT / "tests" / "output"
+
+
+# Opt-in markers (pytest.ini): each runs only with its option, or with the
+# environment variable older scripts and habits set.
+OPT_IN = {
+    "slow": ("--run-slow", "SOLIDWIRE_SLOW"),
+    "eevee": ("--run-eevee", "SOLIDWIRE_TEST_EEVEE"),
+}
+
+
+def pytest_addoption(parser):
+    for marker, (option, variable) in OPT_IN.items():
+        parser.addoption(option, action="store_true", default=False,
+                         help=f"also run the tests marked '{marker}' (or set {variable}=1)")
+
+
+def pytest_collection_modifyitems(config, items):
+    for marker, (option, variable) in OPT_IN.items():
+        if config.getoption(option) or os.environ.get(variable, "") not in ("", "0"):
+            continue
+        skip = pytest.mark.skip(reason=f"opt-in '{marker}' test: run with {option} ({variable}=1)")
+        for item in items:
+            if marker in item.keywords:
+                item.add_marker(skip)
 
 
 @pytest.fixture(scope="session", autouse=True)

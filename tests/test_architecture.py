@@ -1,7 +1,8 @@
 """The package's layering, read from its source: no import cycles (module- or
 function-level imports alike), nothing in ``core`` that faces Blender's UI or
-context, no private names used across modules, and a shader parameter block
-that is exactly the schema's.
+context, no private names used across modules, a shader parameter block
+that is exactly the schema's, one module map in the manual that lists every
+module, one formatter for errors as one line, and one table of render passes.
 """
 
 from __future__ import annotations
@@ -126,7 +127,7 @@ def test_no_private_name_is_used_across_modules():
 
 def test_the_parameter_block_is_the_schemas():
     glsl = schema.param_block_glsl()
-    members = re.findall(r"^\s*(vec4|float) (\w+);", glsl, re.M)
+    members = re.findall(r"^\s*(vec4|float) (\w+);", glsl, re.MULTILINE)
     assert [name for _kind, name in members] == [m.glsl for m in schema.PARAM_BLOCK]
     floats = sum(4 if kind == "vec4" else 1 for kind, _name in members)
     assert floats == schema.PARAM_FLOATS and floats % 4 == 0  # std140: whole vec4s
@@ -189,3 +190,78 @@ def test_every_table_is_laid_out_as_fetch_texel_reads_it():
         assert width == cache.TABLE_WIDTH or height == 1
         last = max(count, 1) - 1
         assert (last & (width - 1) if width == cache.TABLE_WIDTH else last) < width and (last >> shift) < height
+
+
+MODULE_MAP = ROOT / "docs" / "dev" / "architecture.md"
+
+
+def test_the_module_map_lists_every_module():
+    """docs/dev/architecture.md is the one module map (the package docstrings
+    point to it): every module under solidwire_addon/ has a row there, named
+    by its path inside the package (``core/passes.py``), and the map names no
+    module that is gone."""
+    text = MODULE_MAP.read_text(encoding="utf-8")
+    modules = {p.relative_to(PACKAGE).as_posix() for p in PACKAGE.rglob("*.py") if p.name != "__init__.py"}
+    missing = sorted(m for m in modules if f"`{m}`" not in text)
+    assert not missing, f"modules missing from {MODULE_MAP.relative_to(ROOT)}: {missing}"
+    named = set(re.findall(r"`((?:core|blender)/\w+\.py)`", text))
+    assert not named - modules, f"the module map names modules that do not exist: {sorted(named - modules)}"
+
+
+def test_errors_are_made_one_line_by_one_function():
+    """core.log.one_line is the one formatter of an exception as one line:
+    its whitespace folded, its type's name when it has no text. No other
+    module folds an exception's text by hand, and none puts an exception's
+    raw text (which may span lines) after its type's name in a message."""
+    from solidwire_addon.core.log import one_line
+
+    assert one_line(OSError("cannot open\n  the file:\tdenied ")) == "cannot open the file: denied"
+    assert one_line(KeyError()) == "KeyError"
+    assert one_line(RuntimeError("  \n")) == "RuntimeError"
+    by_hand = re.compile(r"""["']\s["']\.join\(str\(\w+\)\.split\(\)\)|__name__\}: \{(exc|error|e)\}""")
+    for path in PACKAGE.rglob("*.py"):
+        if path.name == "log.py" and path.parent.name == "core":
+            continue
+        source = path.read_text(encoding="utf-8")
+        assert not by_hand.search(source), f"{path.relative_to(ROOT)} formats an error by hand: use core.log.one_line"
+
+
+def test_render_passes_come_from_one_table():
+    """core.schema.RENDER_PASSES is the one list of render passes: the
+    engine's pass layout and switches, the panel's Blender switches, the pass
+    names core/passes.py draws and the view layer settings all derive from it,
+    and no other module spells a pass name out."""
+    from types import SimpleNamespace
+
+    import bpy
+
+    from solidwire_addon.blender import engine, ui
+    from solidwire_addon.core import passes
+
+    table = schema.RENDER_PASSES
+    names = tuple(p.name for p in table)
+    assert len(set(names)) == len(names) and len({p.switch for p in table}) == len(table)
+    assert engine.PASS_LAYOUT == {p.name: (p.channels, p.channel_ids, p.kind) for p in table}
+    assert all(len(p.channel_ids) == p.channels for p in table)
+    # SolidWire's own switches are exactly the view layer settings, in order.
+    assert [s.name for s in schema.settings_in(schema.VIEW_LAYER)] == [p.switch for p in table if p.own]
+    # Blender's own switches exist on a view layer, and the panel shows them all.
+    assert ui.BLENDER_PASSES == tuple(p.switch for p in table if not p.own)
+    assert set(ui.BLENDER_PASSES) <= set(bpy.types.ViewLayer.bl_rna.properties.keys())
+    assert schema.EXTRA_PASSES == tuple(n for n in names if n != schema.DEPTH_PASS)
+    for constant in ("WIRE_PASS", "HIDDEN_WIRE_PASS", "EDGE_DISTANCE_PASS", "NORMAL_PASS", "OBJECT_INDEX_PASS",
+                     "MATERIAL_INDEX_PASS"):
+        assert getattr(passes, constant) == getattr(schema, constant)
+    # What a view layer asks for, read through the table.
+    every = SimpleNamespace(**{p.switch: True for p in table if not p.own},
+                            solidwire=SimpleNamespace(**{p.switch: True for p in table if p.own}))
+    assert engine.passes_of(every) == names
+    assert engine.extra_passes_of(every) == schema.EXTRA_PASSES
+    none = SimpleNamespace(**{p.switch: False for p in table if not p.own})  # no SolidWire settings at all
+    assert engine.passes_of(none) == ()
+    # Nobody else spells a pass name out.
+    spelled = set(names)
+    for module in ("blender/engine.py", "blender/ui.py", "core/passes.py"):
+        tree = ast.parse((PACKAGE / module).read_text(encoding="utf-8"))
+        literals = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
+        assert not literals & spelled, f"{module} spells out {sorted(literals & spelled)}: use core.schema"

@@ -1,4 +1,4 @@
-"""Bad geometry never takes a render down (issue 6, item 1).
+"""Bad geometry never takes a render down.
 
 Each faulty object sits beside a good one, out of its way in the picture.
 Every case checks, through the real engine and a float EXR file (which keeps
@@ -16,12 +16,8 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import robustness
-from tests.support import scenes
-from solidwire_addon.core import extract
-from solidwire_addon.core import log
+from solidwire_addon.core import extract, log
+from tests.support import accuracy, reference, robustness, scenes
 
 W, H = 96, 64
 NAN, INF = math.nan, math.inf

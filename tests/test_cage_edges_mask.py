@@ -15,7 +15,6 @@ from mathutils import Matrix
 from solidwire_addon.blender.cage import cage_edge_mask, cage_key, peel
 from tests.support import scenes
 
-
 # -- helpers ---------------------------------------------------------------
 
 
@@ -249,7 +248,7 @@ def test_a_mesh_that_is_not_the_objects_gives_none():
 
 def test_peel_rejects_a_layout_that_only_fits_the_counts():
     _scene, obj, _mod = _subdivided_cube(2)
-    _mask_, edges, positions = _mask(obj)
+    _unused_mask, edges, positions = _mask(obj)
     faces = 96
     assert peel(edges, len(positions), faces, 2) is not None
     assert peel(edges, len(positions), faces, 1) is None  # wrong level
@@ -335,7 +334,7 @@ def test_render_levels_in_a_render_depsgraph(probe_engine):
     bpy.ops.render.render(scene=scene.name)
     assert probe_engine.found["Cube"] == ("RENDER", 768, 12 * 8)  # level 3: 768 edges
     # The viewport depsgraph has the viewport level.
-    mask, _edges_, _positions = _mask(obj)
+    mask, _unused_edges, _positions = _mask(obj)
     assert int(mask.sum()) == 12 * 2
     # Render Simplify lowers the render level only.
     scene.render.use_simplify = True
@@ -374,7 +373,7 @@ def test_edit_mode_follows_the_edited_cage():
         assert _mask(obj)[0] is None
     finally:
         bpy.ops.object.mode_set(mode="OBJECT")
-    mask, _edges_, _positions = _mask(obj)
+    mask, _unused_edges, _positions = _mask(obj)
     assert int(mask.sum()) == 13 * 4
 
 
@@ -391,7 +390,7 @@ def _user_data_snapshot(obj):
             for domain in ("verts", "edges", "faces", "loops")
             for kind in ("int", "float", "bool", "string", "float_vector", "float_color", "color")
             if hasattr(getattr(bm, domain).layers, kind)
-            for name in getattr(getattr(bm, domain).layers, kind).keys()
+            for name in getattr(getattr(bm, domain).layers, kind).keys()  # noqa: SIM118  (iterating the collection gives layers, not names)
         )
     modifiers = [(m.name, m.type) for m in obj.modifiers]
     return ids, attributes, layers, modifiers, dict(data.items()), dict(obj.items())

@@ -10,6 +10,7 @@ module) and ``sys.argv`` looks like Blender's.
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import os
 import subprocess
@@ -52,6 +53,7 @@ def run_cli(*args, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, str(RENDER_SCRIPT), *map(str, args)],
         cwd=cwd, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S,
+        check=False,
     )
 
 
@@ -72,6 +74,7 @@ def run_cli_blender_form(blend: Path, *args, cwd: Path) -> subprocess.CompletedP
     return subprocess.run(
         [sys.executable, "-c", _SIMULATED_BLENDER, str(blend), str(RENDER_SCRIPT), *map(str, args)],
         cwd=cwd, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S,
+        check=False,
     )
 
 
@@ -122,7 +125,7 @@ def test_colour_option_parsing():
     assert render_cli._color("0,0,0,0.25") == (0.0, 0.0, 0.0, 0.25)
     assert render_cli._color("#ff0080") == pytest.approx((1.0, 0.0, 128 / 255, 1.0))
     for bad in ("1,0", "1,2,0", "red", "#12345", "nan,0,0"):
-        with pytest.raises(Exception):
+        with pytest.raises(argparse.ArgumentTypeError):
             render_cli._color(bad)
 
 
@@ -301,7 +304,8 @@ def test_blender_form_without_an_open_file_is_an_error(tmp_path):
         """
     )
     result = subprocess.run(
-        [sys.executable, "-c", script], cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S
+        [sys.executable, "-c", script], cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S,
+        check=False,
     )
     assert result.returncode == 2
     assert meaningful_lines(result.stderr) == ["solidwire: error: no scene given: pass SCENE.blend or --demo"]
@@ -330,7 +334,8 @@ def test_a_failing_render_exits_1_with_a_clear_line(tmp_path):
         """
     )
     result = subprocess.run(
-        [sys.executable, "-c", script], cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S
+        [sys.executable, "-c", script], cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S,
+        check=False,
     )
     assert result.returncode == 1, result.stdout + result.stderr
     lines = meaningful_lines(result.stderr)

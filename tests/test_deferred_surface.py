@@ -56,7 +56,7 @@ def _render_both(scene, path, monkeypatch):
 def _assert_same(direct: dict, deferred: dict) -> None:
     assert direct.keys() == deferred.keys()
     for name, values in direct.items():
-        if name.endswith(".Z") or name.endswith(".Depth.Z") or "Depth" in name:
+        if name.endswith((".Z", ".Depth.Z")) or "Depth" in name:
             np.testing.assert_array_equal(deferred[name], values, err_msg=name)
         else:
             np.testing.assert_allclose(deferred[name], values, rtol=0.0, atol=COLOUR_TOLERANCE, err_msg=name)

@@ -16,9 +16,7 @@ import pytest
 import solidwire_addon
 from solidwire_addon.blender import runtime
 from solidwire_addon.core import cache, draw, extract, passes, shaders
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import scenes
+from tests.support import accuracy, reference, scenes
 
 FRAMES = (1, 2, 3, 4)
 

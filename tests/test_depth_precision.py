@@ -5,7 +5,7 @@ an interior camera's situation) must hide the wall's lines whatever the clip
 start and end are. With the standard GL depth mapping the precision left at
 25 m with clip 1 cm .. 1 km is a few float32 steps and the wall bled through
 in stipples; the engine writes linear view depth into its float depth buffer
-instead (docs/image_model.md §2, README "Robustness"). Checked against the
+instead (docs/image_model.md §2, docs/dev/robustness.md). Checked against the
 float64 reference, which decides every pixel by ray casting.
 """
 
@@ -16,7 +16,7 @@ import math
 import bpy
 import pytest
 
-from tests.support import accuracy, reference, scenes
+from tests.support import accuracy, scenes
 
 DISTANCE = 25.0
 GAP = 1e-4 * DISTANCE

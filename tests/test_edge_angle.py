@@ -7,14 +7,10 @@ from __future__ import annotations
 
 import math
 
-import bmesh
-import bpy
 import numpy as np
 import pytest
 
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import scenes
+from tests.support import accuracy, reference, scenes
 
 
 def _smooth_subdivided(scene):

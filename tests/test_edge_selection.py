@@ -14,7 +14,6 @@ import pytest
 from solidwire_addon.core import edge_select, extract
 from tests.support import accuracy, reference, scenes
 
-
 # ---------------------------------------------------------------- bookkeeping (no GPU)
 
 

@@ -11,7 +11,6 @@ from solidwire_addon.blender import engine, gather, runtime
 from solidwire_addon.core import exr
 from tests.support import scenes
 
-
 _multilayer_render = scenes.render_multilayer_exr
 
 
@@ -112,9 +111,9 @@ def _panels_for(engine_id: str) -> set[str]:
     names = set()
     for panel in bpy.types.Panel.__subclasses__():
         engines = getattr(panel, "COMPAT_ENGINES", None)
-        if getattr(panel, "bl_space_type", "") == "PROPERTIES" and getattr(panel, "bl_context", "") in TABS:
-            if isinstance(engines, set) and engine_id in engines:
-                names.add(panel.__name__)
+        in_tabs = getattr(panel, "bl_space_type", "") == "PROPERTIES" and getattr(panel, "bl_context", "") in TABS
+        if in_tabs and isinstance(engines, set) and engine_id in engines:
+            names.add(panel.__name__)
     return names
 
 

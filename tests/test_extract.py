@@ -1,4 +1,4 @@
-"""Fast extraction (issue 5): the triangles we build for tris and quads are
+"""Fast extraction: the triangles we build for tris and quads are
 exactly Blender's own (``loop_triangles``), including its quad split rule on
 concave, non-planar and degenerate quads; the whole MeshArrays of the fast
 path equals the reference path's, byte for byte."""
@@ -9,8 +9,8 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.support import scenes
 from solidwire_addon.core import extract
+from tests.support import scenes
 
 FIELDS = ("positions", "centre", "triangles", "edge_flags", "triangle_polygons", "bounds_min", "bounds_max", "ngon_corners")
 

@@ -5,16 +5,12 @@ wire colour sources, measured as colour error (reference.color_error_report)."""
 
 from __future__ import annotations
 
-import math
-
 import bpy
 import numpy as np
 import pytest
 
 from solidwire_addon.core import schema
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import scenes
+from tests.support import accuracy, reference, scenes
 
 
 def _shading_scene(**settings):
@@ -151,7 +147,7 @@ def _colour_scene(**settings):
 ])
 def test_colour_sources_match_reference(fill_source, wire_source, output_dir):
     scene = _colour_scene(fill_color_source=fill_source, wire_color_source=wire_source, fill_color=(0.6, 0.6, 0.6))
-    report, rgba, ref = _measure(scene, f"colors_{fill_source.lower()}_{wire_source.lower()}", output_dir)
+    report, _rgba, ref = _measure(scene, f"colors_{fill_source.lower()}_{wire_source.lower()}", output_dir)
     accuracy.assert_accurate(report)
     # The sources really differ per object/face (not one colour everywhere).
     fills = {tuple(np.round(c, 3)) for c in ref.fill[ref.face >= 0]}
@@ -211,8 +207,8 @@ def test_matcap_decoding_leaves_nothing_in_the_file():
 def test_pending_matcap_draws_flat_until_decoded():
     """A loader that cannot decode yet (Blender's interface) gets asked
     again: nothing is cached until real pixels come."""
-    from solidwire_addon.core import matcaps
     from solidwire_addon.blender import matcap_files
+    from solidwire_addon.core import matcaps
 
     answers = [matcaps.PENDING, (np.ones((4, 4, 4), np.float32), None)]
     matcaps.set_loader(lambda _name: answers.pop(0))

@@ -4,8 +4,6 @@ wrapped back."""
 
 from __future__ import annotations
 
-import bpy
-
 import solidwire_addon
 from scripts import frame_stages
 from solidwire_addon.blender import engine

@@ -1,4 +1,4 @@
-"""Property-based tests (issue 6, item 7): random small meshes, cameras and
+"""Property-based tests: random small meshes, cameras and
 settings. Every example renders through the real engine to a float EXR and
 must raise nothing, hold no NaN/Inf and agree with the float64 reference on
 non-silhouette pixels (p99.9 <= 2/255, max <= 0.1).
@@ -15,14 +15,14 @@ import os
 
 import bpy
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import robustness
-from tests.support import scenes
 from solidwire_addon.core import log
+from tests.support import accuracy, reference, robustness, scenes
+
+pytestmark = pytest.mark.fuzz
 
 W, H = 48, 36
 LONG_RUN = int(os.environ.get("SOLIDWIRE_FUZZ_EXAMPLES", "0") or 0)

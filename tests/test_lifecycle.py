@@ -1,4 +1,4 @@
-"""Lifecycle (issue 6, item 3): register/unregister leaves nothing behind
+"""Lifecycle: register/unregister leaves nothing behind
 (measured: classes, properties, handlers, draw handler, keymaps, timers,
 panel appends, exit hooks, GPU objects); the add-on keeps no Blender data; the
 overlay survives file load, undo, deletion, scene switch and renders."""
@@ -17,15 +17,11 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.support import robustness
-from tests.support import scenes
 import solidwire_addon
-from solidwire_addon.core import log
-from solidwire_addon.blender import ops
-from solidwire_addon.blender import overlay
-from solidwire_addon.blender import runtime
-from solidwire_addon.blender import ui
+from solidwire_addon.blender import ops, overlay, runtime, ui
 from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.core import log
+from tests.support import robustness, scenes
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -67,7 +63,7 @@ def leftovers() -> dict:
         "properties": [
             f"{t.__name__}.{p}"
             for t in (bpy.types.Scene, bpy.types.Object, bpy.types.WindowManager, bpy.types.ViewLayer)
-            for p in t.bl_rna.properties.keys()
+            for p in t.bl_rna.properties.keys()  # noqa: SIM118  (iterating the collection gives properties, not names)
             if "solidwire" in p
         ],
         "app handlers": [f"{name}:{f.__name__}" for name, funcs in _handler_lists() for f in funcs if _ours(f)],
@@ -179,7 +175,7 @@ def test_process_exits_cleanly_after_rendering_while_registered(tmp_path):
     """
     env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
     result = subprocess.run([sys.executable, "-c", textwrap.dedent(script)], capture_output=True, text=True,
-                            timeout=300, env=env)
+                            timeout=300, env=env, check=False)
     assert "RENDERED" in result.stdout
     assert result.returncode == 0, result.stderr[-2000:]
 
@@ -232,7 +228,7 @@ def test_overlay_handler_headless_is_quiet(capfd):
 def test_overlay_survives_deletion_load_scene_switch_and_renders(output_dir):
     ensure_gpu()
     viewport = robustness.Viewport()
-    scene, keep, gone = _overlay_scene()
+    scene, _keep, gone = _overlay_scene()
     stats, alpha_both = viewport.draw(scene)
     assert stats["objects_drawn"] == 2
 
@@ -317,6 +313,7 @@ def test_the_test_order_that_crashed_the_driver_passes(tmp_path):
         [sys.executable, "-X", "faulthandler", "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly",
          *CRASH_ORDER],
         cwd=ROOT, env=env, capture_output=True, text=True, timeout=600,
+        check=False,
     )
     assert result.returncode == 0, (result.stdout + result.stderr)[-3000:]
     assert "5 passed" in result.stdout

@@ -1,6 +1,6 @@
-"""Features of two lines of work used together (merge of issue11/16 into
-issue12): shaded fill and colour sources with per-object overrides, render
-passes and the viewport clipping region. Each alone is tested elsewhere;
+"""Features that were built apart, used together: shaded fill and colour
+sources with per-object overrides, render passes and the viewport clipping
+region. Each alone is tested elsewhere;
 these check that the shader variants combine (samplers, blocks, push
 constants) and that an override shows through the colour table."""
 
@@ -54,7 +54,7 @@ def test_override_fill_is_shaded_and_passes_are_written():
     plain.pass_index, styled.pass_index = 3, 7
     depsgraph = bpy.context.evaluated_depsgraph_get()
     extra: dict = {}
-    rgba, depth = engine.render_scene(depsgraph, (WIDTH, HEIGHT), extra_passes=("IndexOB", "Normal"),
+    rgba, _depth = engine.render_scene(depsgraph, (WIDTH, HEIGHT), extra_passes=("IndexOB", "Normal"),
                                       extra_out=extra)
     index = extra["IndexOB"][..., 0]
     on_plain, on_styled = index == 3, index == 7

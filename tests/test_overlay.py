@@ -16,18 +16,14 @@ import numpy as np
 import pytest
 from mathutils import Matrix
 
-from tests.support import scenes
-from solidwire_addon.core import draw
-from solidwire_addon.blender import engine
-from solidwire_addon.core import log
-from solidwire_addon.blender import overlay
-from solidwire_addon.blender import runtime
+from solidwire_addon.blender import engine, overlay, runtime
 from solidwire_addon.blender.gather import gather
 from solidwire_addon.blender.gpu_context import ensure_gpu
-from solidwire_addon.core.targets import BACKGROUND_DEPTH
 from solidwire_addon.blender.views import camera_view
-from solidwire_addon.core import passes
+from solidwire_addon.core import draw, log, passes
+from solidwire_addon.core.targets import BACKGROUND_DEPTH
 from solidwire_addon.core.view import View
+from tests.support import scenes
 
 WIDTH, HEIGHT = 200, 150
 
@@ -438,7 +434,7 @@ def test_redraws_reuse_meshes_and_see_edits():
     ids=["hidden_lines", "silhouettes", "hidden_lines_fill"],
 )
 def test_overlay_matches_render_engine_with_line_styles(features, output_dir):
-    """Hidden-line style and full-width silhouettes (issue 7) look the same in
+    """Hidden-line style and full-width silhouettes look the same in
     the viewport as in the render. Silhouette fins blend "over" in the
     viewport (the render keeps the exact maximum), so only the corner pixels
     where two fins overlap may differ; they are few and bounded."""

@@ -1,13 +1,13 @@
 """The viewport overlay in every shading mode and viewport state, headless.
 
-Each state of the README table ("The viewport overlay", states) is turned
+Each state of the table in docs/user/overlay.md ("Viewport states") is turned
 into the plain inputs the draw handler reads (``core/overlay_state.py``:
 ``ViewportState`` / ``ObjectState``), planned by the same pure function the
 handler calls, and drawn by ``blender/overlay.py::draw_scene_overlay`` (and so
 ``core/passes.py::draw_over_viewport``) into the offscreen sRGB target of
 tests/test_overlay.py, with or without a Blender-like scene depth. The image
 is checked against the float64 reference (tests/support/reference.py) or
-against the rule the README states for that state.
+against the rule that table states for that state.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from solidwire_addon.blender import overlay
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.blender.views import camera_view
 from solidwire_addon.core import overlay_state
-from solidwire_addon.core.overlay_state import MATERIAL, RENDERED, SOLID, WIREFRAME, ObjectState, ViewportState
+from solidwire_addon.core.overlay_state import MATERIAL, RENDERED, WIREFRAME, ObjectState, ViewportState
 from tests.support import accuracy, reference, scenes
 from tests.test_overlay import HEIGHT, WIDTH, FakeViewport, build_scene
 
@@ -94,7 +94,7 @@ def test_nothing_drawn_when_switched_off():
 
 def test_which_objects():
     plan = overlay_state.plan_overlay(ViewportState())
-    keep = lambda **kw: overlay_state.keep_object(plan, ObjectState(**kw))  # noqa: E731
+    keep = lambda **kw: overlay_state.keep_object(plan, ObjectState(**kw))
     assert keep(visible=True)
     assert not keep(visible=False)  # hidden, hidden/excluded collection, outside local view
     assert not keep(visible=True, excluded=True)
@@ -273,7 +273,7 @@ def test_hidpi_lines_are_ui_scaled():
 
 def _two_objects_one_in_mode(mode: str):
     scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
-    front, back = objects
+    front, _back = objects
     for obj in bpy.context.view_layer.objects:
         obj.select_set(obj == front)
     bpy.context.view_layer.objects.active = front
@@ -282,7 +282,7 @@ def _two_objects_one_in_mode(mode: str):
 
 
 def test_edit_mode_objects_left_to_blender_by_default():
-    scene, objects = _two_objects_one_in_mode("EDIT")
+    scene, _objects = _two_objects_one_in_mode("EDIT")
     try:
         # (Blender-like depth is left out: the test's depth pass reads
         # Object Mode mesh data; the own depth pre-pass stands in for it.)

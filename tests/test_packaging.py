@@ -40,6 +40,7 @@ def blender_ext(*args) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, str(BLENDER_EXT), *map(str, args)],
         capture_output=True, text=True, timeout=TIMEOUT_S,
+        check=False,
     )
 
 
@@ -160,6 +161,7 @@ def test_zip_installs_enables_renders_and_disables(extension_zip, tmp_path, outp
         [sys.executable, "-c", _INSTALL_AND_RENDER, str(extension_zip), str(ROOT),
          str(ROOT / "scripts" / "render.py"), str(output_dir)],
         cwd=tmp_path, env=env, capture_output=True, text=True, timeout=TIMEOUT_S,
+        check=False,
     )
     assert result.returncode == 0, result.stdout + result.stderr
     assert "SolidWire skips" not in result.stderr, result.stderr

@@ -15,9 +15,9 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.support import scenes
 from solidwire_addon.blender import engine
 from solidwire_addon.blender.gpu_context import ensure_gpu
+from tests.support import scenes
 
 SIZE = 511  # odd: world y = 0 maps to the centre of pixel row 255
 HALF_WIDTH, HALF_HEIGHT = 0.92, 0.6  # world units; the camera sees 2 x 2

@@ -12,13 +12,10 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.support import scenes
 import solidwire_addon
-from solidwire_addon.blender import engine
-from solidwire_addon.blender import ops
-from solidwire_addon.blender import presets
-from solidwire_addon.blender import ui
+from solidwire_addon.blender import engine, ops, presets, ui
 from solidwire_addon.blender.gpu_context import ensure_gpu
+from tests.support import scenes
 
 SIZE = (240, 180)
 
@@ -654,7 +651,7 @@ def test_import_refuses_a_bad_file_with_one_line(case, user_dir, tmp_path):
     with pytest.raises(RuntimeError) as caught:
         bpy.ops.solidwire.preset_import(filepath=str(path))
     line = str(caught.value).strip()
-    assert "\n" not in line and f"cannot import preset: incoming.json: " in line and message in line
+    assert "\n" not in line and "cannot import preset: incoming.json: " in line and message in line
     assert list(user_dir.iterdir()) == []
 
 

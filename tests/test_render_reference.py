@@ -1,18 +1,18 @@
 """The exact path against the float64 reference (SPEC 1), through the real
-render engine and PNG files, on the scenes the core issue names and a few
-more that stress the general case."""
+render engine and PNG files, on the core scenes (the default cube, Suzanne,
+a floor and a wall through the near plane, a mesh 1e5 units from the
+origin, a shifted orthographic camera, mixed tris/quads/n-gons, a camera
+inside a room, a 6 mm lens with vertical sensor fit) and a few more that stress
+the general case."""
 
 from __future__ import annotations
 
 import math
 
-import bmesh
 import numpy as np
 import pytest
 
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import scenes
+from tests.support import accuracy, reference, scenes
 
 
 def _floor_and_wall(scene):
@@ -214,7 +214,7 @@ def test_ngon_and_quad_diagonals_match_reference(mode, output_dir):
 )
 @pytest.mark.parametrize("ortho", [False, True], ids=["persp", "ortho"])
 def test_thickness_modes_match_reference(settings, ortho, output_dir):
-    """World-space and depth-attenuated widths (issue 7), exact per pixel."""
+    """World-space and depth-attenuated widths, exact per pixel."""
     scene = scenes.empty_scene(200, 150, **settings)
     scenes.monkey(scene, subdivisions=1)
     scenes.grid(scene, "Floor", x_segments=10, y_segments=10, size=20.0, location=(0, 0, -1))
@@ -230,7 +230,7 @@ def test_thickness_modes_match_reference(settings, ortho, output_dir):
 
 @pytest.mark.parametrize("fill", [False, True], ids=["overlay", "fill"])
 def test_hidden_lines_match_reference(fill, output_dir):
-    """Technical-drawing style (issue 7): edges behind the visible surface are
+    """Technical-drawing style: edges behind the visible surface are
     drawn dimmed and dashed, under the visible wire and over the fill."""
     scene = scenes.empty_scene(200, 150, use_hidden_lines=True, hidden_alpha=0.5, hidden_period=6.0, use_fill=fill)
     scene.solidwire.wire_color = (1.0, 1.0, 1.0, 1.0)
@@ -271,7 +271,7 @@ class _Override:
     ["suzanne", "cube_on_floor", "open_grid_near_plane", "world_thickness"],
 )
 def test_full_width_silhouettes_match_reference(case, output_dir):
-    """Outer halves of contour and boundary edges (issue 7), occluded by
+    """Outer halves of contour and boundary edges, occluded by
     nearer surfaces only, against the extended float64 reference."""
     settings = {"use_silhouettes": True, "thickness": 2.0}
     if case == "world_thickness":

@@ -1,4 +1,4 @@
-"""Scale (issue 5), asserted through ``solidwire_addon.stats()``: the GPU
+"""Scale, asserted through ``solidwire_addon.stats()``: the GPU
 cache reuses what did not change, shares one upload between duplicates and
 instances, frees what is gone; culling and instanced drawing."""
 
@@ -6,13 +6,12 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-import pytest
 
-from tests.support import scenes
 import solidwire_addon
+from solidwire_addon.blender import runtime
 from solidwire_addon.core import draw
 from solidwire_addon.core.view import outside_frustum_many
-from solidwire_addon.blender import runtime
+from tests.support import scenes
 
 
 def render(scene) -> dict:
@@ -278,7 +277,7 @@ def test_viewport_trusts_depsgraph_updates(monkeypatch):
     from solidwire_addon.blender import gather
     from solidwire_addon.blender.gpu_context import ensure_gpu
 
-    scene, cubes = ten_cubes()
+    _scene, cubes = ten_cubes()
     ensure_gpu()
     runtime.begin_frame(reuse=True)  # installs the handlers
     fingerprints = []

@@ -1,7 +1,7 @@
-"""Soak (issue 6, item 4; opt-in): a 1000-frame background animation render
+"""Soak (opt-in, marked slow): a 1000-frame background animation render
 keeps resident memory flat and the GPU mesh cache bounded.
 
-    SOLIDWIRE_SLOW=1 .venv/bin/python -m pytest tests/test_soak.py -s
+    .venv/bin/python -m pytest tests/test_soak.py --run-slow -s
     (make soak; SOLIDWIRE_SOAK_FRAMES=N for another length)
 
 Every frame deforms a mesh (wave modifier) and moves an object and the
@@ -18,15 +18,14 @@ import os
 import bpy
 import pytest
 
-from tests.support import robustness
-from tests.support import scenes
 import solidwire_addon
+from tests.support import scenes
 
 FRAMES = int(os.environ.get("SOLIDWIRE_SOAK_FRAMES", "1000"))
 WARMUP = min(100, FRAMES // 5)  # allocator and caches settle first
 RSS_GROWTH_LIMIT_MB = 32.0
 
-pytestmark = pytest.mark.skipif(not robustness.SLOW, reason="opt-in soak: SOLIDWIRE_SLOW=1 (make soak)")
+pytestmark = pytest.mark.slow  # make soak
 
 
 def _rss_mb() -> float:

@@ -15,15 +15,15 @@ import bpy
 import numpy as np
 import pytest
 
-from tests.support import accuracy
-from tests.support import reference
-from tests.support import scenes
+from scripts.bench import methods
 from solidwire_addon.blender import gather
 from solidwire_addon.blender import views as view_mod
-from solidwire_addon.core.cache import MeshCache
 from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.core.cache import MeshCache
 from solidwire_addon.core.settings import DrawSettings
-from scripts.bench import methods
+from tests.support import accuracy, reference, scenes
+
+pytestmark = pytest.mark.stress
 
 SIZE = (1280, 720)
 ROW_STEP = 8

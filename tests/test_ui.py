@@ -14,12 +14,10 @@ from types import SimpleNamespace
 import bpy
 import pytest
 
-from tests.support import scenes
-from solidwire_addon.core import schema
 import solidwire_addon
-from solidwire_addon.blender import ops
-from solidwire_addon.blender import presets
-from solidwire_addon.blender import ui
+from solidwire_addon.blender import ops, presets, ui
+from solidwire_addon.core import schema
+from tests.support import scenes
 
 SPEC_PROPERTIES = (
     "thickness",

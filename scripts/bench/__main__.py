@@ -1,4 +1,3 @@
-#!/usr/bin/env python3
 """Run time against error: SolidWire's exact method and the published methods.
 
 For every method x scene at 1280 x 720 (``--size``), this measures
@@ -59,22 +58,21 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 os.environ.setdefault("BLENDER_USER_RESOURCES", tempfile.mkdtemp(prefix="solidwire-bench-"))
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
+import bpy
+import numpy as np
 
-import solidwire_addon  # noqa: E402
-from solidwire_addon.blender import gather
+import solidwire_addon
 from scripts.bench import methods
+from solidwire_addon.blender import gather
 from solidwire_addon.blender import views as view_mod
-from solidwire_addon.core.cache import MeshCache  # noqa: E402
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
-
-from tests.support import scenes  # noqa: E402  (tests/support/scenes.py: the scene builders)
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.core.cache import MeshCache
 from solidwire_addon.core.settings import DrawSettings
 from solidwire_addon.core.view import translation
+from tests.support import scenes
 
 try:  # written by the lead alongside this script; the bench times without it
-    from tests.support import reference  # noqa: E402
+    from tests.support import reference
 except ImportError:  # pragma: no cover
     reference = None
 
@@ -189,9 +187,9 @@ def fmt_err(value):
 
 def write_markdown(results, meta, path: Path):
     lines = [
-        f"Machine: {meta['machine']}. Frame {meta['size'][0]}x{meta['size'][1]}; time = median ms per frame over "
+        (f"Machine: {meta['machine']}. Frame {meta['size'][0]}x{meta['size'][1]}; time = median ms per frame over "
         f"{meta['frames']} frames after {meta['warmup']} warm-up frames, GPU synchronised (CPU timings on llvmpipe). "
-        f"Error vs the float64 reference on {meta['reference_rows']}, silhouette samples excluded.",
+        f"Error vs the float64 reference on {meta['reference_rows']}, silhouette samples excluded."),
         "",
         "| scene | method | ms/frame | x fill_only | mean abs dI | p99.9 abs dI | max abs dI | px > 2/255 |",
         "|---|---|---:|---:|---:|---:|---:|---:|",
@@ -210,7 +208,7 @@ def write_markdown(results, meta, path: Path):
 
 
 def targets_summary(results):
-    """The issue's targets, measured: exact / fill_only ratio on the mesh
+    """The benchmark's targets, measured: exact / fill_only ratio on the mesh
     scenes; lowest error and Pareto front per scene."""
     summary = {}
     for scene_name, rows in results.items():
@@ -228,7 +226,7 @@ def targets_summary(results):
         # "Error" ranks visible errors first: pixels off by more than 2/255,
         # then the 99.9th percentile, then the mean. Each single metric is
         # reported too, since they do not always agree.
-        key = lambda r: (r["error"]["over_2_255"], r["error"]["p999"], r["error"]["mean"])  # noqa: E731
+        key = lambda r: (r["error"]["over_2_255"], r["error"]["p999"], r["error"]["mean"])
         entry["exact_lowest_error"] = all(key(ex) <= key(r) for r in others)
         entry["beaten_by"] = [r["method"] for r in others if key(r) < key(ex)]
         for metric in ("over_2_255", "p999", "max", "mean"):
@@ -304,7 +302,7 @@ def crops(images: dict, path: Path, crop=(220, 150), zoom=3):
     diff = np.abs(base - other)
     if diff.max() == 0 and "exact" in images:
         diff = np.abs(base - images["exact"])
-    h, w = base.shape
+    _h, _w = base.shape
     cw, ch = crop
     # Box-sum of the difference over crop-sized windows (integral image).
     integral = np.pad(diff, ((1, 0), (1, 0))).cumsum(0).cumsum(1)
@@ -346,7 +344,7 @@ def main(argv=None):
     parser.add_argument("--ref-row-step", type=int, default=None, help="reference on every N-th window row")
     parser.add_argument("--no-peers", action="store_true", help="skip Workbench and Freestyle")
     parser.add_argument("--out", default=str(ROOT / "out" / "bench"))
-    parser.add_argument("--docs", metavar="DIR", help="also copy the two pictures there (e.g. docs/, for the README)")
+    parser.add_argument("--docs", metavar="DIR", help="also copy the two pictures there (e.g. docs/, for the manual)")
     parser.add_argument("--engines", action="append", metavar="WxH",
                         help="also time F12 against Blender's own engines at this size, with the SolidWire frame "
                         "stage by stage (scripts/bench_engines.py; repeatable)")

@@ -38,8 +38,7 @@ import gpu
 import numpy as np
 
 from solidwire_addon.core import draw as draw_mod
-from solidwire_addon.core import passes
-from solidwire_addon.core import shaders
+from solidwire_addon.core import passes, shaders
 from solidwire_addon.core.targets import Targets, read_texture
 from solidwire_addon.core.view import View
 
@@ -70,7 +69,7 @@ ALL_METHODS = (
 # nearby surfaces (the offset methods' known fault).
 LINE_DEPTH_OFFSET = 2.0**-13
 
-_line_batches: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+_line_batches: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def base_method(method: str) -> tuple[str, int]:

@@ -37,6 +37,7 @@ import bpy
 
 from ..core import compat, output, schema
 from ..core.ids import ENGINE_ID, EXTENSION_ID
+from ..core.log import one_line
 from . import composite, ops, presets, runtime
 
 EXIT_USAGE = 2
@@ -129,8 +130,6 @@ def _frame_range(text: str) -> tuple[int, int]:
     if last < first:
         raise argparse.ArgumentTypeError(f"frame range '{text}' ends before it starts")
     return first, last
-
-
 
 
 def _frame_list(text: str) -> list[int]:
@@ -253,9 +252,7 @@ def open_blend(path: Path) -> None:
     try:
         bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     except RuntimeError as exc:
-        raise UsageError(f"cannot open '{path}': {_one_line(exc)}") from None
-
-
+        raise UsageError(f"cannot open '{path}': {one_line(exc)}") from None
 
 
 def load_scene(args, build_demo=None):
@@ -361,7 +358,6 @@ def apply_options(scene, args) -> None:
         render.resolution_percentage = _checked_rna(render, "resolution_percentage", args.percentage, "--percentage")
 
 
-
 def frames_to_render(scene, args) -> list[int]:
     """The frames, by Blender's rules: -f wins, -a (or -s/-e/-j) renders the
     range with its step, otherwise the current frame."""
@@ -463,10 +459,6 @@ def set_file_format(scene, path: Path, color_depth: str | None) -> None:
 # -- rendering -----------------------------------------------------------------
 
 
-def _one_line(exc: BaseException) -> str:
-    return " ".join(str(exc).split()) or type(exc).__name__
-
-
 def _seconds(value: float) -> str:
     return f"{value:.2f} s"
 
@@ -513,7 +505,7 @@ def render_frames(scene, paths: dict, args, over=None) -> None:
             else:
                 over(scene, path)
         except RuntimeError as exc:
-            raise RenderFailed(f"frame {frame}: {_one_line(exc)}") from None
+            raise RenderFailed(f"frame {frame}: {one_line(exc)}") from None
         seconds = time.perf_counter() - start
         if not path.is_file() or path.stat().st_size == 0:
             raise RenderFailed(f"frame {frame}: no image was written to '{path}'")
@@ -592,7 +584,7 @@ def main(arguments: list[str], **kwargs) -> int:
     except RenderFailed as exc:
         print(f"solidwire: error: render failed: {exc}", file=sys.stderr, flush=True)
         return EXIT_FAILURE
-    except Exception:  # a bug: keep the traceback, but never exit 0
+    except Exception:  # noqa: BLE001  (a bug: keep the traceback, but never exit 0)
         traceback.print_exc()
         print("solidwire: error: unexpected failure (traceback above)", file=sys.stderr, flush=True)
         return EXIT_FAILURE

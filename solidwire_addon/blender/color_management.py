@@ -41,7 +41,7 @@ import numpy as np
 
 from ..core import compat, display_transform, shaders
 from ..core.display_transform import DisplayLUT
-from ..core.log import warn_once
+from ..core.log import one_line, warn_once
 from . import runtime
 
 # Tables kept (LRU): one per view-transform state recently shown. Each is
@@ -226,7 +226,7 @@ def _build_and_store(scene, key) -> DisplayLUT | None:
         _failed.add(key)
         warn_once(("display lut", type(exc).__name__, str(exc)),
                   f"SolidWire: the overlay could not apply the scene's colour management "
-                  f"({type(exc).__name__}: {exc}); it shows scene-linear colours")
+                  f"({type(exc).__name__}: {one_line(exc)}); it shows scene-linear colours")
         return None
 
 
@@ -268,7 +268,7 @@ def _build_requested():
             built = _build_and_store(scene, key) is not None or built
     if built:
         runtime.redraw_viewports()
-    return None  # once
+    # once
 
 
 def release() -> None:

@@ -33,8 +33,8 @@ from __future__ import annotations
 import contextlib
 import os
 import re
-import sys
 import shutil
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,7 +44,7 @@ import numpy as np
 from ..core import compat, output
 from ..core.exr import ExrError, exr_pass, read_exr
 from ..core.ids import ENGINE_ID
-
+from ..core.log import one_line
 
 # Friendly and older names of Blender's engines (EEVEE was BLENDER_EEVEE_NEXT
 # in Blender 4.2 to 4.4 and is BLENDER_EEVEE again from 5.0).
@@ -225,7 +225,7 @@ def _render_to(scene, engine: str, path: Path, layer: str) -> dict:
         with _quiet_stdout():
             bpy.ops.render.render(write_still=True, scene=scene.name, layer=layer)
     except RuntimeError as exc:
-        raise CompositeError(f"{engine} render failed: {' '.join(str(exc).split())}") from None
+        raise CompositeError(f"{engine} render failed: {one_line(exc)}") from None
     if not path.is_file():
         raise CompositeError(f"{engine} render wrote no image (see Blender's messages above)")
     try:

@@ -14,11 +14,12 @@ import time
 import bpy
 import numpy as np
 
-from ..core import compositing, passes, shaders
+from ..core import compositing, passes, schema, shaders
 from ..core.ids import ENGINE_ID
+from ..core.log import one_line
+from ..core.view import DrawStats, View
 from . import gather, runtime
 from .gpu_context import ensure_gpu, is_init_scene
-from ..core.view import DrawStats, View
 from .views import NoCameraError, camera_view, render_size
 
 
@@ -83,7 +84,7 @@ def tiles_of(region, tile_pixels: int | None = None):
 class PreparedFrame:
     """What every tile of one frame shares: the full-frame view, the settings
     snapshot and the gathered draw items (extracted and uploaded once).
-    ``extra_passes`` (core.passes.EXTRA_PASSES) are drawn with each tile."""
+    ``extra_passes`` (core.schema.EXTRA_PASSES) are drawn with each tile."""
 
     def __init__(self, depsgraph, size, *, should_stop=None, extra_passes=()):
         ensure_gpu()  # uploads start in gather(), before anything is drawn
@@ -134,7 +135,7 @@ def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=
     premultiplied over the film, view depth), or None when ``should_stop()``
     said so. ``region`` (x0, y0, w, h) in pixels of the full frame draws that
     window only. ``report(text, fraction)`` hears about the stages. The render
-    passes named in ``extra_passes`` (core.passes.EXTRA_PASSES) go into the
+    passes named in ``extra_passes`` (core.schema.EXTRA_PASSES) go into the
     dict ``extra_out``."""
     report = report or (lambda _text, _fraction: None)
     report("extracting meshes", 0.0)
@@ -162,35 +163,25 @@ def sub_view(view, region):
     return View(view.view_matrix, window @ view.projection, (0, 0, w, h))
 
 
-def extra_passes_of(view_layer) -> tuple:
-    """The render passes beyond Combined and Depth that ``view_layer`` asks
-    for: Blender's own switches and SolidWire's (``view_layer.solidwire``)."""
-    names = []
-    if view_layer.use_pass_normal:
-        names.append(passes.NORMAL_PASS)
-    if view_layer.use_pass_object_index:
-        names.append(passes.OBJECT_INDEX_PASS)
-    if view_layer.use_pass_material_index:
-        names.append(passes.MATERIAL_INDEX_PASS)
+def passes_of(view_layer) -> tuple:
+    """The render passes beyond Combined that ``view_layer`` asks for, in
+    core.schema.RENDER_PASSES order: Blender's own switches and SolidWire's
+    (``view_layer.solidwire``)."""
     props = getattr(view_layer, "solidwire", None)
-    if props is not None:
-        for enabled, name in ((props.use_pass_wire, passes.WIRE_PASS),
-                              (props.use_pass_hidden_wire, passes.HIDDEN_WIRE_PASS),
-                              (props.use_pass_edge_distance, passes.EDGE_DISTANCE_PASS)):
-            if enabled:
-                names.append(name)
-    return tuple(names)
+    return tuple(
+        p.name for p in schema.RENDER_PASSES
+        if (props is not None or not p.own) and getattr(props if p.own else view_layer, p.switch)
+    )
 
 
-# (channels, channel ids, type) of each extra pass as Blender registers it.
-PASS_LAYOUT = {
-    passes.NORMAL_PASS: (3, "XYZ", "VECTOR"),
-    passes.OBJECT_INDEX_PASS: (1, "X", "VALUE"),
-    passes.MATERIAL_INDEX_PASS: (1, "X", "VALUE"),
-    passes.WIRE_PASS: (1, "X", "VALUE"),
-    passes.HIDDEN_WIRE_PASS: (1, "X", "VALUE"),
-    passes.EDGE_DISTANCE_PASS: (1, "X", "VALUE"),
-}
+def extra_passes_of(view_layer) -> tuple:
+    """:func:`passes_of` less Depth, which a frame reads back on its own
+    (``read_depth``) rather than drawing it as an extra pass."""
+    return tuple(name for name in passes_of(view_layer) if name != schema.DEPTH_PASS)
+
+
+# (channels, channel ids, type) of each pass as Blender registers it.
+PASS_LAYOUT = {p.name: (p.channels, p.channel_ids, p.kind) for p in schema.RENDER_PASSES}
 
 
 def write_pass(render_pass, array: np.ndarray) -> None:
@@ -219,8 +210,8 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
                 self._render_frame(depsgraph, (width, height), region, layer_name)
         except NoCameraError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
-        except Exception as exc:  # never take the render (or Blender) down
-            self.report({"ERROR"}, f"SolidWire render failed: {type(exc).__name__}: {exc}")
+        except Exception as exc:  # noqa: BLE001  (never take the render, or Blender, down)
+            self.report({"ERROR"}, f"SolidWire render failed: {type(exc).__name__}: {one_line(exc)}")
         else:
             self.update_progress(1.0)
 
@@ -253,7 +244,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         try:
             layer = result.layers[0]
             write_pass(layer.passes["Combined"], rgba)
-            depth_pass = layer.passes.find("Depth")
+            depth_pass = layer.passes.find(schema.DEPTH_PASS)
             if depth_pass != -1 and depth is not None:
                 write_pass(layer.passes[depth_pass], depth)
             for name, values in extra.items():
@@ -261,16 +252,14 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
                 if index != -1:
                     write_pass(layer.passes[index], values)
             cancel = False
-        except Exception as exc:
-            raise RuntimeError(f"could not write the result: {type(exc).__name__}: {exc}") from None
+        except Exception as exc:  # noqa: BLE001  (any failure to fill the result is one render error)
+            raise RuntimeError(f"could not write the result: {type(exc).__name__}: {one_line(exc)}") from None
         finally:
             self.end_result(result, cancel=cancel)
 
     def update_render_passes(self, scene=None, renderlayer=None):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
-        if renderlayer.use_pass_z:
-            self.register_pass(scene, renderlayer, "Depth", 1, "Z", "VALUE")
-        for name in extra_passes_of(renderlayer):
+        for name in passes_of(renderlayer):
             channels, channel_ids, kind = PASS_LAYOUT[name]
             self.register_pass(scene, renderlayer, name, channels, channel_ids, kind)
 

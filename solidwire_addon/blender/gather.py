@@ -27,7 +27,7 @@ import numpy as np
 from ..core import edge_select, extract
 from ..core.cache import MeshCache
 from ..core.colors import ItemSource
-from ..core.log import warn_once
+from ..core.log import one_line, warn_once
 from ..core.view import DrawItem, Style, outside_frustum_many
 from . import cage, runtime
 
@@ -154,9 +154,14 @@ def item_source(obj) -> ItemSource:
     return ItemSource(obj.name, tuple(float(c) for c in obj.color[:3]), tuple(materials))
 
 
+# The default edge selection (every option off); Selection is frozen, so one
+# instance serves every call.
+NO_SELECTION = edge_select.Selection()
+
+
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
            should_stop=None, corners: bool = False, colors: bool = False,
-           edges: edge_select.Selection = edge_select.Selection(),
+           edges: edge_select.Selection = NO_SELECTION,
            object_settings: ObjectSettings | None = None, materials: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
@@ -278,7 +283,7 @@ class _FrameGather:
                 try:
                     key, uids = self._key(obj, pointer, parent)
                 except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
-                    warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
+                    warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
                     key = None
                 if key is not None:
                     if self.view_projection is not None and key not in self.cache:
@@ -311,7 +316,7 @@ class _FrameGather:
             mesh, ms = _mesh_for(obj, data, pointer, key, uids, self.cache, self.trust, self.versions,
                                  self.corners, self._edges_for(obj)[0], self.mode == "RENDER")
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
-            warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
+            warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
             return None
         self.ms_extract += ms
         return mesh
@@ -400,7 +405,7 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
 
 
 def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False,
-              edges: edge_select.Selection = edge_select.Selection(), render: bool = False):
+              edges: edge_select.Selection = NO_SELECTION, render: bool = False):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
     obj_orig = obj.original
     fast = None

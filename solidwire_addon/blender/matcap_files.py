@@ -23,8 +23,8 @@ import tempfile
 import threading
 
 import bpy
-from bpy.app.handlers import persistent
 import numpy as np
+from bpy.app.handlers import persistent
 
 from ..core import exr, matcaps, shaders
 from . import runtime
@@ -90,7 +90,8 @@ def _multilayer_size(image) -> tuple[int, int]:
     images until an image user has loaded them)."""
     import struct
 
-    data = open(bpy.path.abspath(image.filepath), "rb").read(1 << 16)
+    with open(bpy.path.abspath(image.filepath), "rb") as file:
+        data = file.read(1 << 16)
     marker = data.index(b"dataWindow\0box2i\0")
     x0, y0, x1, y1 = struct.unpack_from("<4i", data, marker + len("dataWindow\0box2i\0") + 4)
     return x1 - x0 + 1, y1 - y0 + 1
@@ -151,13 +152,11 @@ def request(name: str) -> None:
             _decoded[name] = None
         matcaps.forget(name)
         runtime.redraw_viewports()
-        return None
 
     bpy.app.timers.register(decode, first_interval=0.0)
 
 
 _requested: set[str] = set()
-
 
 
 def _decode_once(name: str):

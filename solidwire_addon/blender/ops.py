@@ -14,6 +14,7 @@ import numpy as np
 from bpy.props import BoolProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
+from ..core.log import one_line
 from . import overlay, presets
 from .overlay import viewport_object_filter
 from .properties import redraw_viewports
@@ -65,7 +66,7 @@ def one_line_errors(method):
         try:
             return method(self, *args)
         except Exception as exc:  # noqa: BLE001 - no traceback from an operator
-            message = " ".join(str(exc).split()) or type(exc).__name__
+            message = one_line(exc)
             self.report({"ERROR"}, f"SolidWire: {self.bl_label} failed: {type(exc).__name__}: {message}")
             return {"CANCELLED"}
 
@@ -423,7 +424,7 @@ class SOLIDWIRE_OT_preset_export(bpy.types.Operator, ExportHelper):
             path = export_preset_file(bpy.path.abspath(self.filepath), _solidwire(context), preset=self.preset,
                                       name=self.name or _default_export_name(), description=self.preset_description)
         except (presets.PresetError, OSError) as exc:
-            self.report({"ERROR"}, f"SolidWire: cannot export preset: {' '.join(str(exc).split())}")
+            self.report({"ERROR"}, f"SolidWire: cannot export preset: {one_line(exc)}")
             return {"CANCELLED"}
         self.report({"INFO"}, f"SolidWire: exported preset to {path}")
         return {"FINISHED"}
@@ -455,7 +456,7 @@ class SOLIDWIRE_OT_preset_import(bpy.types.Operator, ImportHelper):
             preset = presets.import_file(Path(bpy.path.abspath(self.filepath)), name=self.name,
                                          overwrite=self.overwrite)
         except (presets.PresetError, OSError) as exc:
-            self.report({"ERROR"}, f"SolidWire: cannot import preset: {' '.join(str(exc).split())}")
+            self.report({"ERROR"}, f"SolidWire: cannot import preset: {one_line(exc)}")
             return {"CANCELLED"}
         self.report({"INFO"}, f"SolidWire: imported preset '{preset.name}'")
         return {"FINISHED"}

@@ -25,7 +25,7 @@ import time
 import bpy
 
 from ..core import overlay_state, passes
-from ..core.log import warn_once
+from ..core.log import one_line, warn_once
 from ..core.view import View
 from . import color_management, gather, properties, runtime
 from .views import region_view
@@ -212,7 +212,7 @@ def _draw_callback() -> None:
             display=color_management.display_lut(context.scene, request=True),
         )
     except Exception as exc:  # noqa: BLE001 - a draw handler must never raise
-        warn_once(("overlay", type(exc).__name__, str(exc)), f"SolidWire overlay: {type(exc).__name__}: {exc}")
+        warn_once(("overlay", type(exc).__name__, str(exc)), f"SolidWire overlay: {type(exc).__name__}: {one_line(exc)}")
 
 
 def is_registered() -> bool:

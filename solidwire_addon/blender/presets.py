@@ -37,7 +37,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import re
 import stat
 import unicodedata
 from dataclasses import dataclass, replace
@@ -120,7 +119,7 @@ def parse(text: str, *, source: str = "preset") -> Preset:
             raise PresetError("must be a JSON object")
         unknown = set(data) - _TOP_LEVEL_KEYS
         if unknown:
-            raise PresetError(f"unknown key '{sorted(unknown)[0]}' (expected: {', '.join(sorted(_TOP_LEVEL_KEYS))})")
+            raise PresetError(f"unknown key '{min(unknown)}' (expected: {', '.join(sorted(_TOP_LEVEL_KEYS))})")
         if data.get("solidwire_preset") != FORMAT_VERSION:
             raise PresetError(f"'solidwire_preset' must be {FORMAT_VERSION} (the preset format version)")
         name = data.get("name")

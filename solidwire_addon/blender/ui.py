@@ -224,7 +224,7 @@ class OBJECT_PT_solidwire(bpy.types.Panel):
 
 
 # Blender's own pass switches the engine writes (docs/image_model.md §6).
-BLENDER_PASSES = ("use_pass_z", "use_pass_normal", "use_pass_object_index", "use_pass_material_index")
+BLENDER_PASSES = tuple(p.switch for p in schema.RENDER_PASSES if not p.own)
 
 
 class VIEWLAYER_PT_solidwire_passes(bpy.types.Panel):

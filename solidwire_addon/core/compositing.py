@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 BLOCK_PIXELS = 16384
 
 

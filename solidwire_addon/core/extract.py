@@ -20,8 +20,8 @@ its 4th corner joins p2 and p0.
 from __future__ import annotations
 
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 

@@ -11,6 +11,13 @@ MAX_MESSAGES = 100
 _SUPPRESSED = ("solidwire", "suppressed")
 
 
+def one_line(exc: BaseException) -> str:
+    """An exception's text as one line (a message box, a report or a shell's
+    ``solidwire: error: ...`` shows one line; Blender's and the OS's messages
+    can span several), or its type's name when it has no text."""
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
 def warn_once(key, message: str) -> None:
     if key in _said:
         return

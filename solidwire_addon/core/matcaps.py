@@ -11,7 +11,7 @@ it). Textures are made on first use and freed by :func:`clear`.
 
 from __future__ import annotations
 
-from typing import Callable
+from collections.abc import Callable
 
 import gpu
 import numpy as np

@@ -6,7 +6,7 @@ The draw handler (``blender/overlay.py``) only reads ``bpy.context`` into a
 decision is made here, so tests can call it with any state a real window
 could be in (X-ray, Rendered shading, clipping region, HiDPI, Edit Mode...).
 
-Rules (README "Viewport overlay", table of states):
+Rules (docs/user/overlay.md, "Viewport states"):
 
 * Nothing is drawn when this viewport's SolidWire toggle is off or the
   viewport's own Overlays switch is off.
@@ -121,9 +121,7 @@ def keep_object(plan: OverlayPlan, obj: ObjectState) -> bool:
         return False
     if plan.only_selected and not obj.selected:
         return False
-    if obj.in_edit_mode and not plan.draw_edit_mode:
-        return False
-    return True
+    return not (obj.in_edit_mode and not plan.draw_edit_mode)
 
 
 PIXEL_SETTINGS = tuple(s.name for s in schema.SETTINGS if s.kind == schema.FLOAT and s.subtype == "PIXEL" and s.in_snapshot)

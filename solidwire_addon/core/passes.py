@@ -22,20 +22,25 @@ from dataclasses import dataclass, replace
 import gpu
 import numpy as np
 
-from . import colors, compositing, edge_select, shaders
+from . import colors, compositing, edge_select, shaders, silhouettes
 from . import draw as draw_mod
-from . import silhouettes
 from .log import warn_once
+
+# Render passes beyond Combined and Depth (docs/image_model.md §6), by the
+# name they have in Blender's render result: the schema's one table.
+from .schema import (
+    EDGE_DISTANCE_PASS,
+    HIDDEN_WIRE_PASS,
+    MATERIAL_INDEX_PASS,
+    NORMAL_PASS,
+    OBJECT_INDEX_PASS,
+    WIRE_PASS,
+)
 from .targets import BACKGROUND_DEPTH, read_texture, targets_for
 from .view import View
 
 SURFACE, HIDDEN, WIRE, SILHOUETTES = "surface", "hidden", "wire", "silhouettes"
 
-# Render passes beyond Combined and Depth (docs/image_model.md §6), by the
-# name they have in Blender's render result.
-WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS = "Wire", "Hidden Wire", "Edge Distance"
-NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS = "Normal", "IndexOB", "IndexMA"
-EXTRA_PASSES = (WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS)
 # Written by the surface pass's extra outputs (the rest has its own pass).
 _SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
 
@@ -89,7 +94,7 @@ def render(items, view: View, settings, *, cull: bool = True):
 def render_passes(items, view: View, settings, *, cull: bool = True, extra_passes=(), keep_readback: bool = False,
                   read_depth: bool = True):
     """:func:`render` plus the render passes named in ``extra_passes`` (of
-    EXTRA_PASSES): (rgba, view_depth, stats, {name: (H, W, channels)}).
+    schema.EXTRA_PASSES): (rgba, view_depth, stats, {name: (H, W, channels)}).
     A pass that is not asked for costs nothing: the surface pass gets its
     extra outputs only when one of them is wanted, Hidden Wire its own pass
     only when asked for, and with ``read_depth`` False (no Depth pass) the
@@ -101,7 +106,6 @@ def render_passes(items, view: View, settings, *, cull: bool = True, extra_passe
     width, height = view.width, view.height
     targets = targets_for(width, height)
     steps = plan(settings)
-    stats = None
     surface = steps[0]
     stats = draw_surface(targets, items, view, surface.settings, show_wire=surface.show_wire, aovs=aovs, cull=cull)
     blended = [step for step in steps[1:] if step.kind in (HIDDEN, WIRE)]

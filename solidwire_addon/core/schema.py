@@ -21,8 +21,8 @@ This module imports nothing from Blender: it is plain data.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 # Where a setting lives in Blender: ``scene.solidwire``, ``object.solidwire``
 # or ``view_layer.solidwire``.
@@ -179,7 +179,7 @@ PATTERN_DUTY = {"SOLID": 1.0, "DOTTED": 0.25, "DASHED": 0.5}
 
 def edge_class_settings(name, label, what, color, width, pattern) -> tuple:
     """The four settings of one edge class: on/off, colour, width, pattern."""
-    active = lambda p, flag=f"use_{name}_edges": getattr(p, flag)  # noqa: E731
+    active = lambda p, flag=f"use_{name}_edges": getattr(p, flag)
     return (
         Setting(
             f"use_{name}_edges", BOOL, False, f"{label} Edges",
@@ -450,7 +450,7 @@ SETTINGS: tuple[Setting, ...] = (
 # Not part of the scene's snapshot, presets or command line: gather() reads
 # them per drawn instance. The override's three values share their names with
 # the scene settings they replace (scope tells them apart).
-_OVERRIDE_ACTIVE = lambda p: p.use_override  # noqa: E731
+_OVERRIDE_ACTIVE = lambda p: p.use_override
 OBJECT_SETTINGS: tuple[Setting, ...] = (
     Setting(
         "show_in_viewport", BOOL, True, "Show in Viewport",
@@ -513,6 +513,39 @@ VIEW_LAYER_SETTINGS: tuple[Setting, ...] = (
 )
 
 SETTINGS = (*SETTINGS, *OBJECT_SETTINGS, *VIEW_LAYER_SETTINGS)
+
+
+# -- render passes (docs/image_model.md §6) --------------------------------------
+@dataclass(frozen=True)
+class RenderPass:
+    """A pass the engine writes beyond Combined, as Blender registers it."""
+
+    name: str  # the pass's name in Blender's render result
+    switch: str  # the view layer property that turns it on
+    own: bool  # True: on view_layer.solidwire (a VIEW_LAYER setting); False: Blender's own switch
+    channels: int
+    channel_ids: str
+    kind: str  # Blender's pass type
+
+
+DEPTH_PASS = "Depth"
+NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS = "Normal", "IndexOB", "IndexMA"
+WIRE_PASS, HIDDEN_WIRE_PASS, EDGE_DISTANCE_PASS = "Wire", "Hidden Wire", "Edge Distance"
+
+# The one list of render passes: the engine registers and writes them in
+# this order (blender/engine.py), View Layer Properties > Passes shows their
+# switches (blender/ui.py), and core/passes.py draws the extra ones.
+RENDER_PASSES = (
+    RenderPass(DEPTH_PASS, "use_pass_z", False, 1, "Z", "VALUE"),
+    RenderPass(NORMAL_PASS, "use_pass_normal", False, 3, "XYZ", "VECTOR"),
+    RenderPass(OBJECT_INDEX_PASS, "use_pass_object_index", False, 1, "X", "VALUE"),
+    RenderPass(MATERIAL_INDEX_PASS, "use_pass_material_index", False, 1, "X", "VALUE"),
+    RenderPass(WIRE_PASS, "use_pass_wire", True, 1, "X", "VALUE"),
+    RenderPass(HIDDEN_WIRE_PASS, "use_pass_hidden_wire", True, 1, "X", "VALUE"),
+    RenderPass(EDGE_DISTANCE_PASS, "use_pass_edge_distance", True, 1, "X", "VALUE"),
+)
+# Beyond Combined and Depth: the passes drawn on request (``extra_passes``).
+EXTRA_PASSES = tuple(p.name for p in RENDER_PASSES if p.name != DEPTH_PASS)
 
 # (scope, name) -> setting: a name may exist in several scopes.
 BY_SCOPE: dict[tuple[str, str], Setting] = {(s.scope, s.name): s for s in SETTINGS}

@@ -37,7 +37,7 @@ def _post_init(self) -> None:
 
 
 @classmethod
-def _from_properties(cls, props) -> "DrawSettings":
+def _from_properties(cls, props) -> DrawSettings:
     """Snapshot of a property group made from the schema (or any object
     with the same attribute names)."""
     values = {}

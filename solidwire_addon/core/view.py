@@ -63,7 +63,7 @@ class DrawStats:
     triangles_drawn: int = 0
     extra: dict = field(default_factory=dict)
 
-    def add(self, other: "DrawStats") -> None:
+    def add(self, other: DrawStats) -> None:
         """Count ``other``'s draws in too (one pass drawn in parts)."""
         self.objects_drawn += other.objects_drawn
         self.objects_culled += other.objects_culled

@@ -5,10 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tests.support import reference
-from tests.support import scenes
+from tests.support import reference, scenes
 
-# Core thresholds of the exact path (issue 2 / SPEC 1.5).
+# Core thresholds of the exact path (image model §7, the specification's error measure).
 P999_LIMIT = 2.0 / 255.0
 MAX_LIMIT = 0.1
 

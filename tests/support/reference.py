@@ -36,11 +36,10 @@ Method:
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import bpy
-import warnings
-
 import numpy as np
 
 SILHOUETTE_OFFSET = 0.01  # px, SPEC 1.5
@@ -76,7 +75,7 @@ class _Geometry:
     edge_face: np.ndarray  # (E,) global face id
     edge_real: np.ndarray  # (E,) bool: a drawn line (else a diagonal)
     edge_origin_first: np.ndarray  # (E,) bool: pattern measured from endpoint 0
-    # Silhouette candidates (issue 7): real edges with one or two faces.
+    # Silhouette candidates (image model §5.5): real edges with one or two faces.
     sil_edges: np.ndarray = None  # (S, 2, 3) view-space endpoints
     sil_third: np.ndarray = None  # (S, 2, 3) third vertex of the face on each side (NaN: none)
     # Fill shading and colour sources (image model §5.8).
@@ -301,7 +300,7 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
     members: dict = {}
     for e in range(ne):
         members.setdefault(int(chain[e]), []).append(e)
-    for c, es in members.items():
+    for es in members.values():
         count: dict = {}
         for e in es:
             for v in ev[e]:
@@ -321,7 +320,7 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
             ca.append(chain_ends[e][0])
             cb.append(chain_ends[e][1])
     hidden = {(int(min(ev[e])), int(max(ev[e]))) for e in np.flatnonzero(~drawn)}
-    as_array = lambda x: np.array(x, np.int64)  # noqa: E731
+    as_array = lambda x: np.array(x, np.int64)
     return {"key": key, "owner": as_array(owner), "a": as_array(a), "b": as_array(b), "style": as_array(style),
             "chain_a": as_array(ca), "chain_b": as_array(cb), "hidden": hidden}
 
@@ -888,8 +887,8 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
         name = EDGE_CLASSES[style - 1] if style else None
         pattern = getattr(s, f"{name}_pattern") if name else "SOLID"
         style_ties = {}
-        d, along, index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
-                                                  want_along=False, want_index=True, ties=style_ties)
+        d, _along, _index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
+                                                    want_along=False, want_index=True, ties=style_ties)
         d_real = np.minimum(d_real, d)
         width_px = float(getattr(s, f"{name}_thickness")) if name else thickness
         duty = PATTERN_DUTY[pattern]
@@ -939,8 +938,8 @@ def _eye(proj):
 
 
 def _outer_half(s, geo, proj, width, height, rows, depth):
-    """Outer-half intensity per pixel of ``rows`` (issue 7 definition, see
-    solidwire_addon/silhouettes.py): max over silhouette edges whose outer
+    """Outer-half intensity per pixel of ``rows`` (image model §5.5; see
+    solidwire_addon/core/silhouettes.py): max over silhouette edges whose outer
     side holds the sample and whose nearest point q is not behind the
     visible surface there, of P(d) * fade with thickness and fade at q."""
     out = np.zeros(len(rows) * width)
@@ -1053,7 +1052,7 @@ def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj) 
 
 def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha,
                           undecided=None):
-    """Alpha of the hidden-line layer per pixel (issue 7 definition): every
+    """Alpha of the hidden-line layer per pixel (image model §5.4): every
     face hit behind the visible surface contributes
     a_k = wire_alpha * hidden_alpha * P(d_real) * dash(t) * fade(z_k), with
     t measured along its nearest real edge from that edge's lower-id end;
@@ -1140,7 +1139,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         mode = s.diagonal_mode
         if mode != "HIDDEN":
             diag_ties = {}
-            d_diag, along, index = _min_distance_per_pixel(
+            d_diag, along, _index = _min_distance_per_pixel(
                 pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, want_along=(mode in ("DOTTED", "DASHED")),
                 want_index=True, ties=diag_ties,
             )

@@ -1,9 +1,8 @@
-"""Helpers for the robustness tests (issue 6): float renders through the real
+"""Helpers for the robustness tests: float renders through the real
 engine, captured messages, and scans of the add-on's module state."""
 
 from __future__ import annotations
 
-import os
 import sys
 import types
 from pathlib import Path
@@ -11,13 +10,9 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from tests.support import scenes
 from solidwire_addon.blender import overlay
 from solidwire_addon.blender.views import camera_view
-
-# Opt-in suites (soak, large frames, compat): `SOLIDWIRE_SLOW=1 pytest ...`
-# or `pytest --run-slow` (see conftest.py); default CI skips them.
-SLOW = os.environ.get("SOLIDWIRE_SLOW", "") not in ("", "0")
+from tests.support import scenes
 
 # The bpy 4.2 module crashes at interpreter exit (SIGSEGV) once any
 # PropertyGroup with an update= callback was registered, even after it was

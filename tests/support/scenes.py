@@ -14,7 +14,6 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
-
 # The look of the image model's sections 1.2-1.4 (no shading, no colour
 # sources, no fill): what the accuracy tests measure unless they ask for more.
 CORE_LOOK = dict(use_fill=False, fill_shading="FLAT", fill_color=(1.0, 1.0, 1.0),

@@ -4,7 +4,7 @@
 //
 // Install: copy this file into the `scripts` folder next to the
 // flamenco-manager executable (the job type is named after the file:
-// "solidwire"). See docs/render_farm.md.
+// "solidwire"). See docs/user/render-farm.md.
 //
 // Two modes:
 //   SOLIDWIRE  Blender's own animation render with the SolidWire engine:
