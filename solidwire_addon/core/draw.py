@@ -19,8 +19,16 @@ from .cache import table_texture
 from .edge_select import EDGE_CLASSES
 from .log import warn_once
 from .settings import pack_params
-from .view import (DrawStats, View, box_pixels, outside_frustum_many, translation, wholly_in_front, window_boxes,
-                   window_rect)
+from .view import (
+    DrawStats,
+    View,
+    box_pixels,
+    outside_frustum_many,
+    translation,
+    wholly_in_front,
+    window_boxes,
+    window_rect,
+)
 
 
 def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0,
@@ -295,12 +303,12 @@ def draw(
         extras["matcap_image"] = matcaps.texture(settings.matcap)
         if extras["matcap_image"] is None:
             variant = replace(variant, shading=shaders.SHADING_FLAT)
-    if variant.shading != shaders.SHADING_FLAT or variant.material_colors:
-        if any(item.mesh.corners is None for item in items):
-            # Meshes gathered without their corner table (a caller that did
-            # not ask for it): draw flat rather than read a missing table.
-            warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
-            variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
+    if (variant.shading != shaders.SHADING_FLAT or variant.material_colors) and any(
+            item.mesh.corners is None for item in items):
+        # Meshes gathered without their corner table (a caller that did not
+        # ask for it): draw flat rather than read a missing table.
+        warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
+        variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
     # Two per-object mechanisms side by side:
     # an object's style override (wire colour, thickness, fill colour) is a
     # parameter block per distinct style (``ubo(style)``), since thickness
@@ -612,7 +620,7 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             if variant.per_item:
                 shader.uniform_int("item_slot", slot)
             _bind_mesh(shader, variant, mesh)
-            numbering.draw(shader, mesh, lambda: program.batch(mesh), object_to_clip)
+            numbering.draw(shader, mesh, lambda mesh=mesh: program.batch(mesh), object_to_clip)
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
@@ -744,7 +752,7 @@ def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras, nu
             gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
         shader.uniform_int("instance_base", base)
         _bind_mesh(shader, variant, mesh)
-        numbering.draw(shader, mesh, lambda: mesh.batch, object_to_clip, instance_count=count)
+        numbering.draw(shader, mesh, lambda mesh=mesh: mesh.batch, object_to_clip, instance_count=count)
         base += count * shaders.INSTANCE_TEXELS
         stats.objects_drawn += count
         stats.triangles_drawn += count * mesh.triangle_count

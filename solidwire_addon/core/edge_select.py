@@ -34,8 +34,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from .extract import (
-    EDGE0_HIDDEN, EDGE0_REAL, EDGE1_REAL, EDGE2_REAL, EDGE3_HIDDEN, EDGE4_HIDDEN, HAS_QUAD_CORNER, IN_REGION,
-    IS_NGON, NGON_SHIFT, REGION_LINES, MeshArrays, read_face_normals,
+    EDGE0_HIDDEN,
+    EDGE0_REAL,
+    EDGE1_REAL,
+    EDGE2_REAL,
+    EDGE3_HIDDEN,
+    EDGE4_HIDDEN,
+    HAS_QUAD_CORNER,
+    IN_REGION,
+    IS_NGON,
+    NGON_SHIFT,
+    REGION_LINES,
+    MeshArrays,
+    read_face_normals,
 )
 
 # Edge classes, in style order: style k + 1 is class k (style 0 is the
@@ -253,7 +264,7 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     arrays.triangles[listed, 3] = base + TEXELS_PER_SEGMENT * first[at]
     stats.regions = int((walked_region & (np.arange(face_count) == label)).sum())
     stats.listed_triangles = int(listed.sum())
-    stats.segments = int(len(seg_a))
+    stats.segments = len(seg_a)
     _region_lines(arrays, verts, classes, ends, label, walked, pairs, stats)
     return stats
 
@@ -261,7 +272,7 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
 def _one_per_class(bits: np.ndarray, *columns: np.ndarray):
     """(style, columns repeated): one row per class bit set in ``bits`` (its
     style k + 1 for class k), one row of style 0 where no bit is set."""
-    popcount = np.array([bin(b).count("1") for b in range(1 << len(EDGE_CLASSES))])
+    popcount = np.array([b.bit_count() for b in range(1 << len(EDGE_CLASSES))])
     per_row = np.maximum(popcount[bits], 1)
     bits = np.repeat(bits, per_row)
     rank = np.arange(len(bits)) - np.repeat(np.cumsum(per_row) - per_row, per_row)
