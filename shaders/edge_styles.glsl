@@ -1,21 +1,34 @@
 /* SolidWire line styles of the exact path (docs/image_model.md §3.6-§3.7):
  * style 0 is the wire; styles 1..5 are the edge classes in the order of
  * core/edge_select.py EDGE_CLASSES (boundary, sharp, crease, seam,
- * Freestyle), each with its own colour, width (pixels in every thickness
- * mode) and pattern duty from the parameter block. */
+ * Freestyle), each with its own colour, width (relative to the wire's)
+ * and pattern duty from the parameter block. */
 
+/* A class's half width where the wire's is `wire_half_thickness`: its own
+ * width scaled as the wire's is scaled from the Thickness in the parameter
+ * block (the thickness mode's factor; an object's override is already in
+ * both, draw.styled); unscaled where that Thickness is 0. */
 float style_half_thickness(int style, float wire_half_thickness)
 {
 #if STYLE_COUNT > 1
+  float own = 0.0;
   switch (style) {
-    case 1: return params.boundary_half_thickness;
-    case 2: return params.sharp_half_thickness;
-    case 3: return params.crease_half_thickness;
-    case 4: return params.seam_half_thickness;
-    case 5: return params.freestyle_half_thickness;
+    case 1: own = params.boundary_half_thickness; break;
+    case 2: own = params.sharp_half_thickness; break;
+    case 3: own = params.crease_half_thickness; break;
+    case 4: own = params.seam_half_thickness; break;
+    case 5: own = params.freestyle_half_thickness; break;
+    default: return wire_half_thickness;
   }
-#endif
+#  if THICKNESS_MODE != 0
+  if (params.half_thickness > 0.0) {
+    own *= wire_half_thickness / params.half_thickness;
+  }
+#  endif
+  return own;
+#else
   return wire_half_thickness;
+#endif
 }
 
 #if STYLE_COUNT > 1

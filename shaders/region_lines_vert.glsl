@@ -46,8 +46,9 @@ void main()
   line_instance = float(gl_InstanceID);
 #endif
 
-  /* The widest the style's line can be here, plus its 2s fall-off and a
-   * pixel so that every sample the profile reaches is rasterised. */
+  /* The widest the style's line can be here, plus its 2s fall-off (the
+   * profile is 0 beyond it) and a hundredth of a pixel for rounding: every
+   * sample the profile reaches lies inside the quad, and no more. */
   float depth_a = a.z + a.w, depth_b = b.z + b.w;
   vec4 a_front = (depth_a < 0.0) ? mix(a, b, depth_a / (depth_a - depth_b)) : a;
   vec4 b_front = (depth_b < 0.0) ? mix(b, a, depth_b / (depth_b - depth_a)) : b;
@@ -56,7 +57,7 @@ void main()
   half_width = params.world_half_thickness_px / max(min(a_front.w, b_front.w), 1e-6);
 #endif
   half_width = style_half_thickness(line_style, half_width);
-  float reach = half_width + 2.0 * params.softness + 1.0;
+  float reach = half_width + 2.0 * params.softness + 0.01;
 
   vec2 dir = vec2(-line.y, line.x);
   vec2 foot = -line.z * line.xy + viewport_centre(); /* the line's point nearest the centre */

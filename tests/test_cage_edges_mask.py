@@ -191,6 +191,35 @@ def test_stacked_subdivisions_compose():
     _assert_simple_cube_cage(mask, edges, positions, level=3)
 
 
+def test_optimal_display_off_shows_every_edge_of_that_modifier():
+    """Blender's overlay shows a subdivision's new edges when the modifier's
+    Optimal Display is off: the last modifier's setting decides whether
+    any edge is hidden, and an earlier one's whether its own are."""
+    _scene, obj, mod = _subdivided_cube(2, "SIMPLE")
+    mod.show_only_control_edges = False
+    mask, _edges, _positions = _mask(obj)
+    assert mask is None
+    # First modifier shows everything, the second hides its inner edges:
+    # the drawn edges are the children of every edge the first one made.
+    mod.levels = 1
+    second = obj.modifiers.new("Second", "SUBSURF")
+    second.subdivision_type = "SIMPLE"
+    second.levels = 1
+    mask, edges, positions = _mask(obj)
+    first_level_edges = 12 * 2 + 6 * 4  # a cube subdivided once: 48 edges
+    assert mask is not None and int(mask.sum()) == 2 * first_level_edges
+    # Each drawn edge lies on a line of the first level's grid: the two
+    # coordinates it does not run along are 0 or +-1 (never +-0.5).
+    a, b = positions[edges[mask, 0]], positions[edges[mask, 1]]
+    fixed = np.isclose(a, b, atol=1e-5)
+    assert (fixed.sum(axis=1) == 2).all()
+    assert np.isin(np.round(np.abs(a[fixed]), 4), (0.0, 1.0)).all()
+    # Both on: the original cube's 12 edges, cut 4 times each.
+    mod.show_only_control_edges = True
+    mask, edges, positions = _mask(obj)
+    _assert_simple_cube_cage(mask, edges, positions, level=2)
+
+
 def test_simplify_lowering_the_level_is_followed():
     scene, obj, _mod = _subdivided_cube(3)
     scene.render.use_simplify = True

@@ -182,6 +182,7 @@ class _Mesh:
     bounds_min = -np.ones(3)
     bounds_max = np.ones(3)
     has_ngons = False
+    region_line_count = 0
 
     def __init__(self, triangles):
         self.triangle_count = triangles
@@ -223,6 +224,11 @@ def test_dense_meshes_are_deferred_sparse_ones_direct():
     blocky.has_ngons = True  # n-gon and region blocks make a triangle dearer to set up
     deferred, direct = draw.split_deferred([_Item(plain), _Item(blocky)], view)
     assert [item.mesh for item in deferred] == [blocky] and [item.mesh for item in direct] == [plain]
+    # Multi-face regions draw their lines over the visibility record: such a
+    # mesh is deferred however sparse.
+    regions = _Mesh(10)
+    regions.region_line_count = 4
+    assert draw.split_deferred([_Item(regions)], view)[0][0].mesh is regions
 
 
 def test_numbers_beyond_float32_whole_numbers_keep_the_direct_pass():

@@ -84,10 +84,11 @@ def _requested_level(md, render: bool, sculpt: bool) -> int:
 
 
 def _stack(obj, render: bool):
-    """(requested levels of the subdivision modifiers in stack order, whether
-    only topology-keeping modifiers come before the first one) or None when
-    the answer is unknowable or trivial (no subdivision modifier, a modifier
-    that changes the topology after one)."""
+    """(requested (level, Optimal Display) of the subdivision modifiers in
+    stack order, whether only topology-keeping modifiers come before the
+    first one) or None when the answer is unknowable or trivial (no
+    subdivision modifier, a modifier that changes the topology after one,
+    or the last one shows every edge: Optimal Display off)."""
     original = getattr(obj, "original", None) or obj
     mode = getattr(original, "mode", "OBJECT")
     edit = mode == "EDIT"
@@ -101,14 +102,17 @@ def _stack(obj, render: bool):
         if kind in SUBDIVISION_TYPES:
             if edit and kind == "MULTIRES":
                 continue  # Multires is not evaluated in Edit Mode
-            levels.append(_requested_level(md, render, sculpt))
+            # Optimal Display (show_only_control_edges), per modifier as in
+            # Blender's own overlay: off, the modifier's new edges show too.
+            levels.append((_requested_level(md, render, sculpt), bool(getattr(md, "show_only_control_edges", True))))
         elif kind in TOPOLOGY_KEEPING_TYPES:
             continue
         elif levels:
             return None  # topology changed after a subdivision
         else:
             plain_before = False
-    if not any(levels):
+    levels = [entry for entry in levels if entry[0] > 0]
+    if not levels or not levels[-1][1]:
         return None
     return levels, plain_before
 
@@ -201,7 +205,13 @@ def _cage_layout(obj, mesh, *, render: bool):
     edges = _read_edges(mesh)
     verts_num, faces_num = len(mesh.vertices), len(mesh.polygons)
     total = 1  # child edges per cage edge so far
-    for requested in reversed(levels):
+    own_mesh = True  # peeled down to the object's own mesh
+    for requested, optimal in reversed(levels):
+        if not optimal:
+            # This modifier shows every edge it makes: the drawn edges are
+            # the children of all of its input's edges.
+            own_mesh = False
+            break
         # Simplify can lower a level (and 0 skips the modifier): the first
         # level whose layout fits is the one used; none fits -> skipped.
         for level in range(min(requested, MAX_LEVEL), 0, -1):
@@ -212,7 +222,7 @@ def _cage_layout(obj, mesh, *, render: bool):
                 break
     if total == 1:
         return None  # left coarse: every edge is a cage edge
-    if plain_before:
+    if plain_before and own_mesh:
         counts = _cage_counts(obj)
         if counts is not None and (verts_num, len(edges)) not in counts:
             return None  # not this object's own mesh (or not yet re-evaluated)
@@ -262,9 +272,9 @@ def cage_key(obj, render: bool):
     for md in obj.modifiers:
         entry = (md.type, bool(md.show_viewport), bool(md.show_render), bool(md.show_in_editmode))
         if md.type == "SUBSURF":
-            entry += (int(md.levels), int(md.render_levels))
+            entry += (int(md.levels), int(md.render_levels), bool(md.show_only_control_edges))
         elif md.type == "MULTIRES":
             entry += (int(md.levels), int(md.render_levels), int(md.sculpt_levels), int(md.total_levels),
-                      bool(md.use_sculpt_base_mesh))
+                      bool(md.use_sculpt_base_mesh), bool(md.show_only_control_edges))
         parts.append(entry)
     return tuple(parts)

@@ -181,7 +181,7 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
                                             **passes.gather_options(settings))
     start = time.perf_counter()
     stats = passes.draw_over_viewport(
-        items,
+        overlay_state.draw_items(plan, items),
         view,
         overlay_state.draw_settings(plan, settings),
         scene_depth=plan.scene_depth,

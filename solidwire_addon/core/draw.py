@@ -161,8 +161,11 @@ def styled(settings, style, show_wire: bool = True):
     pass whatever the override's colour (the fill-only surface pass under
     hidden lines)."""
     if style is not None:
+        # Class widths keep their ratio to the wire's (image model §3.6).
+        scale = style.thickness / settings.thickness if settings.thickness > 0.0 else 1.0
+        classes = {f"{name}_thickness": getattr(settings, f"{name}_thickness") * scale for name in EDGE_CLASSES}
         settings = replace(settings, wire_color=style.wire_color, thickness=style.thickness,
-                           fill_color=style.fill_color)
+                           fill_color=style.fill_color, **classes)
     if not show_wire and settings.wire_color[3] != 0.0:
         settings = replace(settings, wire_color=(*settings.wire_color[:3], 0.0))
     return settings

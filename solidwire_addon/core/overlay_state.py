@@ -127,6 +127,16 @@ def keep_object(plan: OverlayPlan, obj: ObjectState) -> bool:
 PIXEL_SETTINGS = tuple(s.name for s in schema.SETTINGS if s.kind == schema.FLOAT and s.subtype == "PIXEL" and s.in_snapshot)
 
 
+def draw_items(plan: OverlayPlan, items):
+    """``items`` as this viewport draws them: an object's own Thickness is a
+    pixel length like the scene's, so it takes the UI scale too."""
+    if plan.pixel_scale == 1.0:
+        return items
+    return [item if item.style is None else
+            replace(item, style=replace(item.style, thickness=item.style.thickness * plan.pixel_scale))
+            for item in items]
+
+
 def draw_settings(plan: OverlayPlan, settings):
     """``settings`` as this viewport draws them: pixel lengths times the UI
     scale, silhouettes off while clipping."""

@@ -890,7 +890,7 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
         d, _along, _index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
                                                     want_along=False, want_index=True, ties=style_ties)
         d_real = np.minimum(d_real, d)
-        width_px = float(getattr(s, f"{name}_thickness")) if name else thickness
+        width_px = _class_width(s, name, thickness) if name else thickness
         duty = PATTERN_DUTY[pattern]
         if use_density or duty < 1.0:
             # The style's intensity is its strongest line (§3.6-§3.7), not
@@ -907,6 +907,17 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
         winner[wins] = style
         value = np.maximum(value, v)
     return value, d_real, winner, density, tied
+
+
+def _class_width(s, name, wire_width):
+    """A class's core width where the wire's is ``wire_width`` (image model
+    §3.6): its Thickness scaled as the wire's width is scaled from the
+    scene's Thickness (object override, thickness mode); its Thickness
+    itself where the scene's Thickness is 0."""
+    own, scene_width = float(getattr(s, f"{name}_thickness")), float(s.thickness)
+    if scene_width <= 0.0:
+        return own
+    return own * np.asarray(wire_width, np.float64) / scene_width
 
 
 def _thickness_at(s, z, proj, height, override=None):

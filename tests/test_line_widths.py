@@ -1,0 +1,66 @@
+"""Line widths that follow one another (image model §3.6, §5.9): an edge
+class keeps its ratio to the wire's width under an object's override and in
+every thickness mode, and an object's own Thickness takes the viewport's UI
+scale like the scene's."""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+import pytest
+
+from solidwire_addon.blender.views import camera_view
+from solidwire_addon.core import overlay_state
+from tests.support import accuracy, scenes
+
+
+def _classed_cube(scene, name="Cube", **kwargs):
+    cube = scenes.cube(scene, name, rotation=(0.3, 0.1, 0.6), **kwargs)
+    for edge in cube.data.edges[:5]:
+        edge.use_edge_sharp = True
+    return cube
+
+
+@pytest.mark.parametrize("mode", ["PIXELS", "DEPTH", "WORLD"])
+@pytest.mark.parametrize("override", [False, True])
+def test_class_widths_follow_the_wire(mode, override, output_dir):
+    scene = scenes.empty_scene(200, 150, thickness=1.5, use_sharp_edges=True, sharp_thickness=4.0,
+                               thickness_mode=mode, thickness_far=0.75, thickness_depth_start=4.0,
+                               thickness_depth_end=9.0, world_thickness=0.03)
+    cube = _classed_cube(scene)
+    scenes.cube(scene, "Other", size=1.0, location=(0.0, 2.5, -0.5))  # the scene's own widths
+    if override:
+        cube.solidwire.use_override = True
+        cube.solidwire.thickness = 3.0
+    scenes.add_camera(scene, location=(3.5, -5.0, 2.8), target=(0, 0.6, 0))
+    report = accuracy.measure(scene, f"class_width_{mode.lower()}_{'override' if override else 'scene'}", output_dir)
+    accuracy.assert_accurate(report)
+
+
+def test_an_override_thickness_takes_the_ui_scale(output_dir):
+    """At UI scale 2 a scene whose pixel lengths are halved (Thickness, Softness,
+    a class's and an object's own) draws exactly as at UI scale 1."""
+    from tests.test_overlay import FakeViewport
+
+    def overlay_alpha(pixel_size: float, own_thickness: float = 4.0):
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        scene = scenes.empty_scene(160, 120, thickness=2.0 / pixel_size, softness=1.0 / pixel_size, use_sharp_edges=True,
+                                   sharp_thickness=3.0 / pixel_size)
+        cube = _classed_cube(scene)
+        cube.solidwire.use_override = True
+        cube.solidwire.thickness = own_thickness / pixel_size
+        scenes.add_camera(scene, location=(3.5, -5.0, 2.8), target=(0, 0, 0))
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        view = camera_view(scene, depsgraph, (160, 120))
+        viewport = FakeViewport(160, 120)
+        viewport.depth_pass(depsgraph, view, [cube])
+        plan = overlay_state.plan_overlay(overlay_state.ViewportState(pixel_size=pixel_size))
+        viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), plan=plan, display=None)
+        return viewport.rgba()[..., 3]
+
+    plain = overlay_alpha(1.0)
+    assert plain.max() > 0.9
+    assert np.abs(overlay_alpha(2.0) - plain).max() <= 1.0 / 255.0
+    # The object's own width left unscaled is visibly thinner: the
+    # comparison above can fail.
+    assert np.abs(overlay_alpha(1.0, own_thickness=2.0) - plain).max() > 0.3
