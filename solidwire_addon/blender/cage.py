@@ -193,8 +193,10 @@ def _cage_layout(obj, mesh, *, render: bool):
     after the subdivision that changes the topology, an edge layout that is
     not the subdivision's).
 
-    Returned as (edges that are cage children, children per cage edge):
-    the mask is the first ones, each cage edge's children consecutive."""
+    Returned as (edges that are cage children, children per cage edge,
+    (C, 2) the two end vertices of each cage edge): the mask is the first
+    ones, each cage edge's children consecutive. A subdivision keeps the
+    coarse vertices' numbers, so the ends are vertices of ``mesh`` too."""
     stack = _stack(obj, render)
     if stack is None:
         return None
@@ -229,7 +231,7 @@ def _cage_layout(obj, mesh, *, render: bool):
     cage_children = len(edges) * total
     if cage_children >= edges_num:
         return None  # a mesh without faces: every edge comes from a cage edge
-    return cage_children, total
+    return cage_children, total, edges
 
 
 def cage_edge_mask(obj, mesh, *, render: bool):
@@ -244,16 +246,19 @@ def cage_edge_mask(obj, mesh, *, render: bool):
 
 
 def cage_edges(obj, mesh, *, render: bool):
-    """(drawn mask, chain id per edge) for core/edge_select.py, or None: the
-    children of one cage edge share a chain id, so the density fade measures
-    the whole cage edge, not its pieces."""
+    """(drawn mask, chain id per edge, (E, 2) chain ends per edge) for
+    core/edge_select.py, or None: the children of one cage edge share a
+    chain id and ends, so the density fade measures the whole cage edge,
+    not its pieces (an edge that is no cage child is its own chain)."""
     layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
         return None
-    children, per_edge = layout
+    children, per_edge, cage = layout
     index = np.arange(len(mesh.edges), dtype=np.int64)
     mask = index < children
-    return mask, np.where(mask, index // per_edge, -1 - index)
+    ends = _read_edges(mesh).astype(np.int64)
+    ends[:children] = np.repeat(np.asarray(cage, np.int64), per_edge, axis=0)
+    return mask, np.where(mask, index // per_edge, -1 - index), ends
 
 
 def subdivides(obj, render: bool) -> bool:
