@@ -16,7 +16,7 @@ import atexit
 import bpy
 
 from .blender import cli, color_management, engine, matcap_files, ops, ops_composite, overlay, properties, runtime, ui
-from .core import draw, log, matcaps, silhouettes, targets
+from .core import draw, log, matcaps, silhouettes, strands, targets
 
 _classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
 _registered = False
@@ -73,6 +73,7 @@ def release_gpu() -> None:
     targets.release()
     runtime.release()
     silhouettes.release()
+    strands.release()
     draw.release_rectangle()
     matcaps.clear()
     color_management.release()
