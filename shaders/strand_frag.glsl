@@ -34,6 +34,12 @@ void main()
 #  endif
 #else
   vec2 wa = window_point(seg_a), wb = window_point(seg_b);
+#  ifdef STRAND_OVERLAY
+  /* This segment's side of each joint (strand_vert.glsl, joint_normal). */
+  if (dot(p - wa, seg_split.xy) < 0.0 || dot(p - wb, seg_split.zw) > 0.0) {
+    discard;
+  }
+#  endif
   vec2 ab = wb - wa;
   float len2 = dot(ab, ab);
   float s = (len2 > 0.0) ? clamp(dot(p - wa, ab) / len2, 0.0, 1.0) : 0.0;

@@ -33,6 +33,32 @@ vec4 quad_corner(vec2 wa, vec2 wb, float reach, int corner)
   return vec4(ndc, 0.0, 1.0);
 }
 
+#if defined(STRAND_OVERLAY) && !defined(STRAND_POINTS)
+/* The overlay blends segments "over" each other, so at a joint two
+ * segments would both paint the pixels they share. Each segment keeps only
+ * its side of the bisector of the joint: the plane through the joint whose
+ * normal is the sum of the two unit directions (the pixels nearer its own
+ * segment's line). (0, 0): no split (no neighbour, the end is near-clipped,
+ * the neighbour is behind the camera, or the strand turns back on itself). */
+vec2 joint_normal(float neighbour, vec2 win_a, vec2 win_b, bool clipped, bool at_a)
+{
+  if (neighbour < 0.0 || clipped) {
+    return vec2(0.0);
+  }
+  vec4 n = object_to_clip * vec4(fetch_texel(vertex_positions, int(neighbour)).xyz, 1.0);
+  if (!(n.z + n.w >= 0.0) || !(n.w > 0.0)) {
+    return vec2(0.0);
+  }
+  vec2 win_n = window_point(n);
+  vec2 along = win_b - win_a;
+  vec2 other = at_a ? win_a - win_n : win_n - win_b;
+  if (dot(along, along) == 0.0 || dot(other, other) == 0.0) {
+    return vec2(0.0);
+  }
+  return normalize(along) + normalize(other);
+}
+#endif
+
 void main()
 {
   int prim = gl_VertexID / 6;
@@ -86,6 +112,11 @@ void main()
   float half_a = max(half_thickness_at(seg_depth.x, wa_inv), seg_radius.x * PX_PER_UNIT * wa_inv);
   float half_b = max(half_thickness_at(seg_depth.y, wb_inv), seg_radius.y * PX_PER_UNIT * wb_inv);
   float reach = min(max(half_a, half_b), 16384.0) + 2.0 * params.softness + 1.0;
-  gl_Position = quad_corner(window_point(a_front), window_point(b_front), reach, corner);
+  vec2 win_a = window_point(a_front), win_b = window_point(b_front);
+#  ifdef STRAND_OVERLAY
+  seg_split = vec4(joint_normal(ids.z, win_a, win_b, ta > 0.0, true),
+                   joint_normal(ids.w, win_a, win_b, tb > 0.0, false));
+#  endif
+  gl_Position = quad_corner(win_a, win_b, reach, corner);
 #endif
 }

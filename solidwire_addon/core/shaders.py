@@ -687,6 +687,8 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             iface.flat("VEC4", "seg_b")
             iface.flat("VEC2", "seg_depth")
             iface.flat("VEC2", "seg_radius")
+            if overlay_bias:
+                iface.flat("VEC4", "seg_split")  # bisector normals at the two joints (overlay)
         info = pulling_info()
         info.push_constant("VEC4", "strand_view")  # px per unit at w = 1, radius scale
         info.push_constant("INT", "prim_count")

@@ -48,8 +48,10 @@ class StrandGeometry:
 
     ``points`` (N, 4) float32: position relative to ``centre`` (float64; the
     draw composes the translation in float64 so large coordinates keep their
-    precision) and radius. ``segments`` (S, 4) float32 rows (i0, i1, 0, 0)
-    of point indices (curves only)."""
+    precision) and radius. ``segments`` (S, 4) float32 rows (i0, i1,
+    previous, next) of point indices (curves only): the segment's ends and
+    the points before i0 and after i1 along the strand (-1: none), which
+    the overlay uses to split a joint between its two segments."""
 
     kind: str
     points: np.ndarray
@@ -130,8 +132,7 @@ def _finish(kind, values: np.ndarray, segments: np.ndarray | None, dropped: int)
     rows = rows.astype(np.float32)
     seg_rows = None
     if segments is not None:
-        seg_rows = np.zeros((len(segments), 4), dtype=np.float32)
-        seg_rows[:, :2] = segments
+        seg_rows = np.asarray(segments, dtype=np.float32)
     return StrandGeometry(kind, rows, seg_rows, centre, lo - centre - reach, hi - centre + reach, dropped)
 
 
@@ -159,31 +160,44 @@ def curves_geometry(positions, radius=None, offsets=None, curve_types=None, reso
         if kind == CATMULL_ROM and len(control) >= 2:
             res = int(resolutions[c]) if resolutions is not None else DEFAULT_RESOLUTION
             evaluated = catmull_rom(control, res, closed)
-            closed_here = False  # catmull_rom closed it already
+            closed_here, wrapped = False, closed  # catmull_rom closed it (last point = first)
         else:
-            evaluated, closed_here = control, closed and len(control) > 2
+            evaluated, closed_here, wrapped = control, closed and len(control) > 2, False
         n = len(evaluated)
         if n >= 2:
             a = np.arange(n - 1)
-            seg = np.stack([a, a + 1], axis=1)
+            seg = np.stack([a, a + 1, a - 1, a + 2], axis=1)
+            seg[-1, 3] = -1
             if closed_here:
-                seg = np.concatenate([seg, [[n - 1, 0]]])
+                seg = np.concatenate([seg, [[n - 1, 0, n - 2, 1]]])
+                seg[0, 2], seg[-2, 3] = n - 1, 0
+            elif wrapped and n > 2:
+                seg[0, 2], seg[-1, 3] = n - 2, 1
             good = np.isfinite(evaluated).all(axis=1)
             keep = good[seg[:, 0]] & good[seg[:, 1]]
             dropped += int((~good).sum())
-            segments.append(seg[keep] + total)
+            seg = seg[keep]
+            # A neighbour that is not finite is no neighbour.
+            for column in (2, 3):
+                ok = seg[:, column] >= 0
+                ok[ok] = good[seg[ok, column]]
+                seg[~ok, column] = -1
+            seg[:, :4] += np.where(seg >= 0, total, 0)
+            segments.append(seg)
         parts.append(evaluated)
         total += n
     if not parts:
         return None
     values = np.concatenate(parts)
-    segments = np.concatenate(segments) if segments else np.zeros((0, 2), np.int64)
+    segments = np.concatenate(segments) if segments else np.zeros((0, 4), np.int64)
     # Points no kept segment uses (non-finite ones among them) stay out of
-    # the bounds: renumber the used ones.
+    # the bounds: renumber the used ones (a neighbour no segment uses
+    # becomes -1).
     used = np.zeros(len(values), bool)
-    used[segments.ravel()] = True
-    new_index = np.cumsum(used) - 1
-    return _finish(CURVES, values[used], new_index[segments], dropped)
+    used[segments[:, :2].ravel()] = True
+    new_index = np.where(used, np.cumsum(used) - 1, -1)
+    renumbered = np.where(segments >= 0, new_index[np.maximum(segments, 0)], -1)
+    return _finish(CURVES, values[used], renumbered, dropped)
 
 
 def points_geometry(positions, radius=None) -> StrandGeometry | None:
