@@ -48,8 +48,9 @@ def _measure(scene, name, output_dir, wire_alpha=1.0):
         {"thickness": 0.0, "softness": 1.0},
         {"thickness": 4.0, "softness": 0.5},
         {"thickness": 1.5, "ortho": True},
+        {"thickness": 2.0, "use_fade": True, "fade_start": 9.0, "fade_end": 11.0},
     ],
-    ids=["default", "thin", "wide_sharp", "ortho"],
+    ids=["default", "thin", "wide_sharp", "ortho", "fade"],
 )
 def test_strands_and_discs_match_reference(case, output_dir):
     settings = dict(case)
@@ -60,8 +61,10 @@ def test_strands_and_discs_match_reference(case, output_dir):
     _rgba, ref, report = _measure(scene, name, output_dir)
     accuracy.assert_accurate(report)
     # Strands, wide strands and discs really draw, and the cube hides some.
-    assert (ref.strand > 0.99).sum() > 150
+    assert (ref.strand > 0.99).sum() > (60 if "use_fade" in case else 150)
     assert (ref.weight == 1.0).sum() > 100  # disc insides and line cores
+    if "use_fade" in case:
+        assert ((ref.strand > 0.2) & (ref.strand < 0.8) & (ref.weight == ref.strand)).sum() > 100  # faded lines
 
 
 def test_mesh_hides_strands_and_points(output_dir):
@@ -221,3 +224,28 @@ def test_overlay_draws_them_as_the_render_does(output_dir):
     assert np.percentile(diff, 99.9) <= 3.0 / 255.0
     # Every strand pixel the render draws, the overlay draws too.
     assert np.all(alpha_overlay[(alpha_engine > 0.99) & ~crossing] > 0.95)
+
+
+def test_overlay_honours_show_in_viewport():
+    import bpy
+
+    from solidwire_addon.blender.views import camera_view
+    from tests.test_overlay import FakeViewport
+
+    scene = scenes.empty_scene(160, 120, thickness=1.5)
+    strand_scenes.hair(scene, "Hair", [[(-2.0, 0.0, 0.0), (2.0, 0.0, 0.0)]])
+    strand_scenes.point_cloud(scene, "Points", [(0.0, 0.0, 1.0)], 0.3)
+    scenes.add_camera(scene, location=(0.0, -6.0, 0.0), target=(0.0, 0.0, 0.0))
+
+    def drawn():
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        view = camera_view(scene, depsgraph, (160, 120))
+        viewport = FakeViewport(160, 120)
+        viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
+        return int((viewport.rgba()[..., 3] > 0.5).sum())
+
+    both = drawn()
+    bpy.data.objects["Hair"].solidwire.show_in_viewport = False
+    points_only = drawn()
+    bpy.data.objects["Points"].solidwire.show_in_viewport = False
+    assert both > points_only > 20 and drawn() == 0

@@ -9,9 +9,11 @@ Per sample c (pixel centre) and primitive:
   (perspective-correct), q = A + u (B - A); at q: view depth z, clip w,
   radius r (linear in u, times the object's radius scale cbrt|det M|);
   half-width h' = max(h, r * px_per_unit / w) with px_per_unit =
-  H/2 |P[1][1]|; I = P(d; h'), weight = I; depth = z - r.
+  H/2 |P[1][1]|; I = P(d; h') (times the depth fade at z when on),
+  weight = I; depth = z - r.
 * point p (centre in front of the near plane): window centre o, radius
-  R = r px_per_unit / w; rim = |c - o| - R; I = P(|rim|; h); weight = 1
+  R = r px_per_unit / w; rim = |c - o| - R; I = P(|rim|; h) (times the
+  depth fade at z_p); weight = 1
   inside (rim <= 0) else I; depth = z_p - r.
 
 A primitive is visible at c when its depth <= the visible mesh surface's
@@ -204,6 +206,8 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
         z = za + u * (zb - za)
         r = ra + u * (rb - ra)
         value = reference.profile(d, 2.0 * np.maximum(h, r * ppu / w), soft)  # (full width)
+        if getattr(s, "use_fade", False):
+            value = value * reference._fade(s, z)
         consider(x0, x1, y0, y1, value, value, z - r)
     for p_obj, r, matrix, _name in points:
         scale = abs(np.linalg.det(matrix[:3, :3])) ** (1 / 3)
@@ -221,6 +225,8 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
         px, py = np.meshgrid(np.arange(x0, x1) + 0.5, np.arange(y0, y1) + 0.5)
         rim = np.hypot(px - o[0], py - o[1]) - radius
         value = reference.profile(np.abs(rim), 2.0 * h, soft)
+        if getattr(s, "use_fade", False):
+            value = value * reference._fade(s, np.full_like(px, -v[2]))
         consider(x0, x1, y0, y1, np.where(rim <= 0, 1.0, value), value, np.full_like(px, -v[2] - r))
 
     wire_alpha = float(s.wire_color[3])
