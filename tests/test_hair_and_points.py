@@ -249,3 +249,25 @@ def test_overlay_honours_show_in_viewport():
     points_only = drawn()
     bpy.data.objects["Points"].solidwire.show_in_viewport = False
     assert both > points_only > 20 and drawn() == 0
+
+
+def test_unchanged_hair_is_reused_and_an_edit_is_seen(output_dir):
+    """Evaluated strands are kept by content: a second frame reuses them, a
+    moved point makes them anew (the image follows the edit)."""
+    import bpy
+
+    from solidwire_addon.core import strands
+
+    scene = scenes.empty_scene(120, 90, thickness=2.0)
+    hair = strand_scenes.hair(scene, "Hair", [[(-2.0, 0.0, 0.0), (2.0, 0.0, 0.0)]])
+    scenes.add_camera(scene, location=(0.0, -6.0, 0.0), target=(0.0, 0.0, 0.0))
+    first = scenes.render_to_file(scene, output_dir / "hair_cache_1.png")
+    hits, misses = strands.geometry_cache.hits, strands.geometry_cache.misses
+    again = scenes.render_to_file(scene, output_dir / "hair_cache_2.png")
+    assert strands.geometry_cache.hits == hits + 1 and strands.geometry_cache.misses == misses
+    assert np.array_equal(first, again)
+    hair.data.attributes["position"].data[1].vector = (2.0, 0.0, 1.5)
+    hair.data.update_tag()
+    moved = scenes.render_to_file(scene, output_dir / "hair_cache_3.png")
+    assert strands.geometry_cache.misses == misses + 1
+    assert np.abs(moved[..., 3] - first[..., 3]).max() > 0.9

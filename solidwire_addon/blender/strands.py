@@ -4,9 +4,10 @@ Every instance of a Curves or PointCloud object in the evaluated depsgraph
 (an object of that type, or what a geometry-nodes modifier makes) follows the
 same visibility and per-object rules as a mesh instance (gather.instance_shown): the
 target's object filter, ``object.solidwire.show_in_render`` /
-``show_in_viewport``, the style override and the colour sources. Geometry is
-read anew each frame (hair changes with every sculpt stroke; reading a few
-attributes costs far less than a mesh extraction).
+``show_in_viewport``, the style override and the colour sources. The
+attributes are read each frame (a few bulk reads); what is made from them
+(evaluated curves, uploaded tables) is reused while they stay the same
+(core/strands.GeometryCache).
 """
 
 from __future__ import annotations
@@ -43,8 +44,10 @@ def geometry_of(obj) -> strands.StrandGeometry | None:
     if positions is None:
         return None
     radius = _read(attributes, "radius", count, 1, "value")
+    cache = strands.geometry_cache
     if obj.type == "POINTCLOUD":
-        return strands.points_geometry(positions, radius)
+        return cache.get(cache.fingerprint(strands.POINTS, positions, radius),
+                         lambda: strands.points_geometry(positions, radius))
     curve_count = len(data.curves)
     offsets = np.empty(curve_count + 1, dtype=np.int32)
     data.curve_offset_data.foreach_get("value", offsets)
@@ -54,7 +57,8 @@ def geometry_of(obj) -> strands.StrandGeometry | None:
     if curve_types is not None and np.isin(curve_types, (strands.BEZIER, strands.NURBS)).any():
         warn_once(("curve types", obj.name), f"SolidWire: '{obj.name}' has Bezier or NURBS curves; "
                                              "their control polygons are drawn")
-    return strands.curves_geometry(positions, radius, offsets, curve_types, resolutions, cyclic)
+    return cache.get(cache.fingerprint(strands.CURVES, positions, radius, offsets, curve_types, resolutions, cyclic),
+                     lambda: strands.curves_geometry(positions, radius, offsets, curve_types, resolutions, cyclic))
 
 
 def gather_strands(depsgraph, *, object_filter=None, object_settings=None, colors: bool = False):

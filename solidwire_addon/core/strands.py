@@ -25,6 +25,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+import zlib
+
 import gpu
 import numpy as np
 
@@ -90,34 +92,47 @@ class StrandItem:
 
 
 def catmull_rom(points: np.ndarray, resolution: int, cyclic: bool) -> np.ndarray:
-    """A uniform Catmull-Rom curve through ``points`` (n, k) sampled
+    """A uniform Catmull-Rom curve through ``points`` (..., n, k) sampled
     ``resolution`` times per segment, as Blender evaluates its CATMULL_ROM
     curves: every control point is on the curve, an open curve's end
-    segments extrapolate a neighbour (2 p_0 - p_1), and an open curve gets
-    its last point appended."""
+    segments extrapolate a neighbour (2 p_0 - p_1), and the last point is
+    appended (the first again for a closed curve). Leading axes are curves
+    of the same size, evaluated at once."""
     points = np.asarray(points, dtype=np.float64)
-    n = len(points)
+    n = points.shape[-2]
     resolution = max(int(resolution), 1)
-    if n < 2 or resolution == 1:
-        return points.copy() if not cyclic or n < 2 else np.concatenate([points, points[:1]])
+    if n < 2:
+        return points.copy()
     if cyclic:
-        ext = np.concatenate([points[-1:], points, points[:2]])
+        ext = np.concatenate([points[..., -1:, :], points, points[..., :2, :]], axis=-2)
         segments = n
     else:
-        ext = np.concatenate([2.0 * points[:1] - points[1:2], points, 2.0 * points[-1:] - points[-2:-1]])
+        ext = np.concatenate([2.0 * points[..., :1, :] - points[..., 1:2, :], points,
+                              2.0 * points[..., -1:, :] - points[..., -2:-1, :]], axis=-2)
         segments = n - 1
     t = np.arange(resolution, dtype=np.float64) / resolution
     t2, t3 = t * t, t * t * t
-    w0 = 0.5 * (-t3 + 2.0 * t2 - t)
-    w1 = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0)
-    w2 = 0.5 * (-3.0 * t3 + 4.0 * t2 + t)
-    w3 = 0.5 * (t3 - t2)
+    weights = (0.5 * (-t3 + 2.0 * t2 - t), 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0), 0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+               0.5 * (t3 - t2))
     i = np.arange(segments)
-    p0, p1, p2, p3 = ext[i], ext[i + 1], ext[i + 2], ext[i + 3]
-    out = (w0[None, :, None] * p0[:, None] + w1[None, :, None] * p1[:, None] + w2[None, :, None] * p2[:, None]
-           + w3[None, :, None] * p3[:, None]).reshape(-1, points.shape[1])
-    # Closed: end where it started; open: the last control point.
-    return np.concatenate([out, points[:1] if cyclic else points[-1:]])
+    out = sum(w[:, None] * ext[..., i + k, None, :] for k, w in enumerate(weights))  # (..., segments, res, k)
+    out = out.reshape(*points.shape[:-2], segments * resolution, points.shape[-1])
+    return np.concatenate([out, points[..., :1, :] if cyclic else points[..., -1:, :]], axis=-2)
+
+
+def _chain(n: int, closed: bool, wrapped: bool) -> np.ndarray:
+    """(S, 4) rows (i0, i1, previous, next) of a polyline of n points (-1:
+    no neighbour); ``closed`` adds the segment back to the first point,
+    ``wrapped`` says the last point is the first one again."""
+    a = np.arange(n - 1)
+    seg = np.stack([a, a + 1, a - 1, a + 2], axis=1)
+    seg[-1, 3] = -1
+    if closed:
+        seg = np.concatenate([seg, [[n - 1, 0, n - 2, 1]]])
+        seg[0, 2], seg[-2, 3] = n - 1, 0
+    elif wrapped and n > 2:
+        seg[0, 2], seg[-1, 3] = n - 2, 1
+    return seg
 
 
 def _finish(kind, values: np.ndarray, segments: np.ndarray | None, dropped: int) -> StrandGeometry | None:
@@ -150,42 +165,45 @@ def curves_geometry(positions, radius=None, offsets=None, curve_types=None, reso
     offsets = np.array([0, count]) if offsets is None else np.asarray(offsets, dtype=np.int64)
     curve_count = len(offsets) - 1
     values = np.concatenate([positions, radius[:, None]], axis=1)
+    sizes = np.diff(offsets)
+    kinds = np.full(curve_count, CATMULL_ROM) if curve_types is None else np.asarray(curve_types, np.int64)
+    res = (np.full(curve_count, DEFAULT_RESOLUTION) if resolutions is None
+           else np.maximum(np.asarray(resolutions, np.int64), 1))
+    closed = np.zeros(curve_count, bool) if cyclic is None else np.asarray(cyclic, bool)
+    smooth = (kinds == CATMULL_ROM) & (sizes >= 2)
+    res = np.where(smooth, res, 0)  # (not a key for the other types)
+    # Curves of one size, type, resolution and closure are evaluated at once
+    # (hair: usually one group for the whole datablock).
+    keys = np.stack([sizes, smooth, res, closed], axis=1)
+    groups, group_of = np.unique(keys, axis=0, return_inverse=True)
     parts, segments = [], []
     total, dropped = 0, 0
-    for c in range(curve_count):
-        start, end = int(offsets[c]), int(offsets[c + 1])
-        control = values[start:end]
-        closed = bool(cyclic[c]) if cyclic is not None else False
-        kind = int(curve_types[c]) if curve_types is not None else CATMULL_ROM
-        if kind == CATMULL_ROM and len(control) >= 2:
-            res = int(resolutions[c]) if resolutions is not None else DEFAULT_RESOLUTION
-            evaluated = catmull_rom(control, res, closed)
-            closed_here, wrapped = False, closed  # catmull_rom closed it (last point = first)
+    for g, (n, is_smooth, resolution, is_closed) in enumerate(groups):
+        members = np.nonzero(group_of.reshape(-1) == g)[0]
+        control = values[offsets[members][:, None] + np.arange(n)[None, :]]  # (m, n, 4)
+        if is_smooth:
+            evaluated = catmull_rom(control, int(resolution), bool(is_closed))
+            chain = _chain(evaluated.shape[1], False, bool(is_closed)) if evaluated.shape[1] >= 2 else None
         else:
-            evaluated, closed_here, wrapped = control, closed and len(control) > 2, False
-        n = len(evaluated)
-        if n >= 2:
-            a = np.arange(n - 1)
-            seg = np.stack([a, a + 1, a - 1, a + 2], axis=1)
-            seg[-1, 3] = -1
-            if closed_here:
-                seg = np.concatenate([seg, [[n - 1, 0, n - 2, 1]]])
-                seg[0, 2], seg[-2, 3] = n - 1, 0
-            elif wrapped and n > 2:
-                seg[0, 2], seg[-1, 3] = n - 2, 1
-            good = np.isfinite(evaluated).all(axis=1)
-            keep = good[seg[:, 0]] & good[seg[:, 1]]
+            evaluated = control
+            chain = _chain(int(n), bool(is_closed) and n > 2, False) if n >= 2 else None
+        m, e = evaluated.shape[:2]
+        parts.append(evaluated.reshape(-1, 4))
+        if chain is not None:
+            good = np.isfinite(evaluated).all(axis=2)  # (m, e)
             dropped += int((~good).sum())
-            seg = seg[keep]
-            # A neighbour that is not finite is no neighbour.
+            base = total + e * np.arange(m)[:, None, None]
+            seg = np.where(chain[None] >= 0, chain[None] + base, -1)  # (m, S, 4)
+            # A segment with a non-finite end is left out; a non-finite
+            # neighbour is no neighbour.
+            flat_good = good.reshape(-1)
+            ends_ok = flat_good[seg[..., 0] - total] & flat_good[seg[..., 1] - total]
             for column in (2, 3):
-                ok = seg[:, column] >= 0
-                ok[ok] = good[seg[ok, column]]
-                seg[~ok, column] = -1
-            seg[:, :4] += np.where(seg >= 0, total, 0)
-            segments.append(seg)
-        parts.append(evaluated)
-        total += n
+                has = seg[..., column] >= 0
+                ok = np.where(has, flat_good[np.maximum(seg[..., column] - total, 0)], False)
+                seg[..., column] = np.where(ok, seg[..., column], -1)
+            segments.append(seg[ends_ok])
+        total += m * e
     if not parts:
         return None
     values = np.concatenate(parts)
@@ -208,6 +226,45 @@ def points_geometry(positions, radius=None) -> StrandGeometry | None:
     values = np.concatenate([positions, radius[:, None]], axis=1)
     good = np.isfinite(values).all(axis=1)
     return _finish(POINTS, values[good], None, int((~good).sum()))
+
+
+class GeometryCache:
+    """Evaluated strands and points (with their uploaded tables) by the
+    content they were made from, so an unchanged datablock is neither
+    evaluated nor uploaded again on the next frame or redraw. Keyed by a
+    fingerprint of the inputs (counts and CRC-32 of every array), so a
+    stale entry can never be drawn; the least recently used entries go
+    beyond ``size``."""
+
+    def __init__(self, size: int = 32):
+        self.size = size
+        self.entries: dict = {}
+        self.hits = self.misses = 0
+
+    @staticmethod
+    def fingerprint(kind: str, *arrays) -> tuple:
+        return (kind, *((None if a is None else (a.shape, str(a.dtype), zlib.crc32(np.ascontiguousarray(a).view(np.uint8))))
+                        for a in arrays))
+
+    def get(self, key, make):
+        """The geometry of ``key`` (a fingerprint), made by ``make()`` when
+        new (None is remembered too)."""
+        if key in self.entries:
+            self.hits += 1
+            geometry = self.entries.pop(key)
+        else:
+            self.misses += 1
+            geometry = make()
+        self.entries[key] = geometry  # most recent last
+        while len(self.entries) > self.size:
+            del self.entries[next(iter(self.entries))]
+        return geometry
+
+    def clear(self) -> None:
+        self.entries.clear()
+
+
+geometry_cache = GeometryCache()
 
 
 # -- drawing ---------------------------------------------------------------------
@@ -255,6 +312,7 @@ def release() -> None:
     """Drop every GPU object of this module (add-on unregister)."""
     _batches.clear()
     _targets.clear()
+    geometry_cache.clear()
 
 
 def _radius_scale(matrix: np.ndarray) -> float:
