@@ -271,3 +271,22 @@ def test_unchanged_hair_is_reused_and_an_edit_is_seen(output_dir):
     moved = scenes.render_to_file(scene, output_dir / "hair_cache_3.png")
     assert strands.geometry_cache.misses == misses + 1
     assert np.abs(moved[..., 3] - first[..., 3]).max() > 0.9
+
+
+def test_a_strand_failure_leaves_the_meshes_image(output_dir, monkeypatch, capfd):
+    """A GPU backend that refuses the strand shader: the meshes still render
+    and one line says what is missing."""
+    from solidwire_addon.core import log, shaders
+
+    def refuse(*_args, **_kwargs):
+        raise RuntimeError("no strand shader here")
+
+    monkeypatch.setattr(shaders, "get_strand", refuse)
+    log.forget()
+    scene = scenes.empty_scene(120, 90, thickness=1.5)
+    _hair_and_points(scene)
+    capfd.readouterr()
+    rgba = scenes.render_to_file(scene, output_dir / "hair_points_refused.png")
+    err = capfd.readouterr().err
+    assert err.count("hair and point clouds not drawn") == 1
+    assert (rgba[..., 3] > 0.9).sum() > 50  # the cube's wire

@@ -33,6 +33,7 @@ import numpy as np
 from . import colors, shaders
 from .cache import table_texture
 from .draw import bind_display_transform, shader_variant, styled
+from .log import warn_once
 from .settings import pack_params
 from .targets import read_texture
 from .view import outside_frustum_many, translation
@@ -378,7 +379,18 @@ def composite_render(rgba, depth, surface_targets, view, settings, items):
     """The render's strand layer over ``rgba`` (premultiplied, (H, W, 4),
     changed in place), hidden by the mesh depth in ``surface_targets``;
     ``depth`` (view depth or None) takes the strands' depth where they
-    cover (weight >= 1/2). Returns (rgba, depth)."""
+    cover (weight >= 1/2). Returns (rgba, depth). A failure here (a GPU
+    backend that refuses the shader, say) leaves the meshes' image as it
+    is and says so once."""
+    try:
+        return _composite_render(rgba, depth, surface_targets, view, settings, items)
+    except Exception as exc:  # noqa: BLE001 - the meshes' image must survive
+        warn_once(("strands draw", type(exc).__name__), f"SolidWire: hair and point clouds not drawn: "
+                                                        f"{type(exc).__name__}: {exc}")
+        return rgba, depth
+
+
+def _composite_render(rgba, depth, surface_targets, view, settings, items):
     width, height = view.width, view.height
     targets = _targets_for(width, height)
     framebuffer = gpu.types.GPUFrameBuffer(depth_slot=targets.depth, color_slots=(targets.color, targets.info))
@@ -415,4 +427,9 @@ def draw_over_viewport(items, view, settings, depth_bias: float, display=None) -
     gpu.state.depth_test_set("LESS_EQUAL")
     gpu.state.depth_mask_set(False)
     gpu.state.face_culling_set("NONE")
-    return _draw(items, view, settings, overlay_bias=depth_bias, display=display)
+    try:
+        return _draw(items, view, settings, overlay_bias=depth_bias, display=display)
+    except Exception as exc:  # noqa: BLE001 - the meshes' overlay must survive
+        warn_once(("strands overlay", type(exc).__name__), f"SolidWire: hair and point clouds not drawn: "
+                                                          f"{type(exc).__name__}: {exc}")
+        return 0
