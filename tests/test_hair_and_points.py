@@ -290,3 +290,23 @@ def test_a_strand_failure_leaves_the_meshes_image(output_dir, monkeypatch, capfd
     err = capfd.readouterr().err
     assert err.count("hair and point clouds not drawn") == 1
     assert (rgba[..., 3] > 0.9).sum() > 50  # the cube's wire
+
+
+def test_overlay_through_the_scenes_colour_management():
+    """The handler's path: the display transform variant of the strand
+    shaders compiles and draws."""
+    import bpy
+
+    from solidwire_addon.blender.views import camera_view
+    from tests.test_overlay import FakeViewport
+
+    scene = scenes.empty_scene(120, 90, thickness=2.0)
+    scene.view_settings.view_transform = "AgX"
+    strand_scenes.hair(scene, "Hair", [[(-2.0, 0.0, 0.0), (2.0, 0.0, 0.0)]])
+    strand_scenes.point_cloud(scene, "Points", [(0.0, 0.0, 1.0)], 0.3)
+    scenes.add_camera(scene, location=(0.0, -6.0, 0.0), target=(0.0, 0.0, 0.0))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    viewport = FakeViewport(120, 90)
+    viewport.draw_overlay(depsgraph, camera_view(scene, depsgraph, (120, 90)), scene.solidwire.snapshot())
+    rgba = viewport.rgba()
+    assert (rgba[..., 3] > 0.99).sum() > 100

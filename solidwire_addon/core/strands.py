@@ -23,9 +23,8 @@ they blend "over" the viewport straight away, under its depth buffer.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-
 import zlib
+from dataclasses import dataclass, replace
 
 import gpu
 import numpy as np
