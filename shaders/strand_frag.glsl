@@ -56,6 +56,20 @@ void main()
   intensity *= depth_fade(q_depth);
 #  endif
 #endif
+#ifdef USE_CLIP_PLANES
+  /* Outside the viewport's clipping region (docs/image_model.md §5.6): a
+   * point by its centre, a strand at its nearest point q. */
+#  ifdef STRAND_POINTS
+  vec4 clip_position = disc_clip;
+#  else
+  vec4 clip_position = mix(seg_a, seg_b, u);
+#  endif
+  for (int k = 0; k < 6; k++) {
+    if (dot(clip_params.planes[k], clip_position) < 0.0) {
+      discard;
+    }
+  }
+#endif
   weight = inside ? 1.0 : intensity;
   if (weight <= 0.0) {
     discard;

@@ -3,8 +3,8 @@
  * tables by gl_VertexID / 6 (core/strands.py). The quad covers every pixel
  * the fragment stage can give a non-zero value: the segment (or disc) widened
  * by its half-width, two softness widths and a pixel of slack. Primitives
- * past `prim_count`, wholly behind the near plane or with a non-finite
- * position collapse to nothing. */
+ * wholly behind the near plane or with a non-finite position collapse to
+ * nothing. */
 
 /* Outside the clip volume: the rasteriser drops the triangle. */
 const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
@@ -63,10 +63,6 @@ void main()
 {
   int prim = gl_VertexID / 6;
   int corner = strand_corner;
-  if (prim >= prim_count) {
-    gl_Position = COLLAPSED;
-    return;
-  }
 #ifdef STRAND_POINTS
   vec4 point = fetch_texel(vertex_positions, prim);
   vec4 c = object_to_clip * vec4(point.xyz, 1.0);
@@ -81,6 +77,9 @@ void main()
   float radius_px = radius * PX_PER_UNIT / c.w;
   float depth = view_depth_of(point.xyz);
   disc = vec4(centre, radius_px, depth);
+#  ifdef USE_CLIP_PLANES
+  disc_clip = c;
+#  endif
   disc_extra = vec2(radius, 1.0 / c.w);
   float reach = radius_px + max(half_thickness_at(depth, 1.0 / c.w), 0.0) + 2.0 * params.softness + 1.0;
   gl_Position = quad_corner(centre, centre, reach, corner);

@@ -310,3 +310,29 @@ def test_overlay_through_the_scenes_colour_management():
     viewport.draw_overlay(depsgraph, camera_view(scene, depsgraph, (120, 90)), scene.solidwire.snapshot())
     rgba = viewport.rgba()
     assert (rgba[..., 3] > 0.99).sum() > 100
+
+
+def test_overlay_clipping_region_cuts_them():
+    """Alt+B: strands and points outside the planes are not drawn (a strand
+    at its nearest point, a point by its centre); inside, as without."""
+    import bpy
+
+    from solidwire_addon.blender.views import camera_view
+    from solidwire_addon.core.overlay_state import ViewportState
+    from tests.test_overlay_states import draw_state
+
+    scene = scenes.empty_scene(160, 120, thickness=2.0)
+    strand_scenes.hair(scene, "Hair", [[(-2.0, 0.0, 0.0), (2.0, 0.0, 0.0)]])
+    strand_scenes.point_cloud(scene, "Points", [(-1.0, 0.0, 1.0), (1.0, 0.0, 1.0)], 0.2)
+    scenes.add_camera(scene, location=(0.0, -8.0, 0.0), target=(0.0, 0.0, 0.0))
+    planes = [(1.0, 0.0, 0.0, -0.2)] + [(0.0, 0.0, 0.0, 0.0)] * 5  # keeps x >= 0.2
+    free, _ = draw_state(scene, ViewportState(), size=(160, 120))
+    clipped, _ = draw_state(scene, ViewportState(clip_planes=planes), size=(160, 120))
+    view = camera_view(scene, bpy.context.evaluated_depsgraph_get(), (160, 120))
+    clip = view.projection @ view.view_matrix @ np.array([0.2, 0.0, 0.0, 1.0])
+    column = (clip[0] / clip[3] * 0.5 + 0.5) * 160
+    cols = np.arange(160) + 0.5
+    outside, inside = cols < column - 4.0, cols > column + 4.0  # (the strand's round end reaches past the plane)
+    assert free[:, outside].max() > 0.9 and free[:, inside].max() > 0.9
+    assert clipped[:, outside].max() == 0.0
+    assert np.abs(clipped[:, inside] - free[:, inside]).max() <= 1.0 / 255.0

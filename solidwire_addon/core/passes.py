@@ -303,7 +303,7 @@ def draw_over_viewport(
             elif step.kind == SILHOUETTES:
                 silhouettes.draw_silhouettes(items, view, step.settings, overlay_bias=depth_bias, display=display)
         if strands:  # hair and point clouds (core/strands.py)
-            strands_mod.draw_over_viewport(strands, view, settings, depth_bias, display)
+            strands_mod.draw_over_viewport(strands, view, settings, depth_bias, display, clip_planes)
     finally:
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set(saved_blend)

@@ -674,7 +674,8 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
     outputs, occluded by the ``scene_depth`` texture)."""
     key = (bool(points), ShaderVariant(use_fade=variant.use_fade, use_fill=variant.use_fill and bool(points),
                                        thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
-                                       display_transform=variant.display_transform and bool(overlay_bias)))
+                                       display_transform=variant.display_transform and bool(overlay_bias),
+                                       clip_planes=variant.clip_planes and bool(overlay_bias)))
     shader = _strand_cache.get((_context, key))
     if shader is None:
         flags = key[1]
@@ -682,6 +683,8 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
         if points:
             iface.flat("VEC4", "disc")  # window centre, radius px, view depth of the centre
             iface.flat("VEC2", "disc_extra")  # radius in scene units, 1 / clip w
+            if flags.clip_planes:
+                iface.flat("VEC4", "disc_clip")  # the centre in clip space
         else:
             iface.flat("VEC4", "seg_a")
             iface.flat("VEC4", "seg_b")
@@ -690,8 +693,10 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             if overlay_bias:
                 iface.flat("VEC4", "seg_split")  # bisector normals at the two joints (overlay)
         info = pulling_info()
+        # Push constants: 120 of the 128 bytes every backend guarantees with
+        # the overlay's proj_z and display_shaper (draw_range draws exactly
+        # the primitives there are, so no count is needed).
         info.push_constant("VEC4", "strand_view")  # px per unit at w = 1, radius scale
-        info.push_constant("INT", "prim_count")
         info.sampler(1, "FLOAT_2D", "strand_segments")
         info.vertex_in(0, "INT", "strand_corner")
         info.vertex_out(iface)
@@ -712,6 +717,11 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             info.define("USE_FILL", "1")
         if flags.display_transform:
             add_display_transform(info)
+        if flags.clip_planes:
+            # (A block, as in the exact path: the push constants are full.)
+            info.uniform_buf(2, "SolidWireClip", "clip_params")
+            info.typedef_source(schema.param_block_glsl() + CLIP_BLOCK_GLSL)
+            info.define("USE_CLIP_PLANES", "1")
         common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("line_style.glsl")
         info.vertex_source(common + read_source("strand_vert.glsl"))
         info.fragment_source(common + _display_source(flags) + read_source("strand_frag.glsl"))

@@ -31,7 +31,7 @@ import numpy as np
 
 from . import colors, shaders
 from .cache import table_texture
-from .draw import bind_display_transform, shader_variant, styled
+from .draw import bind_display_transform, clip_space_planes, shader_variant, styled
 from .log import warn_once
 from .settings import pack_params
 from .targets import read_texture
@@ -322,12 +322,18 @@ def _radius_scale(matrix: np.ndarray) -> float:
     return det ** (1.0 / 3.0) if np.isfinite(det) else 0.0
 
 
-def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0, display=None) -> int:
+def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0, display=None,
+          clip_planes=None) -> int:
     """Draw ``items`` into the bound framebuffer (the caller sets blending
     and the depth test). Returns the number of items drawn."""
     variant = shader_variant(settings)
     if display is not None and overlay_bias:
         variant = replace(variant, display_transform=True)
+    clip_block = None
+    if clip_planes is not None and overlay_bias:
+        variant = replace(variant, clip_planes=True)
+        rows = clip_space_planes(clip_planes, view)
+        clip_block = gpu.types.GPUUniformBuf(np.asarray(rows, dtype=np.float32).tobytes())
     px_per_unit = 0.5 * float(view.viewport[3]) * abs(float(view.projection[1][1]))
     proj = view.projection
     blocks: dict = {}
@@ -350,6 +356,8 @@ def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0,
                                                     float(proj[3][3])])
                     if variant.display_transform:
                         bind_display_transform(shader, display)
+                    if clip_block is not None:
+                        shader.uniform_block("clip_params", clip_block)
                 else:
                     shader.uniform_sampler("scene_depth", scene_depth)
             key = (item.style, item.source)
@@ -364,7 +372,6 @@ def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0,
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
             shader.uniform_float("strand_view", [px_per_unit, _radius_scale(item.matrix), 0.0, 0.0])
-            shader.uniform_int("prim_count", geometry.count)
             point_table, segment_table = geometry.textures()
             shader.uniform_sampler("vertex_positions", point_table)
             if segment_table is not None:
@@ -418,16 +425,17 @@ def _composite_render(rgba, depth, surface_targets, view, settings, items):
     return rgba, depth
 
 
-def draw_over_viewport(items, view, settings, depth_bias: float, display=None) -> int:
+def draw_over_viewport(items, view, settings, depth_bias: float, display=None, clip_planes=None) -> int:
     """The strands over the bound viewport framebuffer: "over" blending,
-    occluded by its depth buffer (LESS_EQUAL, no depth write). The caller
-    restores the GPU state."""
+    occluded by its depth buffer (LESS_EQUAL, no depth write), cut by the
+    viewport's clipping region ``clip_planes`` ((6, 4) world-space planes)
+    when there is one. The caller restores the GPU state."""
     gpu.state.blend_set("ALPHA_PREMULT")
     gpu.state.depth_test_set("LESS_EQUAL")
     gpu.state.depth_mask_set(False)
     gpu.state.face_culling_set("NONE")
     try:
-        return _draw(items, view, settings, overlay_bias=depth_bias, display=display)
+        return _draw(items, view, settings, overlay_bias=depth_bias, display=display, clip_planes=clip_planes)
     except Exception as exc:  # noqa: BLE001 - the meshes' overlay must survive
         warn_once(("strands overlay", type(exc).__name__), f"SolidWire: hair and point clouds not drawn: "
                                                           f"{type(exc).__name__}: {exc}")
