@@ -45,7 +45,7 @@ def build_scene():
         t = np.linspace(0.0, 1.0, 5)[:, None]
         droop = np.array([0.0, 0.0, -1.0]) * t * t * 0.5
         curves.append(root + t * 0.7 * (normal + rng.normal(0.0, 0.15, 3)) + droop)
-    radii = [np.linspace(0.018, 0.004, 5) for _ in curves]
+    radii = [np.linspace(0.012, 0.002, 5) for _ in curves]
     strand_scenes.hair(scene, "Hair", curves, radii, types=[strand_scenes.CATMULL_ROM] * len(curves), resolution=6)
     angles = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
     ring = np.stack([1.9 * np.cos(angles), 1.9 * np.sin(angles), 0.15 + 0.1 * np.sin(3.0 * angles)], axis=1)

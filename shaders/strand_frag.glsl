@@ -4,7 +4,8 @@
  *     nearest point; I = P(d) with half-width max(h, projected radius at q);
  *   point: a disc of the projected radius around the centre's window
  *     position; the outline is P(|distance to the rim|), the inside is
- *     covered (fill colour with Fill on).
+ *     covered (fill colour with Fill on, shaded as a sphere by the fill
+ *     shading).
  *
  * Occlusion: the primitive's depth (the front of the tube at q, the front of
  * the sphere for a point) against the surface depth at this pixel.
@@ -78,7 +79,16 @@ void main()
   vec4 color = vec4(params.wire_color.rgb * a, a);
 #if defined(STRAND_POINTS) && defined(USE_FILL)
   if (inside) {
-    color = vec4(params.wire_color.rgb * a + params.fill_color.rgb * (1.0 - a), 1.0);
+    vec3 fill = params.fill_color.rgb;
+#  if defined(SHADING) && SHADING != 0
+    /* The sphere's normal under this pixel (view space, +z to the camera;
+     * the disc's window offset over its radius). */
+    vec2 offset = clamp((p - disc.xy) / max(disc.z, 1e-6), -1.0, 1.0);
+    shading_normal = vec3(offset, sqrt(max(1.0 - dot(offset, offset), 0.0)));
+    item_info = vec4(0.0);
+    fill = shaded_fill(fill);
+#  endif
+    color = vec4(params.wire_color.rgb * a + fill * (1.0 - a), 1.0);
   }
 #endif
 #ifdef STRAND_OVERLAY

@@ -336,3 +336,33 @@ def test_overlay_clipping_region_cuts_them():
     assert free[:, outside].max() > 0.9 and free[:, inside].max() > 0.9
     assert clipped[:, outside].max() == 0.0
     assert np.abs(clipped[:, inside] - free[:, inside]).max() <= 1.0 / 255.0
+
+
+@pytest.mark.parametrize("shading", ["STUDIO", "MATCAP"])
+def test_fill_shading_shades_discs_as_spheres(shading, output_dir):
+    """With a shaded fill a disc's inside is lit as the sphere it stands
+    for: at its centre the normal faces the camera (STUDIO: fill times the
+    studio light of (0, 0, 1), the reference's formula)."""
+    from tests.support import reference
+
+    scene = scenes.empty_scene(120, 90, thickness=1.0, use_fill=True, fill_shading=shading)
+    scene.solidwire.fill_color = (0.8, 0.8, 0.8)
+    strand_scenes.point_cloud(scene, "Points", [(0.0, 0.0, 0.0)], 0.8)
+    scenes.add_camera(scene, location=(0.0, -6.0, 0.0), target=(0.0, 0.0, 0.0))
+    rgba = scenes.render_to_file(scene, output_dir / f"disc_{shading.lower()}.png")
+    linear = np.where(rgba[..., :3] <= 0.04045, rgba[..., :3] / 12.92, ((rgba[..., :3] + 0.055) / 1.055) ** 2.4)
+    centre = linear[45, 60]
+    assert rgba[45, 60, 3] > 0.999
+    if shading == "STUDIO":
+        import bpy
+
+        from solidwire_addon.blender.views import camera_view
+
+        view = camera_view(scene, bpy.context.evaluated_depsgraph_get(), (120, 90))
+        radius_px = 0.8 * 0.5 * 90 * abs(view.projection[1, 1]) / 6.0
+        offset = np.array([0.5, 0.5]) / radius_px  # pixel (60, 45)'s centre from the disc's
+        normal = np.array([*offset, np.sqrt(1.0 - offset @ offset)])
+        assert np.allclose(centre, 0.8 * reference.studio_light(normal), atol=1e-3)
+    # Lit from the upper left: the disc is not one flat colour.
+    inside = (rgba[..., 3] > 0.999) & (np.hypot(np.arange(120)[None] - 60, np.arange(90)[:, None] - 45) < 8)
+    assert np.ptp(linear[inside][:, 0]) > 0.05

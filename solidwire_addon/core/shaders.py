@@ -675,7 +675,8 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
     key = (bool(points), ShaderVariant(use_fade=variant.use_fade, use_fill=variant.use_fill and bool(points),
                                        thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
                                        display_transform=variant.display_transform and bool(overlay_bias),
-                                       clip_planes=variant.clip_planes and bool(overlay_bias)))
+                                       clip_planes=variant.clip_planes and bool(overlay_bias),
+                                       shading=variant.shading if points and variant.use_fill else SHADING_FLAT))
     shader = _strand_cache.get((_context, key))
     if shader is None:
         flags = key[1]
@@ -715,6 +716,16 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             info.define("USE_FADE", "1")
         if flags.use_fill:
             info.define("USE_FILL", "1")
+        shading_source = ""
+        if flags.shading != SHADING_FLAT:
+            # A disc's inside is shaded as the sphere it stands for, by the
+            # mesh fill's own code (fill_shading.glsl), whose inputs are
+            # declared here as plain globals the fragment stage sets.
+            info.define("SHADING", str(flags.shading))
+            if flags.shading == SHADING_MATCAP:
+                info.sampler(6, "FLOAT_2D", "matcap_image")
+            shading_source = ("#define SW_FRONT_FACING true\nvec3 shading_normal;\nvec4 item_info;\n"
+                              + read_source("fill_shading.glsl"))
         if flags.display_transform:
             add_display_transform(info)
         if flags.clip_planes:
@@ -724,6 +735,6 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             info.define("USE_CLIP_PLANES", "1")
         common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("line_style.glsl")
         info.vertex_source(common + read_source("strand_vert.glsl"))
-        info.fragment_source(common + _display_source(flags) + read_source("strand_frag.glsl"))
+        info.fragment_source(common + _display_source(flags) + shading_source + read_source("strand_frag.glsl"))
         shader = _keep(_strand_cache, (_context, key), gpu.shader.create_from_info(info))
     return shader

@@ -29,7 +29,7 @@ from dataclasses import dataclass, replace
 import gpu
 import numpy as np
 
-from . import colors, shaders
+from . import colors, matcaps, shaders
 from .cache import table_texture
 from .draw import bind_display_transform, clip_space_planes, shader_variant, styled
 from .log import warn_once
@@ -327,6 +327,11 @@ def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0,
     """Draw ``items`` into the bound framebuffer (the caller sets blending
     and the depth test). Returns the number of items drawn."""
     variant = shader_variant(settings)
+    matcap = None
+    if variant.shading == shaders.SHADING_MATCAP:
+        matcap = matcaps.texture(settings.matcap)
+        if matcap is None:
+            variant = replace(variant, shading=shaders.SHADING_FLAT)
     if display is not None and overlay_bias:
         variant = replace(variant, display_transform=True)
     clip_block = None
@@ -360,6 +365,8 @@ def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0,
                         shader.uniform_block("clip_params", clip_block)
                 else:
                     shader.uniform_sampler("scene_depth", scene_depth)
+                if kind == POINTS and matcap is not None and variant.use_fill:
+                    shader.uniform_sampler("matcap_image", matcap)
             key = (item.style, item.source)
             block = blocks.get(key)
             if block is None:
