@@ -366,3 +366,17 @@ def test_fill_shading_shades_discs_as_spheres(shading, output_dir):
     # Lit from the upper left: the disc is not one flat colour.
     inside = (rgba[..., 3] > 0.999) & (np.hypot(np.arange(120)[None] - 60, np.arange(90)[:, None] - 45) < 8)
     assert np.ptp(linear[inside][:, 0]) > 0.05
+
+
+def test_tiles_and_render_region_do_not_cut_them(output_dir, monkeypatch):
+    """A frame drawn tile by tile is the frame drawn at once, strands and
+    discs across the tile borders included."""
+    from solidwire_addon.blender import engine
+
+    scene = scenes.empty_scene(200, 150, thickness=1.5)
+    _hair_and_points(scene)
+    whole = scenes.render_to_file(scene, output_dir / "hair_points_whole.png")
+    monkeypatch.setattr(engine, "TILE_PIXELS", 64 * 48)
+    tiled = scenes.render_to_file(scene, output_dir / "hair_points_tiled.png")
+    assert len(list(engine.tiles_of((0, 0, 200, 150)))) > 4
+    assert np.abs(tiled - whole).max() <= 1.0 / 255.0
