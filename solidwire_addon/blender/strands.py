@@ -82,11 +82,13 @@ def gather_strands(depsgraph, *, object_filter=None, object_settings=None, color
                 geometry = geometry_of(obj)
                 by_data[pointer] = geometry
                 if geometry is None:
-                    warn_once(("strands empty", obj.name), f"SolidWire skips '{obj.name}': no drawable points")
+                    warn_once(("strands empty", obj.name), f"SolidWire skips '{obj.name}': it has no points "
+                                                           "with finite coordinates")
                 elif geometry.dropped:
+                    count = geometry.dropped
                     warn_once(("strands nonfinite", obj.name),
-                              f"SolidWire: '{obj.name}' has {geometry.dropped} points with non-finite coordinates "
-                              "or radius; they are not drawn")
+                              f"SolidWire: '{obj.name}' has {count} point{'s' if count != 1 else ''} with non-finite "
+                              "coordinates or radius, left out (with the strand segments that touch them)")
             geometry = by_data[pointer]
             if geometry is None:
                 continue
