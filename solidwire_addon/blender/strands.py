@@ -82,8 +82,8 @@ def gather_strands(depsgraph, *, object_filter=None, object_settings=None, color
                 geometry = geometry_of(obj)
                 by_data[pointer] = geometry
                 if geometry is None:
-                    warn_once(("strands empty", obj.name), f"SolidWire skips '{obj.name}': it has no points "
-                                                           "with finite coordinates")
+                    what = "no points" if len(obj.data.points) == 0 else "no points with finite coordinates"
+                    warn_once(("strands empty", obj.name), f"SolidWire skips '{obj.name}': it has {what}")
                 elif geometry.dropped:
                     count = geometry.dropped
                     warn_once(("strands nonfinite", obj.name),
