@@ -380,3 +380,19 @@ def test_tiles_and_render_region_do_not_cut_them(output_dir, monkeypatch):
     tiled = scenes.render_to_file(scene, output_dir / "hair_points_tiled.png")
     assert len(list(engine.tiles_of((0, 0, 200, 150)))) > 4
     assert np.abs(tiled - whole).max() <= 1.0 / 255.0
+
+
+def test_bezier_curves_match_reference(output_dir):
+    """Bezier curves with handles are drawn as Blender evaluates them (the
+    cubic through the handles, radius linear), open and closed."""
+    scene = scenes.empty_scene(200, 150, thickness=1.5)
+    points = [[(-2.0, 0.0, -1.0), (0.0, 0.0, 1.0), (2.0, 0.0, -1.0)], [(-1.0, 0.5, 0.0), (1.0, 0.5, 0.0), (0.0, 0.5, 1.5)]]
+    left = [(-2.5, 0.0, -1.5), (-1.0, 0.0, 1.0), (2.0, 0.0, 0.0), (-1.0, 0.5, -0.5), (1.5, 0.5, -0.5), (0.8, 0.5, 1.6)]
+    right = [(-1.5, 0.0, -0.5), (1.0, 0.0, 1.0), (2.5, 0.0, -1.5), (-1.0, 0.5, 0.5), (0.5, 0.5, 0.5), (-0.8, 0.5, 1.4)]
+    hair = strand_scenes.hair(scene, "Bezier", points, [np.array([0.0, 0.05, 0.0]), 0.0],
+                              types=[strand_scenes.BEZIER] * 2, resolution=8, handles=(left, right))
+    hair.data.attributes.new("cyclic", "BOOLEAN", "CURVE").data.foreach_set("value", np.array([False, True]))
+    scenes.add_camera(scene, location=(0.0, -7.0, 0.3), target=(0.0, 0.0, 0.2))
+    _rgba, ref, report = _measure(scene, "hair_bezier", output_dir)
+    accuracy.assert_accurate(report)
+    assert (ref.strand > 0.99).sum() > 300

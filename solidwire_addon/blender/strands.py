@@ -54,11 +54,21 @@ def geometry_of(obj) -> strands.StrandGeometry | None:
     curve_types = _read(attributes, "curve_type", curve_count, 1, "value", np.int32)
     resolutions = _read(attributes, "resolution", curve_count, 1, "value", np.int32)
     cyclic = _read(attributes, "cyclic", curve_count, 1, "value", bool)
-    if curve_types is not None and np.isin(curve_types, (strands.BEZIER, strands.NURBS)).any():
-        warn_once(("curve types", obj.name), f"SolidWire: '{obj.name}' has Bezier or NURBS curves; "
+    handles = None
+    if curve_types is not None and (curve_types == strands.BEZIER).any():
+        left = _read(attributes, "handle_left", count, 3, "vector")
+        right = _read(attributes, "handle_right", count, 3, "vector")
+        handles = None if left is None or right is None else (left, right)
+        if handles is None:
+            warn_once(("curve handles", obj.name), f"SolidWire: '{obj.name}' has Bezier curves without handle "
+                                                   "positions; their control polygons are drawn")
+    if curve_types is not None and (curve_types == strands.NURBS).any():
+        warn_once(("curve types", obj.name), f"SolidWire: '{obj.name}' has NURBS curves; "
                                              "their control polygons are drawn")
-    return cache.get(cache.fingerprint(strands.CURVES, positions, radius, offsets, curve_types, resolutions, cyclic),
-                     lambda: strands.curves_geometry(positions, radius, offsets, curve_types, resolutions, cyclic))
+    key = cache.fingerprint(strands.CURVES, positions, radius, offsets, curve_types, resolutions, cyclic,
+                            *(handles or (None, None)))
+    return cache.get(key, lambda: strands.curves_geometry(positions, radius, offsets, curve_types, resolutions,
+                                                          cyclic, handles))
 
 
 def gather_strands(depsgraph, *, object_filter=None, object_settings=None, colors: bool = False):

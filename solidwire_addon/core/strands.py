@@ -151,14 +151,37 @@ def _finish(kind, values: np.ndarray, segments: np.ndarray | None, dropped: int)
     return StrandGeometry(kind, rows, seg_rows, centre, lo - centre - reach, hi - centre + reach, dropped)
 
 
+def bezier(points: np.ndarray, left: np.ndarray, right: np.ndarray, resolution: int, cyclic: bool) -> np.ndarray:
+    """Cubic Bezier segments through ``points`` (..., n, 4: position and
+    radius) with handles ``left`` / ``right`` (..., n, 3), ``resolution``
+    samples per segment, as Blender evaluates BEZIER curves: segment i runs
+    p_i, right_i, left_(i+1), p_(i+1); the radius goes linearly from p_i to
+    p_(i+1). The last point is appended (the first again when closed)."""
+    points = np.asarray(points, dtype=np.float64)
+    n = points.shape[-2]
+    resolution = max(int(resolution), 1)
+    nxt = np.r_[np.arange(1, n), 0] if cyclic else np.arange(1, n)
+    cur = np.arange(len(nxt))
+    t = (np.arange(resolution, dtype=np.float64) / resolution)[:, None]
+    s_ = 1.0 - t
+    p0, p3 = points[..., cur, None, :3], points[..., nxt, None, :3]
+    p1, p2 = np.asarray(right, np.float64)[..., cur, None, :], np.asarray(left, np.float64)[..., nxt, None, :]
+    xyz = s_ ** 3 * p0 + 3.0 * s_ * s_ * t * p1 + 3.0 * s_ * t * t * p2 + t ** 3 * p3
+    r = points[..., cur, None, 3:] * s_ + points[..., nxt, None, 3:] * t
+    out = np.concatenate([xyz, r], axis=-1).reshape(*points.shape[:-2], len(cur) * resolution, 4)
+    return np.concatenate([out, points[..., :1, :] if cyclic else points[..., -1:, :]], axis=-2)
+
+
 def curves_geometry(positions, radius=None, offsets=None, curve_types=None, resolutions=None,
-                    cyclic=None) -> StrandGeometry | None:
+                    cyclic=None, handles=None) -> StrandGeometry | None:
     """Strands of a Curves datablock: ``positions`` (P, 3) control points,
     ``radius`` (P,) (None: 0), ``offsets`` (C + 1,) first point of each
     curve, per curve ``curve_types``, ``resolutions`` and ``cyclic`` (None:
-    Blender's defaults, Catmull-Rom at 12). Catmull-Rom curves are evaluated
-    (positions and radius alike); other types draw their control polygon.
-    A segment with a non-finite end is left out. None when nothing is left."""
+    Blender's defaults, Catmull-Rom at 12), ``handles`` (left, right) (P, 3)
+    each, or None. Catmull-Rom curves and Bezier curves with handles are
+    evaluated (positions and radius alike); other types draw their control
+    polygon. A segment with a non-finite end is left out. None when nothing
+    is left."""
     positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     count = len(positions)
     radius = np.zeros(count) if radius is None else np.asarray(radius, dtype=np.float64).reshape(-1)
@@ -170,19 +193,27 @@ def curves_geometry(positions, radius=None, offsets=None, curve_types=None, reso
     res = (np.full(curve_count, DEFAULT_RESOLUTION) if resolutions is None
            else np.maximum(np.asarray(resolutions, np.int64), 1))
     closed = np.zeros(curve_count, bool) if cyclic is None else np.asarray(cyclic, bool)
-    smooth = (kinds == CATMULL_ROM) & (sizes >= 2)
-    res = np.where(smooth, res, 0)  # (not a key for the other types)
-    # Curves of one size, type, resolution and closure are evaluated at once
-    # (hair: usually one group for the whole datablock).
-    keys = np.stack([sizes, smooth, res, closed], axis=1)
+    # How each curve is evaluated: 1 Catmull-Rom, 2 Bezier, 0 its control polygon.
+    method = np.where((kinds == CATMULL_ROM) & (sizes >= 2), 1, 0)
+    if handles is not None:
+        method = np.where((kinds == BEZIER) & (sizes >= 2), 2, method)
+    res = np.where(method > 0, res, 0)  # (not a key for the other types)
+    # Curves of one size, method, resolution and closure are evaluated at
+    # once (hair: usually one group for the whole datablock).
+    keys = np.stack([sizes, method, res, closed], axis=1)
     groups, group_of = np.unique(keys, axis=0, return_inverse=True)
     parts, segments = [], []
     total, dropped = 0, 0
-    for g, (n, is_smooth, resolution, is_closed) in enumerate(groups):
+    for g, (n, how, resolution, is_closed) in enumerate(groups):
         members = np.nonzero(group_of.reshape(-1) == g)[0]
-        control = values[offsets[members][:, None] + np.arange(n)[None, :]]  # (m, n, 4)
-        if is_smooth:
-            evaluated = catmull_rom(control, int(resolution), bool(is_closed))
+        rows = offsets[members][:, None] + np.arange(n)[None, :]
+        control = values[rows]  # (m, n, 4)
+        if how:
+            if how == 1:
+                evaluated = catmull_rom(control, int(resolution), bool(is_closed))
+            else:
+                left, right = (np.asarray(h, dtype=np.float64).reshape(-1, 3)[rows] for h in handles)
+                evaluated = bezier(control, left, right, int(resolution), bool(is_closed))
             chain = _chain(evaluated.shape[1], False, bool(is_closed)) if evaluated.shape[1] >= 2 else None
         else:
             evaluated = control

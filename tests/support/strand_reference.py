@@ -70,6 +70,22 @@ def catmull_rom(points, resolution, cyclic):
     return np.array(out)
 
 
+def bezier(points, left, right, resolution, cyclic):
+    """Blender's cubic Bezier evaluation: segment i from p_i over right_i
+    and left_(i+1) to p_(i+1), radius linear; float64."""
+    n = len(points)
+    out = []
+    for i in range(n if cyclic else n - 1):
+        j = (i + 1) % n
+        for k in range(resolution):
+            t = k / resolution
+            xyz = ((1 - t) ** 3 * points[i, :3] + 3 * (1 - t) ** 2 * t * right[i] + 3 * (1 - t) * t * t * left[j]
+                   + t ** 3 * points[j, :3])
+            out.append(np.append(xyz, (1 - t) * points[i, 3] + t * points[j, 3]))
+    out.append(points[0] if cyclic else points[-1])
+    return np.array(out)
+
+
 def _attribute(data, name, count, width, prop, dtype=np.float64):
     attribute = data.attributes.get(name)
     if attribute is None or len(attribute.data) != count:
@@ -115,8 +131,14 @@ def primitives(depsgraph, show="show_in_render"):
             ctrl = np.concatenate([pos[offsets[c]:offsets[c + 1]], rad[offsets[c]:offsets[c + 1], None]], axis=1)
             closed = bool(cyc[c]) if cyc is not None else False
             kind = int(types[c]) if types is not None else 0
+            left = _attribute(data, "handle_left", count, 3, "vector")
+            right = _attribute(data, "handle_right", count, 3, "vector")
             if kind == 0 and len(ctrl) >= 2:
                 ev = catmull_rom(ctrl, int(res[c]) if res is not None else 12, closed)
+                pairs = [(i, i + 1) for i in range(len(ev) - 1)]
+            elif kind == 2 and len(ctrl) >= 2 and left is not None and right is not None:
+                ev = bezier(ctrl, left[offsets[c]:offsets[c + 1]], right[offsets[c]:offsets[c + 1]],
+                            int(res[c]) if res is not None else 12, closed)
                 pairs = [(i, i + 1) for i in range(len(ev) - 1)]
             else:
                 ev = ctrl

@@ -5,13 +5,15 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
-CATMULL_ROM, POLY = 0, 1
+CATMULL_ROM, POLY, BEZIER = 0, 1, 2
 
 
-def hair(scene, name, curves, radii=None, *, types=None, resolution=None, location=(0, 0, 0), scale=(1, 1, 1)):
+def hair(scene, name, curves, radii=None, *, types=None, resolution=None, handles=None, location=(0, 0, 0),
+         scale=(1, 1, 1)):
     """A Curves object with one curve per (n, 3) array of ``curves``;
     ``radii`` one (n,) array (or None) per curve; ``types`` per curve
-    (default POLY)."""
+    (default POLY); ``handles`` (left, right) (P, 3) positions of every
+    point (Bezier curves)."""
     data = bpy.data.hair_curves.new(name)
     sizes = [len(c) for c in curves]
     if sizes:
@@ -24,10 +26,14 @@ def hair(scene, name, curves, radii=None, *, types=None, resolution=None, locati
             data.attributes.new("radius", "FLOAT", "POINT").data.foreach_set("value", values)
         kinds = [POLY] * len(curves) if types is None else list(types)
         # (set_types: a foreach_set on the INT8 attribute overruns its buffer.)
-        for kind, type_name in ((CATMULL_ROM, "CATMULL_ROM"), (POLY, "POLY")):
+        for kind, type_name in ((CATMULL_ROM, "CATMULL_ROM"), (POLY, "POLY"), (BEZIER, "BEZIER")):
             indices = [i for i, k in enumerate(kinds) if k == kind]
             if indices:
                 data.set_types(type=type_name, indices=indices)
+        if handles is not None:
+            for attribute, values in zip(("handle_left", "handle_right"), handles):
+                data.attributes.new(attribute, "FLOAT_VECTOR", "POINT").data.foreach_set(
+                    "vector", np.asarray(values, dtype=np.float32).ravel())
         if resolution is not None:
             data.attributes.new("resolution", "INT", "CURVE").data.foreach_set("value", [resolution] * len(curves))
     obj = bpy.data.objects.new(name, data)
