@@ -16,14 +16,14 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 
-import bpy  # noqa: E402
-import numpy as np  # noqa: E402
+import bpy
+import numpy as np
 
-from scripts import preset_gallery  # noqa: E402  (compose/write/over: the gallery sheet layout)
-from tests.support import scenes, strand_scenes  # noqa: E402  (scene builders shared with the tests)
-import solidwire_addon  # noqa: E402
-from solidwire_addon.blender import engine  # noqa: E402
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
+import solidwire_addon
+from scripts import preset_gallery
+from solidwire_addon.blender import engine
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from tests.support import scenes, strand_scenes
 
 CELL = (420, 315)
 

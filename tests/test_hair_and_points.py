@@ -74,7 +74,7 @@ def test_mesh_hides_strands_and_points(output_dir):
     strand_scenes.hair(scene, "Hair", [[(-2.0, 0.0, -0.5), (2.0, 0.0, -0.5)], [(-2.0, 0.5, 0.5), (2.0, 0.5, 0.5)]])
     strand_scenes.point_cloud(scene, "Points", [(0.0, -0.5, -0.5), (0.3, 0.3, 0.5)], 0.1)
     scenes.add_camera(scene, location=(0.0, 0.0, 6.0), target=(0.0, 0.0, 0.0), lens=35.0)
-    rgba, ref, report = _measure(scene, "hair_behind_wall", output_dir)
+    rgba, _ref, report = _measure(scene, "hair_behind_wall", output_dir)
     accuracy.assert_accurate(report)
     # The wall (z = 0) spans x, y in [-1, 1]: the strand and the point at
     # z = -0.5 show only outside it, the strand at z = 0.5 across it.
@@ -254,7 +254,6 @@ def test_overlay_honours_show_in_viewport():
 def test_unchanged_hair_is_reused_and_an_edit_is_seen(output_dir):
     """Evaluated strands are kept by content: a second frame reuses them, a
     moved point makes them anew (the image follows the edit)."""
-    import bpy
 
     from solidwire_addon.core import strands
 
