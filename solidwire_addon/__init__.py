@@ -16,7 +16,7 @@ import atexit
 import bpy
 
 from .blender import cli, color_management, engine, matcap_files, ops, ops_composite, overlay, properties, runtime, ui
-from .core import draw, log, matcaps, targets
+from .core import draw, log, matcaps, strands, targets
 
 _classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
 _registered = False
@@ -72,6 +72,7 @@ def release_gpu() -> None:
     until interpreter exit (core/shaders.py says why)."""
     targets.release()
     runtime.release()
+    strands.release()
     draw.release_rectangle()
     matcaps.clear()
     color_management.release()

@@ -14,11 +14,11 @@ import time
 import bpy
 import numpy as np
 
-from ..core import compositing, passes, schema, shaders
+from ..core import colors, compositing, passes, schema, shaders
 from ..core.ids import ENGINE_ID
 from ..core.log import one_line
 from ..core.view import DrawStats, View
-from . import gather, runtime
+from . import gather, runtime, strands
 from .gpu_context import ensure_gpu, is_init_scene
 from .views import NoCameraError, camera_view, render_size
 
@@ -104,6 +104,9 @@ class PreparedFrame:
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
             **passes.gather_options(self.settings),
         )
+        # Hair and point clouds (blender/strands.py), drawn by the same passes.
+        self.strands = strands.gather_strands(depsgraph, object_settings=gather.ObjectSettings(
+            gather.SHOW_IN_RENDER, bpy.data.objects), colors=colors.needs_item_colors(self.settings))
         self.draw_stats = None
         self.ms_draw = 0.0
 
@@ -119,7 +122,7 @@ class PreparedFrame:
         start = time.perf_counter()
         rgba, depth, stats, extra = passes.render_passes(self.items, view, self.settings,
                                                          extra_passes=self.extra_passes, keep_readback=keep_readback,
-                                                         read_depth=read_depth)
+                                                         read_depth=read_depth, strands=self.strands)
         self.ms_draw += (time.perf_counter() - start) * 1000.0
         if self.draw_stats is None:
             self.draw_stats = stats

@@ -199,7 +199,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
             continue
         if should_stop is not None and should_stop():
             break
-        shown = _shown(instance, obj, object_filter, object_settings)
+        shown = instance_shown(instance, obj, object_filter, object_settings)
         if shown is None:
             continue
         parent, style, pass_index = shown
@@ -215,7 +215,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     return items, frame.seen, frame.ms_extract
 
 
-def _shown(instance, obj, object_filter, object_settings):
+def instance_shown(instance, obj, object_filter, object_settings):
     """(parent, style, pass index) of a drawn instance, or None when the
     target does not draw it. An instance is as visible as the object that
     instances it (its source may well be hidden or in an excluded

@@ -24,10 +24,10 @@ import time
 
 import bpy
 
-from ..core import overlay_state, passes
+from ..core import colors, overlay_state, passes
 from ..core.log import one_line, warn_once
 from ..core.view import View
-from . import color_management, gather, properties, runtime
+from . import color_management, gather, properties, runtime, strands
 from .views import region_view
 
 _handle = None
@@ -179,6 +179,9 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
                                             object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
                                             **passes.gather_options(settings))
+    # Hair and point clouds (blender/strands.py), drawn by the same passes.
+    strand_items = strands.gather_strands(depsgraph, object_filter=object_filter, object_settings=gather.ObjectSettings(
+        gather.SHOW_IN_VIEWPORT, bpy.data.objects), colors=colors.needs_item_colors(settings))
     start = time.perf_counter()
     stats = passes.draw_over_viewport(
         overlay_state.draw_items(plan, items),
@@ -187,6 +190,7 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
         scene_depth=plan.scene_depth,
         clip_planes=plan.clip_planes,
         display=display,
+        strands=strand_items,
     )
     ms_draw = (time.perf_counter() - start) * 1000.0
     return runtime.end_frame(frame, stats, ms_extract, ms_draw, seen)

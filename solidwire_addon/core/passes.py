@@ -24,6 +24,7 @@ import numpy as np
 
 from . import colors, compositing, edge_select, shaders, silhouettes
 from . import draw as draw_mod
+from . import strands as strands_mod
 from .log import warn_once
 
 # Render passes beyond Combined and Depth (docs/image_model.md §6), by the
@@ -92,7 +93,7 @@ def render(items, view: View, settings, *, cull: bool = True):
 
 
 def render_passes(items, view: View, settings, *, cull: bool = True, extra_passes=(), keep_readback: bool = False,
-                  read_depth: bool = True):
+                  read_depth: bool = True, strands=()):
     """:func:`render` plus the render passes named in ``extra_passes`` (of
     schema.EXTRA_PASSES): (rgba, view_depth, stats, {name: (H, W, channels)}).
     A pass that is not asked for costs nothing: the surface pass gets its
@@ -139,6 +140,8 @@ def render_passes(items, view: View, settings, *, cull: bool = True, extra_passe
         extra[NORMAL_PASS] = read_texture(targets.normal, 4)[..., :3]
     if any(step.kind == SILHOUETTES for step in steps):
         rgba = _composite_silhouettes(rgba, targets, items, view, settings)
+    if strands:  # hair and point clouds (core/strands.py), over everything above
+        rgba, depth = strands_mod.composite_render(rgba, depth, targets, view, settings, strands)
     return rgba, depth, stats, {name: value for name, value in extra.items() if name in extra_passes}
 
 
@@ -296,7 +299,7 @@ OVERLAY_DEPTH_BIAS = 2.0**-18
 
 def draw_over_viewport(
     items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS, scene_depth: bool = True, clip_planes=None,
-    display=None,
+    display=None, strands=(),
 ):
     """Draw ``items`` over a bound framebuffer that already holds the scene's
     colour and depth (a 3D viewport after its own drawing). Returns the
@@ -356,6 +359,8 @@ def draw_over_viewport(
                 stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **options)
             elif step.kind == SILHOUETTES:
                 silhouettes.draw_silhouettes(items, view, step.settings, overlay_bias=depth_bias, display=display)
+        if strands:  # hair and point clouds (core/strands.py)
+            strands_mod.draw_over_viewport(strands, view, settings, depth_bias, display, clip_planes)
     finally:
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set(saved_blend)

@@ -668,6 +668,7 @@ def release_at_exit() -> None:
     """Free every compiled program (interpreter exit only; see _cache)."""
     _cache.clear()
     _silhouette_cache.clear()
+    _strand_cache.clear()
 
 
 # Full-width silhouettes (image model §5.5): the fin pass of silhouettes.py. Shares
@@ -714,4 +715,84 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         info.fragment_source(common + read_source("line_style.glsl") + _display_source(key)
                              + read_source("silhouette_frag.glsl"))
         shader = _keep(_silhouette_cache, (_context, key), gpu.shader.create_from_info(info))
+    return shader
+
+
+# Hair and point clouds (docs/user/hair-and-points.md): the quad pass of
+# core/strands.py. Shares the parameter block, vertex pulling and the line
+# profile with the exact path.
+_strand_cache: dict[tuple, object] = {}
+
+
+def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
+    """The strand shader (``points``: the disc form). ``overlay_bias`` > 0
+    gives the viewport-overlay form (colour "over" the viewport, its depth
+    buffer occludes; see strand_frag.glsl), with the variant's display
+    transform; otherwise the render form (colour and (depth, weight)
+    outputs, occluded by the ``scene_depth`` texture)."""
+    key = (bool(points), ShaderVariant(use_fade=variant.use_fade, use_fill=variant.use_fill and bool(points),
+                                       thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
+                                       display_transform=variant.display_transform and bool(overlay_bias),
+                                       clip_planes=variant.clip_planes and bool(overlay_bias),
+                                       shading=variant.shading if points and variant.use_fill else SHADING_FLAT))
+    shader = _strand_cache.get((_context, key))
+    if shader is None:
+        flags = key[1]
+        iface = gpu.types.GPUStageInterfaceInfo("solidwire_strand_iface")
+        if points:
+            iface.flat("VEC4", "disc")  # window centre, radius px, view depth of the centre
+            iface.flat("VEC2", "disc_extra")  # radius in scene units, 1 / clip w
+            if flags.clip_planes:
+                iface.flat("VEC4", "disc_clip")  # the centre in clip space
+        else:
+            iface.flat("VEC4", "seg_a")
+            iface.flat("VEC4", "seg_b")
+            iface.flat("VEC2", "seg_depth")
+            iface.flat("VEC2", "seg_radius")
+            if overlay_bias:
+                iface.flat("VEC4", "seg_split")  # bisector normals at the two joints (overlay)
+        info = pulling_info()
+        # Push constants: 120 of the 128 bytes every backend guarantees with
+        # the overlay's proj_z and display_shaper (draw_range draws exactly
+        # the primitives there are, so no count is needed).
+        info.push_constant("VEC4", "strand_view")  # px per unit at w = 1, radius scale
+        info.sampler(1, "FLOAT_2D", "strand_segments")
+        info.vertex_in(0, "INT", "strand_corner")
+        info.vertex_out(iface)
+        info.fragment_out(0, "VEC4", "frag_color")
+        if flags.depth_bias:
+            info.push_constant("VEC4", "proj_z")  # P[2][2], P[2][3], P[3][2], P[3][3]
+            info.define("STRAND_OVERLAY", repr(float(flags.depth_bias)))
+        else:
+            info.sampler(2, "DEPTH_2D", "scene_depth")
+            info.fragment_out(1, "VEC4", "frag_info")
+        compat.depth_write(info, "ANY")
+        info.define("THICKNESS_MODE", str(flags.thickness_mode))
+        if points:
+            info.define("STRAND_POINTS", "1")
+        if flags.use_fade:
+            info.define("USE_FADE", "1")
+        if flags.use_fill:
+            info.define("USE_FILL", "1")
+        shading_source = ""
+        if flags.shading != SHADING_FLAT:
+            # A disc's inside is shaded as the sphere it stands for, by the
+            # mesh fill's own code (fill_shading.glsl), whose inputs are
+            # declared here as plain globals the fragment stage sets.
+            info.define("SHADING", str(flags.shading))
+            if flags.shading == SHADING_MATCAP:
+                info.sampler(6, "FLOAT_2D", "matcap_image")
+            shading_source = ("#define SW_FRONT_FACING true\nvec3 shading_normal;\nvec4 item_info;\n"
+                              + read_source("fill_shading.glsl"))
+        if flags.display_transform:
+            add_display_transform(info)
+        if flags.clip_planes:
+            # (A block, as in the exact path: the push constants are full.)
+            info.uniform_buf(2, "SolidWireClip", "clip_params")
+            info.typedef_source(schema.param_block_glsl() + CLIP_BLOCK_GLSL)
+            info.define("USE_CLIP_PLANES", "1")
+        common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("line_style.glsl")
+        info.vertex_source(common + read_source("strand_vert.glsl"))
+        info.fragment_source(common + _display_source(flags) + shading_source + read_source("strand_frag.glsl"))
+        shader = _keep(_strand_cache, (_context, key), gpu.shader.create_from_info(info))
     return shader

@@ -1,0 +1,117 @@
+/* SolidWire hair and point clouds, fragment stage (docs/user/hair-and-points.md):
+ *
+ *   strand segment: d = window distance to the near-clipped segment, q its
+ *     nearest point; I = P(d) with half-width max(h, projected radius at q);
+ *   point: a disc of the projected radius around the centre's window
+ *     position; the outline is P(|distance to the rim|), the inside is
+ *     covered (fill colour with Fill on, shaded as a sphere by the fill
+ *     shading).
+ *
+ * Occlusion: the primitive's depth (the front of the tube at q, the front of
+ * the sphere for a point) against the surface depth at this pixel.
+ * Render form: premultiplied colour plus (view depth, weight) in a second
+ * target, and a depth key that lets the fragment with the largest weight win
+ * (nearest on ties), so overlapping segments of one strand meet without a
+ * seam. Overlay form: premultiplied "over" into the viewport, occluded by
+ * the viewport's depth buffer. */
+
+#define PX_PER_UNIT strand_view.x
+
+void main()
+{
+  vec2 p = gl_FragCoord.xy;
+  float intensity, weight, depth, inv_w;
+  bool inside = false;
+#ifdef STRAND_POINTS
+  float rim = length(p - disc.xy) - disc.z;
+  inside = rim <= 0.0;
+  inv_w = disc_extra.y;
+  /* The sphere's nearest point along the view axis: a point resting on a
+   * surface is not cut in half by it. */
+  depth = disc.w - disc_extra.x;
+  intensity = line_profile(abs(rim), half_thickness_at(disc.w, inv_w));
+#  ifdef USE_FADE
+  intensity *= depth_fade(disc.w);
+#  endif
+#else
+  vec2 wa = window_point(seg_a), wb = window_point(seg_b);
+#  ifdef STRAND_OVERLAY
+  /* This segment's side of each joint (strand_vert.glsl, joint_normal). */
+  if (dot(p - wa, seg_split.xy) < 0.0 || dot(p - wb, seg_split.zw) > 0.0) {
+    discard;
+  }
+#  endif
+  vec2 ab = wb - wa;
+  float len2 = dot(ab, ab);
+  float s = (len2 > 0.0) ? clamp(dot(p - wa, ab) / len2, 0.0, 1.0) : 0.0;
+  float d = length(p - (wa + s * ab));
+  /* Window parameter s -> parameter u along the clip-space segment
+   * (perspective-correct). */
+  float u = s * seg_a.w / (s * seg_a.w + (1.0 - s) * seg_b.w);
+  inv_w = 1.0 / mix(seg_a.w, seg_b.w, u);
+  float q_depth = mix(seg_depth.x, seg_depth.y, u);
+  float radius = mix(seg_radius.x, seg_radius.y, u);
+  depth = q_depth - radius;
+  intensity = line_profile(d, max(half_thickness_at(q_depth, inv_w), radius * PX_PER_UNIT * inv_w));
+#  ifdef USE_FADE
+  intensity *= depth_fade(q_depth);
+#  endif
+#endif
+#ifdef USE_CLIP_PLANES
+  /* Outside the viewport's clipping region (docs/image_model.md §5.6): a
+   * point by its centre, a strand at its nearest point q. */
+#  ifdef STRAND_POINTS
+  vec4 clip_position = disc_clip;
+#  else
+  vec4 clip_position = mix(seg_a, seg_b, u);
+#  endif
+  for (int k = 0; k < 6; k++) {
+    if (dot(clip_params.planes[k], clip_position) < 0.0) {
+      discard;
+    }
+  }
+#endif
+  weight = inside ? 1.0 : intensity;
+  if (weight <= 0.0) {
+    discard;
+  }
+  float a = intensity * params.wire_color.a;
+  vec4 color = vec4(params.wire_color.rgb * a, a);
+#if defined(STRAND_POINTS) && defined(USE_FILL)
+  if (inside) {
+    vec3 fill = params.fill_color.rgb;
+#  if defined(SHADING) && SHADING != 0
+    /* The sphere's normal under this pixel (view space, +z to the camera;
+     * the disc's window offset over its radius). */
+    vec2 offset = clamp((p - disc.xy) / max(disc.z, 1e-6), -1.0, 1.0);
+    shading_normal = vec3(offset, sqrt(max(1.0 - dot(offset, offset), 0.0)));
+    item_info = vec4(0.0);
+    fill = shaded_fill(fill);
+#  endif
+    color = vec4(params.wire_color.rgb * a + fill * (1.0 - a), 1.0);
+  }
+#endif
+#ifdef STRAND_OVERLAY
+  /* Viewport: the window depth of `depth`, moved towards the camera by the
+   * overlay's depth bias (as the mesh wire), tested LESS_EQUAL against what
+   * Blender drew; blended "over". */
+  float clip_z = -proj_z.x * depth + proj_z.y;
+  float clip_w = -proj_z.z * depth + proj_z.w;
+  gl_FragDepth = clamp(0.5 * (clip_z / clip_w) + 0.5 - 0.5 * STRAND_OVERLAY, 0.0, 1.0);
+  frag_color = color;
+#  ifdef DISPLAY_TRANSFORM
+  frag_color = display_transform(frag_color);
+#  endif
+#else
+  float key_depth = depth * params.inv_clip_end;
+  float scene = texelFetch(scene_depth, ivec2(p), 0).r;
+  if (key_depth > scene) {
+    discard; /* a nearer surface (or the far plane) hides it here */
+  }
+  /* Largest weight first, nearest next: the weight in 1/1024 steps, the
+   * depth within a step (float32 keeps ~6e-5 of the clip range there). */
+  gl_FragDepth = (floor((1.0 - weight) * 1023.0) + clamp(key_depth, 0.0, 0.999)) / 1024.0;
+  frag_color = color;
+  frag_info = vec4(depth, weight, 0.0, 0.0);
+#endif
+}
