@@ -109,13 +109,16 @@ def _region_labels(face_count: int, f1: np.ndarray, f2: np.ndarray) -> np.ndarra
     jumping: a few passes over the pairs even for a long chain of faces."""
     label = np.arange(face_count, dtype=np.int64)
     while True:
-        l1, l2 = label[f1], label[f2]
+        l1, l2 = label[f1], label[f2]  # roots: every label points at one
         differ = l1 != l2
         if not differ.any():
             return label
-        low = np.minimum(l1[differ], l2[differ])
-        np.minimum.at(label, l1[differ], low)
-        np.minimum.at(label, l2[differ], low)
+        l1, l2 = l1[differ], l2[differ]
+        # Hook each larger root under a smaller one. Where one root gets
+        # several, the last write wins: any of them is a valid hook, and the
+        # others are joined in a later round (a plain write is far cheaper
+        # than np.minimum.at).
+        label[np.maximum(l1, l2)] = np.minimum(l1, l2)
         while True:
             jumped = label[label]
             if np.array_equal(jumped, label):
@@ -175,19 +178,22 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     # Regions: faces joined across edges that are not drawn (each has two
     # faces: the one its first corner belongs to, and the other, which the
     # sum of both gives without sorting corners by edge).
+    hidden_edges = np.flatnonzero(~drawn)
     first_face = np.empty(edge_count, np.int64)
     first_face[corner_edge[::-1]] = corner_face[::-1]  # the last write is the first corner's
-    hidden_edges = np.flatnonzero(~drawn)
-    f1 = first_face[hidden_edges]
-    f2 = np.bincount(corner_edge, weights=corner_face, minlength=edge_count)[hidden_edges].astype(np.int64) - f1
-    label = _region_labels(face_count, f1, f2)
+    last_face = np.empty(edge_count, np.int64)
+    last_face[corner_edge] = corner_face
+    label = _region_labels(face_count, first_face[hidden_edges], last_face[hidden_edges])
     region_size = np.bincount(label, minlength=face_count)
 
-    # Drawn edges of each region (unique (label, edge) pairs).
+    # Drawn edges of each region (unique (label, edge) pairs, as one key).
     drawn_corner = drawn[corner_edge]
-    pairs = np.unique(np.stack([label[corner_face[drawn_corner]], corner_edge[drawn_corner]], axis=1), axis=0)
+    keys = np.unique(label[corner_face[drawn_corner]] * edge_count + corner_edge[drawn_corner])
+    pairs = np.stack([keys // edge_count, keys % edge_count], axis=1)
     walked_region = region_size > 1
-    styled_face = np.bincount(corner_face, weights=(classes[corner_edge] != 0), minlength=face_count) > 0
+    styled_face = np.zeros(face_count, bool)
+    if classes.any():
+        styled_face = np.bincount(corner_face, weights=(classes[corner_edge] != 0), minlength=face_count) > 0
     walked = walked_region[label]
     ngon_face = sizes > 4
     # Owner of each listed face's block: its region's block (id = the region
@@ -354,13 +360,15 @@ def _mark_own_edges(arrays: MeshArrays, verts: np.ndarray, drawn: np.ndarray, co
     # some corner (extraction rotates corners, never reflects them), so its
     # edge k is the polygon edge leaving corner (first + k) mod n: found by
     # a few gathers, no search. Other triangles look edges up by vertex pair.
-    size = sizes[arrays.triangle_polygons]
-    start = offsets[arrays.triangle_polygons]
+    size = sizes[arrays.triangle_polygons].astype(np.int32)
+    start = offsets[arrays.triangle_polygons].astype(np.int32)
     last = len(corner_vert) - 1
     first = _corner_in_polygon(tri[:, 0], start, size, corner_vert)
 
     def corner(k):
-        return np.minimum(start + (first + k) % size, last)
+        local = first + np.int32(k)  # < 2 * size: one subtraction wraps it
+        local = np.where(local >= size, local - size, local)
+        return np.minimum(start + local, last)
 
     walks = (size <= 4) & (first >= 0) & (corner_vert[corner(1)] == tri[:, 1]) & (corner_vert[corner(2)] == tri[:, 2])
     by_key = np.flatnonzero(~walks)
@@ -396,7 +404,7 @@ def _mark_own_edges(arrays: MeshArrays, verts: np.ndarray, drawn: np.ndarray, co
 def _corner_in_polygon(vertex, start, size, corner_vert) -> np.ndarray:
     """Where ``vertex`` sits among the first four corners of each row's
     polygon (``start``, ``size``), -1 where it is not one of them."""
-    local = np.full(len(vertex), -1, np.int64)
+    local = np.full(len(vertex), -1, np.int32)
     last = len(corner_vert) - 1
     for j in range(3, -1, -1):  # the first match wins (a corrupt face repeats a vertex)
         at = (j < size) & (corner_vert[np.minimum(start + j, last)] == vertex)
