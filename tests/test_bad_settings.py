@@ -111,6 +111,34 @@ def test_non_finite_setting_falls_back_to_its_default(name, value, output_dir, c
     assert np.array_equal(image, expected)
     said = robustness.lines_of(err.out + err.err, f"'{name}'")
     assert len(said) == 1, said
+    # Said in the engine's report (Blender prints render warnings as
+    # "Warning: ..."), and the stored property is put right as well.
+    assert said[0].startswith("Warning: SolidWire"), said
+    stored = getattr(scene.solidwire, name)
+    if isinstance(fixed, tuple):
+        assert tuple(stored) == pytest.approx(fixed)
+    else:
+        assert stored == pytest.approx(fixed)
+
+
+def test_bad_colour_is_repaired_component_by_component(output_dir, capfd):
+    """A fill colour (-1, 2, NaN) set from Python: Blender clamps the first
+    two to the hard range, the NaN takes the default's component; the
+    colour drawn and the colour stored are both (0, 1, default blue)."""
+    from solidwire_addon.core.settings import DrawSettings
+
+    scene = _monkey_scene(use_fill=True, fill_shading="FLAT")
+    default_blue = DrawSettings().fill_color[2]
+    scene.solidwire.fill_color = (0.0, 1.0, default_blue)
+    expected = robustness.render_exr(scene, output_dir / "bad_colour_expected.exr")
+    scene.solidwire.fill_color = (-1.0, 2.0, math.nan)
+    capfd.readouterr()
+    image = robustness.render_exr(scene, output_dir / "bad_colour.exr")
+    err = capfd.readouterr()
+    assert np.array_equal(image, expected)
+    assert tuple(scene.solidwire.fill_color) == pytest.approx((0.0, 1.0, default_blue))
+    said = robustness.lines_of(err.out + err.err, "'fill_color'")
+    assert len(said) == 1 and said[0].startswith("Warning: SolidWire") and "(0, 1, 0.8)" in said[0], said
 
 
 # ------------------------------------------------------------------- camera

@@ -16,7 +16,8 @@ import numpy as np
 
 from ..core import compositing, passes, shaders
 from ..core.ids import ENGINE_ID
-from . import gather, runtime
+from ..core.log import warn_once
+from . import gather, runtime, setting_repair
 from .gpu_context import ensure_gpu, is_init_scene
 from ..core.view import DrawStats, View
 from .views import NoCameraError, camera_view, render_size
@@ -89,7 +90,10 @@ class PreparedFrame:
         ensure_gpu()  # uploads start in gather(), before anything is drawn
         self.scene = depsgraph.scene
         self.view = camera_view(self.scene, depsgraph, size)
-        self.settings = self.scene.solidwire.snapshot()
+        # A stored NaN is drawn as its default and put right in the scene
+        # itself (the original: self.scene is the depsgraph's copy); the
+        # messages go to the engine's report (``messages``).
+        self.settings, self.messages = setting_repair.checked_snapshot(self.scene, self.scene.original.solidwire)
         # Reuse: unchanged meshes are recognised by their content fingerprint
         # (runtime.py says why), so a multi-frame render re-extracts only what
         # changed on each frame.
@@ -139,6 +143,8 @@ def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=
     report = report or (lambda _text, _fraction: None)
     report("extracting meshes", 0.0)
     frame = PreparedFrame(depsgraph, size, should_stop=should_stop, extra_passes=extra_passes)
+    for line in frame.messages:
+        warn_once(("repaired", line), line)
     if should_stop is not None and should_stop():
         return None
     report(f"drawing {len(frame.items)} objects", 0.5)
@@ -229,6 +235,8 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         self.update_stats("SolidWire", f"{layer_name} | extracting meshes")
         frame = PreparedFrame(depsgraph, size, should_stop=self.test_break,
                               extra_passes=extra_passes_of(depsgraph.view_layer))
+        for line in frame.messages:
+            self.report({"WARNING"}, line)
         tiles = list(tiles_of(region))
         for number, tile in enumerate(tiles, start=1):
             if self.test_break():

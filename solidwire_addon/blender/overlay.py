@@ -27,7 +27,7 @@ import bpy
 from ..core import overlay_state, passes
 from ..core.log import warn_once
 from ..core.view import View
-from . import color_management, gather, properties, runtime
+from . import color_management, gather, properties, runtime, setting_repair
 from .views import region_view
 
 _handle = None
@@ -202,10 +202,14 @@ def _draw_callback() -> None:
         plan = overlay_state.plan_overlay(state) if state is not None else None
         if plan is None:
             return
+        # A stored NaN draws as its default; the stored value is put right
+        # by a timer (no data changes while Blender draws).
+        settings, messages = setting_repair.checked_snapshot(context.scene, defer=True)
+        setting_repair.report_later(messages)
         draw_scene_overlay(
             context.evaluated_depsgraph_get(),
             region_view(context.region, context.region_data),
-            context.scene.solidwire.snapshot(),
+            settings,
             object_filter=object_filter(plan, context.view_layer, context.space_data),
             plan=plan,
             # Never built inside a draw: asked of a timer (color_management).
