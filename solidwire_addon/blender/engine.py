@@ -17,7 +17,7 @@ import numpy as np
 from ..core import compositing, passes, shaders
 from ..core.ids import ENGINE_ID
 from ..core.log import warn_once
-from . import gather, runtime, setting_repair
+from . import density, gather, runtime, setting_repair
 from .gpu_context import ensure_gpu, is_init_scene
 from ..core.view import DrawStats, View
 from .views import NoCameraError, camera_view, render_size
@@ -105,8 +105,11 @@ class PreparedFrame:
             object_settings=gather.ObjectSettings(
                 gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes),
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
+            edge_lengths=density.needs_lengths(self.settings),
             **passes.gather_options(self.settings),
         )
+        # Measured on the whole frame's view, so every tile fades alike.
+        density.fade_dense_items(self.items, self.view, self.settings)
         self.draw_stats = None
         self.ms_draw = 0.0
 

@@ -29,7 +29,7 @@ from ..core.cache import MeshCache
 from ..core.colors import ItemSource
 from ..core.log import warn_once
 from ..core.view import DrawItem, Style, outside_frustum_many
-from . import cage, runtime
+from . import cage, density, runtime
 
 # Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
 SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
@@ -157,7 +157,7 @@ def item_source(obj) -> ItemSource:
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
            should_stop=None, corners: bool = False, colors: bool = False,
            edges: edge_select.Selection = edge_select.Selection(),
-           object_settings: ObjectSettings | None = None, materials: bool = False):
+           object_settings: ObjectSettings | None = None, materials: bool = False, edge_lengths: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -182,7 +182,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     and the object it instances are shown, and takes the style override of
     the object it instances (docs/image_model.md §5.9). ``materials`` (the
     IndexMA pass) gives each item its faces' material slots and the slots'
-    material pass indices."""
+    material pass indices. ``edge_lengths`` (Fade Dense Objects) gives each
+    GPU mesh its typical edge length (``mesh.edge_length``, density.py)."""
     if trust_updates is None:
         trust_updates = depsgraph.mode == "VIEWPORT"
     frame = _FrameGather(depsgraph, cache, trust_updates=trust_updates, view=view, corners=corners,
@@ -201,6 +202,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
         mesh = frame.mesh_for(instance, obj, parent)
         if mesh is None:
             continue
+        if edge_lengths and getattr(mesh, "edge_length", None) is None:
+            mesh.edge_length = frame.edge_length_of(obj)
         item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), frame.source_of(obj) if colors else None,
                         style, pass_index)
         if materials:
@@ -333,6 +336,18 @@ class _FrameGather:
                 edges = replace(edges, use_cage=False)
         known = self.edge_choice[obj.as_pointer()] = (edges, cage_key)
         return known
+
+    def edge_length_of(self, obj) -> float:
+        """The typical edge length of the lines ``obj`` draws: its cage's
+        (the original mesh's) where cage edges are drawn, else its evaluated
+        mesh's. Read once per GPU mesh (kept on it until it is extracted
+        again); 0.0 (never faded) when it cannot be read."""
+        try:
+            cage_drawn = self._edges_for(obj)[1] is not None
+            return density.typical_edge_length(obj.original.data if cage_drawn else obj.data)
+        except (AttributeError, ReferenceError, RuntimeError, TypeError, ValueError) as exc:
+            warn_once(("edge_length", obj.name), f"SolidWire: no edge length for '{obj.name}' (never faded): {exc}")
+            return 0.0
 
     def source_of(self, obj) -> ItemSource:
         source = self.sources.get(obj.as_pointer())

@@ -27,7 +27,7 @@ import bpy
 from ..core import overlay_state, passes
 from ..core.log import warn_once
 from ..core.view import View
-from . import color_management, gather, properties, runtime, setting_repair
+from . import color_management, density, gather, properties, runtime, setting_repair
 from .views import region_view
 
 _handle = None
@@ -178,12 +178,15 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     frame = runtime.begin_frame(reuse=True)
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
                                             object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
+                                            edge_lengths=density.needs_lengths(settings),
                                             **passes.gather_options(settings))
+    drawn = overlay_state.draw_settings(plan, settings)
+    density.fade_dense_items(items, view, drawn)  # (pixel lengths at the UI scale)
     start = time.perf_counter()
     stats = passes.draw_over_viewport(
         items,
         view,
-        overlay_state.draw_settings(plan, settings),
+        drawn,
         scene_depth=plan.scene_depth,
         clip_planes=plan.clip_planes,
         display=display,

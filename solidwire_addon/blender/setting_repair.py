@@ -88,7 +88,7 @@ def store(props, repairs: dict, *, defer: bool = False) -> None:
                 setattr(props, name, fixed)
         except (AttributeError, ReferenceError, RuntimeError, TypeError):
             pass
-        return None  # a timer that runs once
+        # Returning None: a timer that runs once.
 
     if not defer and threading.current_thread() is threading.main_thread():
         write()
@@ -119,7 +119,6 @@ def report_later(lines) -> None:
                 bpy.ops.solidwire.report_message(message=line)
             except (AttributeError, RuntimeError):
                 pass  # no window to report in (already said on the console)
-        return None
 
     bpy.app.timers.register(say, first_interval=0.0)
 
