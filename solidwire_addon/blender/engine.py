@@ -106,6 +106,7 @@ class PreparedFrame:
                 gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes),
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
             edge_lengths=density.needs_lengths(self.settings),
+            tessellation=bool(self.settings.show_tessellation),
             **passes.gather_options(self.settings),
         )
         # Measured on the whole frame's view, so every tile fades alike.

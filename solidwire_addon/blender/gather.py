@@ -29,7 +29,7 @@ from ..core.cache import MeshCache
 from ..core.colors import ItemSource
 from ..core.log import warn_once
 from ..core.view import DrawItem, Style, outside_frustum_many
-from . import cage, density, runtime
+from . import cage, density, outlines, runtime
 
 # Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
 SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
@@ -74,6 +74,10 @@ class ObjectSettings:
                 shown = False
             known = self._known[uid] = (shown, style, int(getattr(obj_orig, "pass_index", 0)))
         return known
+
+
+# The cage key of a tessellated source drawn as outlines (outlines.py).
+OUTLINE_KEY = "outlines"
 
 
 class SeenKeys(set):
@@ -157,7 +161,8 @@ def item_source(obj) -> ItemSource:
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
            should_stop=None, corners: bool = False, colors: bool = False,
            edges: edge_select.Selection = edge_select.Selection(),
-           object_settings: ObjectSettings | None = None, materials: bool = False, edge_lengths: bool = False):
+           object_settings: ObjectSettings | None = None, materials: bool = False, edge_lengths: bool = False,
+           tessellation: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -183,11 +188,14 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     the object it instances (docs/image_model.md §5.9). ``materials`` (the
     IndexMA pass) gives each item its faces' material slots and the slots'
     material pass indices. ``edge_lengths`` (Fade Dense Objects) gives each
-    GPU mesh its typical edge length (``mesh.edge_length``, density.py)."""
+    GPU mesh its typical edge length (``mesh.edge_length``, density.py).
+    ``tessellation`` (Tessellation): text, curves, surfaces and metaballs
+    draw every edge of their tessellation instead of their outlines
+    (outlines.py)."""
     if trust_updates is None:
         trust_updates = depsgraph.mode == "VIEWPORT"
     frame = _FrameGather(depsgraph, cache, trust_updates=trust_updates, view=view, corners=corners,
-                         edges=edges)
+                         edges=edges, outlines=not tessellation)
     items: list[DrawItem] = []
     for instance in depsgraph.object_instances:
         obj = instance.object
@@ -240,12 +248,12 @@ class _FrameGather:
     and material slots read once per object/mesh."""
 
     def __init__(self, depsgraph, cache: MeshCache, *, trust_updates: bool, view, corners: bool,
-                 edges: edge_select.Selection):
+                 edges: edge_select.Selection, outlines: bool = True):
         self.cache = cache
         self.mode = depsgraph.mode
         self.trust = (depsgraph.as_pointer(), runtime.epoch) if trust_updates else None
         self.versions = runtime.geometry_version
-        self.corners, self.edges = corners, edges
+        self.corners, self.edges, self.outlines = corners, edges, outlines
         self.view_projection = None if view is None else view.projection @ view.view_matrix
         self.seen = SeenKeys()
         self.seen.scope = (self.mode,)
@@ -311,8 +319,9 @@ class _FrameGather:
 
     def _resolve_safely(self, obj, data, pointer, key, uids):
         try:
+            edges, cage_key = self._edges_for(obj)
             mesh, ms = _mesh_for(obj, data, pointer, key, uids, self.cache, self.trust, self.versions,
-                                 self.corners, self._edges_for(obj)[0], self.mode == "RENDER")
+                                 self.corners, edges, self.mode == "RENDER", outline=cage_key == OUTLINE_KEY)
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
             warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {exc}")
             return None
@@ -328,7 +337,15 @@ class _FrameGather:
             return known
         edges = self.edges
         cage_key = None
-        if edges.use_cage:
+        tessellated = outlines.is_tessellated(obj)
+        if tessellated and self.outlines:
+            # The outline mask goes in through the cage input (a
+            # tessellation has no cage of its own).
+            edges = replace(edges, use_cage=True)
+            cage_key = OUTLINE_KEY
+        elif tessellated:
+            edges = replace(edges, use_cage=False)
+        elif edges.use_cage:
             render = self.mode == "RENDER"
             if cage.subdivides(obj.original, render):
                 cage_key = cage.cage_key(obj.original, render)
@@ -343,7 +360,7 @@ class _FrameGather:
         mesh's. Read once per GPU mesh (kept on it until it is extracted
         again); 0.0 (never faded) when it cannot be read."""
         try:
-            cage_drawn = self._edges_for(obj)[1] is not None
+            cage_drawn = self._edges_for(obj)[1] not in (None, OUTLINE_KEY)
             return density.typical_edge_length(obj.original.data if cage_drawn else obj.data)
         except (AttributeError, ReferenceError, RuntimeError, TypeError, ValueError) as exc:
             warn_once(("edge_length", obj.name), f"SolidWire: no edge length for '{obj.name}' (never faded): {exc}")
@@ -415,8 +432,10 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
 
 
 def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False,
-              edges: edge_select.Selection = edge_select.Selection(), render: bool = False):
-    """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
+              edges: edge_select.Selection = edge_select.Selection(), render: bool = False, outline: bool = False):
+    """(GPUMesh or None, ms spent validating/extracting) for one evaluated
+    mesh. ``outline``: the drawn mask is outlines.py's (``edges.use_cage``
+    says a mask is passed), not the cage's."""
     obj_orig = obj.original
     fast = None
     if trust is not None:
@@ -441,10 +460,15 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
             arrays = extract.extract_mesh(source_mesh, positions=positions, corner_vert=corner_vert,
                                           corners=corner_inputs if corners else None)
             if edges.active:
-                cage_edges = cage.cage_edges(obj.original, source_mesh, render=render) if edges.use_cage else None
+                face_offsets = extract.read_face_offsets(source_mesh)
+                cage_edges = None
+                if outline:
+                    cage_edges = outlines.outline_mask(source_mesh, face_offsets)
+                elif edges.use_cage:
+                    cage_edges = cage.cage_edges(obj.original, source_mesh, render=render)
                 edge_select.apply_to_mesh(
                     arrays, source_mesh, corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
-                    extract.read_face_offsets(source_mesh), edges, cage_edges)
+                    face_offsets, edges, cage_edges)
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
             return None

@@ -179,6 +179,7 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
                                             object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
                                             edge_lengths=density.needs_lengths(settings),
+                                            tessellation=bool(settings.show_tessellation),
                                             **passes.gather_options(settings))
     drawn = overlay_state.draw_settings(plan, settings)
     density.fade_dense_items(items, view, drawn)  # (pixel lengths at the UI scale)

@@ -295,6 +295,12 @@ SETTINGS: tuple[Setting, ...] = (
         section="edges", cli="--density-fade",
     ),
     Setting(
+        "show_tessellation", BOOL, False, "Tessellation",
+        "On text, curves, surfaces and metaballs, draw every edge of the mesh Blender makes of them (flat fills "
+        "show their triangles) instead of their outlines and profiles",
+        section="edges",
+    ),
+    Setting(
         "use_object_density_fade", BOOL, True, "Fade Dense Objects",
         "Fade the whole wire of an object or instance whose edges are typically short on screen even at its "
         "nearest point (crowds of small or distant objects show their fill instead of a mass of lines)",

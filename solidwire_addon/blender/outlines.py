@@ -1,0 +1,44 @@
+"""Outlines of tessellated sources (docs/objects.md): text, curves with fill,
+bevel or extrusion, NURBS surfaces and metaballs reach SolidWire as the
+mesh Blender tessellates them into, and a flat fill (a letter's face, a
+filled curve) is an arbitrary fan of triangles that says nothing about the
+shape. For those objects an edge between two faces that lie in one plane
+is not drawn: the faces of a flat fill form one region (core/edge_select.py)
+whose outline is drawn, and the profile edges where the surface bends stay.
+``show_tessellation`` draws every edge again.
+
+The mask goes into the same input as the cage edges (edge_select's drawn
+mask), so no mesh data is changed and nothing is saved in the file.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core import edge_select, extract
+
+# Object types whose evaluated mesh is a tessellation Blender made.
+TESSELLATED_TYPES = frozenset({"FONT", "CURVE", "SURFACE", "META"})
+# Faces whose normals differ by less than this lie in one plane (float32
+# normals of coplanar faces differ by ~1e-7 rad; the finest curved
+# tessellation Blender makes bends by far more than this per edge).
+COPLANAR_ANGLE = 1.0e-3
+
+
+def is_tessellated(obj) -> bool:
+    """Whether an evaluated object's mesh comes from a text, curve, surface
+    or metaball object (its original, or the object that made the mesh)."""
+    original = getattr(obj, "original", None) or obj
+    return getattr(original, "type", "MESH") in TESSELLATED_TYPES
+
+
+def outline_mask(mesh, face_offsets: np.ndarray | None = None) -> tuple[np.ndarray, None]:
+    """(drawn mask, chain ids = None) of ``mesh``'s edges in the form
+    edge_select.apply_to_mesh takes for its cage input: False for an edge
+    of exactly two faces in one plane."""
+    if face_offsets is None:
+        face_offsets = extract.read_face_offsets(mesh)
+    verts, corner_edge = edge_select.read_edge_topology(mesh)
+    flat = edge_select.flat_edges(corner_edge, face_offsets, extract.read_face_normals(mesh), len(verts),
+                                  COPLANAR_ANGLE)
+    return ~flat, None
