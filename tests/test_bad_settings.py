@@ -141,6 +141,29 @@ def test_bad_colour_is_repaired_component_by_component(output_dir, capfd):
     assert len(said) == 1 and said[0].startswith("Warning: SolidWire") and "(0, 1, 0.8)" in said[0], said
 
 
+def test_non_finite_object_override_is_reset_too(output_dir, capfd):
+    """An object's own thickness set to NaN from Python: drawn with the
+    override's default and put back to it in the object, said once."""
+    from solidwire_addon.core import schema
+
+    scene = _monkey_scene()
+    suzanne = scene.objects["Suzanne"]
+    suzanne.solidwire.use_override = True
+    suzanne.solidwire.wire_color = (0.2, 0.9, 0.3, 1.0)
+    default = schema.BY_SCOPE[(schema.OBJECT, "thickness")].default
+    suzanne.solidwire.thickness = default
+    expected = robustness.render_exr(scene, output_dir / "nonfinite_override_expected.exr")
+    suzanne.solidwire.thickness = math.nan
+    capfd.readouterr()
+    image = robustness.render_exr(scene, output_dir / "nonfinite_override.exr")
+    robustness.render_exr(scene, output_dir / "nonfinite_override.exr")
+    err = capfd.readouterr()
+    assert np.array_equal(image, expected)
+    assert suzanne.solidwire.thickness == pytest.approx(default)
+    said = robustness.lines_of(err.out + err.err, "'thickness'")
+    assert len(said) == 1 and "object 'Suzanne'" in said[0] and said[0].startswith("Warning: SolidWire"), said
+
+
 # ------------------------------------------------------------------- camera
 
 

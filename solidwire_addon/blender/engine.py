@@ -100,15 +100,17 @@ class PreparedFrame:
         self.frame = runtime.begin_frame(reuse=True)
         # The view lets gather skip extracting meshes that are wholly off-screen.
         self.extra_passes = tuple(extra_passes)
+        object_settings = gather.ObjectSettings(
+            gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes)
         self.items, self.seen, self.ms_extract = gather.gather(
             depsgraph, runtime.mesh_cache, view=self.view, should_stop=should_stop,
-            object_settings=gather.ObjectSettings(
-                gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes),
+            object_settings=object_settings,
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
             edge_lengths=density.needs_lengths(self.settings),
             tessellation=bool(self.settings.show_tessellation),
             **passes.gather_options(self.settings),
         )
+        self.messages += object_settings.messages
         # Measured on the whole frame's view, so every tile fades alike.
         density.fade_dense_items(self.items, self.view, self.settings)
         self.draw_stats = None

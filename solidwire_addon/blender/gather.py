@@ -28,8 +28,9 @@ from ..core import edge_select, extract
 from ..core.cache import MeshCache
 from ..core.colors import ItemSource
 from ..core.log import warn_once
+from ..core.schema import OBJECT, OVERRIDE_FIELDS
 from ..core.view import DrawItem, Style, outside_frustum_many
-from . import cage, density, outlines, runtime
+from . import cage, density, outlines, runtime, setting_repair
 
 # Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
 SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
@@ -48,6 +49,9 @@ class ObjectSettings:
         scenes that do not use these settings pay one scan per frame."""
         self.show = show
         self._known: dict[int, tuple] = {}
+        # One line per object override that held a NaN (put right in the
+        # object too, setting_repair.py); the target reports them.
+        self.messages: list[str] = []
         self.active = pass_index or any(self._non_default(obj) for obj in objects)
 
     def _non_default(self, obj) -> bool:
@@ -68,8 +72,15 @@ class ObjectSettings:
             if props is not None:
                 shown = bool(getattr(props, self.show))
                 if props.use_override:
-                    style = Style(tuple(float(c) for c in props.wire_color), float(props.thickness),
-                                  tuple(float(c) for c in props.fill_color))
+                    values = {name: getattr(props, name) for name in OVERRIDE_FIELDS}
+                    repairs = setting_repair.find_repairs(props, OBJECT)
+                    if repairs:
+                        values.update({name: fixed for name, (_stored, fixed) in repairs.items()})
+                        setting_repair.store(props, repairs, defer=self.show == SHOW_IN_VIEWPORT)
+                        self.messages += [setting_repair.message(f"object '{obj_orig.name}'", name, *pair)
+                                          for name, pair in repairs.items()]
+                    style = Style(tuple(float(c) for c in values["wire_color"]), float(values["thickness"]),
+                                  tuple(float(c) for c in values["fill_color"]))
             if self.show == SHOW_IN_VIEWPORT and getattr(obj_orig, "solidwire_exclude", False):
                 shown = False
             known = self._known[uid] = (shown, style, int(getattr(obj_orig, "pass_index", 0)))

@@ -176,11 +176,13 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     # Meshes are reused across redraws: the viewport depsgraph reports every
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
+    object_settings = gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects)
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
-                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
+                                            object_settings=object_settings,
                                             edge_lengths=density.needs_lengths(settings),
                                             tessellation=bool(settings.show_tessellation),
                                             **passes.gather_options(settings))
+    setting_repair.report_later(object_settings.messages)
     drawn = overlay_state.draw_settings(plan, settings)
     density.fade_dense_items(items, view, drawn)  # (pixel lengths at the UI scale)
     start = time.perf_counter()
