@@ -298,7 +298,7 @@ SETTINGS: tuple[Setting, ...] = (
         "show_tessellation", BOOL, False, "Tessellation",
         "On text, curves, surfaces and metaballs, draw every edge of the mesh Blender makes of them (flat fills "
         "show their triangles) instead of their outlines and profiles",
-        section="edges",
+        section="edges", cli="--tessellation",
     ),
     Setting(
         "use_object_density_fade", BOOL, True, "Fade Dense Objects",
