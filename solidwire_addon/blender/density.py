@@ -73,7 +73,17 @@ def on_screen_lengths(items, view: View) -> np.ndarray:
     result = np.full(count, np.inf)
     if count == 0:
         return result
-    lengths = np.array([float(getattr(item.mesh, "edge_length", 0.0) or 0.0) for item in items])
+    # Per distinct mesh once (instances share theirs), then by index.
+    index_of: dict = {}
+    mesh_list: list = []
+    which = np.empty(count, np.int64)
+    for number, item in enumerate(items):
+        index = index_of.get(id(item.mesh))
+        if index is None:
+            index = index_of[id(item.mesh)] = len(mesh_list)
+            mesh_list.append(item.mesh)
+        which[number] = index
+    lengths = np.array([float(getattr(mesh, "edge_length", 0.0) or 0.0) for mesh in mesh_list])[which]
     matrices = np.stack([item.matrix for item in items])  # (N, 4, 4) object -> world
     scale = np.linalg.norm(matrices[:, :3, :3], axis=1).mean(axis=1)
     world_length = lengths * scale
@@ -83,8 +93,8 @@ def on_screen_lengths(items, view: View) -> np.ndarray:
     if float(projection[3][3]) == 1.0:  # orthographic: the same size at any depth
         pixels = world_length * px_per_unit
     else:
-        lo = np.stack([item.mesh.centre + item.mesh.bounds_min for item in items])  # (N, 3)
-        hi = np.stack([item.mesh.centre + item.mesh.bounds_max for item in items])
+        lo = np.stack([mesh.centre + mesh.bounds_min for mesh in mesh_list])[which]  # (N, 3)
+        hi = np.stack([mesh.centre + mesh.bounds_max for mesh in mesh_list])[which]
         corners = np.stack([np.where(np.array(bits, dtype=bool), hi, lo)
                             for bits in np.ndindex(2, 2, 2)], axis=1)  # (N, 8, 3)
         to_view_z = np.einsum("j,njk->nk", view.view_matrix[2], matrices)  # (N, 4): view z row
