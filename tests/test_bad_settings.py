@@ -164,6 +164,43 @@ def test_non_finite_object_override_is_reset_too(output_dir, capfd):
     assert len(said) == 1 and "object 'Suzanne'" in said[0] and said[0].startswith("Warning: SolidWire"), said
 
 
+def test_overlay_draws_the_default_and_resets_the_setting_later(monkeypatch, capfd):
+    """The viewport overlay never changes data while Blender draws: it draws
+    the default at once, and a timer puts the stored value right and says
+    so in Blender's report (one line, however many redraws came first)."""
+    from types import SimpleNamespace
+
+    from solidwire_addon.blender import overlay, setting_repair
+    from solidwire_addon.core.settings import DrawSettings
+    from solidwire_addon.core.view import View
+
+    scene = scenes.empty_scene(show_overlay=True)
+    scenes.cube(scene)
+    scene.solidwire.thickness = math.nan
+    later, drawn = [], []
+    monkeypatch.setattr(setting_repair, "run_later", later.append)
+    monkeypatch.setattr(overlay, "region_view", lambda *_a: View(np.eye(4), np.eye(4), (0, 0, 8, 8)))
+    monkeypatch.setattr(overlay, "draw_scene_overlay", lambda _dg, _view, settings, **_k: drawn.append(settings))
+    context = SimpleNamespace(scene=scene, space_data=None, region=object(), region_data=object(),
+                              view_layer=bpy.context.view_layer, screen=None, area=None,
+                              preferences=bpy.context.preferences,
+                              evaluated_depsgraph_get=bpy.context.evaluated_depsgraph_get)
+    monkeypatch.setattr(overlay, "bpy", SimpleNamespace(context=context))
+    capfd.readouterr()
+    overlay._draw_callback()
+    overlay._draw_callback()
+    assert [s.thickness for s in drawn] == [DrawSettings().thickness] * 2
+    assert math.isnan(scene.solidwire.thickness)  # nothing written while drawing
+    for function in list(later):
+        function()
+    assert scene.solidwire.thickness == pytest.approx(DrawSettings().thickness)
+    err = capfd.readouterr()
+    said = robustness.lines_of(err.out + err.err, "'thickness'")
+    # The console at once, and Blender's report from the timer.
+    assert len([line for line in said if line.startswith("SolidWire")]) == 1, said
+    assert len([line for line in said if line.startswith("Warning: SolidWire")]) == 1, said
+
+
 # ------------------------------------------------------------------- camera
 
 

@@ -93,7 +93,12 @@ def store(props, repairs: dict, *, defer: bool = False) -> None:
     if not defer and threading.current_thread() is threading.main_thread():
         write()
     else:
-        bpy.app.timers.register(write, first_interval=0.0)
+        run_later(write)
+
+
+def run_later(function) -> None:
+    """Run ``function`` once from Blender's main loop (a timer)."""
+    bpy.app.timers.register(function, first_interval=0.0)
 
 
 # Messages waiting for the timer that reports them (a viewport redraws many
@@ -120,7 +125,7 @@ def report_later(lines) -> None:
             except (AttributeError, RuntimeError):
                 pass  # no window to report in (already said on the console)
 
-    bpy.app.timers.register(say, first_interval=0.0)
+    run_later(say)
 
 
 def checked_snapshot(scene, stored_props=None, *, defer: bool = False) -> tuple[DrawSettings, list[str]]:
