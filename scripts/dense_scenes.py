@@ -26,15 +26,17 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-import bpy  # noqa: E402  (first: it makes bmesh and mathutils importable)
-import bmesh  # noqa: E402
-import numpy as np  # noqa: E402
-from mathutils import Vector  # noqa: E402
+import bpy  # first: importing bpy makes bmesh and mathutils importable
 
-import solidwire_addon  # noqa: E402
-from solidwire_addon.blender import engine  # noqa: E402
-from solidwire_addon.blender.gpu_context import ensure_gpu  # noqa: E402
-from solidwire_addon.core import schema  # noqa: E402
+# isort: split
+import bmesh
+import numpy as np
+from mathutils import Vector
+
+import solidwire_addon
+from solidwire_addon.blender import engine
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.core import schema
 
 SPHERE_GRID = (40, 25)  # 1,000 spheres
 SPHERE_PX = 20.0  # diameter on screen
