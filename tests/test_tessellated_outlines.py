@@ -128,3 +128,28 @@ def test_other_tessellated_sources_render_without_errors(kind, output_dir, capfd
     assert all(image[..., 3].max() > 0.5 for image in images)
     if kind == "FONT":  # flat letter faces: the triangulation shows only with Tessellation
         assert (images[1][..., 3] - images[0][..., 3]).sum() > 5.0
+
+
+def test_text_outlines_are_not_faded_as_dense(output_dir):
+    """A letter's outline is a chain of short segments along a smooth
+    curve: Fade Dense Objects (default look) leaves text alone, while the
+    same segments as a plain mesh count as dense."""
+    scene = scenes.default_look(scenes.empty_scene(W, H))
+    data = bpy.data.curves.new("Text", "FONT")
+    data.body = "S"
+    data.resolution_u = 24
+    text = bpy.data.objects.new("Text", data)
+    scene.collection.objects.link(text)
+    scenes.add_camera(scene, location=(0.3, -1.6, 1.2), target=(0.3, 0.3, 0.0))
+    assert scene.solidwire.use_object_density_fade
+    default = scenes.render_to_file(scene, output_dir / "text_default.png")
+    scene.solidwire.use_object_density_fade = False
+    unfaded = scenes.render_to_file(scene, output_dir / "text_unfaded.png")
+    assert np.array_equal(default, unfaded)
+    # The same geometry as a mesh object is faded: the rule is live here.
+    verts, faces = _evaluated_mesh(text)
+    _replace_with_mesh(scene, text, verts, faces)
+    mesh_unfaded = scenes.render_to_file(scene, output_dir / "text_mesh_unfaded.png")
+    scene.solidwire.use_object_density_fade = True
+    mesh_default = scenes.render_to_file(scene, output_dir / "text_mesh_default.png")
+    assert np.abs(mesh_default - mesh_unfaded).max() > 0.1

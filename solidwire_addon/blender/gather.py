@@ -369,7 +369,13 @@ class _FrameGather:
         """The typical edge length of the lines ``obj`` draws: its cage's
         (the original mesh's) where cage edges are drawn, else its evaluated
         mesh's. Read once per GPU mesh (kept on it until it is extracted
-        again); 0.0 (never faded) when it cannot be read."""
+        again); 0.0 (never faded) for text and curves, and when it cannot
+        be read."""
+        if outlines.is_curve_outline(obj):
+            # Text and curves draw outlines and profiles: chains of short
+            # segments along smooth curves, which their segment length says
+            # nothing about (a letter would fade away).
+            return 0.0
         try:
             cage_drawn = self._edges_for(obj)[1] not in (None, OUTLINE_KEY)
             return density.typical_edge_length(obj.original.data if cage_drawn else obj.data)

@@ -32,6 +32,13 @@ def is_tessellated(obj) -> bool:
     return getattr(original, "type", "MESH") in TESSELLATED_TYPES
 
 
+def is_curve_outline(obj) -> bool:
+    """Whether an evaluated object's mesh comes from a text or curve object:
+    its lines follow the letters' and curves' smooth outlines."""
+    original = getattr(obj, "original", None) or obj
+    return getattr(original, "type", "MESH") in ("FONT", "CURVE")
+
+
 def outline_mask(mesh, face_offsets: np.ndarray | None = None) -> tuple[np.ndarray, None]:
     """(drawn mask, chain ids = None) of ``mesh``'s edges in the form
     edge_select.apply_to_mesh takes for its cage input: False for an edge
