@@ -76,6 +76,8 @@ def test_filled_curve_draws_its_outline_like_one_ngon(output_dir):
     verts, faces = _evaluated_mesh(disc)
     assert len(faces) > 10  # the fill is triangulated
     rgba = scenes.render_to_file(scene, output_dir / "outline_disc.png")
+    # The reference evaluates §3.9 on the curve itself, too.
+    accuracy.assert_accurate(reference.error_report(rgba[..., 3], reference.render_reference(scene)))
     loop = _outline_loop(faces)
     _replace_with_mesh(scene, disc, verts, [tuple(loop)])
     ref = reference.render_reference(scene)
@@ -92,6 +94,7 @@ def test_tessellation_setting_draws_every_edge(output_dir):
     scene, disc = _disc_scene(show_tessellation=True)
     verts, faces = _evaluated_mesh(disc)
     tessellated = scenes.render_to_file(scene, output_dir / "tessellated_disc.png")
+    accuracy.assert_accurate(reference.error_report(tessellated[..., 3], reference.render_reference(scene)))
     scene.solidwire.show_tessellation = False
     outlined = scenes.render_to_file(scene, output_dir / "outlined_disc.png")
     _replace_with_mesh(scene, disc, verts, faces)
