@@ -156,3 +156,26 @@ def test_text_outlines_are_not_faded_as_dense(output_dir):
     scene.solidwire.use_object_density_fade = True
     mesh_default = scenes.render_to_file(scene, output_dir / "text_mesh_default.png")
     assert np.abs(mesh_default - mesh_unfaded).max() > 0.1
+
+
+def test_geometry_nodes_on_a_curve_make_an_ordinary_mesh(output_dir):
+    """A curve object whose geometry nodes output a grid of quads (geometry
+    the user designed) draws every edge of it, as the reference of a mesh
+    does: only Blender's own tessellation is drawn as outlines."""
+    scene, disc = _disc_scene()
+    tree = bpy.data.node_groups.new("Grid", "GeometryNodeTree")
+    tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    grid = tree.nodes.new("GeometryNodeMeshGrid")
+    grid.inputs["Vertices X"].default_value = 4
+    grid.inputs["Vertices Y"].default_value = 4
+    out = tree.nodes.new("NodeGroupOutput")
+    tree.links.new(grid.outputs["Mesh"], out.inputs[0])
+    disc.modifiers.new("Grid", "NODES").node_group = tree
+    rgba = scenes.render_to_file(scene, output_dir / "curve_nodes_grid.png")
+    ref = reference.render_reference(scene)
+    accuracy.assert_accurate(reference.error_report(rgba[..., 3], ref))
+    # The flat grid's inner lines are there (as Tessellation off would hide them).
+    scene.solidwire.show_tessellation = True
+    assert np.array_equal(scenes.render_to_file(scene, output_dir / "curve_nodes_grid_t.png"), rgba)
+    assert (ref.intensity > 0.5).sum() > 60

@@ -25,18 +25,28 @@ TESSELLATED_TYPES = frozenset({"FONT", "CURVE", "SURFACE", "META"})
 COPLANAR_ANGLE = 1.0e-3
 
 
-def is_tessellated(obj) -> bool:
-    """Whether an evaluated object's mesh comes from a text, curve, surface
-    or metaball object (its original, or the object that made the mesh)."""
+def _source_type(obj) -> str:
+    """The type of the object whose tessellation ``obj``'s mesh is, or
+    "MESH" when its geometry is authored: a geometry-nodes modifier on a
+    text or curve object makes (or instances) meshes of the user's own
+    design, which are drawn as meshes."""
     original = getattr(obj, "original", None) or obj
-    return getattr(original, "type", "MESH") in TESSELLATED_TYPES
+    kind = getattr(original, "type", "MESH")
+    if kind != "MESH" and any(md.type == "NODES" for md in getattr(original, "modifiers", ())):
+        return "MESH"
+    return kind
+
+
+def is_tessellated(obj) -> bool:
+    """Whether an evaluated object's mesh is the tessellation of a text,
+    curve, surface or metaball object."""
+    return _source_type(obj) in TESSELLATED_TYPES
 
 
 def is_curve_outline(obj) -> bool:
-    """Whether an evaluated object's mesh comes from a text or curve object:
-    its lines follow the letters' and curves' smooth outlines."""
-    original = getattr(obj, "original", None) or obj
-    return getattr(original, "type", "MESH") in ("FONT", "CURVE")
+    """Whether an evaluated object's mesh is the tessellation of a text or
+    curve object: its lines follow the letters' and curves' outlines."""
+    return _source_type(obj) in ("FONT", "CURVE")
 
 
 def outline_mask(mesh, face_offsets: np.ndarray | None = None) -> tuple[np.ndarray, None]:

@@ -406,7 +406,7 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         # faces whose face normals differ by less than the angle is not
         # drawn (neither a line nor a diagonal).
         angle = float(getattr(s, "edge_angle", 0.0) or 0.0)
-        tessellated = source.type in TESSELLATED_TYPES
+        tessellated = source.type in TESSELLATED_TYPES and not any(md.type == "NODES" for md in source.modifiers)
         if tessellated and not getattr(s, "show_tessellation", False):
             # §3.9: the tessellation of text, curves, surfaces and metaballs
             # hides edges between coplanar faces (the angle rule at a tiny
