@@ -15,10 +15,23 @@ import atexit
 
 import bpy
 
-from .blender import cli, color_management, engine, matcap_files, ops, ops_composite, overlay, properties, runtime, ui
+from .blender import (
+    cli,
+    color_management,
+    engine,
+    matcap_files,
+    ops,
+    ops_composite,
+    overlay,
+    properties,
+    runtime,
+    setting_repair,
+    ui,
+)
 from .core import draw, log, matcaps, strands, targets
 
-_classes = (*properties.classes, *engine.classes, *ops.classes, *ops_composite.classes, *ui.classes)
+_classes = (*properties.classes, *engine.classes, *setting_repair.classes, *ops.classes, *ops_composite.classes,
+            *ui.classes)
 _registered = False
 
 

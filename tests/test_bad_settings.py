@@ -108,6 +108,94 @@ def test_non_finite_setting_falls_back_to_its_default(name, value, output_dir, c
     assert np.array_equal(image, expected)
     said = robustness.lines_of(err.out + err.err, f"'{name}'")
     assert len(said) == 1, said
+    # Said in the engine's report (Blender prints render warnings as
+    # "Warning: ..."), and the stored property is put right as well.
+    assert said[0].startswith("Warning: SolidWire"), said
+    stored = getattr(scene.solidwire, name)
+    if isinstance(fixed, tuple):
+        assert tuple(stored) == pytest.approx(fixed)
+    else:
+        assert stored == pytest.approx(fixed)
+
+
+def test_bad_colour_is_repaired_component_by_component(output_dir, capfd):
+    """A fill colour (-1, 2, NaN) set from Python: Blender clamps the first
+    two to the hard range, the NaN takes the default's component; the
+    colour drawn and the colour stored are both (0, 1, default blue)."""
+    from solidwire_addon.core.settings import DrawSettings
+
+    scene = _monkey_scene(use_fill=True, fill_shading="FLAT")
+    default_blue = DrawSettings().fill_color[2]
+    scene.solidwire.fill_color = (0.0, 1.0, default_blue)
+    expected = robustness.render_exr(scene, output_dir / "bad_colour_expected.exr")
+    scene.solidwire.fill_color = (-1.0, 2.0, math.nan)
+    capfd.readouterr()
+    image = robustness.render_exr(scene, output_dir / "bad_colour.exr")
+    err = capfd.readouterr()
+    assert np.array_equal(image, expected)
+    assert tuple(scene.solidwire.fill_color) == pytest.approx((0.0, 1.0, default_blue))
+    said = robustness.lines_of(err.out + err.err, "'fill_color'")
+    assert len(said) == 1 and said[0].startswith("Warning: SolidWire") and "(0, 1, 0.8)" in said[0], said
+
+
+def test_non_finite_object_override_is_reset_too(output_dir, capfd):
+    """An object's own thickness set to NaN from Python: drawn with the
+    override's default and put back to it in the object, said once."""
+    from solidwire_addon.core import schema
+
+    scene = _monkey_scene()
+    suzanne = scene.objects["Suzanne"]
+    suzanne.solidwire.use_override = True
+    suzanne.solidwire.wire_color = (0.2, 0.9, 0.3, 1.0)
+    default = schema.BY_SCOPE[(schema.OBJECT, "thickness")].default
+    suzanne.solidwire.thickness = default
+    expected = robustness.render_exr(scene, output_dir / "nonfinite_override_expected.exr")
+    suzanne.solidwire.thickness = math.nan
+    capfd.readouterr()
+    image = robustness.render_exr(scene, output_dir / "nonfinite_override.exr")
+    robustness.render_exr(scene, output_dir / "nonfinite_override.exr")
+    err = capfd.readouterr()
+    assert np.array_equal(image, expected)
+    assert suzanne.solidwire.thickness == pytest.approx(default)
+    said = robustness.lines_of(err.out + err.err, "'thickness'")
+    assert len(said) == 1 and "object 'Suzanne'" in said[0] and said[0].startswith("Warning: SolidWire"), said
+
+
+def test_overlay_draws_the_default_and_resets_the_setting_later(monkeypatch, capfd):
+    """The viewport overlay never changes data while Blender draws: it draws
+    the default at once, and a timer puts the stored value right and says
+    so in Blender's report (one line, however many redraws came first)."""
+    from types import SimpleNamespace
+
+    from solidwire_addon.blender import overlay, setting_repair
+    from solidwire_addon.core.settings import DrawSettings
+    from solidwire_addon.core.view import View
+
+    scene = scenes.empty_scene(show_overlay=True)
+    scenes.cube(scene)
+    scene.solidwire.thickness = math.nan
+    later, drawn = [], []
+    monkeypatch.setattr(setting_repair, "run_later", later.append)
+    monkeypatch.setattr(overlay, "region_view", lambda *_a: View(np.eye(4), np.eye(4), (0, 0, 8, 8)))
+    monkeypatch.setattr(overlay, "draw_scene_overlay", lambda _dg, _view, settings, **_k: drawn.append(settings))
+    context = SimpleNamespace(scene=scene, space_data=None, region=object(), region_data=object(),
+                              view_layer=bpy.context.view_layer, screen=None, area=None,
+                              preferences=bpy.context.preferences,
+                              evaluated_depsgraph_get=bpy.context.evaluated_depsgraph_get)
+    monkeypatch.setattr(overlay, "bpy", SimpleNamespace(context=context))
+    capfd.readouterr()
+    overlay._draw_callback()
+    overlay._draw_callback()
+    assert [s.thickness for s in drawn] == [DrawSettings().thickness] * 2
+    assert math.isnan(scene.solidwire.thickness)  # nothing written while drawing
+    for function in later:
+        function()
+    assert scene.solidwire.thickness == pytest.approx(DrawSettings().thickness)
+    err = capfd.readouterr()
+    said = robustness.lines_of(err.out + err.err, "'thickness'")
+    # The console at once, and Blender's report from the timer.
+    assert len([line for line in said if line.startswith("SolidWire")]) == 1, said
+    assert len([line for line in said if line.startswith("Warning: SolidWire")]) == 1, said
 
 
 # ------------------------------------------------------------------- camera

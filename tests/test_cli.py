@@ -197,6 +197,12 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
             {},
             id="shading-and-colour-sources",
         ),
+        pytest.param(
+            ("--no-fade-dense-objects", "--tessellation"),
+            dict(use_object_density_fade=False, show_tessellation=True),
+            {},
+            id="dense-objects-and-tessellation",
+        ),
     ],
 )
 def test_cli_renders_the_same_image_as_the_engine(tmp_path, cli_options, settings, render_settings):

@@ -16,9 +16,9 @@ import numpy as np
 
 from ..core import colors, compositing, passes, schema, shaders
 from ..core.ids import ENGINE_ID
-from ..core.log import one_line
+from ..core.log import one_line, warn_once
 from ..core.view import DrawStats, View
-from . import gather, runtime, strands
+from . import density, gather, runtime, setting_repair, strands
 from .gpu_context import ensure_gpu, is_init_scene
 from .views import NoCameraError, camera_view, render_size
 
@@ -90,20 +90,29 @@ class PreparedFrame:
         ensure_gpu()  # uploads start in gather(), before anything is drawn
         self.scene = depsgraph.scene
         self.view = camera_view(self.scene, depsgraph, size)
-        self.settings = self.scene.solidwire.snapshot()
+        # A stored NaN is drawn as its default and put right in the scene
+        # itself (the original: self.scene is the depsgraph's copy); the
+        # messages go to the engine's report (``messages``).
+        self.settings, self.messages = setting_repair.checked_snapshot(self.scene, self.scene.original.solidwire)
         # Reuse: unchanged meshes are recognised by their content fingerprint
         # (runtime.py says why), so a multi-frame render re-extracts only what
         # changed on each frame.
         self.frame = runtime.begin_frame(reuse=True)
         # The view lets gather skip extracting meshes that are wholly off-screen.
         self.extra_passes = tuple(extra_passes)
+        object_settings = gather.ObjectSettings(
+            gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes)
         self.items, self.seen, self.ms_extract = gather.gather(
             depsgraph, runtime.mesh_cache, view=self.view, should_stop=should_stop,
-            object_settings=gather.ObjectSettings(
-                gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes),
+            object_settings=object_settings,
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
+            edge_lengths=density.needs_lengths(self.settings),
+            tessellation=bool(self.settings.show_tessellation),
             **passes.gather_options(self.settings),
         )
+        self.messages += object_settings.messages
+        # Measured on the whole frame's view, so every tile fades alike.
+        density.fade_dense_items(self.items, self.view, self.settings)
         # Hair and point clouds (blender/strands.py), drawn by the same passes.
         self.strands = strands.gather_strands(depsgraph, object_settings=gather.ObjectSettings(
             gather.SHOW_IN_RENDER, bpy.data.objects), colors=colors.needs_item_colors(self.settings))
@@ -143,6 +152,8 @@ def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=
     report = report or (lambda _text, _fraction: None)
     report("extracting meshes", 0.0)
     frame = PreparedFrame(depsgraph, size, should_stop=should_stop, extra_passes=extra_passes)
+    for line in frame.messages:
+        warn_once(("repaired", line), line)
     if should_stop is not None and should_stop():
         return None
     report(f"drawing {len(frame.items)} objects", 0.5)
@@ -223,6 +234,8 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         self.update_stats("SolidWire", f"{layer_name} | extracting meshes")
         frame = PreparedFrame(depsgraph, size, should_stop=self.test_break,
                               extra_passes=extra_passes_of(depsgraph.view_layer))
+        for line in frame.messages:
+            self.report({"WARNING"}, line)
         tiles = list(tiles_of(region))
         for number, tile in enumerate(tiles, start=1):
             if self.test_break():

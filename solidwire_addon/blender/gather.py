@@ -28,8 +28,9 @@ from ..core import edge_select, extract
 from ..core.cache import MeshCache
 from ..core.colors import ItemSource
 from ..core.log import one_line, warn_once
+from ..core.schema import OBJECT, OVERRIDE_FIELDS
 from ..core.view import DrawItem, Style, outside_frustum_many
-from . import cage, runtime
+from . import cage, density, outlines, runtime, setting_repair
 
 # Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
 SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
@@ -48,6 +49,9 @@ class ObjectSettings:
         scenes that do not use these settings pay one scan per frame."""
         self.show = show
         self._known: dict[int, tuple] = {}
+        # One line per object override that held a NaN (put right in the
+        # object too, setting_repair.py); the target reports them.
+        self.messages: list[str] = []
         self.active = pass_index or any(self._non_default(obj) for obj in objects)
 
     def _non_default(self, obj) -> bool:
@@ -68,12 +72,23 @@ class ObjectSettings:
             if props is not None:
                 shown = bool(getattr(props, self.show))
                 if props.use_override:
-                    style = Style(tuple(float(c) for c in props.wire_color), float(props.thickness),
-                                  tuple(float(c) for c in props.fill_color))
+                    values = {name: getattr(props, name) for name in OVERRIDE_FIELDS}
+                    repairs = setting_repair.find_repairs(props, OBJECT)
+                    if repairs:
+                        values.update({name: fixed for name, (_stored, fixed) in repairs.items()})
+                        setting_repair.store(props, repairs, defer=self.show == SHOW_IN_VIEWPORT)
+                        self.messages += [setting_repair.message(f"object '{obj_orig.name}'", name, *pair)
+                                          for name, pair in repairs.items()]
+                    style = Style(tuple(float(c) for c in values["wire_color"]), float(values["thickness"]),
+                                  tuple(float(c) for c in values["fill_color"]))
             if self.show == SHOW_IN_VIEWPORT and getattr(obj_orig, "solidwire_exclude", False):
                 shown = False
             known = self._known[uid] = (shown, style, int(getattr(obj_orig, "pass_index", 0)))
         return known
+
+
+# The cage key of a tessellated source drawn as outlines (outlines.py).
+OUTLINE_KEY = "outlines"
 
 
 class SeenKeys(set):
@@ -162,7 +177,8 @@ NO_SELECTION = edge_select.Selection()
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
            should_stop=None, corners: bool = False, colors: bool = False,
            edges: edge_select.Selection = NO_SELECTION,
-           object_settings: ObjectSettings | None = None, materials: bool = False):
+           object_settings: ObjectSettings | None = None, materials: bool = False, edge_lengths: bool = False,
+           tessellation: bool = False):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -187,11 +203,15 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     and the object it instances are shown, and takes the style override of
     the object it instances (docs/image_model.md §5.9). ``materials`` (the
     IndexMA pass) gives each item its faces' material slots and the slots'
-    material pass indices."""
+    material pass indices. ``edge_lengths`` (Fade Dense Objects) gives each
+    GPU mesh its typical edge length (``mesh.edge_length``, density.py).
+    ``tessellation`` (Tessellation): text, curves, surfaces and metaballs
+    draw every edge of their tessellation instead of their outlines
+    (outlines.py)."""
     if trust_updates is None:
         trust_updates = depsgraph.mode == "VIEWPORT"
     frame = _FrameGather(depsgraph, cache, trust_updates=trust_updates, view=view, corners=corners,
-                         edges=edges)
+                         edges=edges, outlines=not tessellation)
     items: list[DrawItem] = []
     for instance in depsgraph.object_instances:
         obj = instance.object
@@ -206,6 +226,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
         mesh = frame.mesh_for(instance, obj, parent)
         if mesh is None:
             continue
+        if edge_lengths and getattr(mesh, "edge_length", None) is None:
+            mesh.edge_length = frame.edge_length_of(obj)
         item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), frame.source_of(obj) if colors else None,
                         style, pass_index)
         if materials:
@@ -242,12 +264,12 @@ class _FrameGather:
     and material slots read once per object/mesh."""
 
     def __init__(self, depsgraph, cache: MeshCache, *, trust_updates: bool, view, corners: bool,
-                 edges: edge_select.Selection):
+                 edges: edge_select.Selection, outlines: bool = True):
         self.cache = cache
         self.mode = depsgraph.mode
         self.trust = (depsgraph.as_pointer(), runtime.epoch) if trust_updates else None
         self.versions = runtime.geometry_version
-        self.corners, self.edges = corners, edges
+        self.corners, self.edges, self.outlines = corners, edges, outlines
         self.view_projection = None if view is None else view.projection @ view.view_matrix
         self.seen = SeenKeys()
         self.seen.scope = (self.mode,)
@@ -313,8 +335,9 @@ class _FrameGather:
 
     def _resolve_safely(self, obj, data, pointer, key, uids):
         try:
+            edges, cage_key = self._edges_for(obj)
             mesh, ms = _mesh_for(obj, data, pointer, key, uids, self.cache, self.trust, self.versions,
-                                 self.corners, self._edges_for(obj)[0], self.mode == "RENDER")
+                                 self.corners, edges, self.mode == "RENDER", outline=cage_key == OUTLINE_KEY)
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
             warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
             return None
@@ -330,7 +353,15 @@ class _FrameGather:
             return known
         edges = self.edges
         cage_key = None
-        if edges.use_cage:
+        tessellated = outlines.is_tessellated(obj)
+        if tessellated and self.outlines:
+            # The outline mask goes in through the cage input (a
+            # tessellation has no cage of its own).
+            edges = replace(edges, use_cage=True)
+            cage_key = OUTLINE_KEY
+        elif tessellated:
+            edges = replace(edges, use_cage=False)
+        elif edges.use_cage:
             render = self.mode == "RENDER"
             if cage.subdivides(obj.original, render):
                 cage_key = cage.cage_key(obj.original, render)
@@ -338,6 +369,24 @@ class _FrameGather:
                 edges = replace(edges, use_cage=False)
         known = self.edge_choice[obj.as_pointer()] = (edges, cage_key)
         return known
+
+    def edge_length_of(self, obj) -> float:
+        """The typical edge length of the lines ``obj`` draws: its cage's
+        (the original mesh's) where cage edges are drawn, else its evaluated
+        mesh's. Read once per GPU mesh (kept on it until it is extracted
+        again); 0.0 (never faded) for text and curves, and when it cannot
+        be read."""
+        if outlines.is_curve_outline(obj):
+            # Text and curves draw outlines and profiles: chains of short
+            # segments along smooth curves, which their segment length says
+            # nothing about (a letter would fade away).
+            return 0.0
+        try:
+            cage_drawn = self._edges_for(obj)[1] not in (None, OUTLINE_KEY)
+            return density.typical_edge_length(obj.original.data if cage_drawn else obj.data)
+        except (AttributeError, ReferenceError, RuntimeError, TypeError, ValueError) as exc:
+            warn_once(("edge_length", obj.name), f"SolidWire: no edge length for '{obj.name}' (never faded): {exc}")
+            return 0.0
 
     def source_of(self, obj) -> ItemSource:
         source = self.sources.get(obj.as_pointer())
@@ -405,8 +454,10 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
 
 
 def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False,
-              edges: edge_select.Selection = NO_SELECTION, render: bool = False):
-    """(GPUMesh or None, ms spent validating/extracting) for one evaluated mesh."""
+              edges: edge_select.Selection = NO_SELECTION, render: bool = False, outline: bool = False):
+    """(GPUMesh or None, ms spent validating/extracting) for one evaluated
+    mesh. ``outline``: the drawn mask is outlines.py's (``edges.use_cage``
+    says a mask is passed), not the cage's."""
     obj_orig = obj.original
     fast = None
     if trust is not None:
@@ -431,10 +482,15 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
             arrays = extract.extract_mesh(source_mesh, positions=positions, corner_vert=corner_vert,
                                           corners=corner_inputs if corners else None)
             if edges.active:
-                cage_edges = cage.cage_edges(obj.original, source_mesh, render=render) if edges.use_cage else None
+                face_offsets = extract.read_face_offsets(source_mesh)
+                cage_edges = None
+                if outline:
+                    cage_edges = outlines.outline_mask(source_mesh, face_offsets)
+                elif edges.use_cage:
+                    cage_edges = cage.cage_edges(obj.original, source_mesh, render=render)
                 edge_select.apply_to_mesh(
                     arrays, source_mesh, corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
-                    extract.read_face_offsets(source_mesh), edges, cage_edges)
+                    face_offsets, edges, cage_edges)
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
             return None

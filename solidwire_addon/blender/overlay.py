@@ -27,7 +27,7 @@ import bpy
 from ..core import colors, overlay_state, passes
 from ..core.log import one_line, warn_once
 from ..core.view import View
-from . import color_management, gather, properties, runtime, strands
+from . import color_management, density, gather, properties, runtime, setting_repair, strands
 from .views import region_view
 
 _handle = None
@@ -176,17 +176,26 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     # Meshes are reused across redraws: the viewport depsgraph reports every
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
+    object_settings = gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects)
     items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
-                                            object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
+                                            object_settings=object_settings,
+                                            edge_lengths=density.needs_lengths(settings),
+                                            tessellation=bool(settings.show_tessellation),
                                             **passes.gather_options(settings))
+    setting_repair.report_later(object_settings.messages)
+    drawn = overlay_state.draw_settings(plan, settings)
+    # Pixel lengths at the UI scale: the objects' own Thickness first, then
+    # the density fade, which styles items from what they draw with.
+    items = overlay_state.draw_items(plan, items)
+    density.fade_dense_items(items, view, drawn)
     # Hair and point clouds (blender/strands.py), drawn by the same passes.
     strand_items = strands.gather_strands(depsgraph, object_filter=object_filter, object_settings=gather.ObjectSettings(
         gather.SHOW_IN_VIEWPORT, bpy.data.objects), colors=colors.needs_item_colors(settings))
     start = time.perf_counter()
     stats = passes.draw_over_viewport(
-        overlay_state.draw_items(plan, items),
+        items,
         view,
-        overlay_state.draw_settings(plan, settings),
+        drawn,
         scene_depth=plan.scene_depth,
         clip_planes=plan.clip_planes,
         display=display,
@@ -206,10 +215,14 @@ def _draw_callback() -> None:
         plan = overlay_state.plan_overlay(state) if state is not None else None
         if plan is None:
             return
+        # A stored NaN draws as its default; the stored value is put right
+        # by a timer (no data changes while Blender draws).
+        settings, messages = setting_repair.checked_snapshot(context.scene, defer=True)
+        setting_repair.report_later(messages)
         draw_scene_overlay(
             context.evaluated_depsgraph_get(),
             region_view(context.region, context.region_data),
-            context.scene.solidwire.snapshot(),
+            settings,
             object_filter=object_filter(plan, context.view_layer, context.space_data),
             plan=plan,
             # Never built inside a draw: asked of a timer (color_management).

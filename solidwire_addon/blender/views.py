@@ -18,6 +18,35 @@ def render_size(scene) -> tuple[int, int]:
     return max(int(r.resolution_x * scale), 1), max(int(r.resolution_y * scale), 1)
 
 
+def refuse_unsupported(scene, camera) -> None:
+    """NoCameraError naming what a render cannot draw: a panoramic camera
+    (its projection is no matrix, and calc_matrix_camera would quietly give
+    a perspective one) or stereo/multiview output (one image per view is
+    not rendered: every view would get the same picture)."""
+    data = camera.data if camera.type == "CAMERA" else None
+    if data is not None and data.type == "PANO":
+        kind = _enum_name(data, "panorama_type")
+        raise NoCameraError(
+            f"camera '{camera.name}' is a panoramic camera ({kind}); SolidWire renders perspective and "
+            "orthographic cameras only"
+        )
+    if scene.render.use_multiview:
+        raise NoCameraError(
+            f"scene '{scene.name}' has Stereoscopy (multiview) on; SolidWire renders one view only "
+            "(Output Properties > Stereoscopy)"
+        )
+
+
+def _enum_name(data, prop: str) -> str:
+    """The UI name of an enum property's current value (its identifier if
+    Blender has no name for it)."""
+    value = getattr(data, prop, "")
+    try:
+        return data.bl_rna.properties[prop].enum_items[value].name
+    except (KeyError, AttributeError):
+        return str(value)
+
+
 def camera_view(scene, depsgraph, size: tuple[int, int] | None = None) -> View:
     """The scene camera's view exactly as Blender projects it (docs/image_model.md §1).
 
@@ -27,6 +56,7 @@ def camera_view(scene, depsgraph, size: tuple[int, int] | None = None) -> View:
     camera = scene.camera
     if camera is None:
         raise NoCameraError(f"scene '{scene.name}' has no camera")
+    refuse_unsupported(scene, camera)
     camera = camera.evaluated_get(depsgraph)
     width, height = size or render_size(scene)
     r = scene.render

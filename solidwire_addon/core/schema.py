@@ -295,11 +295,23 @@ SETTINGS: tuple[Setting, ...] = (
         section="edges", cli="--density-fade",
     ),
     Setting(
+        "show_tessellation", BOOL, False, "Tessellation",
+        "On text, curves, surfaces and metaballs, draw every edge of the mesh Blender makes of them (flat fills "
+        "show their triangles) instead of their outlines and profiles",
+        section="edges", cli="--tessellation",
+    ),
+    Setting(
+        "use_object_density_fade", BOOL, True, "Fade Dense Objects",
+        "Fade the whole wire of an object or instance whose edges are typically short on screen even at its "
+        "nearest point (crowds of small or distant objects show their fill instead of a mass of lines)",
+        section="edges", cli="--fade-dense-objects",
+    ),
+    Setting(
         "density_fade_length", FLOAT, 8.0, "Fade Below",
         "An edge this long on screen (pixels) is drawn in full; shorter edges fade, and edges under half of it "
-        "are not drawn",
+        "are not drawn (Density Fade: each line's own length; Fade Dense Objects: an object's typical edge)",
         minimum=0.0, maximum=10000.0, soft_max=64.0, subtype="PIXEL",
-        section="edges", active_if=lambda p: p.use_density_fade,
+        section="edges", active_if=lambda p: p.use_density_fade or p.use_object_density_fade,
         param=Param("density_fade_length", lambda v: max(float(v), 0.0)),
     ),
     *(setting for edge_class in EDGE_CLASS_STYLES for setting in edge_class_settings(*edge_class)),

@@ -167,6 +167,9 @@ EDGE_CLASSES = ("boundary", "sharp", "crease", "seam", "freestyle")
 _CLASS_ATTRIBUTES = {"sharp": ("sharp_edge",), "crease": ("crease_edge",), "seam": ("uv_seam", ".uv_seam"),
                      "freestyle": ("freestyle_edge",)}
 PATTERN_DUTY = {"SOLID": 1.0, "DOTTED": 0.25, "DASHED": 0.5}
+# Tessellated sources (image model §3.9), and their coplanar angle.
+TESSELLATED_TYPES = ("FONT", "CURVE", "SURFACE", "META")
+COPLANAR_ANGLE = 1.0e-3
 
 
 def _cage_masks(depsgraph, s) -> dict:
@@ -397,8 +400,16 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         # Edge angle (image model §3.4): an edge of exactly two distinct
         # faces whose face normals differ by less than the angle is not
         # drawn (neither a line nor a diagonal).
-        not_drawn = _flat_edges(mesh, loop_poly, real_a, real_b, float(getattr(s, "edge_angle", 0.0) or 0.0))
-        sel = _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage_masks.get(source.name))
+        angle = float(getattr(s, "edge_angle", 0.0) or 0.0)
+        tessellated = source.type in TESSELLATED_TYPES and not any(md.type == "NODES" for md in source.modifiers)
+        if tessellated and not getattr(s, "show_tessellation", False):
+            # §3.9: the tessellation of text, curves, surfaces and metaballs
+            # hides edges between coplanar faces (the angle rule at a tiny
+            # angle, for these types only).
+            angle = max(angle, COPLANAR_ANGLE)
+        not_drawn = _flat_edges(mesh, loop_poly, real_a, real_b, angle)
+        cage = None if tessellated else cage_masks.get(source.name)  # (§3.9: no cage of their own)
+        sel = _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage)
         sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2 and (a, b) not in sel["hidden"]]
         if sil:
             sa = np.array([e[0] for e in sil])

@@ -17,7 +17,8 @@ from mathutils import Vector
 # The look of the image model's sections 1.2-1.4 (no shading, no colour
 # sources, no fill): what the accuracy tests measure unless they ask for more.
 CORE_LOOK = dict(use_fill=False, fill_shading="FLAT", fill_color=(1.0, 1.0, 1.0),
-                 fill_color_source="SINGLE", wire_color_source="SINGLE", use_cage_edges=False)
+                 fill_color_source="SINGLE", wire_color_source="SINGLE", use_cage_edges=False,
+                 use_object_density_fade=False)
 
 
 def empty_scene(width: int = 160, height: int = 120, *, transparent: bool = True, **solidwire):
@@ -47,7 +48,8 @@ def empty_scene(width: int = 160, height: int = 120, *, transparent: bool = True
 
 def default_look(scene):
     """Back to the add-on's own defaults for what CORE_LOOK switches off (a
-    Studio-shaded fill, cage edges): the look a user starts from."""
+    Studio-shaded fill, cage edges, Fade Dense Objects): the look a user
+    starts from."""
     for key in CORE_LOOK:
         scene.solidwire.property_unset(key)
     return scene
