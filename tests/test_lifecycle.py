@@ -82,7 +82,7 @@ def leftovers() -> dict:
 # The one documented exception: compiled shader programs live for the whole
 # process and are freed at interpreter exit (solidwire_addon/core/shaders.py
 # says why: freeing them while another GL context used them crashed llvmpipe).
-SHADER_PROGRAMS = ("solidwire_addon.core.shaders._cache", "solidwire_addon.core.shaders._silhouette_cache")
+SHADER_PROGRAMS = ("solidwire_addon.core.shaders._cache",)
 
 
 def _exit_hook_registered() -> bool:

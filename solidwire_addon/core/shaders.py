@@ -667,13 +667,10 @@ def get_setup(in_front: bool = False):
 def release_at_exit() -> None:
     """Free every compiled program (interpreter exit only; see _cache)."""
     _cache.clear()
-    _silhouette_cache.clear()
-    _strand_cache.clear()
 
 
 # Full-width silhouettes (image model §5.5): the fin pass of silhouettes.py. Shares
 # the parameter block, vertex pulling and edge geometry with the exact path.
-_silhouette_cache: dict[tuple, object] = {}
 
 
 def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
@@ -683,7 +680,7 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
     key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
                         linear_depth=variant.linear_depth and not overlay_bias,
                         display_transform=variant.display_transform and bool(overlay_bias))
-    shader = _silhouette_cache.get((_context, key))
+    shader = _cache.get((_context, "silhouette", key))
     if shader is None:
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
         iface.flat("VEC4", "fin_a")
@@ -714,14 +711,13 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         info.vertex_source(common + read_source("silhouette_vert.glsl"))
         info.fragment_source(common + read_source("line_style.glsl") + _display_source(key)
                              + read_source("silhouette_frag.glsl"))
-        shader = _keep(_silhouette_cache, (_context, key), gpu.shader.create_from_info(info))
+        shader = _keep(_cache, (_context, "silhouette", key), gpu.shader.create_from_info(info))
     return shader
 
 
 # Hair and point clouds (docs/user/hair-and-points.md): the quad pass of
 # core/strands.py. Shares the parameter block, vertex pulling and the line
 # profile with the exact path.
-_strand_cache: dict[tuple, object] = {}
 
 
 def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
@@ -735,7 +731,7 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
                                        display_transform=variant.display_transform and bool(overlay_bias),
                                        clip_planes=variant.clip_planes and bool(overlay_bias),
                                        shading=variant.shading if points and variant.use_fill else SHADING_FLAT))
-    shader = _strand_cache.get((_context, key))
+    shader = _cache.get((_context, "strand", key))
     if shader is None:
         flags = key[1]
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_strand_iface")
@@ -794,5 +790,5 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
         common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("line_style.glsl")
         info.vertex_source(common + read_source("strand_vert.glsl"))
         info.fragment_source(common + _display_source(flags) + shading_source + read_source("strand_frag.glsl"))
-        shader = _keep(_strand_cache, (_context, key), gpu.shader.create_from_info(info))
+        shader = _keep(_cache, (_context, "strand", key), gpu.shader.create_from_info(info))
     return shader
