@@ -27,8 +27,11 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import re
+import signal
 import sys
+import threading
 import time
 import traceback
 from pathlib import Path
@@ -131,21 +134,81 @@ def _frame_range(text: str) -> tuple[int, int]:
     return first, last
 
 
+# Blender's frame limits (MINAFRAME, MAXFRAME): every frame number given on
+# its command line is clamped into them.
+MIN_FRAME = -1048574
+MAX_FRAME = 1048574
+
+_RELATIVE = re.compile(r"[+-]?\d+")
 
 
-def _frame_list(text: str) -> list[int]:
-    """Blender's -f syntax: 'N', 'A..B', or a comma list of those."""
-    frames: list[int] = []
+class Relative(tuple):
+    """A frame number as Blender's command line reads it: ``N`` is frame N,
+    ``+N`` counts from one anchor and ``-N`` from another (which ones depends
+    on the option), resolved once the scene is open."""
+
+    def __new__(cls, text: str):
+        text = text.strip()
+        if not _RELATIVE.fullmatch(text):
+            raise ValueError(text)
+        return super().__new__(cls, (text[0] if text[0] in "+-" else "", int(text.lstrip("+-"))))
+
+    def resolve(self, plus: int, minus: int) -> int:
+        # Blender: "+N" is plus + N, "-N" is minus - N + 1 (creator_args'
+        # parse_int_relative), then clamped to the frame limits.
+        sign, number = self
+        value = plus + number if sign == "+" else minus - number + 1 if sign == "-" else number
+        return min(max(value, MIN_FRAME), MAX_FRAME)
+
+
+def _relative_frame(text: str) -> Relative:
+    try:
+        return Relative(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a frame number (N, +N or -N)") from None
+
+
+def _frame_list(text: str) -> list[tuple[Relative, Relative]]:
+    """Blender's -f syntax: a comma list of 'N' and 'A..B' items, each number
+    absolute or relative ('+N' from the scene's start, '-N' from its end)."""
+    items = []
     for part in text.split(","):
-        match = re.fullmatch(r"\s*(-?\d+)\s*(?:\.\.\s*(-?\d+)\s*)?", part)
-        if not match:
-            raise argparse.ArgumentTypeError(f"'{text}' is not a frame list (N, A..B, or a comma list)")
-        first = int(match.group(1))
-        last = int(match.group(2)) if match.group(2) is not None else first
-        if last < first:
-            raise argparse.ArgumentTypeError(f"frame range '{part.strip()}' ends before it starts")
-        frames.extend(range(first, last + 1))
-    return frames
+        first, dots, last = part.partition("..")
+        try:
+            start = Relative(first)
+            items.append((start, Relative(last) if dots else start))
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"'{text}' is not a frame list (N, A..B or a comma list of them; +N and -N count from "
+                "the scene's start and end)") from None
+    return items
+
+
+def _frame_step(text: str) -> int:
+    value = _positive_int(text)
+    return min(value, MAX_FRAME)  # clamped as Blender clamps -j
+
+
+# Options whose value may start with "-" (Blender's "-f -1"): argparse would
+# read such a value as an option, so it is joined to its long option first.
+_SIGNED_VALUE_OPTIONS = {"-f": "--render-frame", "--render-frame": "--render-frame",
+                         "-s": "--frame-start", "--frame-start": "--frame-start",
+                         "-e": "--frame-end", "--frame-end": "--frame-end"}
+
+
+def _join_signed_values(arguments: list[str]) -> list[str]:
+    joined, index = [], 0
+    while index < len(arguments):
+        word = arguments[index]
+        option = _SIGNED_VALUE_OPTIONS.get(word)
+        if option is not None and index + 1 < len(arguments) and arguments[index + 1].startswith("-") \
+                and arguments[index + 1][1:2].isdigit():
+            joined.append(f"{option}={arguments[index + 1]}")
+            index += 2
+            continue
+        joined.append(word)
+        index += 1
+    return joined
 
 
 def _add_setting_option(group, setting: schema.Setting) -> None:
@@ -184,12 +247,15 @@ def build_parser(prog: str = "solidwire render") -> argparse.ArgumentParser:
 
     frames = parser.add_argument_group("frames (as Blender's own command line spells them)")
     frames.add_argument("-f", "--render-frame", dest="frame_list", type=_frame_list, metavar="N",
-                        help="render frame N ('A..B' and comma lists too)")
+                        help="render frame N ('A..B' and comma lists too; +N counts from the scene's start, "
+                             "-N from its end: -f -1 is the last frame)")
     frames.add_argument("-a", "--render-anim", dest="animation", action="store_true",
                         help="render the scene's frame range with its frame step")
-    frames.add_argument("-s", "--frame-start", type=int, metavar="N", help="first frame of the range (implies -a)")
-    frames.add_argument("-e", "--frame-end", type=int, metavar="N", help="last frame of the range (implies -a)")
-    frames.add_argument("-j", "--frame-jump", type=_positive_int, metavar="N", help="frame step (implies -a)")
+    frames.add_argument("-s", "--frame-start", type=_relative_frame, metavar="N",
+                        help="first frame of the range (implies -a; +N/-N relative to the scene's start)")
+    frames.add_argument("-e", "--frame-end", type=_relative_frame, metavar="N",
+                        help="last frame of the range (implies -a; +N/-N relative to the scene's end)")
+    frames.add_argument("-j", "--frame-jump", type=_frame_step, metavar="N", help="frame step (implies -a)")
     frames.add_argument("--frames", type=_frame_range, metavar="A-B", help="frame or frame range (older spelling)")
 
     look = parser.add_argument_group("look (overrides the scene's SolidWire settings for this render)")
@@ -213,6 +279,10 @@ def build_parser(prog: str = "solidwire render") -> argparse.ArgumentParser:
     image.add_argument("--height", type=_positive_int, metavar="PX", help="resolution Y")
     image.add_argument("--percentage", type=_positive_int, metavar="PCT", help="resolution percentage")
     image.add_argument("--color-depth", choices=("8", "16"), help="bits per channel for PNG/TIFF (default 8)")
+
+    image.add_argument("--overwrite", action=argparse.BooleanOptionalAction, default=None,
+                       help="replace frames that exist (default: the scene's Overwrite setting; with "
+                            "--no-overwrite an existing frame is skipped, as Blender skips it)")
 
     report = parser.add_argument_group("progress")
     report.add_argument("--progress", choices=("text", "json"), default="text",
@@ -305,6 +375,10 @@ def apply_preset(settings, text: str) -> None:
     try:
         path = Path(text).expanduser()
         preset = presets.load(path) if text.endswith(".json") or path.is_file() else presets.find(text)
+    except presets.PresetNotFound:
+        # The names to choose from, so a typo in a farm job is fixed at once.
+        names = [p.name for p in presets.all_presets()]
+        raise UsageError(f"--preset: {presets.unknown_preset_message(text, names)}") from None
     except presets.PresetError as exc:
         raise UsageError(f"--preset: {exc}") from None
     presets.apply(preset, settings, depth_range=lambda: ops.camera_fade_range(settings.id_data))
@@ -364,19 +438,32 @@ def apply_options(scene, args) -> None:
 
 def frames_to_render(scene, args) -> list[int]:
     """The frames, by Blender's rules: -f wins, -a (or -s/-e/-j) renders the
-    range with its step, otherwise the current frame."""
+    range with its step, otherwise the current frame. Relative numbers count
+    as Blender's command line counts them (-f: +N from the start, -N from the
+    end; -s and -e: from the scene's own start and end), and every frame is
+    clamped to Blender's frame limits."""
     ranged = args.animation or args.frame_start is not None or args.frame_end is not None or args.frame_jump
     given = [flag for flag, on in (("-f", args.frame_list), ("--frames", args.frames), ("-a/-s/-e/-j", ranged)) if on]
     if len(given) > 1:
         raise UsageError(f"give only one of {', '.join(given)}")
     if args.frame_list:
-        return list(dict.fromkeys(args.frame_list))
+        frames = []
+        for first, last in args.frame_list:
+            start = first.resolve(scene.frame_start, scene.frame_end)
+            end = last.resolve(scene.frame_start, scene.frame_end)
+            if end < start:
+                raise UsageError(f"-f: the frame range {start}..{end} ends before it starts")
+            frames.extend(range(start, end + 1))
+        return list(dict.fromkeys(frames))
     if args.frames:
         first, last = args.frames
-        return list(range(first, last + 1))
+        return list(range(max(first, MIN_FRAME), min(last, MAX_FRAME) + 1))
     if ranged:
-        start = scene.frame_start if args.frame_start is None else args.frame_start
-        end = scene.frame_end if args.frame_end is None else args.frame_end
+        start, end = scene.frame_start, scene.frame_end
+        if args.frame_start is not None:
+            start = args.frame_start.resolve(scene.frame_start, scene.frame_start - 1)
+        if args.frame_end is not None:
+            end = args.frame_end.resolve(scene.frame_end, scene.frame_end - 1)
         step = args.frame_jump or scene.frame_step
         if end < start:
             raise UsageError(f"the frame range {start}..{end} ends before it starts")
@@ -396,6 +483,13 @@ def output_template(text: str) -> Path:
     return Path(text).expanduser().absolute()
 
 
+def frame_number(frame: int, digits: int) -> str:
+    """The frame as Blender writes it into a name (C's "%.*d"): at least
+    ``digits`` digits, a minus sign in front of them: -3 with '####' is
+    '-0003'."""
+    return ("-" if frame < 0 else "") + str(abs(frame)).zfill(digits)
+
+
 def frame_path(template: Path, frame: int, frame_count: int) -> Path:
     """Blender's rule for -o: the last run of '#' becomes the zero-padded
     frame number. A range rendered to a name without '#' gets 4 digits
@@ -405,10 +499,10 @@ def frame_path(template: Path, frame: int, frame_count: int) -> Path:
     runs = list(re.finditer(r"#+", name))
     if runs:
         run = runs[-1]
-        number = f"{frame:0{len(run.group())}d}" if frame >= 0 else f"-{-frame:0{len(run.group()) - 1}d}"
+        number = frame_number(frame, len(run.group()))
         return template.with_name(name[: run.start()] + number + name[run.end() :])
     if frame_count > 1:
-        return template.with_name(f"{template.stem}{frame:04d}{template.suffix}")
+        return template.with_name(f"{template.stem}{frame_number(frame, 4)}{template.suffix}")
     return template
 
 
@@ -423,19 +517,20 @@ def scene_frame_path(scene, frame: int) -> Path:
 
 
 def check_output_folder(directory: Path) -> None:
-    """Create the folder if needed (as Blender does) and prove it writable."""
+    """Prove the folder writable, or creatable, before any slow work; it is
+    created only when the first frame is written (a failed run leaves none)."""
     try:
-        output.check_output_folder(directory)
+        output.check_output_folder(directory, create=False)
     except output.OutputError as exc:
         raise UsageError(str(exc)) from None
 
 
 def check_output(path: Path) -> None:
     """Fail before rendering if the image cannot be written there."""
-    try:
-        output.check_output(path)
-    except output.OutputError as exc:
-        raise UsageError(str(exc)) from None
+    if path.is_dir():
+        raise UsageError(f"output '{path}' is a directory")
+    if path.exists() and not os.access(path, os.W_OK):
+        raise UsageError(f"cannot overwrite '{path}': permission denied")
 
 
 def file_format_of(path: Path, color_depth: str | None) -> str:
@@ -448,9 +543,47 @@ def file_format_of(path: Path, color_depth: str | None) -> str:
     return file_format
 
 
-def set_file_format(scene, path: Path, color_depth: str | None) -> None:
+MULTILAYER = "OPEN_EXR_MULTILAYER"
+VIDEO_FORMATS = ("FFMPEG", "AVI_JPEG", "AVI_RAW")
+
+
+def written_passes(scene) -> list[str]:
+    """The passes beyond Combined that a multilayer file of the scene holds
+    (the view layers' own and SolidWire's), by their property names."""
+    names = []
+    for layer in scene.view_layers:
+        if not layer.use:
+            continue
+        owners = [layer] + [getattr(layer, "solidwire", None)]
+        for owner in owners:
+            if owner is None:
+                continue
+            for prop in owner.bl_rna.properties:
+                name = prop.identifier
+                if name.startswith("use_pass_") and name != "use_pass_combined" and prop.type == "BOOLEAN" \
+                        and getattr(owner, name):
+                    names.append(name[len("use_pass_"):])
+    return list(dict.fromkeys(names))
+
+
+def _is_multilayer(scene) -> bool:
+    return scene.render.image_settings.file_format == MULTILAYER
+
+
+def set_file_format(scene, path: Path, color_depth: str | None, *, over: bool = False) -> str:
+    """Set the output format from -o's extension; returns a one-line note when
+    the scene's multilayer passes are not written ("" otherwise).
+
+    ``.exr`` keeps a multilayer scene multilayer (every pass the scene would
+    write), unless the image is a composite (--over), which is one image."""
     file_format = file_format_of(path, color_depth)
     image = scene.render.image_settings
+    multilayer = _is_multilayer(scene)
+    passes = written_passes(scene) if multilayer else []
+    if file_format == "OPEN_EXR" and multilayer and not over:
+        # The scene's own multilayer settings (depth, codec) stay as they are.
+        scene.render.use_file_extension = False
+        return ""
     compat.set_media_type(image, "IMAGE")
     image.file_format = file_format
     image.color_mode = "RGBA" if file_format in FORMATS_WITH_ALPHA else "RGB"
@@ -458,6 +591,23 @@ def set_file_format(scene, path: Path, color_depth: str | None) -> None:
         image.color_depth = color_depth or "8"
     # The path given is the path written: no extension added by Blender.
     scene.render.use_file_extension = False
+    if not passes:
+        return ""
+    what = "the --over composite is one image" if over else f"'{path.suffix}' holds one image"
+    keep = "" if over else "; -o NAME.exr keeps them"
+    return f"note: {what}: the scene's passes {', '.join(passes)} are not written{keep}"
+
+
+def check_scene_format(scene, over: bool) -> None:
+    """Without -o the scene's format is written: refuse, before rendering, a
+    format the command line cannot write."""
+    file_format = scene.render.image_settings.file_format
+    if file_format in VIDEO_FORMATS or getattr(scene.render.image_settings, "media_type", "") == "VIDEO":
+        raise UsageError(f"the scene's output format is a video ({file_format}); the command line writes one image "
+                         "per frame: pass -o NAME_####.png (or .exr, .tif, ...)")
+    if over and file_format == MULTILAYER:
+        raise UsageError("--over writes one composited image, but the scene's output format is multilayer "
+                         "OpenEXR: pass -o NAME_####.exr (single-layer) or another image type")
 
 
 # -- rendering -----------------------------------------------------------------
@@ -484,39 +634,234 @@ def over_renderer(scene, args):
     except composite.CompositeError as exc:
         raise UsageError(f"--over: {exc}") from None
 
-    def render(scene, path):
+    def render(scene, path, final_path):
         try:
-            composite.render_wire_over(scene, path, engine, keep_layers=args.over_layers, samples=args.over_samples)
+            composite.render_wire_over(scene, path, engine, keep_layers=args.over_layers, layers_name=final_path,
+                                       samples=args.over_samples)
         except composite.CompositeError as exc:
             raise RenderFailed(f"--over {engine}: {exc}") from None
 
     return render
 
 
-def render_frames(scene, paths: dict, args, over=None) -> None:
+class Interrupted(Exception):
+    """SIGINT or SIGTERM ended the run (exit code 128 + the signal)."""
+
+    def __init__(self, signum: int, done: int, total: int):
+        super().__init__(signum)
+        self.signum, self.done, self.total = signum, done, total
+
+
+def _signal_name(signum: int) -> str:
+    try:
+        return signal.Signals(signum).name
+    except ValueError:
+        return f"signal {signum}"
+
+
+class Interrupts:
+    """SIGINT (Ctrl+C) and SIGTERM (a farm cancelling a task) while frames
+    are rendered.
+
+    The first signal lets the frame in progress finish and be written, then
+    the run stops (exit 128 + the signal: 130, 143). No KeyboardInterrupt is
+    raised: Blender would print it from whatever handler it lands in and
+    carry on. A second signal stops at once, after removing the frame's
+    temporary file (and its placeholder). Python runs signal handlers only
+    between bytecodes of the main thread, which a long render by another
+    engine (--over) does not reach for minutes; so the signal is read from a
+    wake-up pipe by a small thread, which sees it immediately."""
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self):
+        self.signum: int | None = None
+        self.discard: set = set()  # removed when the process stops at once
+        self.folders: list = []  # created by this run: removed if left empty
+        self._previous: dict = {}
+        self._pipe: tuple | None = None
+        self._previous_fd = -1
+
+    def install(self) -> bool:
+        if threading.current_thread() is not threading.main_thread():
+            return False
+        read_fd, write_fd = os.pipe()
+        os.set_blocking(write_fd, False)
+        try:
+            self._previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+            self._previous = {sig: signal.signal(sig, self._ignore) for sig in self.SIGNALS}
+        except (ValueError, OSError):
+            os.close(read_fd)
+            os.close(write_fd)
+            return False
+        self._pipe = (read_fd, write_fd)
+        threading.Thread(target=self._watch, args=(read_fd,), name="solidwire-signals", daemon=True).start()
+        return True
+
+    def uninstall(self) -> None:
+        if self._pipe is None:
+            return
+        for sig, handler in self._previous.items():
+            signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
+        signal.set_wakeup_fd(self._previous_fd)
+        read_fd, write_fd = self._pipe
+        self._pipe = None
+        os.close(write_fd)  # ends the watcher's read
+        os.close(read_fd)
+
+    @staticmethod
+    def _ignore(signum, frame):
+        pass  # the watcher thread has seen it already
+
+    def _watch(self, read_fd: int) -> None:
+        while True:
+            try:
+                data = os.read(read_fd, 1)
+            except OSError:
+                return
+            if not data:
+                return
+            signum = data[0]
+            if signum not in self.SIGNALS:
+                continue
+            if self.signum is None:
+                self.signum = signum
+            else:
+                self.stop_now(signum)
+
+    def check(self, done: int, total: int) -> None:
+        if self.signum is not None:
+            raise Interrupted(self.signum, done, total)
+
+    def remove_leftovers(self) -> None:
+        for path in list(self.discard):
+            try:
+                if path.name.endswith(TEMP_SUFFIX) or (path.is_file() and path.stat().st_size == 0):
+                    path.unlink()
+            except OSError:
+                pass
+        self.discard.clear()
+        for folder in reversed(self.folders):
+            try:
+                folder.rmdir()  # only when empty
+            except OSError:
+                pass
+
+    def stop_now(self, signum: int) -> None:
+        self.remove_leftovers()
+        try:
+            print(f"solidwire: stopped by {_signal_name(signum)} during a frame; frames already written are "
+                  "complete", file=sys.stderr, flush=True)
+        finally:
+            os._exit(128 + signum)
+
+
+_interrupts = Interrupts()
+
+# Frames are rendered to ".<name>.solidwire-<pid>.tmp" in the frame's folder
+# and renamed when complete: a file under a frame's name is always whole. The
+# temporary name ends in no image extension, so nothing watching the folder
+# (a farm's preview, a compositor reading a sequence) takes it for a frame.
+TEMP_SUFFIX = ".solidwire-tmp"
+
+
+def temporary_path(path: Path) -> Path:
+    return path.with_name(f".{path.name}.{os.getpid()}{TEMP_SUFFIX}")
+
+
+def ensure_folder(directory: Path) -> None:
+    """Create ``directory`` (and its parents) when the first frame is written,
+    remembering what was created so a failed run can leave nothing behind."""
+    missing = []
+    folder = directory
+    while not folder.exists():
+        missing.append(folder)
+        folder = folder.parent
+    for folder in reversed(missing):
+        try:
+            folder.mkdir()
+        except FileExistsError:
+            continue
+        except OSError as exc:
+            raise RenderFailed(f"cannot create output folder '{folder}': {exc.strerror}") from None
+        _interrupts.folders.append(folder)
+
+
+def _remove(path: Path) -> None:
+    try:
+        path.unlink()
+    except FileNotFoundError:
+        pass
+
+
+def write_frame(scene, frame: int, path: Path, over, *, placeholder: bool) -> None:
+    """Render ``frame`` and put it at ``path`` whole: rendered to a temporary
+    name in the same folder, then renamed (os.replace, atomic on one file
+    system). With a placeholder (render.use_placeholder) an empty file holds
+    the frame's name while it renders, as Blender does, and is removed again
+    if the frame is not finished."""
+    ensure_folder(path.parent)
+    placed = False
+    if placeholder and not path.exists():
+        try:
+            path.touch(exist_ok=False)
+            placed = True
+            _interrupts.discard.add(path)
+        except FileExistsError:
+            pass  # another machine's placeholder: its frame now
+        except OSError as exc:
+            raise RenderFailed(f"frame {frame}: cannot write placeholder '{path}': {exc.strerror}") from None
+    tmp = temporary_path(path)
+    _interrupts.discard.add(tmp)
+    try:
+        scene.render.filepath = str(tmp)
+        try:
+            if over is None:
+                bpy.ops.render.render(write_still=True, scene=scene.name)
+            else:
+                over(scene, tmp, path)
+        except RuntimeError as exc:
+            raise RenderFailed(f"frame {frame}: {_one_line(exc)}") from None
+        try:
+            size = tmp.stat().st_size
+        except FileNotFoundError:
+            size = 0
+        if size == 0:
+            raise RenderFailed(f"frame {frame}: no image was written to '{path}'")
+        try:
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise RenderFailed(f"frame {frame}: cannot write '{path}': {exc.strerror}") from None
+    except BaseException:
+        _remove(tmp)
+        if placed and path.is_file() and path.stat().st_size == 0:
+            _remove(path)
+        raise
+    finally:
+        _interrupts.discard.discard(tmp)
+        _interrupts.discard.discard(path)
+
+
+def render_frames(scene, paths: dict, args, over=None, *, overwrite: bool = True, placeholder: bool = False) -> None:
     """Render each frame to its path, with one progress line (or JSON
-    object) per frame."""
+    object) per frame. An existing frame is skipped when overwriting is off,
+    as Blender skips it (so a requeued job renders only what is missing)."""
+    for folder in dict.fromkeys(path.parent for path in paths.values()):
+        check_output_folder(folder)
     for path in dict.fromkeys(paths.values()):
         check_output(path)
     frames = list(paths)
     start_all = time.perf_counter()
     for index, frame in enumerate(frames, start=1):
+        _interrupts.check(index - 1, len(frames))
         path = paths[frame]
+        if not overwrite and path.exists():
+            _report_skipped(args, frame, index, len(frames), path)
+            continue
         scene.frame_set(frame)
-        scene.render.filepath = str(path)
-        if path.exists():
-            path.unlink()  # so a failed render cannot leave an old image looking new
         start = time.perf_counter()
-        try:
-            if over is None:
-                bpy.ops.render.render(write_still=True, scene=scene.name)
-            else:
-                over(scene, path)
-        except RuntimeError as exc:
-            raise RenderFailed(f"frame {frame}: {_one_line(exc)}") from None
+        write_frame(scene, frame, path, over, placeholder=placeholder)
         seconds = time.perf_counter() - start
-        if not path.is_file() or path.stat().st_size == 0:
-            raise RenderFailed(f"frame {frame}: no image was written to '{path}'")
         elapsed = time.perf_counter() - start_all
         eta = elapsed / index * (len(frames) - index)
         stats = runtime.stats()
@@ -538,6 +883,16 @@ def render_frames(scene, paths: dict, args, over=None) -> None:
             )
         if args.print_stats:
             print("solidwire: stats " + ", ".join(f"{k}={_format_stat(v)}" for k, v in stats.items()), flush=True)
+    _interrupts.check(len(frames), len(frames))
+
+
+def _report_skipped(args, frame: int, index: int, count: int, path: Path) -> None:
+    if args.progress == "json":
+        print(json.dumps({"frame": frame, "index": index, "count": count, "skipped": True, "output": str(path)}),
+              flush=True)
+    else:
+        print(f"solidwire: frame {index} of {count} (frame {frame}) skipped: '{path}' exists and overwriting is "
+              "off", flush=True)
 
 
 def _format_stat(value) -> str:
@@ -552,7 +907,7 @@ def _render_size(scene) -> tuple[int, int]:
 
 def run(arguments: list[str], *, prog: str = "solidwire render", build_demo=None) -> int:
     """Parse ``arguments`` and render. Raises UsageError / RenderFailed."""
-    args = build_parser(prog).parse_args(arguments)
+    args = build_parser(prog).parse_args(_join_signed_values(arguments))
     if build_demo is None and not args.blend and not bpy.app.binary_path:
         raise UsageError("no scene given: pass SCENE.blend or --demo")
     if args.output is not None:
@@ -563,32 +918,52 @@ def run(arguments: list[str], *, prog: str = "solidwire render", build_demo=None
     scene = load_scene(args, build_demo)
     apply_options(scene, args)
     frames = frames_to_render(scene, args)
+    over = args.over is not None
     if args.output is not None:
         template = output_template(args.output)  # '//' resolves against the file just opened
-        set_file_format(scene, template, args.color_depth)
+        note = set_file_format(scene, template, args.color_depth, over=over)
         paths = {frame: frame_path(template, frame, len(frames)) for frame in frames}
     else:
         if args.color_depth is not None:
             raise UsageError("--color-depth needs -o (without it the scene's own format is used)")
+        check_scene_format(scene, over)
+        note = ""
         paths = {frame: scene_frame_path(scene, frame) for frame in frames}
         # frame_path() already holds the extension: Blender must not add another.
         scene.render.use_file_extension = False
-    over = over_renderer(scene, args)  # before the engine is set: --over SCENE
+    renderer = over_renderer(scene, args)  # before the engine is set: --over SCENE
+    # Blender's own rules for an existing frame: skipped unless overwriting
+    # (render.use_overwrite, or --overwrite / --no-overwrite for this run);
+    # an empty placeholder file while a frame renders (render.use_placeholder).
+    overwrite = scene.render.use_overwrite if args.overwrite is None else args.overwrite
+    placeholder = scene.render.use_placeholder
+    if note:
+        print(f"solidwire: {note}", file=sys.stderr, flush=True)
     scene.render.engine = ENGINE_ID
-    render_frames(scene, paths, args, over)
+    render_frames(scene, paths, args, renderer, overwrite=overwrite, placeholder=placeholder)
     return 0
 
 
 def main(arguments: list[str], **kwargs) -> int:
     """Run the command line; return the exit code (never raises)."""
+    global _interrupts
+    _interrupts = Interrupts()
+    _interrupts.install()
+    ok = False
     try:
-        return run(arguments, **kwargs)
+        code = run(arguments, **kwargs)
+        ok = True
+        return code
     except UsageError as exc:
         print(f"solidwire: error: {exc}", file=sys.stderr, flush=True)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("solidwire: interrupted", file=sys.stderr, flush=True)
-        return 130
+    except Interrupted as exc:
+        print(f"solidwire: stopped by {_signal_name(exc.signum)} after {exc.done} of {exc.total} frames; "
+              "frames already written are complete", file=sys.stderr, flush=True)
+        return 128 + exc.signum
+    except KeyboardInterrupt:  # only where no handler could be installed
+        print("solidwire: stopped by SIGINT", file=sys.stderr, flush=True)
+        return 128 + signal.SIGINT
     except RenderFailed as exc:
         print(f"solidwire: error: render failed: {exc}", file=sys.stderr, flush=True)
         return EXIT_FAILURE
@@ -596,6 +971,10 @@ def main(arguments: list[str], **kwargs) -> int:
         traceback.print_exc()
         print("solidwire: error: unexpected failure (traceback above)", file=sys.stderr, flush=True)
         return EXIT_FAILURE
+    finally:
+        if not ok:
+            _interrupts.remove_leftovers()  # folders this run created, if still empty
+        _interrupts.uninstall()
 
 
 # -- `blender -c solidwire ...` ------------------------------------------------
