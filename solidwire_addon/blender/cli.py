@@ -464,7 +464,7 @@ def frames_to_render(scene, args) -> list[int]:
             start = args.frame_start.resolve(scene.frame_start, scene.frame_start - 1)
         if args.frame_end is not None:
             end = args.frame_end.resolve(scene.frame_end, scene.frame_end - 1)
-        step = args.frame_jump or scene.frame_step
+        step = max(args.frame_jump or scene.frame_step, 1)  # a saved step of 0 renders every frame
         if end < start:
             raise UsageError(f"the frame range {start}..{end} ends before it starts")
         return list(range(start, end + 1, step))
