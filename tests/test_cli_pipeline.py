@@ -159,6 +159,11 @@ def test_existing_frames_are_skipped_when_the_scene_does_not_overwrite(tmp_path,
     result = records(stdout)
     assert [(r["frame"], r.get("skipped", False)) for r in result] == [(2, False), (3, True), (4, False), (5, True)]
     assert kept.read_bytes() == b"rendered by another machine" and placeholder.stat().st_size == 0
+    # Blender's own lines, which farm software reads (Flamenco's Worker counts
+    # a skipped frame as progress and previews the file a "Saved:" line names).
+    lines = stdout.splitlines()
+    assert f'skipping existing frame "{kept}"' in lines
+    assert f"Saved: '{out / 'f_2.png'}'" in lines
     assert_complete_png(out / "f_2.png", (48, 36))
 
     code, stdout, err = command(capsys, blend, "-o", out / "f_#.png", "-f", 3, "--overwrite")

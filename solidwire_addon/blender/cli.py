@@ -861,6 +861,10 @@ def render_frames(scene, paths: dict, args, over=None, *, overwrite: bool = True
         scene.frame_set(frame)
         start = time.perf_counter()
         write_frame(scene, frame, path, over, placeholder=placeholder)
+        # Blender's own line for a written image, under the frame's final name
+        # (Blender's line names the temporary file): render farms read it, e.g.
+        # Flamenco's Worker for its preview of the latest frame.
+        print(f"Saved: '{path}'", flush=True)
         seconds = time.perf_counter() - start
         elapsed = time.perf_counter() - start_all
         eta = elapsed / index * (len(frames) - index)
@@ -887,6 +891,8 @@ def render_frames(scene, paths: dict, args, over=None, *, overwrite: bool = True
 
 
 def _report_skipped(args, frame: int, index: int, count: int, path: Path) -> None:
+    # Blender's line for a skipped frame, which render farms count as progress.
+    print(f'skipping existing frame "{path}"', flush=True)
     if args.progress == "json":
         print(json.dumps({"frame": frame, "index": index, "count": count, "skipped": True, "output": str(path)}),
               flush=True)
