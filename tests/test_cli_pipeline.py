@@ -207,11 +207,14 @@ def _run_with_a_broken_engine(tmp_path: Path, *args) -> subprocess.CompletedProc
                           timeout=TIMEOUT_S)
 
 
-def test_a_failed_frame_removes_its_placeholder_and_the_folders_it_made(tmp_path):
-    blend = _blend(tmp_path, use_placeholder=True)
+@pytest.mark.parametrize("placeholder", [pytest.param(True, id="frame-by-frame"),
+                                         pytest.param(False, id="animation-render")])
+def test_a_failed_frame_removes_its_placeholder_and_the_folders_it_made(tmp_path, placeholder):
+    blend = _blend(tmp_path, use_placeholder=placeholder)
     result = _run_with_a_broken_engine(tmp_path, blend, "-o", tmp_path / "new" / "deeper" / "f_##.png", "-a")
     assert result.returncode == 1, result.stdout + result.stderr
     assert meaningful_lines(result.stderr)[-1].startswith("solidwire: error: render failed: frame 1:")
+    assert "Traceback" not in result.stderr
     assert not (tmp_path / "new").exists()
 
 

@@ -842,52 +842,181 @@ def write_frame(scene, frame: int, path: Path, over, *, placeholder: bool) -> No
         _interrupts.discard.discard(path)
 
 
+class Progress:
+    """One progress line (or JSON object) per frame, and Blender's own
+    ``Saved:`` line under the frame's final name (Blender's line names the
+    temporary file): render farms read it, e.g. Flamenco's Worker for its
+    preview of the latest frame."""
+
+    def __init__(self, scene, args, frames: list[int]):
+        self.scene, self.args = scene, args
+        self.position = {frame: index for index, frame in enumerate(frames, start=1)}
+        self.count = len(frames)
+        self.done: set = set()
+        self.start_all = time.perf_counter()
+
+    def written(self, frame: int, path: Path, seconds: float) -> None:
+        self.done.add(frame)
+        index, count = self.position[frame], self.count
+        print(f"Saved: '{path}'", flush=True)
+        elapsed = time.perf_counter() - self.start_all
+        eta = elapsed / len(self.done) * (count - len(self.done))
+        stats = runtime.stats()
+        if self.args.progress == "json":
+            record = {
+                "frame": frame, "index": index, "count": count, "seconds": round(seconds, 4),
+                "eta_seconds": round(eta, 3), "output": str(path), "stats": stats,
+            }
+            print(json.dumps(record), flush=True)
+            return
+        width, height = _render_size(self.scene)
+        if count == 1:
+            print(f"solidwire: rendered {path} ({width}x{height}) in {_seconds(seconds)}", flush=True)
+        else:
+            print(
+                f"solidwire: frame {index} of {count} (frame {frame}, {width}x{height}) "
+                f"in {_seconds(seconds)} -> {path}; elapsed {_seconds(elapsed)}, ETA {_seconds(eta)}",
+                flush=True,
+            )
+        if self.args.print_stats:
+            print("solidwire: stats " + ", ".join(f"{k}={_format_stat(v)}" for k, v in stats.items()), flush=True)
+
+    def skipped(self, frame: int, path: Path) -> None:
+        self.done.add(frame)
+        _report_skipped(self.args, frame, self.position[frame], self.count, path)
+
+
+# Frames at most this far apart are drawn by one animation render (Blender
+# evaluates the frames in between without drawing them, as its own
+# -a does with a frame step); farther apart, a render each is cheaper.
+MAX_RUN_STEP = 8
+
+
+def animation_runs(frames: list[int]) -> list[list[int]]:
+    """The frames split into runs of a constant step (at most MAX_RUN_STEP)
+    that one Blender animation render can draw, in the order given."""
+    runs: list[list[int]] = []
+    for frame in frames:
+        run = runs[-1] if runs else None
+        if run and 0 < frame - run[-1] <= MAX_RUN_STEP and (len(run) == 1 or frame - run[-1] == run[1] - run[0]):
+            run.append(frame)
+        else:
+            runs.append([frame])
+    return runs
+
+
 def render_frames(scene, paths: dict, args, over=None, *, overwrite: bool = True, placeholder: bool = False) -> None:
     """Render each frame to its path, with one progress line (or JSON
     object) per frame. An existing frame is skipped when overwriting is off,
-    as Blender skips it (so a requeued job renders only what is missing)."""
+    as Blender skips it (so a requeued job renders only what is missing).
+
+    Runs of frames are drawn by Blender's own animation render, which keeps
+    one render depsgraph from frame to frame, where a render per frame builds
+    a new one each time. A render per frame is used where Blender must decide
+    just before each frame (overwrite off, placeholders: other machines may
+    be rendering the same frames), for --over, and for negative frames (the
+    scene's range cannot start below 0)."""
     for folder in dict.fromkeys(path.parent for path in paths.values()):
         check_output_folder(folder)
     for path in dict.fromkeys(paths.values()):
         check_output(path)
     frames = list(paths)
-    start_all = time.perf_counter()
-    for index, frame in enumerate(frames, start=1):
-        _interrupts.check(index - 1, len(frames))
-        path = paths[frame]
-        if not overwrite and path.exists():
-            _report_skipped(args, frame, index, len(frames), path)
+    progress = Progress(scene, args, frames)
+    per_frame = over is not None or not overwrite or placeholder
+    runs = [[frame] for frame in frames] if per_frame else animation_runs(frames)
+    for run in runs:
+        _interrupts.check(len(progress.done), len(frames))
+        if len(run) > 1 and run[0] >= 0 and len({paths[frame].parent for frame in run}) == 1:
+            render_animation(scene, run, paths, progress)
             continue
-        scene.frame_set(frame)
-        start = time.perf_counter()
-        write_frame(scene, frame, path, over, placeholder=placeholder)
-        # Blender's own line for a written image, under the frame's final name
-        # (Blender's line names the temporary file): render farms read it, e.g.
-        # Flamenco's Worker for its preview of the latest frame.
-        print(f"Saved: '{path}'", flush=True)
-        seconds = time.perf_counter() - start
-        elapsed = time.perf_counter() - start_all
-        eta = elapsed / index * (len(frames) - index)
-        stats = runtime.stats()
-        if args.progress == "json":
-            record = {
-                "frame": frame, "index": index, "count": len(frames), "seconds": round(seconds, 4),
-                "eta_seconds": round(eta, 3), "output": str(path), "stats": stats,
-            }
-            print(json.dumps(record), flush=True)
-            continue
-        width, height = _render_size(scene)
-        if len(frames) == 1:
-            print(f"solidwire: rendered {path} ({width}x{height}) in {_seconds(seconds)}", flush=True)
-        else:
-            print(
-                f"solidwire: frame {index} of {len(frames)} (frame {frame}, {width}x{height}) "
-                f"in {_seconds(seconds)} -> {path}; elapsed {_seconds(elapsed)}, ETA {_seconds(eta)}",
-                flush=True,
-            )
-        if args.print_stats:
-            print("solidwire: stats " + ", ".join(f"{k}={_format_stat(v)}" for k, v in stats.items()), flush=True)
+        for frame in run:
+            _interrupts.check(len(progress.done), len(frames))
+            path = paths[frame]
+            if not overwrite and path.exists():
+                progress.skipped(frame, path)
+                continue
+            scene.frame_set(frame)
+            start = time.perf_counter()
+            write_frame(scene, frame, path, over, placeholder=placeholder)
+            progress.written(frame, path, time.perf_counter() - start)
     _interrupts.check(len(frames), len(frames))
+
+
+def render_animation(scene, run: list[int], paths: dict, progress: Progress) -> None:
+    """Draw ``run`` (frames of one step, one folder) with Blender's animation
+    render. Blender writes each frame to a temporary name in the frame's
+    folder; the render_write handler (called once the file is complete)
+    renames it into place and reports it. A stop request or a failed rename
+    ends the render before the next frame (see runtime.render_stop_reason)."""
+    folder = paths[run[0]].parent
+    ensure_folder(folder)
+    render = scene.render
+    render.filepath = str(folder / f".frame.{'#' * 7}.{os.getpid()}{TEMP_SUFFIX}")
+    render.use_file_extension = False
+    # The temporary names never exist, and the overwrite rules were applied
+    # before choosing this path.
+    render.use_overwrite, render.use_placeholder = True, False
+    scene.frame_end = MAX_FRAME  # so the start may move past the old end
+    scene.frame_start, scene.frame_end = run[0], run[-1]
+    scene.frame_step = run[1] - run[0]
+    failure: list[str] = []
+    started = {"frame": run[0], "time": time.perf_counter()}
+
+    def temporary(frame: int) -> Path:
+        return Path(bpy.path.abspath(render.frame_path(frame=frame)))
+
+    def on_pre(scene_arg, *_args):
+        if scene_arg.name != scene.name:
+            return
+        started["frame"], started["time"] = scene.frame_current, time.perf_counter()
+        _interrupts.discard.add(temporary(scene.frame_current))
+
+    def on_write(scene_arg, *_args):
+        if scene_arg.name != scene.name:
+            return
+        frame = scene.frame_current
+        tmp = temporary(frame)
+        try:
+            path = paths[frame]
+            if tmp.stat().st_size == 0:
+                raise OSError("the image is empty")
+            os.replace(tmp, path)
+            _interrupts.discard.discard(tmp)
+            progress.written(frame, path, time.perf_counter() - started["time"])
+        except Exception as exc:  # a handler must not raise: Blender would print it and go on
+            failure.append(f"frame {frame}: cannot write '{paths.get(frame, tmp)}': "
+                           f"{getattr(exc, 'strerror', None) or exc}")
+
+    def stop_reason():
+        if _interrupts.signum is not None:
+            return f"stopped by {_signal_name(_interrupts.signum)}"
+        return "stopped after an error" if failure else None
+
+    handlers = bpy.app.handlers
+    handlers.render_pre.append(on_pre)
+    handlers.render_write.append(on_write)
+    runtime.render_stop_reason = stop_reason
+    try:
+        bpy.ops.render.render(animation=True, scene=scene.name)
+    except RuntimeError as exc:
+        if _interrupts.signum is not None:
+            raise Interrupted(_interrupts.signum, len(progress.done), progress.count) from None
+        if failure:
+            raise RenderFailed(failure[0]) from None
+        raise RenderFailed(f"frame {started['frame']}: {_one_line(exc)}") from None
+    finally:
+        runtime.render_stop_reason = None
+        handlers.render_pre.remove(on_pre)
+        handlers.render_write.remove(on_write)
+        leftover = temporary(started["frame"])
+        _interrupts.discard.discard(leftover)
+        if leftover.exists():
+            _remove(leftover)
+    if failure:
+        raise RenderFailed(failure[0])
+    missing = [frame for frame in run if frame not in progress.done]
+    if missing:
+        raise RenderFailed(f"frame {missing[0]}: no image was written to '{paths[missing[0]]}'")
 
 
 def _report_skipped(args, frame: int, index: int, count: int, path: Path) -> None:
