@@ -77,12 +77,18 @@ def engine_anim(blend: Path, out: Path, frames: int) -> float:
     return time.perf_counter() - start
 
 
-def command_line(blend: Path, out: Path, frames: int) -> float:
+def command_line(blend: Path, out: Path, frames: int, *extra: str) -> float:
     start = time.perf_counter()
-    code = cli.main([str(blend), "-o", str(out / "f_####.png"), "-s", "1", "-e", str(frames)])
+    code = cli.main([str(blend), "-o", str(out / "f_####.png"), "-s", "1", "-e", str(frames), *extra])
     if code:
         raise SystemExit(f"the command line failed ({code})")
     return time.perf_counter() - start
+
+
+def frame_by_frame(blend: Path, out: Path, frames: int) -> float:
+    """The command line's render-per-frame path (taken when overwriting is
+    off, with placeholders, for --over): --no-overwrite into an empty folder."""
+    return command_line(blend, out, frames, "--no-overwrite")
 
 
 def per_frame(run, blend: Path, work: Path, short: int, long: int) -> float:
@@ -97,16 +103,19 @@ def per_frame(run, blend: Path, work: Path, short: int, long: int) -> float:
 
 
 STAGES = {
-    "render operator (all of Blender's render of a frame)": "<built-in method _bpy.ops.call>",
-    "- SolidWire engine, in all": "engine.py:210(render)",
-    "  - set-up (camera, settings)": "engine.py:88(__init__)",
-    "  - draw passes": "passes.py:89(render_passes)",
-    "  - read back pixels": "targets.py:110(read)",
-    "  - hand pixels to Blender": "engine.py:245(_write)",
-    "scene.frame_set": "frame_set",
+    "render operator(s), in all": "<built-in method _bpy.ops.call>",
+    "SolidWire engine, in all": "engine.py:render",
+    "engine: set-up (camera, settings, gather)": "engine.py:__init__",
+    "engine: draw passes": "passes.py:render_passes",
+    "engine: read back pixels": "targets.py:read",
+    "engine: hand pixels to Blender": "engine.py:_write",
     "rename into place (os.replace)": "<built-in method posix.replace>",
-    "progress, stats, checks (command line's own Python)": "cli.py",
+    # cProfile does not time bpy's own functions (scene.frame_set) apart from
+    # their caller: they are in this line.
+    "command line's own Python (progress, stats, checks, frame_set)": "cli.py",
 }
+DERIVED = ("Blender: render depsgraph, render result, PNG encode and write",
+           "render operator(s), in all", "SolidWire engine, in all")
 
 
 def _matches(key: tuple, needle: str) -> bool:
@@ -115,16 +124,16 @@ def _matches(key: tuple, needle: str) -> bool:
         return needle in name
     if needle.endswith(".py"):
         return filename.endswith("/" + needle)
-    return f"{filename.rsplit('/', 1)[-1]}:{line}({name})" == needle
+    return f"{filename.rsplit('/', 1)[-1]}:{name}" == needle  # file:function
 
 
-def stage_breakdown(blend: Path, work: Path, frames: int) -> dict:
+def stage_breakdown(run, blend: Path, work: Path, frames: int) -> dict:
     out = work / "profile"
     shutil.rmtree(out, ignore_errors=True)
     profile = cProfile.Profile()
     with quiet():
         profile.enable()
-        command_line(blend, out, frames)
+        run(blend, out, frames)
         profile.disable()
     shutil.rmtree(out, ignore_errors=True)
     stats = pstats.Stats(profile).stats
@@ -135,6 +144,8 @@ def stage_breakdown(blend: Path, work: Path, frames: int) -> dict:
         column = 2 if needle == "cli.py" else 3
         total = sum(entry[column] for key, entry in stats.items() if _matches(key, needle))
         result[label] = total / frames * 1000.0
+    label, whole, part = DERIVED
+    result[label] = result[whole] - result[part]
     return result
 
 
@@ -150,26 +161,27 @@ def main() -> None:
             work = Path(folder)
             with quiet():
                 blend = build_scene(work / "scene.blend", tuple(args.size))
-            engine, command = [], []
+            engine, command, single = [], [], []
             for _ in range(args.repeats):
                 engine.append(per_frame(engine_anim, blend, work, 5, 5 + args.frames))
                 command.append(per_frame(command_line, blend, work, 5, 5 + args.frames))
-            stages = stage_breakdown(blend, work, args.frames)
+                single.append(per_frame(frame_by_frame, blend, work, 5, 5 + args.frames))
+            stages = {name: stage_breakdown(run, blend, work, args.frames)
+                      for name, run in (("animation", command_line), ("frame by frame", frame_by_frame))}
     finally:
         solidwire_addon.unregister()
-    e, c = statistics.median(engine) * 1000, statistics.median(command) * 1000
+    e, c, f = (statistics.median(values) * 1000 for values in (engine, command, single))
     width, height = args.size
-    print(f"| path ({width}x{height}, median of {args.repeats}) | ms per frame |")
-    print("|---|---|")
-    print(f"| `-E SOLIDWIRE -a` (Blender's animation render) | {e:.1f} |")
-    print(f"| command line `-s 1 -e N` | {c:.1f} |")
-    print(f"| ratio | {c / e:.2f} |")
+    print(f"| path ({width}x{height}, {args.frames} frames, median of {args.repeats}) | ms per frame | vs `-a` |")
+    print("|---|---|---|")
+    print(f"| `-E SOLIDWIRE -a` (Blender's animation render) | {e:.1f} | 1.00 |")
+    print(f"| command line, `-s 1 -e N` (runs drawn by Blender's animation render) | {c:.1f} | {c / e:.2f} |")
+    print(f"| command line, frame by frame (`--no-overwrite`, placeholders, `--over`) | {f:.1f} | {f / e:.2f} |")
     print()
-    print("| command line stage (cProfile, inclusive) | ms per frame |")
-    print("|---|---|")
-    for label, value in stages.items():
-        print(f"| {label} | {value:.2f} |")
-
+    print("| stage (cProfile, so slower than above; inclusive) | animation | frame by frame |")
+    print("|---|---|---|")
+    for label in [*STAGES, DERIVED[0]]:
+        print(f"| {label} | {stages['animation'][label]:.2f} | {stages['frame by frame'][label]:.2f} |")
 
 if __name__ == "__main__":
     main()

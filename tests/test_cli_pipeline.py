@@ -140,7 +140,7 @@ def test_a_killed_run_never_leaves_a_partial_frame(tmp_path, signals):
         assert leftovers(tmp_path) == []  # the frame in progress was cleaned up
     else:
         # SIGKILL cannot be handled: a hidden temporary file may stay, never a frame.
-        assert all(name.startswith(".f_") for name in leftovers(tmp_path))
+        assert all(name.startswith(".") and name.endswith(cli.TEMP_SUFFIX) for name in leftovers(tmp_path))
 
 
 # -- overwrite and placeholders --------------------------------------------------
