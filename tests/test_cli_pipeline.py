@@ -88,11 +88,13 @@ def _wait_for_first_frame(proc: subprocess.Popen) -> dict:
 
 
 @pytest.mark.parametrize("signum, code, name", [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")])
-def test_a_signal_stops_after_the_frame_with_one_line(tmp_path, signum, code, name):
+@pytest.mark.parametrize("options", [pytest.param((), id="animation-render"),
+                                     pytest.param(("--no-overwrite",), id="frame-by-frame")])
+def test_a_signal_stops_after_the_frame_with_one_line(tmp_path, signum, code, name, options):
     size = (48, 36)
     blend = _blend(tmp_path, size=size, frames=(1, 400))
     out = tmp_path / "frames"
-    proc = _start(blend, "-o", out / "f_####.png", "-a", "--progress", "json")
+    proc = _start(blend, "-o", out / "f_####.png", "-a", "--progress", "json", *options)
     try:
         first = _wait_for_first_frame(proc)
         proc.send_signal(signum)
@@ -308,6 +310,15 @@ def test_a_single_image_format_says_that_passes_are_dropped(tmp_path, capsys):
     assert code == 0
     assert len(err) == 1 and err[0].startswith("solidwire: note: ") and "not written" in err[0], err
     assert_complete_png(tmp_path / "shot_0001.png", (48, 36))
+
+
+def test_over_writes_a_single_layer_exr_and_says_the_passes_are_dropped(tmp_path, capsys):
+    blend = _multilayer_blend(tmp_path)
+    code, _stdout, err = command(capsys, blend, "-o", tmp_path / "over_#.exr", "-f", 1, "--over", "WORKBENCH")
+    assert code == 0, err
+    assert len(err) == 1 and err[0].startswith("solidwire: note: the --over composite is one image"), err
+    channels = exr.read_exr(tmp_path / "over_1.exr")
+    assert sorted(channels) == ["A", "B", "G", "R"]
 
 
 def test_over_with_a_multilayer_scene_is_refused_before_rendering(tmp_path, capsys):
