@@ -19,7 +19,12 @@ the images ``blender -b SCENE.blend -E SOLIDWIRE -f 1`` writes.
 
 Expected problems (missing or unreadable file, no camera, unwritable output,
 bad option values) end with one line ``solidwire: error: ...`` on stderr and
-exit code 2; a failed render exits with code 1.
+exit code 2, before anything is rendered or written; a failed render exits
+with code 1; SIGINT and SIGTERM stop after the frame in progress with 130
+and 143. Frames appear under their names only when complete (a temporary
+name, then a rename), a failed run leaves no folder it made, and the
+scene's Overwrite and Placeholders settings work as in Blender's own
+animation render. docs/command-line.md has the details.
 """
 
 from __future__ import annotations
