@@ -770,6 +770,16 @@ _interrupts = Interrupts()
 TEMP_SUFFIX = ".solidwire-tmp"
 
 
+def blender_path(path: Path) -> str:
+    """``path`` as Blender must read it to write exactly there: Blender 5
+    reads "{name}" in an output path as a template variable (and fails on
+    unknown ones), so literal braces are doubled."""
+    text = str(path)
+    if bpy.app.version >= (5, 0, 0):
+        text = text.replace("{", "{{").replace("}", "}}")
+    return text
+
+
 def temporary_path(path: Path) -> Path:
     return path.with_name(f".{path.name}.{os.getpid()}{TEMP_SUFFIX}")
 
@@ -819,7 +829,7 @@ def write_frame(scene, frame: int, path: Path, over, *, placeholder: bool) -> No
     tmp = temporary_path(path)
     _interrupts.discard.add(tmp)
     try:
-        scene.render.filepath = str(tmp)
+        scene.render.filepath = blender_path(tmp)
         try:
             if over is None:
                 bpy.ops.render.render(write_still=True, scene=scene.name)
@@ -956,7 +966,7 @@ def render_animation(scene, run: list[int], paths: dict, progress: Progress) -> 
     folder = paths[run[0]].parent
     ensure_folder(folder)
     render = scene.render
-    render.filepath = str(folder / f".frame.{'#' * 7}.{os.getpid()}{TEMP_SUFFIX}")
+    render.filepath = blender_path(folder / f".frame.{'#' * 7}.{os.getpid()}{TEMP_SUFFIX}")
     render.use_file_extension = False
     # The temporary names never exist, and the overwrite rules were applied
     # before choosing this path.
