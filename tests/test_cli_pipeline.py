@@ -308,7 +308,8 @@ def test_a_single_image_format_says_that_passes_are_dropped(tmp_path, capsys):
     blend = _multilayer_blend(tmp_path)
     code, _stdout, err = command(capsys, blend, "-o", tmp_path / "shot_####.png", "-f", 1)
     assert code == 0
-    assert len(err) == 1 and err[0].startswith("solidwire: note: ") and "not written" in err[0], err
+    assert err == ["solidwire: note: '.png' holds one image: the scene's passes Depth are not written; "
+                   "-o NAME.exr keeps them"], err
     assert_complete_png(tmp_path / "shot_0001.png", (48, 36))
 
 

@@ -552,9 +552,13 @@ MULTILAYER = "OPEN_EXR_MULTILAYER"
 VIDEO_FORMATS = ("FFMPEG", "AVI_JPEG", "AVI_RAW")
 
 
+# Pass switches that are options of another pass, not passes of their own.
+_NOT_PASSES = {"use_pass_combined", "use_pass_cryptomatte_accurate"}
+
+
 def written_passes(scene) -> list[str]:
     """The passes beyond Combined that a multilayer file of the scene holds
-    (the view layers' own and SolidWire's), by their property names."""
+    (the view layers' own and SolidWire's), by their names in Blender's UI."""
     names = []
     for layer in scene.view_layers:
         if not layer.use:
@@ -565,9 +569,9 @@ def written_passes(scene) -> list[str]:
                 continue
             for prop in owner.bl_rna.properties:
                 name = prop.identifier
-                if name.startswith("use_pass_") and name != "use_pass_combined" and prop.type == "BOOLEAN" \
+                if name.startswith("use_pass_") and name not in _NOT_PASSES and prop.type == "BOOLEAN" \
                         and getattr(owner, name):
-                    names.append(name[len("use_pass_"):])
+                    names.append(prop.name)
     return list(dict.fromkeys(names))
 
 
