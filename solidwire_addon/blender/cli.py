@@ -693,34 +693,42 @@ class Interrupts:
 
     def install(self) -> bool:
         if threading.current_thread() is not threading.main_thread():
-            return False
-        read_fd, write_fd = os.pipe()
-        os.set_blocking(write_fd, False)
+            return False  # signal handlers can only be set from the main thread
         try:
-            self._previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
-            self._previous = {sig: signal.signal(sig, self._ignore) for sig in self.SIGNALS}
-        except (ValueError, OSError):
+            read_fd, write_fd = os.pipe()
+        except OSError:
+            read_fd = write_fd = None
+        try:
+            if write_fd is not None:
+                os.set_blocking(write_fd, False)
+                # Windows takes only a socket here (ValueError): then the
+                # handlers below do the work, when the main thread runs Python.
+                self._previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+                self._pipe = (read_fd, write_fd)
+        except (AttributeError, ValueError, OSError):
             os.close(read_fd)
             os.close(write_fd)
-            return False
-        self._pipe = (read_fd, write_fd)
-        threading.Thread(target=self._watch, args=(read_fd,), name="solidwire-signals", daemon=True).start()
+        self._previous = {sig: signal.signal(sig, self._on_signal) for sig in self.SIGNALS}
+        if self._pipe is not None:
+            threading.Thread(target=self._watch, args=(self._pipe[0],), name="solidwire-signals",
+                             daemon=True).start()
         return True
 
     def uninstall(self) -> None:
-        if self._pipe is None:
-            return
         for sig, handler in self._previous.items():
             signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
+        self._previous = {}
+        if self._pipe is None:
+            return
         signal.set_wakeup_fd(self._previous_fd)
         read_fd, write_fd = self._pipe
         self._pipe = None
         os.close(write_fd)  # ends the watcher's read
         os.close(read_fd)
 
-    @staticmethod
-    def _ignore(signum, frame):
-        pass  # the watcher thread has seen it already
+    def _on_signal(self, signum, frame):
+        if self._pipe is None:  # no watcher thread: handled here, later
+            self._received(signum)
 
     def _watch(self, read_fd: int) -> None:
         while True:
@@ -730,13 +738,14 @@ class Interrupts:
                 return
             if not data:
                 return
-            signum = data[0]
-            if signum not in self.SIGNALS:
-                continue
-            if self.signum is None:
-                self.signum = signum
-            else:
-                self.stop_now(signum)
+            if data[0] in self.SIGNALS:
+                self._received(data[0])
+
+    def _received(self, signum: int) -> None:
+        if self.signum is None:
+            self.signum = signum
+        else:
+            self.stop_now(signum)
 
     def check(self, done: int, total: int) -> None:
         if self.signum is not None:
