@@ -341,6 +341,17 @@ def test_a_video_scene_without_o_is_refused_before_rendering(tmp_path, capsys):
     assert not (tmp_path / "scene_out").exists()
 
 
+def test_stereo_views_to_separate_files_are_refused_before_rendering(tmp_path, capsys):
+    blend = _blend(tmp_path)
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    bpy.context.scene.render.use_multiview = True
+    bpy.context.scene.render.image_settings.views_format = "INDIVIDUAL"
+    bpy.ops.wm.save_mainfile()
+    code, _stdout, err = command(capsys, blend, "-o", tmp_path / "out" / "f_#.png", "-a")
+    assert code == 2 and len(err) == 1 and "stereo views" in err[0], err
+    assert not (tmp_path / "out").exists()
+
+
 # -- presets -----------------------------------------------------------------------
 
 

@@ -252,6 +252,7 @@ def test_presets_of_older_versions_move_to_the_presets_folder_once(monkeypatch, 
     versions saved presets in the extension's user folder, which Blender
     deletes on uninstall; a checkout saved them in the config folder. Both
     move to the presets folder, without replacing a preset already there."""
+    from_a_checkout = presets.user_dir()
     monkeypatch.setattr(presets, "__package__", "bl_ext.user_default.solidwire.solidwire_addon")
     monkeypatch.setattr(presets, "_migrated", set())
     extension_dir = Path(bpy.utils.extension_path_user("bl_ext.user_default.solidwire", path="presets",
@@ -265,6 +266,7 @@ def test_presets_of_older_versions_move_to_the_presets_folder_once(monkeypatch, 
     (user_dir / "kept.json").write_text(presets.to_json("Kept", {"thickness": 1.0}), encoding="utf-8")
     (config_dir / "kept.json").write_text(presets.to_json("Kept", {"thickness": 9.0}), encoding="utf-8")
     try:
+        assert presets.user_dir() == from_a_checkout == user_dir  # the extension and a checkout: one folder
         assert presets.find("Old Look").values["thickness"] == 2.5
         assert presets.find("Checkout Look").path == user_dir / "checkout_look.json"
         assert presets.find("Kept").values["thickness"] == 1.0  # the one already there wins

@@ -984,6 +984,7 @@ def render_animation(scene, run: list[int], paths: dict, progress: Progress) -> 
     # The temporary names never exist, and the overwrite rules were applied
     # before choosing this path.
     render.use_overwrite, render.use_placeholder = True, False
+    scene.use_preview_range = False  # the range below is the one rendered
     scene.frame_end = MAX_FRAME  # so the start may move past the old end
     scene.frame_start, scene.frame_end = run[0], run[-1]
     scene.frame_step = run[1] - run[0]
@@ -1094,6 +1095,12 @@ def run(arguments: list[str], *, prog: str = "solidwire render", build_demo=None
         paths = {frame: scene_frame_path(scene, frame) for frame in frames}
         # frame_path() already holds the extension: Blender must not add another.
         scene.render.use_file_extension = False
+    if scene.render.use_multiview and scene.render.image_settings.views_format == "INDIVIDUAL":
+        # Blender then writes one file per view (NAME_L, NAME_R), not the
+        # frame's one file, which the command line writes and renames.
+        raise UsageError(f"scene '{scene.name}' renders stereo views to separate files, which the command line "
+                         "does not write: choose Stereo 3D in the output's Views Format, or render with "
+                         "blender -b SCENE.blend -E SOLIDWIRE -a")
     renderer = over_renderer(scene, args)  # before the engine is set: --over SCENE
     # Blender's own rules for an existing frame: skipped unless overwriting
     # (render.use_overwrite, or --overwrite / --no-overwrite for this run);
