@@ -701,8 +701,8 @@ class Interrupts:
         try:
             if write_fd is not None:
                 os.set_blocking(write_fd, False)
-                # Windows takes only a socket here (ValueError): then the
-                # handlers below do the work, when the main thread runs Python.
+                # Windows refuses a pipe here (ValueError): then the handlers
+                # below do the work, when the main thread runs Python.
                 self._previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
                 self._pipe = (read_fd, write_fd)
         except (AttributeError, ValueError, OSError):
