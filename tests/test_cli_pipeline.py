@@ -388,3 +388,23 @@ def test_braces_in_the_output_path_are_written_as_they_are(tmp_path, capsys, opt
     code, _stdout, err = command(capsys, _blend(tmp_path), "-o", out / "f_#.png", "-s", 1, "-e", 2, *options)
     assert code == 0, err
     assert sorted(p.name for p in out.iterdir()) == ["f_1.png", "f_2.png"]
+
+
+def test_runs_of_frames_go_through_blenders_animation_render(tmp_path):
+    """Where Blender need not decide frame by frame, a run of frames is one
+    animation render (one render depsgraph for the run, the speed of
+    -E SOLIDWIRE -a; see docs/command-line-overhead.md). Blender's own
+    "Saved:" lines show which path wrote the frames: the animation render
+    writes the run's temporary ".frame.NNNNNNN" names."""
+    blend = _blend(tmp_path)
+
+    def blender_saved_lines(name: str, *options) -> list[str]:
+        result = subprocess.run([sys.executable, str(RENDER_SCRIPT), str(blend), "-o", str(tmp_path / name),
+                                 "-s", "1", "-e", "3", *options], env=_env(), capture_output=True, text=True,
+                                timeout=TIMEOUT_S)
+        assert result.returncode == 0, result.stderr
+        return [line for line in result.stdout.splitlines() if "Saved: '" in line and cli.TEMP_SUFFIX in line]
+
+    assert len([line for line in blender_saved_lines("a_#.png") if "/.frame." in line]) == 3
+    frame_by_frame = blender_saved_lines("b_#.png", "--no-overwrite")  # Blender's rule decides per frame
+    assert len(frame_by_frame) == 3 and not any("/.frame." in line for line in frame_by_frame)
