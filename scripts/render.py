@@ -92,8 +92,18 @@ def _leave_without_finalising(code: int) -> None:
     os._exit(code)
 
 
+def _run(argv: list[str]) -> int:
+    # The command line handles SIGINT itself once it runs; before that (while
+    # the add-on registers) Ctrl+C still ends the run with one line.
+    try:
+        return main(argv)
+    except KeyboardInterrupt:
+        print("solidwire: stopped by SIGINT", file=sys.stderr, flush=True)
+        return 130
+
+
 if __name__ == "__main__":
-    code = main(sys.argv)
+    code = _run(sys.argv)
     if _EXIT_CRASHES:
         # At exit, not now: a caller that ran this script (runpy) goes on first.
         atexit.register(_leave_without_finalising, code)

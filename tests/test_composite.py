@@ -427,8 +427,9 @@ def test_cli_over(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["demo_over.beauty.exr", "demo_over.png", "demo_over.wire.exr"]
     assert scenes.load_png(out).shape == (54, 96, 4)
     # Only what was asked for is announced: no "Saved:" line for the
-    # temporary layer files, and one progress line for the composite.
-    assert "Saved:" not in run.stdout, run.stdout
+    # temporary layer files (one, in Blender's form, for the composite), and
+    # one progress line for the composite.
+    assert [line for line in run.stdout.splitlines() if "Saved:" in line] == [f"Saved: '{out}'"], run.stdout
     assert [line for line in run.stdout.splitlines() if line.startswith("solidwire: rendered")] == [
         f"solidwire: rendered {out} (96x54) in " + line.split(" in ")[-1]
         for line in run.stdout.splitlines() if line.startswith("solidwire: rendered")

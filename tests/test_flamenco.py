@@ -41,11 +41,11 @@ SETTING_FIELDS = {"key", "type", "subtype", "choices", "propargs", "description"
                   "eval", "evalInfo", "visible", "required", "editable"}
 
 
-def _harness(action: str, job: dict | None = None) -> dict:
+def _harness(action: str, job: dict | None = None, script: Path = SCRIPT) -> dict:
     # TZ fixes the {timestamp} expansion, which uses local time like Flamenco.
     env = dict(os.environ, TZ="UTC")
     proc = subprocess.run(
-        [NODE, str(HARNESS), str(SCRIPT), action],
+        [NODE, str(HARNESS), str(script), action],
         input=json.dumps(job) if job is not None else "",
         capture_output=True, text=True, timeout=TIMEOUT_S, env=env,
         check=False,
@@ -436,3 +436,53 @@ def test_bad_settings_are_refused(settings, mentions):
 def test_image_formats_are_accepted():
     for fmt in ("PNG", "OPEN_EXR", "OPEN_EXR_MULTILAYER", "JPEG", "TARGA", "", None):
         assert compile_job(format=fmt)["ok"], fmt
+
+
+# -- The stand-in follows Flamenco's job compiler ----------------------------------------------
+
+
+def test_job_type_is_named_after_the_file(job_type):
+    assert job_type["name"] == "solidwire"
+
+
+def flamenco_chunks(frames: str, chunk_size: int) -> list[list[int]]:
+    """Flamenco's own frameChunker (as the harness implements it), as frame lists."""
+    chunks = _harness("frame-chunker", {"frames": frames, "chunk_size": chunk_size})
+    result = []
+    for chunk in chunks:
+        numbers = []
+        for part in chunk.split(","):
+            first, _, last = part.partition("-")
+            numbers.extend(range(int(first), int(last or first) + 1))
+        result.append(numbers)
+    return result
+
+
+@pytest.mark.parametrize("frames, chunk", [("1-100", 10), ("1..10,20-25,40", 4), ("5,3,4,4", 2), ("7", 3)])
+def test_tasks_hold_the_frames_flamencos_chunker_gives(frames, chunk):
+    """The script chunks frames itself (it needs runs for -s/-e); each task
+    renders exactly the frames of the chunk Flamenco's frameChunker makes."""
+    tasks = compiled_tasks(frames=frames, chunk_size=chunk)
+    ours = [[f for start, end in frame_runs(task) for f in range(start, end + 1)] for task in tasks]
+    assert ours == flamenco_chunks(frames, chunk)
+
+
+@pytest.mark.parametrize(
+    "body, works",
+    [
+        ("formatTimestampLocal(job.created)", True),
+        ("job.created.getFullYear()", False),  # a Go time.Time, not a Date
+        ("job.jobType + job.name + job.status", True),
+        ("path.join('a', path.basename('/x/y.blend'))", True),
+        ("frameChunker('1-4', 2).length", True),
+        ("require('fs')", False),
+        ("console.log('x')", False),
+        ("undeclared = 1", False),  # strict mode
+    ],
+)
+def test_the_stand_in_offers_what_the_manager_offers(tmp_path, body, works):
+    script = tmp_path / "probe.js"
+    script.write_text("const JOB_TYPE = {label: 'Probe', settings: []};\n"
+                      f"function compileJob(job) {{ {body}; }}\n", encoding="utf-8")
+    result = _harness("compile", {"name": "probe", "settings": {}}, script=script)
+    assert result["ok"] is works, result

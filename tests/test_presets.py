@@ -228,10 +228,14 @@ def test_partial_preset_sets_only_its_keys_and_mode_before_duty():
     assert scene.solidwire.thickness == 3.0
 
 
-def test_user_dir_fallback_outside_the_addon():
+def test_user_presets_live_in_blenders_user_presets_folder():
+    """Where Blender keeps add-on presets (user scripts/presets/<name>): it
+    survives uninstalling, reinstalling and upgrading the extension, and a
+    checkout (scripts/render.py) sees the same folder."""
     folder = presets.user_dir()
     assert folder.is_dir()
-    assert Path(bpy.utils.user_resource("CONFIG")) in folder.parents
+    assert folder == Path(bpy.utils.user_resource("SCRIPTS", path="presets/solidwire"))
+    assert Path(solidwire_addon.__file__).resolve().parent not in folder.resolve().parents
 
 
 def test_bad_preset_names_are_refused(user_dir):
@@ -240,14 +244,46 @@ def test_bad_preset_names_are_refused(user_dir):
     assert list(user_dir.iterdir()) == []
 
 
-def test_user_dir_of_an_installed_extension(monkeypatch):
-    """Installed as an extension (package bl_ext.<repo>.solidwire.solidwire_addon)
-    the presets go to the extension's own user directory."""
+def test_presets_of_older_versions_move_to_the_presets_folder_once(monkeypatch, user_dir):
+    """Installed as an extension (package bl_ext.<repo>.solidwire...), older
+    versions saved presets in the extension's user folder, which Blender
+    deletes on uninstall; a checkout saved them in the config folder. Both
+    move to the presets folder, without replacing a preset already there."""
+    from_a_checkout = presets.user_dir()
     monkeypatch.setattr(presets, "__package__", "bl_ext.user_default.solidwire.solidwire_addon")
-    folder = presets.user_dir()
-    expected = Path(bpy.utils.extension_path_user("bl_ext.user_default.solidwire", path="presets"))
-    assert folder == expected and folder.is_dir()
-    assert Path(solidwire_addon.__file__).resolve().parent not in folder.resolve().parents
+    monkeypatch.setattr(presets, "_migrated", set())
+    extension_dir = Path(bpy.utils.extension_path_user("bl_ext.user_default.solidwire", path="presets",
+                                                       create=True))
+    config_dir = Path(bpy.utils.user_resource("CONFIG")) / "solidwire_presets"
+    config_dir.mkdir(parents=True, exist_ok=True)
+    old_look = presets.to_json("Old Look", {"thickness": 2.5})
+    (extension_dir / "old_look.json").write_text(old_look, encoding="utf-8")
+    (config_dir / "checkout_look.json").write_text(presets.to_json("Checkout Look", {"thickness": 4.0}),
+                                                   encoding="utf-8")
+    (user_dir / "kept.json").write_text(presets.to_json("Kept", {"thickness": 1.0}), encoding="utf-8")
+    (config_dir / "kept.json").write_text(presets.to_json("Kept", {"thickness": 9.0}), encoding="utf-8")
+    try:
+        assert presets.user_dir() == from_a_checkout == user_dir  # the extension and a checkout: one folder
+        assert presets.find("Old Look").values["thickness"] == 2.5
+        assert presets.find("Checkout Look").path == user_dir / "checkout_look.json"
+        assert presets.find("Kept").values["thickness"] == 1.0  # the one already there wins
+        assert not extension_dir.exists()  # emptied and removed
+        assert [p.name for p in config_dir.iterdir()] == ["kept.json"]  # never overwritten, never lost
+    finally:
+        for folder in (extension_dir, config_dir):
+            if folder.exists():
+                for path in folder.iterdir():
+                    path.unlink()
+                folder.rmdir()
+
+
+def test_an_unknown_preset_name_lists_close_matches_and_every_name():
+    with pytest.raises(presets.PresetNotFound):
+        presets.find("Bluprint")
+    message = presets.unknown_preset_message("Bluprint", [p.name for p in presets.all_presets()])
+    assert message.startswith("no preset named 'Bluprint' (did you mean 'Blueprint'? presets: ")
+    assert all(p.name in message for p in presets.builtin_presets())
+    assert "\n" not in message
 
 
 # ------------------------------------------------- fade range from the scene

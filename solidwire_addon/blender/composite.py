@@ -369,10 +369,13 @@ def _depth(channels: dict, layer: str) -> np.ndarray | None:
     return None if z is None else z[..., 0]
 
 
-def render_wire_over(scene, filepath, engine=None, *, keep_layers: bool = False, **kwargs) -> Layers:
+def render_wire_over(scene, filepath, engine=None, *, keep_layers: bool = False, layers_name=None,
+                     **kwargs) -> Layers:
     """Render the wire over ``engine``'s render and write the composite to
     ``filepath`` in the scene's output format (plus ``NAME.beauty.exr`` and
-    ``NAME.wire.exr`` beside it with ``keep_layers``). Returns the layers."""
+    ``NAME.wire.exr`` beside it with ``keep_layers``; NAME from
+    ``layers_name`` when the composite goes to a temporary name first).
+    Returns the layers."""
     path = Path(os.fspath(filepath)).absolute()
     # Before the (slow) renders: bad input or a path that cannot be written
     # costs nothing.
@@ -382,7 +385,8 @@ def render_wire_over(scene, filepath, engine=None, *, keep_layers: bool = False,
         output.check_output(path)
     except output.OutputError as exc:
         raise CompositeError(str(exc)) from None
-    keep = path.with_name(path.stem) if keep_layers else None
+    named = Path(os.fspath(layers_name)).absolute() if layers_name is not None else path
+    keep = named.with_name(named.stem) if keep_layers else None
     layers = render_layers(scene, engine, keep_exr=keep, **kwargs)
     save_image(scene, layers.composite, path)
     return layers

@@ -216,6 +216,10 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         if is_init_scene(scene):
             return  # gpu_context.ensure_gpu(): the GPU is now initialised
+        stop = runtime.render_stop_reason() if runtime.render_stop_reason is not None else None
+        if stop:
+            self.report({"ERROR"}, stop)  # ends Blender's animation render before this frame
+            return
         width, height = render_size(scene)
         region = region_of(scene, width, height)
         layer_name = depsgraph.view_layer.name

@@ -18,9 +18,13 @@ is checked, and only a fully valid preset is applied. Problems raise
 :class:`PresetError` with one line that says which file and what is wrong.
 
 Built-in presets ship in ``presets_builtin/`` next to this file and are read-only.
-User presets live in the extension's user directory
-(``bpy.utils.extension_path_user``), never inside the add-on folder, which an
-upgrade replaces.
+User presets live where Blender keeps every add-on's presets: ``presets/solidwire``
+in the user scripts folder (``bpy.utils.user_resource('SCRIPTS')``). Not in the
+add-on folder, which an upgrade replaces, and not in the extension's user
+folder, which Blender deletes when the extension is uninstalled; and the same
+folder whether the package runs as the installed extension or from a checkout
+(scripts/render.py), so every entry point sees the same presets. Presets saved
+by older versions in those places are moved here once.
 
 Names: a preset's name is kept as typed (any script: "Böse Linien", "線画"),
 inside its JSON. Its file name is the name's *key* (:func:`name_key`: letters
@@ -34,9 +38,11 @@ looks by one name); replacing an existing user preset needs ``overwrite``.
 
 from __future__ import annotations
 
+import difflib
 import hashlib
 import json
 import os
+import shutil
 import stat
 import unicodedata
 from dataclasses import dataclass, replace
@@ -62,6 +68,10 @@ FROM_SCENE_FIELDS = ("fade_start", "fade_end")
 
 class PresetError(ValueError):
     """A preset that cannot be loaded or saved; str() is one line for the user."""
+
+
+class PresetNotFound(PresetError):
+    """No preset has the name asked for."""
 
 
 @dataclass(frozen=True)
@@ -174,23 +184,62 @@ def load(path: Path, *, builtin: bool = False) -> Preset:
 # ------------------------------------------------------------------- storage
 
 
-def user_dir(*, create: bool = True) -> Path:
-    """Where user presets are saved.
+USER_SUBDIR = "presets/solidwire"
 
-    Inside an installed extension: ``extension_path_user(<extension>)/presets``.
-    Imported as a plain package (tests, scripts), there is no extension, so a
-    folder in Blender's user config directory is used instead; never the
-    add-on folder."""
+
+def user_dir(*, create: bool = True) -> Path:
+    """Where user presets are saved: Blender's user ``presets/solidwire``
+    folder (see the module notes). Presets found in the older places are
+    moved here the first time it is asked for."""
     import bpy
 
-    package = __package__ or ""
-    parts = package.split(".")
-    if parts[0] == "bl_ext" and len(parts) >= 3:
-        return Path(bpy.utils.extension_path_user(".".join(parts[:3]), path="presets", create=create))
-    path = Path(bpy.utils.user_resource("CONFIG")) / "solidwire_presets"
-    if create:
-        path.mkdir(parents=True, exist_ok=True)
+    path = Path(bpy.utils.user_resource("SCRIPTS", path=USER_SUBDIR, create=create))
+    _migrate_old_presets(path)
     return path
+
+
+_migrated: set = set()
+
+
+def old_user_dirs() -> list[Path]:
+    """Where older versions kept user presets: the extension's user folder
+    (when running as the installed extension) and a folder in Blender's
+    config directory (when imported as a plain package)."""
+    import bpy
+
+    folders = [Path(bpy.utils.user_resource("CONFIG")) / "solidwire_presets"]
+    parts = (__package__ or "").split(".")
+    if parts[0] == "bl_ext" and len(parts) >= 3:
+        try:
+            folders.append(Path(bpy.utils.extension_path_user(".".join(parts[:3]), path="presets", create=False)))
+        except (ValueError, RuntimeError):  # not a registered extension (any more)
+            pass
+    return folders
+
+
+def _migrate_old_presets(target: Path) -> None:
+    """Move preset files from :func:`old_user_dirs` into ``target``, once per
+    folder and process. A file whose name is taken in ``target`` stays where
+    it is (nothing is overwritten); a folder left empty is removed."""
+    for folder in old_user_dirs():
+        if folder in _migrated or folder == target:
+            continue
+        _migrated.add(folder)
+        if not folder.is_dir():
+            continue
+        for old in sorted(folder.glob("*.json")):
+            new = target / old.name
+            if new.exists():
+                continue
+            try:
+                target.mkdir(parents=True, exist_ok=True)
+                shutil.move(str(old), str(new))
+            except OSError as exc:
+                print(f"SolidWire: could not move preset '{old.name}' to the presets folder: {exc.strerror or exc}")
+        try:
+            folder.rmdir()  # only when empty
+        except OSError:
+            pass
 
 
 # Names Windows reserves for devices, with any extension.
@@ -281,10 +330,29 @@ def find(name: str) -> Preset:
     """The preset called ``name``: its exact name first, else the same name
     up to case, spaces and punctuation ("blueprint" finds "Blueprint"). User
     presets never share a built-in's name (see :func:`user_presets`)."""
-    matches = _matching(all_presets(), name)
+    everything = all_presets()
+    matches = _matching(everything, name)
     if not matches:
-        raise PresetError(f"no preset named '{name}'")
+        raise PresetNotFound(f"no preset named '{name}'")
     return matches[0]
+
+
+def unknown_preset_message(name: str, names: list[str]) -> str:
+    """One line: no such preset, the close matches, and every name there is."""
+    by_key = {}
+    for known in names:
+        try:
+            by_key.setdefault(name_key(known), known)
+        except PresetError:
+            continue
+    try:
+        key = name_key(name)
+    except PresetError:
+        key = name.casefold()
+    close = [by_key[k] for k in difflib.get_close_matches(key, list(by_key), n=3, cutoff=0.6)]
+    hint = f"did you mean {' or '.join(repr(c) for c in close)}? " if close else ""
+    listed = ", ".join(names) if names else "none"
+    return f"no preset named '{name}' ({hint}presets: {listed})"
 
 
 def user_preset_like(name: str) -> Preset | None:

@@ -39,6 +39,11 @@ epoch = 0  # bumped by frame changes, undo/redo and file loads
 # Benchmark switch (scripts/bench_scale.py): False makes every frame start
 # from an empty cache, the behaviour before reuse, to compare against.
 reuse_enabled = True
+# Set by the command line while Blender's animation render draws its frames:
+# Blender ends an animation render early only when the engine reports an
+# error, so when this returns a reason (a stop was asked for) the engine
+# reports it instead of drawing the next frame.
+render_stop_reason = None  # None, or a callable () -> str | None
 
 
 def _on_depsgraph_update(_scene, depsgraph) -> None:

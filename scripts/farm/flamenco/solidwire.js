@@ -93,8 +93,8 @@ const VIDEO_FORMATS = ["FFMPEG", "AVI_RAW", "AVI_JPEG"];
 // The extension's command line picks the image format from the file
 // extension of -o and refuses a path without one, while Flamenco's output
 // path ends in "######". These are the formats it writes, by the scene's
-// file_format (multilayer EXR comes out as a single-layer EXR: the composite
-// is one image).
+// file_format. A multilayer scene keeps its passes in ".exr" with a preset;
+// a Wire Over composite is one image, so there it is a single-layer EXR.
 const CLI_EXTENSIONS = {
     PNG: ".png",
     JPEG: ".jpg",
