@@ -15,7 +15,7 @@ import time
 import gpu
 import numpy as np
 
-from .extract import MeshArrays
+from .extract import IN_REGION, REGION_LINES, MeshArrays
 
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
@@ -93,6 +93,13 @@ class GPUMesh:
         ngon[len(arrays.ngon_corners) : outline_rows] = region
         self.ngon_corners = table_texture(ngon)
         self.has_ngons = outline_rows > 0
+        # Every triangle that walks a block lies in a multi-face region and
+        # there are no n-gons: where the region-lines pass measures the
+        # lines, no triangle walks anything (the draw needs no block code).
+        flags = arrays.edge_flags
+        self.blocks_only_for_region_lines = (
+            arrays.region_lines is not None and len(arrays.ngon_corners) == 0
+            and not np.any((flags & IN_REGION != 0) & (flags & REGION_LINES == 0)))
         # Shading normals and material indices, a texel per vertex, triangle
         # or triangle corner (normal_domain); only for a shaded or
         # per-material fill.

@@ -367,16 +367,21 @@ def draw(
         for g in groups:
             mesh = g[0]
             ngons = program.supports_ngons and mesh.has_ngons
+            # (Part of the key, so that every stage parts the draws alike.)
+            lines_only = ngons and getattr(mesh, "blocks_only_for_region_lines", False)
             table = (setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g[4], view))
             in_front = wholly_in_front(g[4], mesh.bounds_min, mesh.bounds_max)
-            parts.setdefault((ngons, table, in_front), []).append(g)
+            parts.setdefault((ngons, lines_only, table, in_front), []).append(g)
         # The visibility and region-lines passes read neither n-gon
-        # outlines nor the set-up table.
+        # outlines nor the set-up table; a draw that reads the region lines
+        # needs no block code for a mesh whose blocks only hold them.
         plain_stage = variant.visibility or variant.region_lines_pass
-        for (ngons, table, in_front) in sorted(parts):
-            part_variant = replace(variant, ngons=ngons and not plain_stage, setup_table=table and not plain_stage,
+        for key in sorted(parts):
+            ngons, lines_only, table, in_front = key
+            walks = ngons and not plain_stage and not (lines_only and variant.region_lines)
+            part_variant = replace(variant, ngons=walks, setup_table=table and not plain_stage,
                                    in_front=in_front and not variant.visibility)
-            _draw_groups(parts[(ngons, table, in_front)], part_variant, ubo, settings, program, flip, stats, extras,
+            _draw_groups(parts[key], part_variant, ubo, settings, program, flip, stats, extras,
                          bases, instancing=instancing, numbering=numbering)
     finally:
         gpu.state.face_culling_set("NONE")

@@ -241,12 +241,15 @@ def _draw_region_lines(targets, items, view: View, settings, draw_args: dict, st
 
 
 def _overlay_region_lines(items, view: View, settings, stats):
-    """The viewport overlay's region lines: a visibility record of our own
-    surfaces at the region's size (own depth: Blender's depth buffer cannot
-    be read back here), then the region-lines pass over it. The overlay's
-    surface pass reads the result where its depth test lets a region's
-    triangle through, which is where the record has it: our own depth
-    pre-pass makes our nearest surface the only one that passes."""
+    """The viewport overlay's region lines: a visibility record of the
+    meshes with multi-face regions at the region's size (own depth:
+    Blender's depth buffer cannot be read back here), then the region-lines
+    pass over it. The overlay's surface pass reads the result where its
+    depth test lets a region's triangle through: our own depth pre-pass
+    (of every mesh) makes our nearest surface the only one that passes, and
+    where that is a region's triangle, the record holds it too. So the
+    record needs no other mesh."""
+    items = [item for item in items if item.mesh.region_line_count]
     targets = targets_for(view.width, view.height)
     framebuffer = targets.visibility_framebuffer()
     with framebuffer.bind():
