@@ -18,7 +18,7 @@ BLENDER_TAGS = $(VENV_PYTHON) -c "import importlib.util, os; \
 	print(os.path.join(importlib.util.find_spec('bpy').submodule_search_locations[0], \
 	'5.0', 'scripts', 'modules', '_bpy_internal', 'extensions', 'tags.py'))"
 
-.PHONY: demo test test-newest venv venv-newest zip check-system clean bench bench-scale bench-engines fetch-meshes test-slow soak fuzz compat
+.PHONY: demo test test-newest venv venv-newest zip check-system clean bench bench-scale bench-engines bench-viewport fetch-meshes test-slow soak fuzz compat
 
 venv: $(VENV_STAMP)
 
@@ -81,6 +81,12 @@ bench-scale: $(VENV_STAMP) check-system
 # F12 against Workbench (and Freestyle), with SolidWire's frame stage by stage.
 bench-engines: $(VENV_STAMP) check-system
 	$(VENV_PYTHON) -m scripts.bench_engines --size 1280x720 --size 3840x2160 --repeats 5 --freestyle $(BENCH_ARGS)
+
+# Blender's real viewport drawn headless: its own redraws, with its wireframe
+# overlay, with SolidWire's overlay (docs/viewport-benchmark.md; a few minutes;
+# BENCH_ARGS=--quick for 62k triangles only).
+bench-viewport: $(VENV_STAMP) check-system
+	$(VENV_PYTHON) -m scripts.bench_viewport --profile --output docs/viewport-benchmark.md $(BENCH_ARGS)
 
 # Opt-in robustness runs (not part of `make test` / CI); see README "Robustness".
 test-slow: $(VENV_STAMP) check-system
