@@ -26,7 +26,7 @@ import bpy
 
 from ..core import overlay_state, passes
 from ..core.log import warn_once
-from ..core.view import View
+from ..core.view import DrawStats, View
 from . import color_management, gather, properties, runtime
 from .views import region_view
 
@@ -207,14 +207,20 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
                                             object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
                                             **passes.gather_options(settings))
     start = time.perf_counter()
-    stats = passes.draw_over_viewport(
-        items,
-        view,
-        overlay_state.draw_settings(plan, settings),
-        scene_depth=plan.scene_depth,
-        clip_planes=plan.clip_planes,
-        display=display,
-    )
+    if items:
+        stats = passes.draw_over_viewport(
+            items,
+            view,
+            overlay_state.draw_settings(plan, settings),
+            scene_depth=plan.scene_depth,
+            clip_planes=plan.clip_planes,
+            display=display,
+        )
+    else:
+        # Nothing to draw (every object hidden, opted out or not a mesh):
+        # leave the viewport's buffers and GPU state as Blender left them;
+        # without scene depth the passes would clear the depth first.
+        stats = DrawStats()
     ms_draw = (time.perf_counter() - start) * 1000.0
     return runtime.end_frame(frame, stats, ms_extract, ms_draw, seen)
 
