@@ -33,10 +33,12 @@ def viewport():
     its viewport headless."""
     preferences = bpy.context.preferences.system
     saved_aa = preferences.viewport_aa
-    preferences.viewport_aa = "OFF"
     made = []
 
     def make(scene):
+        # Set here, after the test's scene is made: reading the factory
+        # settings resets the preferences too.
+        preferences.viewport_aa = "OFF"
         try:
             result = HeadlessViewport(WIDTH, HEIGHT)
             made.append(result)
