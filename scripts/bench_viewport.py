@@ -373,7 +373,10 @@ def main() -> None:
         lines.append(f"(run took {time.perf_counter() - started:.0f} s)")
         text = "\n".join(lines)
         print(text, flush=True)
-        if args.output:
+        if args.output and args.quick:
+            # A 62k-only table would replace the page's full one.
+            print(f"(--quick: {args.output} left as it is)")
+        elif args.output:
             write_report(args.output, text)
     finally:
         solidwire_addon.unregister()
