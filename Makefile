@@ -19,7 +19,7 @@ BLENDER_TAGS = $(VENV_PYTHON) -c "import importlib.util, os; \
 	print(os.path.join(importlib.util.find_spec('bpy').submodule_search_locations[0], \
 	'5.0', 'scripts', 'modules', '_bpy_internal', 'extensions', 'tags.py'))"
 
-.PHONY: demo test docs lint test-newest venv venv-newest zip check-system clean bench bench-scale bench-engines fetch-meshes test-slow soak fuzz compat
+.PHONY: demo test docs lint test-newest venv venv-newest zip check-system clean bench bench-scale bench-engines bench-viewport bench-regions fetch-meshes test-slow soak fuzz compat
 
 venv: $(VENV_STAMP)
 
@@ -103,6 +103,17 @@ bench-scale: $(VENV_STAMP) check-system
 # F12 against Workbench (and Freestyle), with SolidWire's frame stage by stage.
 bench-engines: $(VENV_STAMP) check-system
 	$(VENV_PYTHON) -m scripts.bench_engines --size 1280x720 --size 3840x2160 --repeats 5 --freestyle $(BENCH_ARGS)
+
+# Blender's real viewport drawn headless: its own redraws, with its wireframe
+# overlay, with SolidWire's overlay (docs/dev/viewport-benchmark.md; a few
+# minutes; BENCH_ARGS=--quick for 62k triangles only).
+bench-viewport: $(VENV_STAMP) check-system
+	$(VENV_PYTHON) -m scripts.bench_viewport --profile --output docs/dev/viewport-benchmark.md $(BENCH_ARGS)
+
+# What regions cost: the cage look against every edge, the angle threshold
+# and edge classes against a plain frame (docs/dev/benchmarks.md).
+bench-regions: $(VENV_STAMP) check-system
+	$(VENV_PYTHON) -m scripts.bench_regions $(BENCH_ARGS)
 
 # Opt-in robustness runs (not part of `make test` / CI; pytest markers, see
 # pytest.ini); see docs/dev/robustness.md.

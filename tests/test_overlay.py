@@ -296,6 +296,38 @@ def test_visibility_filter():
     assert keep_selected(selected) and not keep_selected(shown)
 
 
+def test_frame_filter_answers_as_the_filter_once_per_object(monkeypatch):
+    """The draw handler's filter (one frame) keeps exactly what the plain
+    filter keeps, and reads each object once however many instances ask."""
+    from solidwire_addon.core import overlay_state
+
+    scene = scenes.empty_scene()
+    shown = scenes.cube(scene, "Shown")
+    hidden = scenes.cube(scene, "Hidden", location=(3, 0, 0))
+    hidden.hide_set(True)
+    opted_out = scenes.cube(scene, "OptedOut", location=(0, 3, 0))
+    opted_out.solidwire.show_in_viewport = False
+    selected = scenes.cube(scene, "Selected", location=(3, 3, 0))
+    for obj in scene.objects:
+        obj.select_set(obj is selected)
+    view_layer = bpy.context.view_layer
+    for state in (overlay_state.ViewportState(), overlay_state.ViewportState(only_selected=True),
+                  overlay_state.ViewportState(draw_edit_mode=False)):
+        plan = overlay_state.plan_overlay(state)
+        plain = overlay.object_filter(plan, view_layer)
+        per_frame = overlay.frame_object_filter(plan, view_layer)
+        for obj in (shown, hidden, opted_out, selected):
+            assert per_frame(obj) == plain(obj), (state, obj.name)
+
+    reads = []
+    real = overlay.object_state
+    monkeypatch.setattr(overlay, "object_state", lambda obj, *args: reads.append(obj.name) or real(obj, *args))
+    per_frame = overlay.frame_object_filter(overlay_state.plan_overlay(overlay_state.ViewportState()), view_layer)
+    for _ in range(3):
+        assert per_frame(shown)
+    assert reads == ["Shown"]
+
+
 def test_instances_follow_their_instancer():
     """A collection instance is drawn when its instancer is visible, even
     though the instanced collection itself is excluded from the view layer."""

@@ -351,3 +351,30 @@ def test_handler_reads_this_viewports_own_switch():
 
     assert state(first) is not None
     assert state(second) is None
+
+
+def test_nothing_to_draw_leaves_the_viewport_untouched():
+    """A frame with no object to draw (here every object opted out) changes
+    neither colour nor depth, not even in X-ray, where a frame that draws
+    clears the depth to use only its own surfaces."""
+    scene, objects = build_scene(thickness=1.5)
+    for obj in objects:
+        obj.solidwire.show_in_viewport = False
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    view = camera_view(scene, depsgraph, (WIDTH, HEIGHT))
+    viewport = FakeViewport(WIDTH, HEIGHT)
+    viewport.depth_pass(depsgraph, view, objects)
+
+    def depth():
+        buffer = viewport.depth.read()
+        return np.array(buffer.to_list(), dtype=np.float64)
+
+    before_depth, before_rgba = depth(), viewport.rgba()
+    assert (before_depth < 1.0).any()
+    plan = overlay_state.plan_overlay(ViewportState(xray=True, xray_alpha=0.5))
+    assert not plan.scene_depth
+    stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), plan=plan,
+                                  object_filter=overlay.object_filter(plan, bpy.context.view_layer))
+    assert stats["objects_drawn"] == 0
+    assert np.array_equal(depth(), before_depth)
+    assert np.array_equal(viewport.rgba(), before_rgba)

@@ -26,7 +26,7 @@ import bpy
 
 from ..core import colors, overlay_state, passes
 from ..core.log import one_line, warn_once
-from ..core.view import View
+from ..core.view import DrawStats, View
 from . import color_management, density, gather, properties, runtime, setting_repair, strands
 from .views import region_view
 
@@ -77,13 +77,16 @@ def set_viewport_shows(screen, area, show: bool) -> None:
 # -- what the overlay draws ------------------------------------------------------
 
 
-def object_state(obj, view_layer, space_view3d=None) -> overlay_state.ObjectState:
+def object_state(obj, view_layer, space_view3d=None, plan=None) -> overlay_state.ObjectState:
     """Read one object's plain state for this viewport.
 
     ``visible_get`` covers hide states (eye icon, ``hide_viewport``),
     collection visibility, and local view when ``space_view3d`` is given.
     The per-object switch (``object.solidwire.show_in_viewport``, or the
-    older ``solidwire_exclude``) makes the object excluded."""
+    older ``solidwire_exclude``) makes the object excluded. With ``plan``
+    only what the plan's rule looks at is read (overlay_state.keep_object:
+    selection only for "only selected", the mode only when Edit Mode objects
+    are left out); the rest keeps its default."""
     props = getattr(obj, "solidwire", None)
     try:
         visible = obj.visible_get(view_layer=view_layer, viewport=space_view3d)
@@ -91,16 +94,21 @@ def object_state(obj, view_layer, space_view3d=None) -> overlay_state.ObjectStat
         # Not in this view layer (e.g. an instancer from a linked scene):
         # the depsgraph already decided it is drawn.
         visible = True
-    try:
-        selected = obj.select_get(view_layer=view_layer)
-    except (TypeError, RuntimeError):
-        selected = False
+    selected = False
+    if plan is None or plan.only_selected:
+        try:
+            selected = obj.select_get(view_layer=view_layer)
+        except (TypeError, RuntimeError):
+            selected = False
+    in_edit_mode = False
+    if plan is None or not plan.draw_edit_mode:
+        in_edit_mode = getattr(obj, "mode", "OBJECT") == "EDIT"
     return overlay_state.ObjectState(
         visible=bool(visible),
         selected=bool(selected),
         excluded=bool(getattr(obj, "solidwire_exclude", False))
         or (props is not None and not getattr(props, "show_in_viewport", True)),
-        in_edit_mode=getattr(obj, "mode", "OBJECT") == "EDIT",
+        in_edit_mode=in_edit_mode,
     )
 
 
@@ -108,7 +116,26 @@ def object_filter(plan, view_layer, space_view3d=None):
     """``object_filter`` for gather(): the plan's rule on each object's state."""
 
     def keep(obj) -> bool:
-        return overlay_state.keep_object(plan, object_state(obj, view_layer, space_view3d))
+        return overlay_state.keep_object(plan, object_state(obj, view_layer, space_view3d, plan))
+
+    return keep
+
+
+def frame_object_filter(plan, view_layer, space_view3d=None):
+    """:func:`object_filter` for one frame: each original object's answer is
+    read once and remembered, since gather() asks for every instance and an
+    instancer (particles, collection instances, geometry nodes) owns
+    thousands. Only for a single draw: an edit between two gathers would not
+    be seen."""
+    keep_object = object_filter(plan, view_layer, space_view3d)
+    known: dict = {}
+
+    def keep(obj) -> bool:
+        uid = obj.session_uid
+        answer = known.get(uid)
+        if answer is None:
+            answer = known[uid] = keep_object(obj)
+        return answer
 
     return keep
 
@@ -192,15 +219,21 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     strand_items = strands.gather_strands(depsgraph, object_filter=object_filter, object_settings=gather.ObjectSettings(
         gather.SHOW_IN_VIEWPORT, bpy.data.objects), colors=colors.needs_item_colors(settings))
     start = time.perf_counter()
-    stats = passes.draw_over_viewport(
-        items,
-        view,
-        drawn,
-        scene_depth=plan.scene_depth,
-        clip_planes=plan.clip_planes,
-        display=display,
-        strands=strand_items,
-    )
+    if items or strand_items:
+        stats = passes.draw_over_viewport(
+            items,
+            view,
+            drawn,
+            scene_depth=plan.scene_depth,
+            clip_planes=plan.clip_planes,
+            display=display,
+            strands=strand_items,
+        )
+    else:
+        # Nothing to draw (every object hidden, opted out or not drawable):
+        # leave the viewport's buffers and GPU state as Blender left them;
+        # without scene depth the passes would clear the depth first.
+        stats = DrawStats()
     ms_draw = (time.perf_counter() - start) * 1000.0
     return runtime.end_frame(frame, stats, ms_extract, ms_draw, seen)
 
@@ -223,7 +256,7 @@ def _draw_callback() -> None:
             context.evaluated_depsgraph_get(),
             region_view(context.region, context.region_data),
             settings,
-            object_filter=object_filter(plan, context.view_layer, context.space_data),
+            object_filter=frame_object_filter(plan, context.view_layer, context.space_data),
             plan=plan,
             # Never built inside a draw: asked of a timer (color_management).
             display=color_management.display_lut(context.scene, request=True),
