@@ -31,7 +31,7 @@ float style_half_thickness(int style, float wire_half_thickness)
 #endif
 }
 
-#if STYLE_COUNT > 1
+#if STYLE_COUNT > 1 || defined(STYLE_COLORS)
 float style_duty(int style)
 {
   switch (style) {

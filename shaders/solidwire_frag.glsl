@@ -399,7 +399,7 @@ void main()
 #else
   vec3 wire_rgb = params.wire_color.rgb;
 #endif
-#if STYLE_COUNT > 1
+#if STYLE_COUNT > 1 || defined(STYLE_COLORS)
   if (winner > 0) {
     vec4 class_color = style_color(winner);
     wire_rgb = class_color.rgb;

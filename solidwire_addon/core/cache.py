@@ -183,8 +183,8 @@ class GPUMesh:
         return 0 if lines is None else len(lines) // 2
 
     def region_tables(self):
-        """(region-lines table, per-triangle region table) as textures (see
-        region_lines.py), made on first use."""
+        """(region-lines table, per-triangle region table) as textures
+        (docs/image_model.md §2.6), made on first use."""
         if self._region_tables is None:
             regions = np.zeros((self.triangle_count, 4), np.float32)
             regions[:, 0] = self._triangle_regions_cpu

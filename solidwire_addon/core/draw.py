@@ -113,7 +113,7 @@ SETUP_TABLE_MIN = 50_000
 # that record. ``stage=None`` draws directly (one pass, every fragment).
 VISIBILITY, RESOLVE = "visibility", "resolve"
 # Between the two: the lines of multi-face regions drawn over the
-# visibility record (region_lines.py, docs/image_model.md §2.6).
+# visibility record (passes._draw_region_lines, docs/image_model.md §2.6).
 LINES = "lines"
 # Triangle numbers, instances and draw numbers travel as float32 whole
 # numbers in the visibility record: exact below 2^24.
@@ -148,7 +148,7 @@ def split_deferred(items, view: View) -> tuple[list, list]:
         pixels = float(box_pixels(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max), view).sum())
         weight = DEFERRED_BLOCK_WEIGHT if mesh.has_ngons else 1.0
         # Multi-face regions draw their lines over the visibility record
-        # (region_lines.py), so such a mesh is always deferred.
+        # (docs/image_model.md §2.6), so such a mesh is always deferred.
         dense = (weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels
                  or mesh.region_line_count > 0)
         (deferred if dense and 0 < mesh.triangle_count < DEFERRED_MAX else direct).extend(group)
@@ -378,9 +378,12 @@ def draw(
         plain_stage = variant.visibility or variant.region_lines_pass
         for key in sorted(parts):
             ngons, lines_only, table, in_front = key
-            walks = ngons and not plain_stage and not (lines_only and variant.region_lines)
+            lines_elsewhere = lines_only and variant.region_lines
+            walks = ngons and not plain_stage and not lines_elsewhere
             part_variant = replace(variant, ngons=walks, setup_table=table and not plain_stage,
                                    in_front=in_front and not variant.visibility)
+            if lines_elsewhere and variant.edge_classes:
+                part_variant = replace(part_variant, edge_classes=False, style_colors=True)
             _draw_groups(parts[key], part_variant, ubo, settings, program, flip, stats, extras,
                          bases, instancing=instancing, numbering=numbering)
     finally:

@@ -273,13 +273,13 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     flags = arrays.edge_flags
     keep = ~(HAS_QUAD_CORNER | IS_NGON | REGION_LINES | (-1 << NGON_SHIFT))
     flags[listed] = (flags[listed] & keep) | IN_REGION | (count[at].astype(np.int32) << NGON_SHIFT)
-    flags[listed & walked[arrays.triangle_polygons]] |= REGION_LINES
+    flags[listed] |= REGION_LINES  # every listed face's lines can come from the region-lines pass
     flags[listed] &= ~(EDGE3_HIDDEN | EDGE4_HIDDEN)
     arrays.triangles[listed, 3] = base + TEXELS_PER_SEGMENT * first[at]
     stats.regions = int((walked_region & (np.arange(face_count) == label)).sum())
     stats.listed_triangles = int(listed.sum())
     stats.segments = len(seg_a)
-    _region_lines(arrays, verts, classes, ends, label, walked, pairs, stats)
+    _region_lines(arrays, verts, classes, ends, label, walked | styled_face, pairs, stats)
     return stats
 
 
@@ -297,16 +297,17 @@ def _one_per_class(bits: np.ndarray, *columns: np.ndarray):
     return style, tuple(np.repeat(column, per_row) for column in columns)
 
 
-def _region_lines(arrays: MeshArrays, verts, classes, ends, label, walked, pairs, stats: SelectionStats) -> None:
-    """The lines of multi-face regions as a table of their own
+def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, pairs, stats: SelectionStats) -> None:
+    """The lines of the listed faces (``lines_face``: those of multi-face
+    regions and faces with a classed edge) as a table of their own
     (``region_lines``, TEXELS_PER_REGION_LINE texels per entry) and each
-    triangle's region (``triangle_regions``, NO_REGION outside one). An edge
-    bounding two regions is one entry naming both; a non-manifold edge
-    bounding more is one entry per pair; an edge in several classes is one
-    entry per class."""
-    region_of_face = np.where(walked, label, -1)
+    triangle's region (``triangle_regions``, NO_REGION for a plain face). An
+    edge bounding two such regions is one entry naming both; a non-manifold
+    edge bounding more is one entry per pair; an edge in several classes is
+    one entry per class."""
+    region_of_face = np.where(lines_face, label, -1)
     arrays.triangle_regions = region_of_face[arrays.triangle_polygons].astype(np.float32)
-    keep = walked[pairs[:, 0]] if len(pairs) else np.zeros(0, bool)
+    keep = lines_face[pairs[:, 0]] if len(pairs) else np.zeros(0, bool)
     pairs = pairs[keep]
     if not len(pairs):
         arrays.region_lines = None

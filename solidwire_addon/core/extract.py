@@ -36,7 +36,7 @@ EDGE0_HIDDEN = 256  # << k for edges 1 and 2
 # segment count.
 IN_REGION = 2048
 # The triangle lies in a region of several faces: where the render draws the
-# region lines as a pass of their own (region_lines.py), its lines come from
+# region lines as a pass of their own (docs/image_model.md §2.6), its lines come from
 # that pass and it walks only the diagonals at the head of its block.
 REGION_LINES = 4096
 NGON_SHIFT = 13  # edge_flags >> NGON_SHIFT is an n-gon's corner count

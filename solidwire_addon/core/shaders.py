@@ -125,6 +125,10 @@ class ShaderVariant:
     # pass's image for those regions' triangles.
     region_lines_pass: bool = False
     region_lines: bool = False
+    # A surface pass that measures no line of a class itself (every class
+    # line comes from the region-lines pass) but colours the winning style:
+    # the class colours without the per-style distance code (STYLE_COLORS).
+    style_colors: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -325,6 +329,8 @@ def _create_info(variant: ShaderVariant):
         info.define("SEGMENT_SLOTS", str(SEGMENT_SLOTS))
         info.define("PROVOKING_CORNERS", str(_provoking_corners()))
     info.define("STYLE_COUNT", "6" if variant.edge_classes else "1")
+    if variant.style_colors:
+        info.define("STYLE_COLORS", "1")
     if variant.density_fade:
         info.define("USE_DENSITY_FADE", "1")
     if variant.write_aovs:

@@ -107,7 +107,7 @@ class Targets:
     def region_lines_framebuffer(self):
         """The region lines' strongest line per pixel (RG32F: intensity,
         style) with its own depth buffer (1 - intensity), created on first
-        use (see region_lines.py)."""
+        use (docs/image_model.md §2.6; passes._draw_region_lines)."""
         if self.lines is None:
             self.lines = gpu.types.GPUTexture(self.size, format="RG32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self._pass_depth(), color_slots=(self.lines,))
