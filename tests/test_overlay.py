@@ -20,7 +20,7 @@ from solidwire_addon.blender import engine, overlay, runtime
 from solidwire_addon.blender.gather import gather
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.blender.views import camera_view
-from solidwire_addon.core import draw, log, passes
+from solidwire_addon.core import draw, log, overlay_state, passes
 from solidwire_addon.core.targets import BACKGROUND_DEPTH
 from solidwire_addon.core.view import View
 from tests.support import scenes
@@ -225,7 +225,8 @@ def test_no_back_edges_through_without_scene_depth():
     rgba_engine, _depth = engine.render_scene(depsgraph, (WIDTH, HEIGHT))
     view = camera_view(scene, depsgraph, (WIDTH, HEIGHT))
     viewport = FakeViewport(WIDTH, HEIGHT)  # empty depth
-    viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot())
+    xray = overlay_state.plan_overlay(overlay_state.ViewportState(shading="WIREFRAME", xray=True, xray_alpha=0.5))
+    viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), plan=xray)
     diff = np.abs(viewport.rgba()[..., 3] - rgba_engine[..., 3])
     assert diff.max() <= 2.0 / 255.0 + 1e-9
 
@@ -299,7 +300,6 @@ def test_visibility_filter():
 def test_frame_filter_answers_as_the_filter_once_per_object(monkeypatch):
     """The draw handler's filter (one frame) keeps exactly what the plain
     filter keeps, and reads each object once however many instances ask."""
-    from solidwire_addon.core import overlay_state
 
     scene = scenes.empty_scene()
     shown = scenes.cube(scene, "Shown")

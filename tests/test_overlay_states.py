@@ -255,7 +255,8 @@ def test_clip_start_cuts_through_an_object():
     scenes.add_camera(scene, location=(4.0, -3.0, 2.5), clip=(5.2, 40.0))
     cube = scenes.cube(scene, "Cube", size=2.0)
     scenes.uv_sphere(scene, "Back", radius=1.2, location=(-1.6, 1.8, -0.3))
-    alpha, _ = draw_state(scene, ViewportState(), (cube,))
+    sphere = bpy.data.objects["Back"]
+    alpha, _ = draw_state(scene, ViewportState(), (cube, sphere))
     assert_matches_reference(scene, alpha, ViewportState())
 
 
@@ -285,10 +286,12 @@ def test_edit_mode_objects_left_to_blender_by_default():
     scene, _objects = _two_objects_one_in_mode("EDIT")
     try:
         # (Blender-like depth is left out: the test's depth pass reads
-        # Object Mode mesh data; the own depth pre-pass stands in for it.)
-        _alpha, stats = draw_state(scene, ViewportState())
+        # Object Mode mesh data. A shading that leaves no depth, as Cycles'
+        # Rendered view does, makes the own depth pre-pass stand in for it.)
+        no_depth = ViewportState(shading=RENDERED)
+        _alpha, stats = draw_state(scene, no_depth)
         assert stats["objects_drawn"] == 1, "the edited cube is left to Blender's edit wire"
-        alpha, stats = draw_state(scene, ViewportState(draw_edit_mode=True))
+        alpha, stats = draw_state(scene, ViewportState(shading=RENDERED, draw_edit_mode=True))
         assert stats["objects_drawn"] == 2
     finally:
         bpy.ops.object.mode_set(mode="OBJECT")
@@ -378,3 +381,16 @@ def test_nothing_to_draw_leaves_the_viewport_untouched():
     assert stats["objects_drawn"] == 0
     assert np.array_equal(depth(), before_depth)
     assert np.array_equal(viewport.rgba(), before_rgba)
+
+
+def test_an_object_blender_draws_as_wire_keeps_the_own_depth_pre_pass():
+    """In Solid shading Blender's depth holds every surface it draws solid,
+    so the overlay skips its own depth pre-pass; an object displayed as Wire
+    leaves no surface in that depth, and its back edges must still stay
+    hidden behind its front faces."""
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    wire, solid = objects
+    wire.display_type = "WIRE"
+    alpha, stats = draw_state(scene, ViewportState(), (solid,))
+    assert stats["objects_drawn"] == 2
+    assert_matches_reference(scene, alpha, ViewportState())

@@ -232,9 +232,15 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
                         style, pass_index)
         if materials:
             item.materials = _materials_of(obj, obj.data, obj.data.as_pointer(), frame.face_slots)
+        # Blender's Solid shading writes the depth of objects drawn solid,
+        # except those shown in front (they have a depth of their own).
+        item.in_scene_depth = obj.display_type in _SOLID_DISPLAY and not obj.show_in_front
         items.append(item)
     frame.finish()
     return items, frame.seen, frame.ms_extract
+
+
+_SOLID_DISPLAY = frozenset(("SOLID", "TEXTURED"))
 
 
 def instance_shown(instance, obj, object_filter, object_settings):

@@ -225,6 +225,7 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
             view,
             drawn,
             scene_depth=plan.scene_depth,
+            scene_surfaces=plan.scene_surfaces,
             clip_planes=plan.clip_planes,
             display=display,
             strands=strand_items,

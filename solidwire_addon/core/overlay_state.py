@@ -74,6 +74,9 @@ class OverlayPlan:
     pixel_scale: float
     only_selected: bool
     draw_edit_mode: bool
+    # Blender's depth holds the surface of every object it draws solid (Solid
+    # shading and Material Preview, no X-ray): our own depth pre-pass can go.
+    scene_surfaces: bool = False
 
 
 def xray_active(state: ViewportState) -> bool:
@@ -108,6 +111,7 @@ def plan_overlay(state: ViewportState) -> OverlayPlan | None:
         return None
     return OverlayPlan(
         scene_depth=not xray_active(state),
+        scene_surfaces=state.shading in (SOLID, MATERIAL) and not xray_active(state),
         clip_planes=_planes(state.clip_planes),
         pixel_scale=_pixel_scale(state.pixel_size),
         only_selected=bool(state.only_selected),

@@ -301,8 +301,8 @@ OVERLAY_DEPTH_BIAS = 2.0**-18
 
 
 def draw_over_viewport(
-    items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS, scene_depth: bool = True, clip_planes=None,
-    display=None, strands=(),
+    items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS, scene_depth: bool = True,
+    scene_surfaces: bool = False, clip_planes=None, display=None, strands=(),
 ):
     """Draw ``items`` over a bound framebuffer that already holds the scene's
     colour and depth (a 3D viewport after its own drawing). Returns the
@@ -316,10 +316,15 @@ def draw_over_viewport(
     management) makes every colour pass write what the F12 render shows
     (docs/image_model.md §9); None writes the scene-linear colour.
 
-    A depth-only pre-pass comes first, so only the nearest of our own
-    surfaces passes the colour passes (no back edges show through where the
-    scene depth is empty, as in X-ray or Wireframe shading); the scene's depth
-    hides wires behind other geometry. Then the plan's passes, blended with
+    Unless ``scene_surfaces`` says the scene's depth holds every item's
+    surface (Solid shading without X-ray: not for an object drawn as wire
+    or in front, item.in_scene_depth), a depth-only
+    pre-pass comes first, so only the nearest of our own surfaces passes the
+    colour passes (no back edges show through where the scene depth is
+    empty). Where it does, the scene's depth already is that surface (our
+    surfaces win the tie by ``depth_bias``) and the pre-pass would only
+    cost a second pass over every triangle. The scene's depth hides wires
+    behind other geometry. Then the plan's passes, blended with
     premultiplied alpha at depth test LESS_EQUAL. GPU state is restored."""
     saved_blend = gpu.state.blend_get()
     saved_depth_test = gpu.state.depth_test_get()
@@ -342,10 +347,11 @@ def draw_over_viewport(
         if not scene_depth:
             gpu.state.depth_mask_set(True)
             gpu.state.active_framebuffer_get().clear(depth=1.0)
-        gpu.state.blend_set("NONE")
-        gpu.state.color_mask_set(False, False, False, False)
-        draw_mod.draw(items, view, settings, depth_bias=depth_bias, **options)
-        gpu.state.color_mask_set(True, True, True, True)
+        if not (scene_depth and scene_surfaces and all(item.in_scene_depth for item in items)):
+            gpu.state.blend_set("NONE")
+            gpu.state.color_mask_set(False, False, False, False)
+            draw_mod.draw(items, view, settings, depth_bias=depth_bias, **options)
+            gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set("ALPHA_PREMULT")
         for step in plan(settings):
             if step.kind == SURFACE:

@@ -54,6 +54,10 @@ class DrawItem:
     # For the IndexMA pass only: (material slot index per face (F,) int32,
     # the pass_index of each material slot). None: every face 0.
     materials: tuple | None = None
+    # Viewport overlay: the viewport's own depth buffer holds this object's
+    # surface (drawn solid, not in front), so that depth alone hides what
+    # lies behind it (passes.draw_over_viewport).
+    in_scene_depth: bool = True
 
 
 @dataclass
