@@ -46,5 +46,12 @@ void main()
                                            + mu.y * corner_row(triangle, 1, ids.y).xyz
                                            + mu.z * corner_row(triangle, 2, ids.z).xyz);
 #endif
+#ifdef ATTRIBUTE_COLORS
+  /* Interpolated with the same perspective-correct weights. */
+  vec4 corner_ids = sw_triangle_ids;
+  attribute_fill = mu.x * attribute_row(triangle, 0, corner_ids.x).rgb
+                   + mu.y * attribute_row(triangle, 1, corner_ids.y).rgb
+                   + mu.z * attribute_row(triangle, 2, corner_ids.z).rgb;
+#endif
   solidwire_fragment();
 }

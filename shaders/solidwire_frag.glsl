@@ -412,6 +412,9 @@ void main()
 #  else
   vec3 fill_rgb = params.fill_color.rgb;
 #  endif
+#  ifdef ATTRIBUTE_COLORS
+  fill_rgb = attribute_fill; /* interpolated over the triangle */
+#  endif
   frag_color = vec4(mix(shaded_fill(fill_rgb), wire_rgb, wire_weight), 1.0);
 #else
   /* Premultiplied: what the render pass expects and what blending needs. */

@@ -125,6 +125,16 @@ float line_reach(float w0, float w1, float w2)
 }
 #endif
 
+#ifdef ATTRIBUTE_COLORS
+/* The mesh's active colour attribute at a triangle corner (the ATTRIBUTE
+ * fill source, image model §5.8): a row per vertex or per triangle corner
+ * (attribute_domain; extract.attribute_color_table). */
+vec4 attribute_row(int triangle, int corner, float vertex_id)
+{
+  return fetch_texel(attribute_colors, (attribute_domain == 0) ? int(vertex_id) : 3 * triangle + corner);
+}
+#endif
+
 /* Corner `corner` of `triangle` (vertex `vertex_id`): the corner table's
  * row for it (extract.corner_table: a row per vertex, triangle or triangle
  * corner, as normal_domain says), and from it the corner's normal in view
@@ -291,6 +301,9 @@ void main()
 #ifdef USE_CORNERS
   vec4 corner_data = corner_shading(triangle, corner, (corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z));
   shading_normal = corner_data.xyz;
+#endif
+#ifdef ATTRIBUTE_COLORS
+  attribute_fill = attribute_row(triangle, corner, (corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z)).rgb;
 #endif
 #ifdef ITEM_COLORS
   /* The object's block of the frame's colour table (core/colors.py). */

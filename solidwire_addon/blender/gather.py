@@ -107,7 +107,7 @@ def _is_plain(obj_orig) -> bool:
     )
 
 
-def fingerprint(mesh, corners: bool = False, edge_classes: tuple = ()):
+def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute_colors: bool = False):
     """(fingerprint, (positions, corner_vert, corner inputs)) of a mesh's
     drawn geometry.
 
@@ -120,7 +120,8 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = ()):
     (extract.normals_follow_geometry), so they are neither read nor
     checksummed here (None in the context: read when the mesh is extracted
     or moved). With ``edge_classes``, the edge data of those classes
-    (marking a seam moves nothing either).
+    (marking a seam moves nothing either); with ``attribute_colors``, the
+    active colour attribute (painting moves nothing).
 
     The fingerprint is ``(topology, shape)`` (see MeshCache.get_validated):
     a deformation changes the shape part alone, and then positions and
@@ -136,6 +137,8 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = ()):
         *_edge_class_checksums(mesh, edge_classes),
     )
     shape = (_crc(positions),)
+    if attribute_colors:
+        topology += extract.attribute_colors_checksum(mesh)
     corner_inputs = None
     if corners:
         materials, domain = extract.read_corner_domain(mesh)
@@ -175,7 +178,7 @@ NO_SELECTION = edge_select.Selection()
 
 
 def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None, corners: bool = False, colors: bool = False,
+           should_stop=None, corners: bool = False, colors: bool = False, attribute_colors: bool = False,
            edges: edge_select.Selection = NO_SELECTION,
            object_settings: ObjectSettings | None = None, materials: bool = False, edge_lengths: bool = False,
            tessellation: bool = False):
@@ -194,6 +197,8 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     ``corners``: meshes carry their corner table (shaded fill, material
     colours; a separate cache entry, so FLAT draws never pay for it).
     ``colors``: each item carries its object's :class:`ItemSource`.
+    ``attribute_colors``: meshes carry their active colour attribute
+    (the ATTRIBUTE fill source), a separate cache entry.
     ``edges``: which edges are drawn and in which style (edge angle, cage
     edges, edge classes; core/edge_select.py), a separate cache entry for
     each selection.
@@ -211,7 +216,7 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     if trust_updates is None:
         trust_updates = depsgraph.mode == "VIEWPORT"
     frame = _FrameGather(depsgraph, cache, trust_updates=trust_updates, view=view, corners=corners,
-                         edges=edges, outlines=not tessellation)
+                         edges=edges, outlines=not tessellation, attribute_colors=attribute_colors)
     items: list[DrawItem] = []
     for instance in depsgraph.object_instances:
         obj = instance.object
@@ -270,12 +275,13 @@ class _FrameGather:
     and material slots read once per object/mesh."""
 
     def __init__(self, depsgraph, cache: MeshCache, *, trust_updates: bool, view, corners: bool,
-                 edges: edge_select.Selection, outlines: bool = True):
+                 edges: edge_select.Selection, outlines: bool = True, attribute_colors: bool = False):
         self.cache = cache
         self.mode = depsgraph.mode
         self.trust = (depsgraph.as_pointer(), runtime.epoch) if trust_updates else None
         self.versions = runtime.geometry_version
         self.corners, self.edges, self.outlines = corners, edges, outlines
+        self.attribute_colors = attribute_colors
         self.view_projection = None if view is None else view.projection @ view.view_matrix
         self.seen = SeenKeys()
         self.seen.scope = (self.mode,)
@@ -334,6 +340,8 @@ class _FrameGather:
         key, uids = _key_for(obj, pointer, parent, self.mode, self.key_pointer, self.instancer_meshes)
         if self.corners:
             key = (*key, "corners")
+        if self.attribute_colors:
+            key = (*key, "attribute colors")
         edges, cage_key = self._edges_for(obj)
         if edges.active:
             key = (*key, "edges", edges, cage_key)
@@ -343,7 +351,8 @@ class _FrameGather:
         try:
             edges, cage_key = self._edges_for(obj)
             mesh, ms = _mesh_for(obj, data, pointer, key, uids, self.cache, self.trust, self.versions,
-                                 self.corners, edges, self.mode == "RENDER", outline=cage_key == OUTLINE_KEY)
+                                 self.corners, edges, self.mode == "RENDER", outline=cage_key == OUTLINE_KEY,
+                                 attribute_colors=self.attribute_colors)
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
             warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
             return None
@@ -460,7 +469,8 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
 
 
 def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False,
-              edges: edge_select.Selection = NO_SELECTION, render: bool = False, outline: bool = False):
+              edges: edge_select.Selection = NO_SELECTION, render: bool = False, outline: bool = False,
+              attribute_colors: bool = False):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated
     mesh. ``outline``: the drawn mask is outlines.py's (``edges.use_cage``
     says a mask is passed), not the cage's."""
@@ -497,6 +507,10 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
                 edge_select.apply_to_mesh(
                     arrays, source_mesh, corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
                     face_offsets, edges, cage_edges)
+            if attribute_colors:
+                extract.attach_attribute_colors(
+                    arrays, source_mesh, corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
+                    extract.read_face_offsets(source_mesh))
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
             return None
@@ -537,7 +551,7 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
         # the edge selection follows the positions (edge angle): then which
         # edges are drawn may change, and the mesh is extracted again.
         mesh, _extracted = cache.get_validated(
-            key, fast, lambda: fingerprint(get_source(), corners, edges.classes),
+            key, fast, lambda: fingerprint(get_source(), corners, edges.classes, attribute_colors),
             make_arrays, None if edges.follows_positions else reposition
         )
     finally:

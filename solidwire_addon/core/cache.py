@@ -104,6 +104,10 @@ class GPUMesh:
         # or triangle corner (normal_domain); only for a shaded or
         # per-material fill.
         self.corners = None if arrays.corners is None else table_texture(arrays.corners)
+        # The ATTRIBUTE fill source's colours, a row per vertex or triangle
+        # corner (attribute_domain); None: the mesh has no colour attribute.
+        self.attribute_colors = None if arrays.attribute_colors is None else table_texture(arrays.attribute_colors)
+        self.attribute_domain = arrays.attribute_domain
         self.corner_rows = arrays.corner_rows  # to refill the corner table when the mesh moves
         self.normal_domain = arrays.normal_domain  # what a row of the corner table is for
         # Kept (no copy) so the silhouette pass can derive its edge table on

@@ -40,6 +40,12 @@ def needs_item_colors(settings) -> bool:
     return (bool(settings.use_fill) and settings.fill_color_source != "SINGLE") or settings.wire_color_source != "SINGLE"
 
 
+def needs_attribute_colors(settings) -> bool:
+    """The fill comes from each mesh's active colour attribute (meshes
+    without one take Fill Color)."""
+    return bool(settings.use_fill) and settings.fill_color_source == "ATTRIBUTE"
+
+
 def needs_material_colors(settings) -> bool:
     return bool(settings.use_fill) and settings.fill_color_source == "MATERIAL"
 

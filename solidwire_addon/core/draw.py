@@ -51,6 +51,7 @@ def shader_variant(settings, write_view_depth: bool = False, depth_bias: float =
         shading=fill_shading(settings),
         item_colors=colors.needs_item_colors(settings),
         material_colors=colors.needs_material_colors(settings),
+        attribute_colors=colors.needs_attribute_colors(settings),
         edge_classes=bool(edge_classes_of(settings)),
         density_fade=bool(settings.use_density_fade),
     )
@@ -276,7 +277,7 @@ def draw(
     variant = shader_variant(settings, write_view_depth, depth_bias, linear_depth)
     if hidden_pass:
         variant = replace(variant, hidden_pass=True, write_view_depth=False, shading=shaders.SHADING_FLAT,
-                          material_colors=False)
+                          material_colors=False, attribute_colors=False)
     if write_aovs:
         variant = replace(variant, write_aovs=True)
     if stage == RESOLVE:
@@ -369,19 +370,21 @@ def draw(
             ngons = program.supports_ngons and mesh.has_ngons
             # (Part of the key, so that every stage parts the draws alike.)
             lines_only = ngons and getattr(mesh, "blocks_only_for_region_lines", False)
+            colored = getattr(mesh, "attribute_colors", None) is not None
             table = (setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g[4], view))
             in_front = wholly_in_front(g[4], mesh.bounds_min, mesh.bounds_max)
-            parts.setdefault((ngons, lines_only, table, in_front), []).append(g)
+            parts.setdefault((ngons, lines_only, colored, table, in_front), []).append(g)
         # The visibility and region-lines passes read neither n-gon
         # outlines nor the set-up table; a draw that reads the region lines
         # needs no block code for a mesh whose blocks only hold them.
         plain_stage = variant.visibility or variant.region_lines_pass
         for key in sorted(parts):
-            ngons, lines_only, table, in_front = key
+            ngons, lines_only, colored, table, in_front = key
             lines_elsewhere = lines_only and variant.region_lines
             walks = ngons and not plain_stage and not lines_elsewhere
             part_variant = replace(variant, ngons=walks, setup_table=table and not plain_stage,
-                                   in_front=in_front and not variant.visibility)
+                                   in_front=in_front and not variant.visibility,
+                                   attribute_colors=variant.attribute_colors and colored and not plain_stage)
             if lines_elsewhere and variant.edge_classes:
                 part_variant = replace(part_variant, edge_classes=False, style_colors=True)
             _draw_groups(parts[key], part_variant, ubo, settings, program, flip, stats, extras,
@@ -443,6 +446,9 @@ def _bind_mesh(shader, variant, mesh) -> None:
     if variant.uses_corners:
         shader.uniform_sampler("corner_table", mesh.corners)
         shader.uniform_int("normal_domain", mesh.normal_domain)
+    if variant.attribute_colors:
+        shader.uniform_sampler("attribute_colors", mesh.attribute_colors)
+        shader.uniform_int("attribute_domain", mesh.attribute_domain)
 
 
 class _DrawNumbers:

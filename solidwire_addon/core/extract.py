@@ -83,6 +83,12 @@ class MeshArrays:
     # no multi-face region.
     region_lines: np.ndarray = None
     triangle_regions: np.ndarray = None
+    # The ATTRIBUTE fill source: the active colour attribute as (R, 4)
+    # float32 scene-linear RGBA rows, one per vertex (attribute_domain
+    # NORMALS_BY_VERTEX) or per triangle corner (NORMALS_BY_CORNER); None:
+    # the mesh has none.
+    attribute_colors: np.ndarray = None
+    attribute_domain: int = 0
     # (3T,) int32 polygon corner of each triangle corner (-1: none), kept with
     # ``corners`` so a moved mesh refills its table (fill_corner_table);
     # only for normals by corner.
@@ -792,6 +798,53 @@ def read_corner_inputs(mesh) -> tuple[np.ndarray, np.ndarray, int]:
     shaded as Blender shades it."""
     materials, domain = read_corner_domain(mesh)
     return read_normals(mesh, domain), materials, domain
+
+
+def read_attribute_colors(mesh):
+    """(colours (N, 4) float32 scene-linear RGBA, domain "POINT" or
+    "CORNER") of the mesh's active colour attribute, as Workbench's
+    Attribute colour shows it (byte colours are read decoded to linear);
+    None when it has none on those domains."""
+    attributes = getattr(mesh, "color_attributes", None)
+    attribute = None if attributes is None else attributes.active_color
+    if attribute is None or attribute.domain not in ("POINT", "CORNER"):
+        return None
+    count = len(attribute.data)
+    values = np.empty(count * 4, np.float32)
+    if count:
+        attribute.data.foreach_get("color", values)
+    return values.reshape(-1, 4), attribute.domain
+
+
+def attribute_colors_checksum(mesh) -> tuple:
+    """What identifies the active colour attribute's content (for the mesh
+    cache: painting changes it without moving a vertex)."""
+    colors = read_attribute_colors(mesh)
+    if colors is None:
+        return (None,)
+    return (colors[1], zlib.crc32(memoryview(np.ascontiguousarray(colors[0])).cast("B")))
+
+
+def attach_attribute_colors(arrays: MeshArrays, mesh, corner_vert: np.ndarray, face_offsets: np.ndarray) -> None:
+    """Read the active colour attribute of ``mesh`` into ``arrays`` as the
+    rows the vertex stage reads: per vertex, or per corner of each drawn
+    triangle (through :func:`corner_rows`). A colour that is not finite
+    reads as black rather than poisoning the interpolation."""
+    read = read_attribute_colors(mesh)
+    if read is None:
+        return
+    colors, domain = read
+    colors = np.nan_to_num(colors, nan=0.0, posinf=0.0, neginf=0.0)
+    if domain == "POINT":
+        if len(colors) != arrays.vertex_count:
+            return
+        arrays.attribute_colors, arrays.attribute_domain = colors, NORMALS_BY_VERTEX
+        return
+    rows = arrays.corner_rows if arrays.corner_rows is not None else corner_rows(arrays, corner_vert, face_offsets)
+    table = np.zeros((len(rows), 4), np.float32)
+    found = (rows >= 0) & (rows < len(colors))
+    table[found] = colors[rows[found]]
+    arrays.attribute_colors, arrays.attribute_domain = table, NORMALS_BY_CORNER
 
 
 def read_corner_domain(mesh) -> tuple[np.ndarray, int]:

@@ -78,6 +78,7 @@ def gather_options(settings) -> dict:
     arguments of blender/gather.gather): corner tables for a shaded fill or
     material colours, colour-source inputs for per-object colours."""
     return {"corners": draw_mod.needs_corners(settings), "colors": colors.needs_item_colors(settings),
+            "attribute_colors": colors.needs_attribute_colors(settings),
             "edges": edge_select.Selection(float(settings.edge_angle), draw_mod.edge_classes_of(settings),
                                            bool(settings.use_cage_edges))}
 

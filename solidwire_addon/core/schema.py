@@ -353,6 +353,8 @@ SETTINGS: tuple[Setting, ...] = (
             ("OBJECT", "Object", "The object's own colour (Object Properties > Viewport Display > Color)"),
             ("MATERIAL", "Material", "Each face's material viewport colour (Material > Viewport Display > Color)"),
             ("RANDOM", "Random", "A stable colour per object, made from its name"),
+            ("ATTRIBUTE", "Attribute", ("The mesh's active colour attribute (vertex colours), as Workbench's "
+                                        "Attribute colour; Fill Color where a mesh has none")),
         ),
         section="colors", active_if=lambda p: p.use_fill, cli="--fill-source",
     ),

@@ -129,6 +129,9 @@ class ShaderVariant:
     # line comes from the region-lines pass) but colours the winning style:
     # the class colours without the per-style distance code (STYLE_COLORS).
     style_colors: bool = False
+    # The ATTRIBUTE fill source for a mesh that has a colour attribute: the
+    # fill is its colours, interpolated over each triangle (ATTRIBUTE_COLORS).
+    attribute_colors: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -482,6 +485,11 @@ def _add_fill_and_colours(info, iface, variant: ShaderVariant) -> None:
         iface.flat("VEC3", "item_fill")
     if variant.material_colors:
         info.define("MATERIAL_COLORS", "1")
+    if variant.attribute_colors:
+        info.sampler(ATTRIBUTE_COLORS_SLOT, "FLOAT_2D", "attribute_colors")
+        info.push_constant("INT", "attribute_domain")
+        info.define("ATTRIBUTE_COLORS", "1")
+        iface.smooth("VEC3", "attribute_fill")
 
 
 # Sampler slot of the display LUT, above every slot the exact path and the
@@ -561,6 +569,7 @@ vec4 sw_triangle_ids;
 RESOLVE_VISIBILITY_SLOT = 10
 RESOLVE_FLAGS_SLOT = 11
 REGION_LINE_IMAGE_SLOT = 12
+ATTRIBUTE_COLORS_SLOT = 13
 
 
 # Per-object values of the render passes (std140): the columns of the normal

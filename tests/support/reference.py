@@ -80,6 +80,9 @@ class _Geometry:
     sil_third: np.ndarray = None  # (S, 2, 3) third vertex of the face on each side (NaN: none)
     # Fill shading and colour sources (image model §5.8).
     tri_normals: np.ndarray = None  # (T, 3, 3) corner normals in view space (not normalised), tri_view's order
+    # (T, 3, 3) the active colour attribute at each corner (linear RGB), NaN
+    # for an object without one: the ATTRIBUTE fill source.
+    tri_colors: np.ndarray = None
     face_fill: np.ndarray = None  # (F, 3) base fill colour of each global face
     face_wire: np.ndarray = None  # (F, 3) wire colour of each global face
     face_thickness: np.ndarray = None  # (F,) override thickness per face (NaN: the scene's)
@@ -139,6 +142,20 @@ def _object_colors(obj, s, npoly, material_index):
         if slots:
             faces[:] = np.array(slots)[np.clip(material_index, 0, len(slots) - 1)]
     return faces, wire
+
+
+def _corner_colors(mesh, tri_loops, tri_vertices) -> np.ndarray:
+    """(T, 3, 3) the active colour attribute at each triangle corner (linear
+    RGB; point colours by vertex, corner colours by loop), NaN without one.
+    Read element by element, independent of the add-on's bulk reads."""
+    out = np.full((len(tri_loops), 3, 3), np.nan)
+    attribute = mesh.color_attributes.active_color
+    if attribute is None or attribute.domain not in ("POINT", "CORNER"):
+        return out
+    values = np.array([tuple(item.color)[:3] for item in attribute.data], np.float64).reshape(-1, 3)
+    values = np.nan_to_num(values, nan=0.0, posinf=0.0, neginf=0.0)
+    index = tri_vertices if attribute.domain == "POINT" else tri_loops
+    return values[index]
 
 
 def _flat_edges(mesh, loop_poly, real_a, real_b, angle) -> set:
@@ -331,7 +348,7 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
 def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
     tris, tri_faces, edges, edge_faces, edge_real, edge_origin = [], [], [], [], [], []
     sil_edges, sil_third = [], []
-    tri_normals, face_fill, face_wire = [], [], []
+    tri_normals, face_fill, face_wire, tri_colors = [], [], [], []
     face_thickness, face_object, objects, offsets = [], [], [], []
     face_key, edge_style, chain_view = [], [], []
     cage_masks = _cage_masks(depsgraph, s)
@@ -442,6 +459,7 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             with np.errstate(all="ignore"):
                 nmat = np.linalg.inv(to_view[:3, :3]).T
             tri_normals.append(corner_n[tri_l[tri_ok]] @ nmat.T)
+            tri_colors.append(_corner_colors(mesh, tri_l, front_winding)[tri_ok])
             material_index = np.zeros(npoly, np.int64)
             if npoly and "material_index" in mesh.attributes:
                 mesh.attributes["material_index"].data.foreach_get("value", material_index)
@@ -482,6 +500,7 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         cat(sil_edges, (0, 2, 3), np.float64),
         cat(sil_third, (0, 2, 3), np.float64),
         cat(tri_normals, (0, 3, 3), np.float64),
+        cat(tri_colors, (0, 3, 3), np.float64),
         cat(face_fill, (0, 3), np.float64),
         cat(face_wire, (0, 3), np.float64),
         cat(face_thickness, (0,), np.float64),
@@ -1280,12 +1299,18 @@ def _colors(s, geo, face, centre_hit):
     f = face[covered]
     base = geo.face_fill[f]
     wire[covered] = geo.face_wire[f]
+    tri = centre_hit["tri"][covered]
+    u, v = centre_hit["u"][covered][:, None], centre_hit["v"][covered][:, None]
+    if getattr(s, "use_fill", False) and getattr(s, "fill_color_source", "SINGLE") == "ATTRIBUTE":
+        # The colour attribute interpolated at the hit (barycentrics of the
+        # ray's hit: perspective-correct); Fill Color without an attribute.
+        corners = geo.tri_colors[tri]
+        attribute = (1 - u - v) * corners[:, 0] + u * corners[:, 1] + v * corners[:, 2]
+        base = np.where(np.isnan(attribute), base, attribute)
     shading = getattr(s, "fill_shading", "FLAT") if getattr(s, "use_fill", False) else "FLAT"
     if shading == "FLAT":
         fill[covered] = base
         return fill, wire
-    tri = centre_hit["tri"][covered]
-    u, v = centre_hit["u"][covered][:, None], centre_hit["v"][covered][:, None]
     corners = geo.tri_normals[tri]
     n = (1 - u - v) * corners[:, 0] + u * corners[:, 1] + v * corners[:, 2]
     length = np.linalg.norm(n, axis=1, keepdims=True)
