@@ -32,11 +32,18 @@ from tests.support import (
 # The edge-selection looks: (name, settings, scene builder).
 EDGE_CASES = (
     ("cage edges (Suzanne, level 2)", dict(use_cage_edges=True, thickness=1.0), selection._subdivided_monkey),
-    ("cage edges + edge angle 25°", dict(use_cage_edges=True, edge_angle=0.436, thickness=1.0),
-     selection._subdivided_monkey),
-    ("cage edges + density fade, dashed diagonals",
-     dict(use_cage_edges=True, use_density_fade=True, density_fade_length=30.0, diagonal_mode="DASHED",
-          thickness=1.0), selection._subdivided_monkey),
+    (
+        "cage edges + edge angle 25°",
+        dict(use_cage_edges=True, edge_angle=0.436, thickness=1.0),
+        selection._subdivided_monkey,
+    ),
+    (
+        "cage edges + density fade, dashed diagonals",
+        dict(
+            use_cage_edges=True, use_density_fade=True, density_fade_length=30.0, diagonal_mode="DASHED", thickness=1.0
+        ),
+        selection._subdivided_monkey,
+    ),
     ("edge angle 20°, one region (grid)", dict(edge_angle=0.349, thickness=3.0), None),
     ("edge classes (5 styles, patterns)", selection.CLASS_LOOK, selection._marked_cube),
 )
@@ -73,7 +80,9 @@ def main(argv=None) -> int:
     print(f"| scene ({width} x {height}) | mean abs dI | p99.9 | max | px > 2/255 | silhouette px |")
     print("|---|---:|---:|---:|---:|---:|")
     for r in rows:
-        print(f"| {r['name']} | {r['mean']:.1e} | {r['p999']:.1e} | {r['max']:.1e} | {r['over_2_255']} | {r['silhouette_pixels']} |")
+        print(
+            f"| {r['name']} | {r['mean']:.1e} | {r['p999']:.1e} | {r['max']:.1e} | {r['over_2_255']} | {r['silhouette_pixels']} |"
+        )
     return 0
 
 

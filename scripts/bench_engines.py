@@ -146,15 +146,28 @@ def run(size, subdivisions: int, repeats: int, freestyle: bool) -> list[str]:
         lines.append(f"| {label} | {median:.3f} | {first_text} | {median / base:.2f} |")
     # What any engine pays to draw these triangles at all, in the same run.
     floor_ms, _covered = frame_stages.bare_draw(scene, obj, size, repeats)
-    lines.append(f"| floor: bare indexed draw of the same triangles (no shading, no readback; "
-                 f"scripts/frame_stages.bare_draw) | {floor_ms / 1000.0:.3f} | – | {floor_ms / 1000.0 / base:.2f} |")
+    lines.append(
+        f"| floor: bare indexed draw of the same triangles (no shading, no readback; "
+        f"scripts/frame_stages.bare_draw) | {floor_ms / 1000.0:.3f} | – | {floor_ms / 1000.0 / base:.2f} |"
+    )
     steady_touched = statistics.median(touched[turn] for turn in range(1, repeats + 1))
-    lines += ["", (f"SolidWire's first render: {first['SOLIDWIRE']:.3f} s against {statistics.median(times['SOLIDWIRE']):.3f} s "
-                  f"steady; extraction {first_stats.get('ms_extract', 0.0):.0f} ms, upload "
-                  f"{first_stats.get('ms_upload', 0.0):.0f} ms; {touched[0]:.0f} MiB of memory touched for the first "
-                  f"time (minor page faults; {steady_touched:.0f} MiB in a steady render).")]
-    lines += ["", (f"SolidWire's steady frame by stage ({repeats} more renders with a sync after each GPU stage; "
-                  "scripts/frame_stages.py):"), ""]
+    lines += [
+        "",
+        (
+            f"SolidWire's first render: {first['SOLIDWIRE']:.3f} s against {statistics.median(times['SOLIDWIRE']):.3f} s "
+            f"steady; extraction {first_stats.get('ms_extract', 0.0):.0f} ms, upload "
+            f"{first_stats.get('ms_upload', 0.0):.0f} ms; {touched[0]:.0f} MiB of memory touched for the first "
+            f"time (minor page faults; {steady_touched:.0f} MiB in a steady render)."
+        ),
+    ]
+    lines += [
+        "",
+        (
+            f"SolidWire's steady frame by stage ({repeats} more renders with a sync after each GPU stage; "
+            "scripts/frame_stages.py):"
+        ),
+        "",
+    ]
     configure(scene, "SOLIDWIRE")
     with frame_stages.StageProbe() as probe:
         for _ in range(repeats):
@@ -173,8 +186,11 @@ def main() -> None:
     parser.add_argument("--freestyle", action="store_true")
     args = parser.parse_args()
     cost = first_touch_ms_per_mib()  # before anything else has touched memory
-    print(f"Touching new memory here costs {cost:.2f} ms per MiB (a 64 MiB fill, first time in the process "
-          "against again).\n", flush=True)
+    print(
+        f"Touching new memory here costs {cost:.2f} ms per MiB (a 64 MiB fill, first time in the process "
+        "against again).\n",
+        flush=True,
+    )
     solidwire_addon.register()
     try:
         for text in args.size or ["1280x720"]:

@@ -27,9 +27,18 @@ from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.blender.views import camera_view
 from tests.support import scenes
 
-PLAIN = dict(use_fill=True, use_cage_edges=False, edge_angle=0.0, use_density_fade=False, diagonal_mode="HIDDEN",
-             use_boundary_edges=False, use_sharp_edges=False, use_seam_edges=False, use_crease_edges=False,
-             use_freestyle_edges=False)
+PLAIN = dict(
+    use_fill=True,
+    use_cage_edges=False,
+    edge_angle=0.0,
+    use_density_fade=False,
+    diagonal_mode="HIDDEN",
+    use_boundary_edges=False,
+    use_sharp_edges=False,
+    use_seam_edges=False,
+    use_crease_edges=False,
+    use_freestyle_edges=False,
+)
 
 
 def build_scene(size, level: int):
@@ -127,16 +136,17 @@ def main(argv=None) -> int:
         ensure_gpu()
         viewport = Viewport(size)
         print(f"{size[0]}x{size[1]}, best of {args.repeats} alternating rounds; ratio = cage / every edge\n")
-        print("| level | triangles | F12 every edge (ms) | F12 cage | ratio | overlay redraw every edge | cage | ratio |"
-              " edit redraw every edge | cage | ratio | first extraction every edge | cage | ratio |")
+        print(
+            "| level | triangles | F12 every edge (ms) | F12 cage | ratio | overlay redraw every edge | cage | ratio |"
+            " edit redraw every edge | cage | ratio | first extraction every edge | cage | ratio |"
+        )
         print("|---:|---:|" + "---:|" * 12)
         for level in args.levels:
             bpy.ops.wm.read_factory_settings(use_empty=True)
             solidwire_addon.register()
             scene, monkey = build_scene(size, level)
             triangles = len(monkey.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
-            best = compare(scene, monkey, size, {"all": {}, "cage": dict(use_cage_edges=True)}, args.repeats,
-                           viewport)
+            best = compare(scene, monkey, size, {"all": {}, "cage": dict(use_cage_edges=True)}, args.repeats, viewport)
             cells = []
             for key in ("f12", "redraw", "edit", "extract"):
                 a, c = best["all"][key], best["cage"][key]
@@ -146,21 +156,28 @@ def main(argv=None) -> int:
         bpy.ops.wm.read_factory_settings(use_empty=True)
         solidwire_addon.register()
         scene, monkey = build_scene(size, 2)
-        looks = {"plain": {}, "angle": dict(edge_angle=math.radians(20.0)),
-                 "classes": dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True),
-                 "angle + classes": dict(edge_angle=math.radians(20.0), use_sharp_edges=True, use_seam_edges=True)}
+        looks = {
+            "plain": {},
+            "angle": dict(edge_angle=math.radians(20.0)),
+            "classes": dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True),
+            "angle + classes": dict(edge_angle=math.radians(20.0), use_sharp_edges=True, use_seam_edges=True),
+        }
         modifier = monkey.modifiers[0]
         modifier.show_viewport = modifier.show_render = False
         bpy.ops.object.select_all(action="DESELECT")
         apply_subdivision(monkey, 3)
         best = compare(scene, monkey, size, looks, args.repeats, viewport)
-        print("\nSuzanne subdivided 3 times and applied "
-              f"({len(monkey.data.loop_triangles):,} triangles); ratio against the plain frame\n")
+        print(
+            "\nSuzanne subdivided 3 times and applied "
+            f"({len(monkey.data.loop_triangles):,} triangles); ratio against the plain frame\n"
+        )
         print("| look | F12 (ms) | ratio | overlay redraw (ms) | ratio |")
         print("|---|---:|---:|---:|---:|")
         for name in looks:
             f, r = best[name]["f12"], best[name]["redraw"]
-            print(f"| {name} | {f:.0f} | {f / best['plain']['f12']:.2f}x | {r:.0f} | {r / best['plain']['redraw']:.2f}x |")
+            print(
+                f"| {name} | {f:.0f} | {f / best['plain']['f12']:.2f}x | {r:.0f} | {r / best['plain']['redraw']:.2f}x |"
+            )
     finally:
         solidwire_addon.unregister()
     return 0

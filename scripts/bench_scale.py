@@ -360,8 +360,14 @@ def bench_animation_1m(level: int, size: tuple, frame_count: int) -> dict:
             later = samples[label][1:]
             row = {"first_ms": samples[label][0][0], "ms_per_frame": statistics.median(w for w, _ in later)}
             if engine == "SOLIDWIRE":
-                for key in ("ms_extract", "ms_upload", "ms_draw", "ms_total", "meshes_extracted",
-                            "meshes_repositioned"):
+                for key in (
+                    "ms_extract",
+                    "ms_upload",
+                    "ms_draw",
+                    "ms_total",
+                    "meshes_extracted",
+                    "meshes_repositioned",
+                ):
                     row[key] = statistics.median(s.get(key, 0.0) for _, s in later)
             result[label] = row
         out[kind] = result
@@ -370,8 +376,10 @@ def bench_animation_1m(level: int, size: tuple, frame_count: int) -> dict:
 
 def animation_1m_table(r: dict, size: tuple) -> str:
     lines = [
-        (f"| deforming mesh, {size[0]} x {size[1]} | per frame ms (median) | first frame ms | x Workbench | extract ms "
-        "| upload ms | draw ms | meshes extracted / repositioned per frame |"),
+        (
+            f"| deforming mesh, {size[0]} x {size[1]} | per frame ms (median) | first frame ms | x Workbench | extract ms "
+            "| upload ms | draw ms | meshes extracted / repositioned per frame |"
+        ),
         "|---|---:|---:|---:|---:|---:|---:|---|",
     ]
     for kind, result in r.items():
@@ -381,11 +389,17 @@ def animation_1m_table(r: dict, size: tuple) -> str:
             row = result[label]
             solidwire = engine == "SOLIDWIRE"
             cells = (
-                f"{row['ms_extract']:.0f} | {row['ms_upload']:.0f} | {row['ms_draw']:.0f} | "
-                f"{row['meshes_extracted']:.0f} / {row['meshes_repositioned']:.0f}"
-            ) if solidwire else " | | | "
-            lines.append(f"| {what}: {label} | {row['ms_per_frame']:.0f} | {row['first_ms']:.0f} | "
-                         f"{row['ms_per_frame'] / base:.2f} | {cells} |")
+                (
+                    f"{row['ms_extract']:.0f} | {row['ms_upload']:.0f} | {row['ms_draw']:.0f} | "
+                    f"{row['meshes_extracted']:.0f} / {row['meshes_repositioned']:.0f}"
+                )
+                if solidwire
+                else " | | | "
+            )
+            lines.append(
+                f"| {what}: {label} | {row['ms_per_frame']:.0f} | {row['first_ms']:.0f} | "
+                f"{row['ms_per_frame'] / base:.2f} | {cells} |"
+            )
     return "\n".join(lines) + "\n"
 
 
@@ -420,8 +434,11 @@ class _Viewport:
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
             gpu.state.viewport_set(0, 0, *self.size)
             stats = overlay.draw_scene_overlay(
-                depsgraph, view, scene.solidwire.snapshot(),
-                object_filter=overlay.object_filter(plan, bpy.context.view_layer), plan=plan,
+                depsgraph,
+                view,
+                scene.solidwire.snapshot(),
+                object_filter=overlay.object_filter(plan, bpy.context.view_layer),
+                plan=plan,
             )
             self.framebuffer.read_color(0, 0, 1, 1, 4, 0, "UBYTE")  # wait for the GPU
         stats["ms_redraw"] = (time.perf_counter() - start) * 1000.0
@@ -430,8 +447,16 @@ class _Viewport:
 
 
 def _median_stats(samples: list) -> dict:
-    keys = ("ms_redraw", "ms_depsgraph", "ms_extract", "ms_upload", "ms_draw", "meshes_extracted",
-            "meshes_repositioned", "triangles_drawn")
+    keys = (
+        "ms_redraw",
+        "ms_depsgraph",
+        "ms_extract",
+        "ms_upload",
+        "ms_draw",
+        "meshes_extracted",
+        "meshes_repositioned",
+        "triangles_drawn",
+    )
     return {key: statistics.median(s[key] for s in samples) for key in keys}
 
 
@@ -502,8 +527,10 @@ def interactive_table(r: dict, args) -> str:
 
     big = f"Suzanne L{args.level} ({r['big_triangles']:,.0f} tris) in Edit Mode"
     lines = [
-        ("| overlay redraw, 640 x 360 (median) | total ms | depsgraph ms | extract ms | upload ms | draw ms "
-        "| meshes re-extracted | positions re-uploaded |"),
+        (
+            "| overlay redraw, 640 x 360 (median) | total ms | depsgraph ms | extract ms | upload ms | draw ms "
+            "| meshes re-extracted | positions re-uploaded |"
+        ),
         "|---|---|---|---|---|---|---|---|",
         row(f"{big}: nothing changed", r["big_steady"]),
         row(f"{big}: one vertex moved", r["big_edit_vertex"]),
@@ -524,40 +551,66 @@ def table(results: dict, args) -> str:
     m = results["memory"]
     a = results["animation"]
     rows = [
-        (f"Extraction, Suzanne L{args.level} ({e['triangles']:,} tris), ms per M tris",
-         f"{e['fast_ms_per_mtri']:.0f}", f"{e['naive_ms_per_mtri']:.0f} (loop_triangles)"),
+        (
+            f"Extraction, Suzanne L{args.level} ({e['triangles']:,} tris), ms per M tris",
+            f"{e['fast_ms_per_mtri']:.0f}",
+            f"{e['naive_ms_per_mtri']:.0f} (loop_triangles)",
+        ),
         ("GPU bytes per triangle", f"{e['gpu_bytes_per_triangle']:.1f}", ""),
-        (f"{args.objects} objects (own mesh each, {o['reuse']['triangles_drawn']:,} tris drawn): first frame, ms (SolidWire share)",
-         f"{o['reuse']['first_wall_ms']:.0f} ({o['reuse']['first_sw_ms']:.0f})",
-         f"{o['no_reuse']['first_wall_ms']:.0f} ({o['no_reuse']['first_sw_ms']:.0f}) (no reuse)"),
-        (f"{args.objects} objects: steady frame, ms (SolidWire share)",
-         f"{o['reuse']['steady_wall_ms']:.0f} ({o['reuse']['steady_sw_ms']:.0f})",
-         f"{o['no_reuse']['steady_wall_ms']:.0f} ({o['no_reuse']['steady_sw_ms']:.0f}) (no reuse)"),
-        (f"{args.objects} objects: steady extraction+upload, ms",
-         f"{o['reuse']['steady_extract_ms']:.1f}", f"{o['no_reuse']['steady_extract_ms']:.1f} (no reuse)"),
-        (f"{args.instances:,} instances of one mesh ({i['instanced']['objects_drawn']:,} drawn): first frame, ms (SolidWire share)",
-         f"{i['instanced']['first_wall_ms']:.0f} ({i['instanced']['first_sw_ms']:.0f})",
-         f"{i['per_instance']['first_wall_ms']:.0f} ({i['per_instance']['first_sw_ms']:.0f}) (draw per instance)"),
-        (f"{args.instances:,} instances: steady frame, ms (SolidWire share)",
-         f"{i['instanced']['steady_wall_ms']:.0f} ({i['instanced']['steady_sw_ms']:.0f})",
-         f"{i['per_instance']['steady_wall_ms']:.0f} ({i['per_instance']['steady_sw_ms']:.0f}) (draw per instance)"),
-        (f"{args.instances:,} instances: draw call time, ms",
-         f"{i['instanced']['steady_draw_ms']:.0f}", f"{i['per_instance']['steady_draw_ms']:.0f} (draw per instance)"),
-        (f"{args.instances:,} one-triangle instances, 64 x 36 px: steady frame / draw, ms",
-         f"{t['instanced']['steady_sw_ms']:.0f} / {t['instanced']['steady_draw_ms']:.0f}",
-         f"{t['per_instance']['steady_sw_ms']:.0f} / {t['per_instance']['steady_draw_ms']:.0f} (draw per instance)"),
-        (f"Peak RSS, {m['triangles'] / 1e6:.1f}M-triangle scene, MiB",
-         f"{m['rss_peak_mib']:.0f}", f"{m['rss_before_render_mib']:.0f} before the first render"),
-        (f"Animation, {a['reuse']['frames']} frames, 1 deforming + {args.static} static: ms per frame (SolidWire share)",
-         f"{a['reuse']['wall_ms_per_frame']:.0f} ({a['reuse']['sw_ms_per_frame']:.0f})",
-         f"{a['no_reuse']['wall_ms_per_frame']:.0f} ({a['no_reuse']['sw_ms_per_frame']:.0f}) (no reuse)"),
-        ("Animation: meshes extracted per frame (after the first)",
-         f"{a['reuse']['meshes_extracted_per_frame']:.1f}", f"{a['no_reuse']['meshes_extracted_per_frame']:.1f} (no reuse)"),
+        (
+            f"{args.objects} objects (own mesh each, {o['reuse']['triangles_drawn']:,} tris drawn): first frame, ms (SolidWire share)",
+            f"{o['reuse']['first_wall_ms']:.0f} ({o['reuse']['first_sw_ms']:.0f})",
+            f"{o['no_reuse']['first_wall_ms']:.0f} ({o['no_reuse']['first_sw_ms']:.0f}) (no reuse)",
+        ),
+        (
+            f"{args.objects} objects: steady frame, ms (SolidWire share)",
+            f"{o['reuse']['steady_wall_ms']:.0f} ({o['reuse']['steady_sw_ms']:.0f})",
+            f"{o['no_reuse']['steady_wall_ms']:.0f} ({o['no_reuse']['steady_sw_ms']:.0f}) (no reuse)",
+        ),
+        (
+            f"{args.objects} objects: steady extraction+upload, ms",
+            f"{o['reuse']['steady_extract_ms']:.1f}",
+            f"{o['no_reuse']['steady_extract_ms']:.1f} (no reuse)",
+        ),
+        (
+            f"{args.instances:,} instances of one mesh ({i['instanced']['objects_drawn']:,} drawn): first frame, ms (SolidWire share)",
+            f"{i['instanced']['first_wall_ms']:.0f} ({i['instanced']['first_sw_ms']:.0f})",
+            f"{i['per_instance']['first_wall_ms']:.0f} ({i['per_instance']['first_sw_ms']:.0f}) (draw per instance)",
+        ),
+        (
+            f"{args.instances:,} instances: steady frame, ms (SolidWire share)",
+            f"{i['instanced']['steady_wall_ms']:.0f} ({i['instanced']['steady_sw_ms']:.0f})",
+            f"{i['per_instance']['steady_wall_ms']:.0f} ({i['per_instance']['steady_sw_ms']:.0f}) (draw per instance)",
+        ),
+        (
+            f"{args.instances:,} instances: draw call time, ms",
+            f"{i['instanced']['steady_draw_ms']:.0f}",
+            f"{i['per_instance']['steady_draw_ms']:.0f} (draw per instance)",
+        ),
+        (
+            f"{args.instances:,} one-triangle instances, 64 x 36 px: steady frame / draw, ms",
+            f"{t['instanced']['steady_sw_ms']:.0f} / {t['instanced']['steady_draw_ms']:.0f}",
+            f"{t['per_instance']['steady_sw_ms']:.0f} / {t['per_instance']['steady_draw_ms']:.0f} (draw per instance)",
+        ),
+        (
+            f"Peak RSS, {m['triangles'] / 1e6:.1f}M-triangle scene, MiB",
+            f"{m['rss_peak_mib']:.0f}",
+            f"{m['rss_before_render_mib']:.0f} before the first render",
+        ),
+        (
+            f"Animation, {a['reuse']['frames']} frames, 1 deforming + {args.static} static: ms per frame (SolidWire share)",
+            f"{a['reuse']['wall_ms_per_frame']:.0f} ({a['reuse']['sw_ms_per_frame']:.0f})",
+            f"{a['no_reuse']['wall_ms_per_frame']:.0f} ({a['no_reuse']['sw_ms_per_frame']:.0f}) (no reuse)",
+        ),
+        (
+            "Animation: meshes extracted per frame (after the first)",
+            f"{a['reuse']['meshes_extracted_per_frame']:.1f}",
+            f"{a['no_reuse']['meshes_extracted_per_frame']:.1f} (no reuse)",
+        ),
     ]
     lines = [
         f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} CPU cores, "
-        f"renderer {results['renderer']}; bpy {bpy.app.version_string}."
-        + (" --quick sizes." if args.quick else ""),
+        f"renderer {results['renderer']}; bpy {bpy.app.version_string}." + (" --quick sizes." if args.quick else ""),
         "",
         "| measure | SolidWire | baseline |",
         "|---|---|---|",
@@ -570,9 +623,12 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="small sizes (a minute or so)")
     parser.add_argument("--out", default=str(ROOT / "out" / "bench_scale.md"))
-    parser.add_argument("--part", choices=["memory", "interactive", "animation_1m"],
-                        help="run one part only (interactive: overlay redraw cost after an edit; "
-                             "animation_1m: a deforming 1M-triangle mesh against Workbench)")
+    parser.add_argument(
+        "--part",
+        choices=["memory", "interactive", "animation_1m"],
+        help="run one part only (interactive: overlay redraw cost after an edit; "
+        "animation_1m: a deforming 1M-triangle mesh against Workbench)",
+    )
     parser.add_argument("--anim-1m-frames", type=int, default=8, help="frames of --part animation_1m")
     args = parser.parse_args(argv)
     args.level = 4 if args.quick else 5
@@ -605,8 +661,10 @@ def main(argv=None) -> int:
     if args.part == "animation_1m":
         size = (640, 360) if args.quick else (1280, 720)
         results["animation_1m"] = bench_animation_1m(args.level, size, max(args.anim_1m_frames, 2))
-        text = (f"Renderer {results['renderer']}; {platform.machine()}, {os.cpu_count()} CPU cores; "
-                f"bpy {bpy.app.version_string}.\n\n" + animation_1m_table(results["animation_1m"], size))
+        text = (
+            f"Renderer {results['renderer']}; {platform.machine()}, {os.cpu_count()} CPU cores; "
+            f"bpy {bpy.app.version_string}.\n\n" + animation_1m_table(results["animation_1m"], size)
+        )
         print(text, flush=True)
         out = Path(args.out).with_name("bench_animation_1m.md")
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -625,7 +683,8 @@ def main(argv=None) -> int:
     print("memory (own process) ...", file=sys.stderr)
     child = subprocess.run(
         [sys.executable, __file__, "--part", "memory"] + (["--quick"] if args.quick else []),
-        capture_output=True, text=True,
+        capture_output=True,
+        text=True,
         check=False,
     )
     lines = [line for line in child.stdout.splitlines() if line.startswith("{")]

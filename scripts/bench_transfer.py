@@ -50,12 +50,19 @@ def write_exr(path: Path, channels: dict[str, np.ndarray]) -> None:
     def attr(name, kind, value):
         return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
 
-    header = (b"\x76\x2f\x31\x01" + struct.pack("<I", 2)
-              + attr("channels", "chlist", chlist) + attr("compression", "compression", b"\0")
-              + attr("dataWindow", "box2i", box) + attr("displayWindow", "box2i", box)
-              + attr("lineOrder", "lineOrder", b"\0") + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
-              + attr("screenWindowCenter", "v2f", struct.pack("<2f", 0, 0))
-              + attr("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    header = (
+        b"\x76\x2f\x31\x01"
+        + struct.pack("<I", 2)
+        + attr("channels", "chlist", chlist)
+        + attr("compression", "compression", b"\0")
+        + attr("dataWindow", "box2i", box)
+        + attr("displayWindow", "box2i", box)
+        + attr("lineOrder", "lineOrder", b"\0")
+        + attr("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+        + attr("screenWindowCenter", "v2f", struct.pack("<2f", 0, 0))
+        + attr("screenWindowWidth", "float", struct.pack("<f", 1.0))
+        + b"\0"
+    )
     line_bytes = 8 + 4 * width * len(names)
     start = len(header) + 8 * height
     offsets = (start + line_bytes * np.arange(height, dtype=np.uint64)).astype("<u8")
@@ -64,7 +71,7 @@ def write_exr(path: Path, channels: dict[str, np.ndarray]) -> None:
     ints[:, 0] = np.arange(height)  # file row y (top first)
     ints[:, 1] = 4 * width * len(names)
     for k, name in enumerate(names):
-        lines[:, 2 + k * width: 2 + (k + 1) * width] = channels[name][::-1]
+        lines[:, 2 + k * width : 2 + (k + 1) * width] = channels[name][::-1]
     with open(path, "wb") as f:
         f.write(header)
         f.write(offsets.tobytes())
@@ -163,8 +170,9 @@ def verify(scene, rgba, depth):
     got_rgba = exr.exr_pass(channels, layer, "Combined", "RGBA").reshape(-1, 4)
     got_depth = exr.exr_pass(channels, layer, "Depth", "Z").reshape(-1, 1)
     (TMP / "verify.exr").unlink()
-    return (np.array_equal(got_rgba.view(np.uint32), rgba.view(np.uint32))
-            and np.array_equal(got_depth.view(np.uint32), depth.view(np.uint32)))
+    return np.array_equal(got_rgba.view(np.uint32), rgba.view(np.uint32)) and np.array_equal(
+        got_depth.view(np.uint32), depth.view(np.uint32)
+    )
 
 
 def bench_writes(sizes, repeats, do_verify, skip_slow):
@@ -231,8 +239,12 @@ def bench_reads(sizes, repeats, skip_slow):
     rows = []
     for width, height in sizes:
         data = {4: rng.random(width * height * 4, dtype=np.float32), 1: rng.random(width * height, dtype=np.float32)}
-        color = gpu.types.GPUTexture((width, height), format="RGBA32F", data=gpu.types.Buffer("FLOAT", data[4].size, data[4]))
-        mono = gpu.types.GPUTexture((width, height), format="R32F", data=gpu.types.Buffer("FLOAT", data[1].size, data[1]))
+        color = gpu.types.GPUTexture(
+            (width, height), format="RGBA32F", data=gpu.types.Buffer("FLOAT", data[4].size, data[4])
+        )
+        mono = gpu.types.GPUTexture(
+            (width, height), format="R32F", data=gpu.types.Buffer("FLOAT", data[1].size, data[1])
+        )
         fb = gpu.types.GPUFrameBuffer(color_slots=(color, mono))
         readers = {
             "texture.read -> np.array (baseline)": r_read_array,
@@ -250,8 +262,17 @@ def bench_reads(sizes, repeats, skip_slow):
                     start = time.perf_counter()
                     out = fn(texture, channels)
                     times.append((time.perf_counter() - start) * 1000.0)
-                ok = np.array_equal(np.asarray(out, dtype=np.float32).ravel().view(np.uint32), data[channels].view(np.uint32))
-                rows.append((f"{name} [{'RGBA32F' if channels == 4 else 'R32F'}]", f"{width}x{height}", statistics.median(times), ok))
+                ok = np.array_equal(
+                    np.asarray(out, dtype=np.float32).ravel().view(np.uint32), data[channels].view(np.uint32)
+                )
+                rows.append(
+                    (
+                        f"{name} [{'RGBA32F' if channels == 4 else 'R32F'}]",
+                        f"{width}x{height}",
+                        statistics.median(times),
+                        ok,
+                    )
+                )
         del fb, color, mono
     return rows
 

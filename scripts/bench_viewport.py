@@ -191,8 +191,11 @@ def measure(kind: str, level: int, size, repeats: int) -> tuple[dict, dict]:
                         edits.make(redraw)
                     times[name][redraw] = min(times[name][redraw], frame(viewport, look is not None))
         evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-        facts = {"triangles": sum(len(p.vertices) - 2 for p in evaluated.data.polygons),
-                 "vertices": len(obj.data.vertices), "once": once}
+        facts = {
+            "triangles": sum(len(p.vertices) - 2 for p in evaluated.data.polygons),
+            "vertices": len(obj.data.vertices),
+            "once": once,
+        }
     finally:
         viewport.free()
     return times, facts
@@ -201,12 +204,14 @@ def measure(kind: str, level: int, size, repeats: int) -> tuple[dict, dict]:
 def table(results) -> list[str]:
     """Markdown: one row per (scene, configuration), ms per redraw kind and
     the ratio to Blender's wireframe overlay frame of the same redraw."""
-    lines = ["| mesh | configuration | " + " | ".join(REDRAWS) + " |",
-             "|---|---|" + "---:|" * len(REDRAWS)]
+    lines = ["| mesh | configuration | " + " | ".join(REDRAWS) + " |", "|---|---|" + "---:|" * len(REDRAWS)]
     for (kind, level), (times, facts) in results.items():
         alone, wire = times[CONFIGS[0][0]], times[CONFIGS[1][0]]
-        label = (f"{LEVELS.get(level, level)} {kind} ({facts['triangles']:,} tris"
-                 + (f", cage {facts['vertices']:,} verts" if kind == "modifier" else "") + ")")
+        label = (
+            f"{LEVELS.get(level, level)} {kind} ({facts['triangles']:,} tris"
+            + (f", cage {facts['vertices']:,} verts" if kind == "modifier" else "")
+            + ")"
+        )
         for name, _wireframe, look in CONFIGS:
             cells = []
             for redraw in REDRAWS:
@@ -281,8 +286,9 @@ def profile(kind: str, level: int, size, repeats: int) -> list[str]:
                 with OverlayProbe() as probe, viewport.offscreen.bind():
                     gpu.state.viewport_set(0, 0, *size)
                     overlay_start = time.perf_counter()
-                    stats = solidwire_addon.blender.overlay.draw_scene_overlay(depsgraph, viewport.view,
-                                                                             scene.solidwire.snapshot())
+                    stats = solidwire_addon.blender.overlay.draw_scene_overlay(
+                        depsgraph, viewport.view, scene.solidwire.snapshot()
+                    )
                     overlay_ms = (time.perf_counter() - overlay_start) * 1000.0
                 stages = {
                     "depsgraph evaluation": (evaluated - start) * 1000.0,
@@ -305,12 +311,18 @@ def profile(kind: str, level: int, size, repeats: int) -> list[str]:
     lines = [f"| stage | {STATIC} ms | after {VERTEX} ms |", "|---|---:|---:|"]
     for name in names:
         lines.append(f"| {name} | " + " | ".join(f"{rows[r][1].get(name, 0.0):.1f}" for r in (STATIC, VERTEX)) + " |")
-    lines.append("| **frame** (stages synchronised) | " + " | ".join(f"{rows[r][0]:.0f}" for r in (STATIC, VERTEX))
-                 + " |")
+    lines.append(
+        "| **frame** (stages synchronised) | " + " | ".join(f"{rows[r][0]:.0f}" for r in (STATIC, VERTEX)) + " |"
+    )
     stats = rows[VERTEX][2]
-    lines += ["", (f"After the edit: meshes extracted {stats['meshes_extracted']}, repositioned "
-                   f"{stats.get('meshes_repositioned', 0)}, reused {stats['meshes_reused']}; "
-                   f"{stats['triangles_drawn']:,} triangles drawn.")]
+    lines += [
+        "",
+        (
+            f"After the edit: meshes extracted {stats['meshes_extracted']}, repositioned "
+            f"{stats.get('meshes_repositioned', 0)}, reused {stats['meshes_reused']}; "
+            f"{stats['triangles_drawn']:,} triangles drawn."
+        ),
+    ]
     return lines
 
 
@@ -327,7 +339,7 @@ def write_report(path: str, text: str) -> None:
     except FileNotFoundError:
         page = ""
     if BEGIN in page and END in page:
-        page = page[:page.index(BEGIN)] + block + page[page.index(END) + len(END):]
+        page = page[: page.index(BEGIN)] + block + page[page.index(END) + len(END) :]
     else:
         page = block + "\n"
     with open(path, "w", encoding="utf-8") as handle:
@@ -340,12 +352,17 @@ def main() -> None:
     parser.add_argument("--levels", type=int, nargs="+", default=None, help="subdivision levels (default 3 4 5)")
     parser.add_argument("--kinds", nargs="+", default=list(KINDS), choices=KINDS)
     parser.add_argument("--size", default="1280x720")
-    parser.add_argument("--repeats", type=int, default=2,
-                        help="timed frames per configuration and redraw kind; the best counts")
-    parser.add_argument("--profile", action="store_true",
-                        help="also SolidWire's overlay frame by stage (252k applied, default look)")
-    parser.add_argument("--output", help="also write the report into this Markdown page, between its "
-                        "bench_viewport markers (the rest of the page stays)")
+    parser.add_argument(
+        "--repeats", type=int, default=2, help="timed frames per configuration and redraw kind; the best counts"
+    )
+    parser.add_argument(
+        "--profile", action="store_true", help="also SolidWire's overlay frame by stage (252k applied, default look)"
+    )
+    parser.add_argument(
+        "--output",
+        help="also write the report into this Markdown page, between its "
+        "bench_viewport markers (the rest of the page stays)",
+    )
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.lower().split("x"))
     levels = args.levels or ([3] if args.quick else sorted(LEVELS))
@@ -357,17 +374,26 @@ def main() -> None:
             for kind in args.kinds:
                 results[(kind, level)] = measure(kind, level, size, args.repeats)
                 print(f"measured {kind} level {level} ({time.perf_counter() - started:.0f} s)", flush=True)
-        lines = [f"## Viewport redraws at {size[0]} x {size[1]}", "",
-                 (f"Machine: {MACHINE} ({platform.machine()}, {os.cpu_count()} CPUs seen); best of {args.repeats}; "
-                  f"GPU subdivision {'on' if bpy.context.preferences.system.use_gpu_subdivision else 'off'}. "
-                  "ms per synchronised frame (depsgraph evaluation, Blender's viewport, SolidWire's overlay, "
-                  "one-pixel read); (+ms) over Blender's viewport alone; SolidWire's x: its frame over the "
-                  "frame with Blender's wireframe overlay instead. ¹: a configuration slower than "
-                  f"{SLOW_FRAME_MS / 1000:.1f} s a frame, timed in one round."), ""]
+        lines = [
+            f"## Viewport redraws at {size[0]} x {size[1]}",
+            "",
+            (
+                f"Machine: {MACHINE} ({platform.machine()}, {os.cpu_count()} CPUs seen); best of {args.repeats}; "
+                f"GPU subdivision {'on' if bpy.context.preferences.system.use_gpu_subdivision else 'off'}. "
+                "ms per synchronised frame (depsgraph evaluation, Blender's viewport, SolidWire's overlay, "
+                "one-pixel read); (+ms) over Blender's viewport alone; SolidWire's x: its frame over the "
+                "frame with Blender's wireframe overlay instead. ¹: a configuration slower than "
+                f"{SLOW_FRAME_MS / 1000:.1f} s a frame, timed in one round."
+            ),
+            "",
+        ]
         lines += table(results)
         if args.profile:
-            lines += ["", (f"### SolidWire's overlay frame by stage (252k applied, default look, best of "
-                           f"{args.repeats})"), ""]
+            lines += [
+                "",
+                (f"### SolidWire's overlay frame by stage (252k applied, default look, best of {args.repeats})"),
+                "",
+            ]
             lines += profile("applied", 4, size, args.repeats)
         lines.append("")
         lines.append(f"(run took {time.perf_counter() - started:.0f} s)")

@@ -114,8 +114,11 @@ STAGES = {
     # their caller: they are in this line.
     "command line's own Python (progress, stats, checks, frame_set)": "cli.py",
 }
-DERIVED = ("Blender: render depsgraph, render result, PNG encode and write",
-           "render operator(s), in all", "SolidWire engine, in all")
+DERIVED = (
+    "Blender: render depsgraph, render result, PNG encode and write",
+    "render operator(s), in all",
+    "SolidWire engine, in all",
+)
 
 
 def _matches(key: tuple, needle: str) -> bool:
@@ -166,8 +169,10 @@ def main() -> None:
                 engine.append(per_frame(engine_anim, blend, work, 5, 5 + args.frames))
                 command.append(per_frame(command_line, blend, work, 5, 5 + args.frames))
                 single.append(per_frame(frame_by_frame, blend, work, 5, 5 + args.frames))
-            stages = {name: stage_breakdown(run, blend, work, args.frames)
-                      for name, run in (("animation", command_line), ("frame by frame", frame_by_frame))}
+            stages = {
+                name: stage_breakdown(run, blend, work, args.frames)
+                for name, run in (("animation", command_line), ("frame by frame", frame_by_frame))
+            }
     finally:
         solidwire_addon.unregister()
     e, c, f = (statistics.median(values) * 1000 for values in (engine, command, single))
@@ -182,6 +187,7 @@ def main() -> None:
     print("|---|---|---|")
     for label in [*STAGES, DERIVED[0]]:
         print(f"| {label} | {stages['animation'][label]:.2f} | {stages['frame by frame'][label]:.2f} |")
+
 
 if __name__ == "__main__":
     main()

@@ -101,29 +101,46 @@ def build(name: str = SCENE_NAME):
     look.pattern_duty = 0.3
 
     suzanne = _object(
-        scene, "Suzanne", lambda bm: bmesh.ops.create_monkey(bm),
-        location=(0.0, 0.3, 0.45), rotation=(math.radians(-12), 0.0, math.radians(18)), scale=(1.3, 1.3, 1.3),
+        scene,
+        "Suzanne",
+        lambda bm: bmesh.ops.create_monkey(bm),
+        location=(0.0, 0.3, 0.45),
+        rotation=(math.radians(-12), 0.0, math.radians(18)),
+        scale=(1.3, 1.3, 1.3),
     )
     subdivision = suzanne.modifiers.new("Subdivision", "SUBSURF")
     subdivision.levels = subdivision.render_levels = 1
     suzanne.data.shade_smooth()  # the studio-lit fill follows Blender's smooth normals
 
     torus = _object(
-        scene, "Torus", _torus,
-        location=(-2.45, -0.6, -0.25), rotation=(math.radians(58), 0.0, math.radians(-25)), scale=(0.8, 0.8, 0.8),
+        scene,
+        "Torus",
+        _torus,
+        location=(-2.45, -0.6, -0.25),
+        rotation=(math.radians(58), 0.0, math.radians(-25)),
+        scale=(0.8, 0.8, 0.8),
     )
     torus.data.shade_smooth()
 
     def cylinder(bm):
         bmesh.ops.create_cone(
-            bm, cap_ends=True, cap_tris=False, segments=16, radius1=0.65, radius2=0.65, depth=1.6,
+            bm,
+            cap_ends=True,
+            cap_tris=False,
+            segments=16,
+            radius1=0.65,
+            radius2=0.65,
+            depth=1.6,
         )
 
     _object(scene, "Cylinder", cylinder, location=(2.5, 1.2, -0.2), rotation=(0.0, 0.0, math.radians(10)))
 
     cube = _object(
-        scene, "Bevelled Cube", lambda bm: bmesh.ops.create_cube(bm, size=1.1),
-        location=(1.85, -1.35, -0.45), rotation=(0.0, 0.0, math.radians(28)),
+        scene,
+        "Bevelled Cube",
+        lambda bm: bmesh.ops.create_cube(bm, size=1.1),
+        location=(1.85, -1.35, -0.45),
+        rotation=(0.0, 0.0, math.radians(28)),
     )
     bevel = cube.modifiers.new("Bevel", "BEVEL")
     bevel.width = 0.14

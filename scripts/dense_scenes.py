@@ -233,25 +233,30 @@ def main(argv=None) -> int:
         for rule, length, changed, largest in demo_change(args.lengths or [default_length]):
             print(f"demo, {rule} at {length:g} px: {changed} pixels changed, largest {largest:.2f} levels")
         cells = []
-        for label, build in (("1,000 spheres (1:1 crop)", sphere_grid),
-                             ("5,000 instances", instances),
-                             ("NURBS torus", nurbs_torus)):
+        for label, build in (
+            ("1,000 spheres (1:1 crop)", sphere_grid),
+            ("5,000 instances", instances),
+            ("NURBS torus", nurbs_torus),
+        ):
             scene = build()
             for fade in (False, True):
                 start = time.perf_counter()
                 share, pixels, image = wire_share(scene, use_object_density_fade=fade)
                 ms = (time.perf_counter() - start) * 1000.0
                 state = "default look" if fade else "Fade Dense Objects off"
-                print(f"{label}: {state}: {share:.1%} of {pixels} object pixels near the wire colour "
-                      f"(two renders, {ms:.0f} ms)")
+                print(
+                    f"{label}: {state}: {share:.1%} of {pixels} object pixels near the wire colour "
+                    f"(two renders, {ms:.0f} ms)"
+                )
                 cells.append((f"{label}, {'default' if fade else 'fade off'}: {share:.0%} wire", _cell(image)))
         scene = demo()
         image, _covered = render(scene, size=CELL, use_object_density_fade=False)
         cells.append(("Demo, Fade Dense Objects off", image[..., :3]))
         image, _covered = render(scene, size=CELL)
         cells.append(("Demo, default look (identical)", image[..., :3]))
-        preset_gallery.write(preset_gallery.compose(cells, columns=2, cell=CELL), cells, args.output, columns=2,
-                             cell=CELL)
+        preset_gallery.write(
+            preset_gallery.compose(cells, columns=2, cell=CELL), cells, args.output, columns=2, cell=CELL
+        )
     finally:
         solidwire_addon.unregister()
     print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")

@@ -19,12 +19,33 @@ ROOT = Path(__file__).resolve().parent.parent
 from scripts import preset_gallery
 
 CELL = (360, 270)
-LOOK = dict(use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0),
-            thickness=1.2, softness=1.0, use_cage_edges=True, edge_angle=0.0, use_density_fade=False,
-            density_fade_length=10.0, use_boundary_edges=False, use_sharp_edges=False, use_seam_edges=False)
-CLASSES = dict(use_boundary_edges=True, boundary_thickness=3.0, boundary_color=(0.02, 0.02, 0.02, 1.0),
-               use_sharp_edges=True, sharp_thickness=2.5, sharp_color=(0.0, 0.3, 0.85, 1.0),
-               use_seam_edges=True, seam_thickness=2.0, seam_color=(0.9, 0.2, 0.05, 1.0), seam_pattern="DASHED")
+LOOK = dict(
+    use_fill=True,
+    fill_shading="STUDIO",
+    fill_color=(0.8, 0.8, 0.8),
+    wire_color=(0.0, 0.0, 0.0, 1.0),
+    thickness=1.2,
+    softness=1.0,
+    use_cage_edges=True,
+    edge_angle=0.0,
+    use_density_fade=False,
+    density_fade_length=10.0,
+    use_boundary_edges=False,
+    use_sharp_edges=False,
+    use_seam_edges=False,
+)
+CLASSES = dict(
+    use_boundary_edges=True,
+    boundary_thickness=3.0,
+    boundary_color=(0.02, 0.02, 0.02, 1.0),
+    use_sharp_edges=True,
+    sharp_thickness=2.5,
+    sharp_color=(0.0, 0.3, 0.85, 1.0),
+    use_seam_edges=True,
+    seam_thickness=2.0,
+    seam_color=(0.9, 0.2, 0.05, 1.0),
+    seam_pattern="DASHED",
+)
 CELLS = (
     ("Every evaluated edge", dict(use_cage_edges=False)),
     ("Cage edges (default)", {}),
@@ -59,8 +80,9 @@ def render_cells(scene):
 
 
 def main(argv=None) -> int:
-    return preset_gallery.run_gallery(argv, __doc__.splitlines()[0], ROOT / "docs" / "edges.png", build_scene,
-                                      render_cells, cell=CELL)
+    return preset_gallery.run_gallery(
+        argv, __doc__.splitlines()[0], ROOT / "docs" / "edges.png", build_scene, render_cells, cell=CELL
+    )
 
 
 if __name__ == "__main__":

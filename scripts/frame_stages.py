@@ -46,8 +46,23 @@ FILM = "film composite (CPU)"
 TRANSFER = "transfer into the result (foreach_set)"
 HAND_OVER = "Blender's begin_result / end_result"
 OTHER = "the rest (depsgraph, gather, Blender's render set-up)"
-ORDER = (EXTRACT, UPLOAD, SETUP, DIRECT, VISIBILITY, RESOLVE, HIDDEN, WIRE, SILHOUETTES, READBACK,
-         SILHOUETTE_COMPOSITE, FILM, TRANSFER, HAND_OVER, OTHER)
+ORDER = (
+    EXTRACT,
+    UPLOAD,
+    SETUP,
+    DIRECT,
+    VISIBILITY,
+    RESOLVE,
+    HIDDEN,
+    WIRE,
+    SILHOUETTES,
+    READBACK,
+    SILHOUETTE_COMPOSITE,
+    FILM,
+    TRANSFER,
+    HAND_OVER,
+    OTHER,
+)
 
 
 def _sync() -> None:

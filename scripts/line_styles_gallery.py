@@ -23,11 +23,21 @@ LOOK = dict(use_fill=True, fill_shading="FLAT", fill_color=PAPER, wire_color=INK
 STYLES = (
     ("Single pass (SPEC): outlines half width", {}),
     ("Full-width silhouettes", dict(use_silhouettes=True)),
-    ("Hidden lines, dashed (technical drawing)", dict(use_silhouettes=True, use_hidden_lines=True, hidden_alpha=0.5,
-                                                      hidden_period=7.0, hidden_duty=0.55)),
+    (
+        "Hidden lines, dashed (technical drawing)",
+        dict(use_silhouettes=True, use_hidden_lines=True, hidden_alpha=0.5, hidden_period=7.0, hidden_duty=0.55),
+    ),
     ("World-space thickness (0.025 units)", dict(thickness_mode="WORLD", world_thickness=0.025)),
-    ("Depth cue: 3 px near to 0.6 px far", dict(thickness_mode="DEPTH", thickness=3.0, thickness_far=0.6,
-                                                 thickness_depth_start=4.0, thickness_depth_end=16.0)),
+    (
+        "Depth cue: 3 px near to 0.6 px far",
+        dict(
+            thickness_mode="DEPTH",
+            thickness=3.0,
+            thickness_far=0.6,
+            thickness_depth_start=4.0,
+            thickness_depth_end=16.0,
+        ),
+    ),
     ("Dashed diagonals + silhouettes", dict(diagonal_mode="DASHED", pattern_period=7.0, use_silhouettes=True)),
 )
 
@@ -42,8 +52,9 @@ def render_cells(scene):
 
 
 def main(argv=None) -> int:
-    return preset_gallery.run_gallery(argv, __doc__.splitlines()[0], ROOT / "docs" / "line_styles.png", build_scene,
-                                      render_cells)
+    return preset_gallery.run_gallery(
+        argv, __doc__.splitlines()[0], ROOT / "docs" / "line_styles.png", build_scene, render_cells
+    )
 
 
 if __name__ == "__main__":

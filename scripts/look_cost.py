@@ -25,10 +25,20 @@ from solidwire_addon.core import passes
 from tests.support import scenes
 
 SIZE = (1920, 1080)
-BASE = dict(use_fill=True, fill_shading="FLAT", fill_color_source="SINGLE", wire_color_source="SINGLE",
-            fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0), edge_angle=0.0,
-            use_cage_edges=False, use_density_fade=False, use_boundary_edges=False, use_sharp_edges=False,
-            use_seam_edges=False)
+BASE = dict(
+    use_fill=True,
+    fill_shading="FLAT",
+    fill_color_source="SINGLE",
+    wire_color_source="SINGLE",
+    fill_color=(0.8, 0.8, 0.8),
+    wire_color=(0.0, 0.0, 0.0, 1.0),
+    edge_angle=0.0,
+    use_cage_edges=False,
+    use_density_fade=False,
+    use_boundary_edges=False,
+    use_sharp_edges=False,
+    use_seam_edges=False,
+)
 OPTIONS = (
     ("Flat fill (baseline)", {}),
     ("STUDIO shading", dict(fill_shading="STUDIO")),
@@ -42,8 +52,10 @@ OPTIONS = (
     ("Density fade", dict(use_density_fade=True, density_fade_length=8.0)),
     ("Cage edges + density fade", dict(use_cage_edges=True, use_density_fade=True, density_fade_length=8.0)),
     ("Edge classes: boundary, sharp, seam", dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True)),
-    ("Cage edges + edge classes", dict(use_cage_edges=True, use_boundary_edges=True, use_sharp_edges=True,
-                                       use_seam_edges=True)),
+    (
+        "Cage edges + edge classes",
+        dict(use_cage_edges=True, use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True),
+    ),
 )
 
 
@@ -52,10 +64,11 @@ def build_scene():
     red = bpy.data.materials.new("Red")
     red.diffuse_color = (0.8, 0.2, 0.1, 1.0)
     for k in range(7):
-        suzanne = scenes.monkey(scene, f"Suzanne{k}", subdivisions=2,
-                                location=(2.6 * (k % 4) - 3.9, 2.5 * (k // 4), 0.0))
+        suzanne = scenes.monkey(
+            scene, f"Suzanne{k}", subdivisions=2, location=(2.6 * (k % 4) - 3.9, 2.5 * (k // 4), 0.0)
+        )
         suzanne.data.shade_smooth()
-        for edge in suzanne.data.edges[: 60]:  # some marked edges for the edge classes
+        for edge in suzanne.data.edges[:60]:  # some marked edges for the edge classes
             edge.use_seam = edge.index % 2 == 0
             edge.use_edge_sharp = edge.index % 2 == 1
         suzanne.data.materials.append(red)
@@ -97,11 +110,16 @@ def main(argv=None) -> int:
     try:
         ensure_gpu()
         scene = build_scene()
-        triangles = sum(len(o.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
-                        for o in scene.objects if o.type == "MESH")
+        triangles = sum(
+            len(o.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
+            for o in scene.objects
+            if o.type == "MESH"
+        )
         print(f"{SIZE[0]}x{SIZE[1]}, {triangles} triangles in 7 objects, median of {args.repeats} rounds\n")
-        print("| option | render, meshes cached (ms) | vs flat | direct surface pass (ms) | "
-              "extract + upload, first frame (ms) |")
+        print(
+            "| option | render, meshes cached (ms) | vs flat | direct surface pass (ms) | "
+            "extract + upload, first frame (ms) |"
+        )
         print("|---|---:|---:|---:|---:|")
         for _label, settings in OPTIONS:  # compile every variant, fill the cache
             for deferred in (True, False):

@@ -20,9 +20,17 @@ import bpy
 from scripts import preset_gallery
 
 CELL = (360, 270)
-LOOK = dict(use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.8, 0.8), wire_color=(0.0, 0.0, 0.0, 1.0),
-            thickness=1.2, softness=1.0, fill_color_source="SINGLE", wire_color_source="SINGLE",
-            use_cage_edges=True)  # the default look (the test scenes switch cage edges off)
+LOOK = dict(
+    use_fill=True,
+    fill_shading="STUDIO",
+    fill_color=(0.8, 0.8, 0.8),
+    wire_color=(0.0, 0.0, 0.0, 1.0),
+    thickness=1.2,
+    softness=1.0,
+    fill_color_source="SINGLE",
+    wire_color_source="SINGLE",
+    use_cage_edges=True,
+)  # the default look (the test scenes switch cage edges off)
 CELLS = (
     ("Flat fill (the image model's core)", dict(fill_shading="FLAT")),
     ("Studio: camera-fixed lights (default)", {}),
@@ -55,8 +63,9 @@ def render_cells(scene):
 
 
 def main(argv=None) -> int:
-    return preset_gallery.run_gallery(argv, __doc__.splitlines()[0], ROOT / "docs" / "looks.png", build_scene,
-                                      render_cells, cell=CELL)
+    return preset_gallery.run_gallery(
+        argv, __doc__.splitlines()[0], ROOT / "docs" / "looks.png", build_scene, render_cells, cell=CELL
+    )
 
 
 if __name__ == "__main__":

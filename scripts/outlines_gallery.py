@@ -66,8 +66,7 @@ def _metaballs(scene):
     dense_scenes._camera(scene, (0.6, -4.5, 2.0), (0.5, 0.0, 0.0), lens=50.0)
 
 
-SOURCES = (("Text", _text), ("Filled curve, bevel", _curve), ("NURBS sphere", _surface),
-           ("Metaballs", _metaballs))
+SOURCES = (("Text", _text), ("Filled curve, bevel", _curve), ("NURBS sphere", _surface), ("Metaballs", _metaballs))
 
 
 def render_cells() -> list:
@@ -95,8 +94,9 @@ def main(argv=None) -> int:
     try:
         cells = render_cells()
         columns = len(SOURCES)
-        preset_gallery.write(preset_gallery.compose(cells, columns=columns, cell=CELL), cells, args.output,
-                             columns=columns, cell=CELL)
+        preset_gallery.write(
+            preset_gallery.compose(cells, columns=columns, cell=CELL), cells, args.output, columns=columns, cell=CELL
+        )
     finally:
         solidwire_addon.unregister()
     print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")

@@ -113,8 +113,11 @@ def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS, cell=CEL
         # Without labels a sheet is easy to misread (the last tile of the
         # preset sheet, Blender's Solid shading with no overlay, passed for a
         # preset that draws no wire), so say so and name the tiles.
-        print(f"warning: Pillow is not installed, so {path.name} has empty label strips; its tiles, "
-              f"left to right, top to bottom: {'; '.join(label for label, _linear in cells)}", file=sys.stderr)
+        print(
+            f"warning: Pillow is not installed, so {path.name} has empty label strips; its tiles, "
+            f"left to right, top to bottom: {'; '.join(label for label, _linear in cells)}",
+            file=sys.stderr,
+        )
         _write_with_blender(sheet, path)
         return
     image = Image.fromarray(sheet)

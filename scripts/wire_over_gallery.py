@@ -142,6 +142,7 @@ def checkerboard(height: int, width: int, cell: int = 12) -> np.ndarray:
 
 def layers_strip(layers: composite.Layers) -> np.ndarray:
     """Beauty | wire pass over a checkerboard | composite, 1/2 size each."""
+
     def half(image):
         return image.reshape(image.shape[0] // 2, 2, image.shape[1] // 2, 2, 4).mean(axis=(1, 3))
 

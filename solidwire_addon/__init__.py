@@ -30,8 +30,14 @@ from .blender import (
 )
 from .core import draw, log, matcaps, strands, targets
 
-_classes = (*properties.classes, *engine.classes, *setting_repair.classes, *ops.classes, *ops_composite.classes,
-            *ui.classes)
+_classes = (
+    *properties.classes,
+    *engine.classes,
+    *setting_repair.classes,
+    *ops.classes,
+    *ops_composite.classes,
+    *ui.classes,
+)
 _registered = False
 
 

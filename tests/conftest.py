@@ -36,8 +36,12 @@ OPT_IN = {
 
 def pytest_addoption(parser):
     for marker, (option, variable) in OPT_IN.items():
-        parser.addoption(option, action="store_true", default=False,
-                         help=f"also run the tests marked '{marker}' (or set {variable}=1)")
+        parser.addoption(
+            option,
+            action="store_true",
+            default=False,
+            help=f"also run the tests marked '{marker}' (or set {variable}=1)",
+        )
 
 
 def pytest_collection_modifyitems(config, items):

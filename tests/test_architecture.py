@@ -51,7 +51,9 @@ def import_graph() -> dict[str, set[str]]:
                 targets = [alias.name for alias in node.names]
             elif isinstance(node, ast.ImportFrom):
                 base = _resolve(name, node, name in packages)
-                targets = [f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base for alias in node.names]
+                targets = [
+                    f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base for alias in node.names
+                ]
             for target in targets:
                 if target in modules and target != name:
                     graph[name].add(target)
@@ -67,7 +69,7 @@ def _cycle(graph) -> list[str] | None:
         stack.append(node)
         for nxt in sorted(graph[node]):
             if state.get(nxt) == 1:
-                return stack[stack.index(nxt):] + [nxt]
+                return stack[stack.index(nxt) :] + [nxt]
             if nxt not in state:
                 found = visit(nxt)
                 if found:
@@ -162,8 +164,16 @@ def test_a_new_setting_needs_only_a_schema_entry(monkeypatch):
     from solidwire_addon.blender import cli, properties
 
     extra = schema.Setting(
-        "example_width", schema.FLOAT, 2.0, "Example Width", "An example", minimum=0.0, maximum=10.0,
-        subtype="PIXEL", section="line", param=schema.Param("example_width"),
+        "example_width",
+        schema.FLOAT,
+        2.0,
+        "Example Width",
+        "An example",
+        minimum=0.0,
+        maximum=10.0,
+        subtype="PIXEL",
+        section="line",
+        param=schema.Param("example_width"),
     )
     monkeypatch.setattr(schema, "SETTINGS", (*schema.SETTINGS, extra))
     group = properties.make_group(schema.SCENE)
@@ -249,12 +259,20 @@ def test_render_passes_come_from_one_table():
     assert ui.BLENDER_PASSES == tuple(p.switch for p in table if not p.own)
     assert set(ui.BLENDER_PASSES) <= set(bpy.types.ViewLayer.bl_rna.properties.keys())
     assert schema.EXTRA_PASSES == tuple(n for n in names if n != schema.DEPTH_PASS)
-    for constant in ("WIRE_PASS", "HIDDEN_WIRE_PASS", "EDGE_DISTANCE_PASS", "NORMAL_PASS", "OBJECT_INDEX_PASS",
-                     "MATERIAL_INDEX_PASS"):
+    for constant in (
+        "WIRE_PASS",
+        "HIDDEN_WIRE_PASS",
+        "EDGE_DISTANCE_PASS",
+        "NORMAL_PASS",
+        "OBJECT_INDEX_PASS",
+        "MATERIAL_INDEX_PASS",
+    ):
         assert getattr(passes, constant) == getattr(schema, constant)
     # What a view layer asks for, read through the table.
-    every = SimpleNamespace(**{p.switch: True for p in table if not p.own},
-                            solidwire=SimpleNamespace(**{p.switch: True for p in table if p.own}))
+    every = SimpleNamespace(
+        **{p.switch: True for p in table if not p.own},
+        solidwire=SimpleNamespace(**{p.switch: True for p in table if p.own}),
+    )
     assert engine.passes_of(every) == names
     assert engine.extra_passes_of(every) == schema.EXTRA_PASSES
     none = SimpleNamespace(**{p.switch: False for p in table if not p.own})  # no SolidWire settings at all

@@ -260,8 +260,9 @@ def test_stray_far_vertex_does_not_spoil_the_faces(output_dir):
     """One loose vertex 1e6 away once moved the re-centring point to ~5e5,
     where float32 cannot hold the real faces (p99.9 |dI| = 1.0)."""
     scene = scenes.empty_scene(64, 48)
-    _mesh_object(scene, "Stray", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0), (1e6, 1e6, 1e6)], [], [(0, 1, 2, 3)],
-                 (0, 0, 0))
+    _mesh_object(
+        scene, "Stray", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0), (1e6, 1e6, 1e6)], [], [(0, 1, 2, 3)], (0, 0, 0)
+    )
     scenes.add_camera(scene, location=(0.5, -3.0, 3.0), target=(0, 0, 0))
     report = accuracy.measure(scene, "stray_far_vertex", output_dir)
     accuracy.assert_accurate(report)
@@ -278,4 +279,3 @@ def test_messages_are_capped(capfd):
     assert len(lines) == log.MAX_MESSAGES + 1
     assert "further ones are not shown" in lines[-1]
     assert len(log._said) <= log.MAX_MESSAGES + 1
-

@@ -178,10 +178,17 @@ def test_overlay_draws_the_default_and_resets_the_setting_later(monkeypatch, cap
     monkeypatch.setattr(setting_repair, "run_later", later.append)
     monkeypatch.setattr(overlay, "region_view", lambda *_a: View(np.eye(4), np.eye(4), (0, 0, 8, 8)))
     monkeypatch.setattr(overlay, "draw_scene_overlay", lambda _dg, _view, settings, **_k: drawn.append(settings))
-    context = SimpleNamespace(scene=scene, space_data=None, region=object(), region_data=object(),
-                              view_layer=bpy.context.view_layer, screen=None, area=None,
-                              preferences=bpy.context.preferences,
-                              evaluated_depsgraph_get=bpy.context.evaluated_depsgraph_get)
+    context = SimpleNamespace(
+        scene=scene,
+        space_data=None,
+        region=object(),
+        region_data=object(),
+        view_layer=bpy.context.view_layer,
+        screen=None,
+        area=None,
+        preferences=bpy.context.preferences,
+        evaluated_depsgraph_get=bpy.context.evaluated_depsgraph_get,
+    )
     monkeypatch.setattr(overlay, "bpy", SimpleNamespace(context=context))
     capfd.readouterr()
     overlay._draw_callback()
@@ -323,10 +330,16 @@ def _run_bpy(script: str, tmp_path: Path) -> subprocess.CompletedProcess:
     prelude = f"import sys; sys.path.insert(0, {str(ROOT)!r})\n"
     result = subprocess.run(
         [sys.executable, "-c", prelude + textwrap.dedent(script)],
-        capture_output=True, text=True, timeout=300, env=env, cwd=str(tmp_path),
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+        cwd=str(tmp_path),
         check=False,
     )
-    assert robustness.exited_cleanly(result.returncode), f"exit {result.returncode}\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
+    assert robustness.exited_cleanly(result.returncode), (
+        f"exit {result.returncode}\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
+    )
     return result
 
 

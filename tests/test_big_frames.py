@@ -56,11 +56,17 @@ _SCRIPT = textwrap.dedent(
 
 def _peak(size: int, tmp_path: Path) -> dict:
     env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
-    result = subprocess.run([sys.executable, "-c", _SCRIPT, str(ROOT), str(size), str(tmp_path)],
-                            capture_output=True, text=True, timeout=1800, env=env, check=False)
+    result = subprocess.run(
+        [sys.executable, "-c", _SCRIPT, str(ROOT), str(size), str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=1800,
+        env=env,
+        check=False,
+    )
     assert robustness.exited_cleanly(result.returncode), result.stderr[-3000:]
     line = next(line for line in result.stdout.splitlines() if line.startswith("RESULT "))
-    return json.loads(line[len("RESULT "):])
+    return json.loads(line[len("RESULT ") :])
 
 
 @pytest.mark.parametrize(
@@ -75,8 +81,10 @@ def test_peak_memory_stays_near_the_result_size(size, tmp_path):
     measured = _peak(size, tmp_path)
     result_bytes = size * size * 16
     growth = (measured["peak_kib"] - measured["base_kib"]) * 1024
-    print(f"{size}^2: result {result_bytes / 2**20:.0f} MiB, peak growth {growth / 2**20:.0f} MiB "
-          f"({growth / result_bytes:.2f}x)")
+    print(
+        f"{size}^2: result {result_bytes / 2**20:.0f} MiB, peak growth {growth / 2**20:.0f} MiB "
+        f"({growth / result_bytes:.2f}x)"
+    )
     assert measured["objects_drawn"] == 1
     # + fixed overhead: shaders, and one tile's float targets and readback
     # (about 48 bytes a pixel of engine.TILE_PIXELS, which a frame smaller

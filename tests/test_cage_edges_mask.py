@@ -59,8 +59,7 @@ def _on_box_edge(p, q, center=(0.0, 0.0, 0.0), half=1.0, tol=1e-5):
 
 
 def _box_edge_set(edges, positions, centers):
-    return {i for i, (a, b) in enumerate(edges)
-            if any(_on_box_edge(positions[a], positions[b], c) for c in centers)}
+    return {i for i, (a, b) in enumerate(edges) if any(_on_box_edge(positions[a], positions[b], c) for c in centers)}
 
 
 def _subdivided_cube(levels=1, kind="CATMULL_CLARK", name="Cube"):
@@ -148,8 +147,9 @@ def test_no_modifier_level_zero_or_disabled_draws_everything():
 
 def test_mirror_before_the_subdivision():
     scene = scenes.empty_scene()
-    obj = scenes.mesh_object(scene, "Half", lambda bm: bmesh.ops.create_cube(
-        bm, size=2.0, matrix=Matrix.Translation((2.0, 0.0, 0.0))))
+    obj = scenes.mesh_object(
+        scene, "Half", lambda bm: bmesh.ops.create_cube(bm, size=2.0, matrix=Matrix.Translation((2.0, 0.0, 0.0)))
+    )
     obj.modifiers.new("Mirror", "MIRROR")
     mod = obj.modifiers.new("Subdivision", "SUBSURF")
     mod.subdivision_type = "SIMPLE"
@@ -342,7 +342,11 @@ class _Probe(bpy.types.RenderEngine):
             if obj.type == "MESH":
                 mesh = obj.data
                 mask = cage_edge_mask(obj, mesh, render=depsgraph.mode == "RENDER")
-                type(self).found[obj.name] = (depsgraph.mode, len(mesh.edges), None if mask is None else int(mask.sum()))
+                type(self).found[obj.name] = (
+                    depsgraph.mode,
+                    len(mesh.edges),
+                    None if mask is None else int(mask.sum()),
+                )
 
 
 @pytest.fixture
@@ -408,8 +412,10 @@ def test_edit_mode_follows_the_edited_cage():
 
 def _user_data_snapshot(obj):
     data = obj.data
-    ids = {name: len(getattr(bpy.data, name)) for name in (
-        "meshes", "objects", "textures", "node_groups", "images", "texts", "materials")}
+    ids = {
+        name: len(getattr(bpy.data, name))
+        for name in ("meshes", "objects", "textures", "node_groups", "images", "texts", "materials")
+    }
     attributes = sorted((a.name, a.domain, a.data_type) for a in data.attributes)
     layers = None
     if data.is_editmode:  # the edit BMesh's layers (the mesh's own are stale)

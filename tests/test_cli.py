@@ -52,7 +52,11 @@ def _env() -> dict:
 def run_cli(*args, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, str(RENDER_SCRIPT), *map(str, args)],
-        cwd=cwd, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S,
+        cwd=cwd,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
         check=False,
     )
 
@@ -73,7 +77,11 @@ _SIMULATED_BLENDER = textwrap.dedent(
 def run_cli_blender_form(blend: Path, *args, cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, "-c", _SIMULATED_BLENDER, str(blend), str(RENDER_SCRIPT), *map(str, args)],
-        cwd=cwd, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S,
+        cwd=cwd,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
         check=False,
     )
 
@@ -166,20 +174,69 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
     [
         pytest.param((), {}, {}, id="scene-settings"),
         pytest.param(
-            ("--thickness", "3", "--softness", "0.6", "--wire-color", "1,0.2,0.1", "--fill",
-             "--fill-color", "0.1,0.2,0.3", "--diagonals", "SOLID", "--opaque",
-             "--width", "120", "--height", "80", "--percentage", "50"),
-            dict(thickness=3.0, softness=0.6, wire_color=(1.0, 0.2, 0.1, 1.0), use_fill=True,
-                 fill_color=(0.1, 0.2, 0.3), diagonal_mode="SOLID"),
+            (
+                "--thickness",
+                "3",
+                "--softness",
+                "0.6",
+                "--wire-color",
+                "1,0.2,0.1",
+                "--fill",
+                "--fill-color",
+                "0.1,0.2,0.3",
+                "--diagonals",
+                "SOLID",
+                "--opaque",
+                "--width",
+                "120",
+                "--height",
+                "80",
+                "--percentage",
+                "50",
+            ),
+            dict(
+                thickness=3.0,
+                softness=0.6,
+                wire_color=(1.0, 0.2, 0.1, 1.0),
+                use_fill=True,
+                fill_color=(0.1, 0.2, 0.3),
+                diagonal_mode="SOLID",
+            ),
             dict(film_transparent=False, resolution_x=120, resolution_y=80, resolution_percentage=50),
             id="options",
         ),
         pytest.param(
-            ("--thickness-mode", "DEPTH", "--thickness", "4", "--thickness-far", "1", "--thickness-depth", "3", "9",
-             "--silhouettes", "--hidden-lines", "--hidden-alpha", "0.5", "--hidden-period", "6", "--hidden-duty", "0.4"),
-            dict(thickness_mode="DEPTH", thickness=4.0, thickness_far=1.0, thickness_depth_start=3.0,
-                 thickness_depth_end=9.0, use_silhouettes=True, use_hidden_lines=True, hidden_alpha=0.5,
-                 hidden_period=6.0, hidden_duty=0.4),
+            (
+                "--thickness-mode",
+                "DEPTH",
+                "--thickness",
+                "4",
+                "--thickness-far",
+                "1",
+                "--thickness-depth",
+                "3",
+                "9",
+                "--silhouettes",
+                "--hidden-lines",
+                "--hidden-alpha",
+                "0.5",
+                "--hidden-period",
+                "6",
+                "--hidden-duty",
+                "0.4",
+            ),
+            dict(
+                thickness_mode="DEPTH",
+                thickness=4.0,
+                thickness_far=1.0,
+                thickness_depth_start=3.0,
+                thickness_depth_end=9.0,
+                use_silhouettes=True,
+                use_hidden_lines=True,
+                hidden_alpha=0.5,
+                hidden_period=6.0,
+                hidden_duty=0.4,
+            ),
             {},
             id="line-styles",
         ),
@@ -190,10 +247,27 @@ def test_demo_renders_png_with_wire_fill_and_world(tmp_path, output_dir):
             id="world-thickness",
         ),
         pytest.param(
-            ("--fill", "--shading", "matcap", "--matcap", "clay_brown", "--fill-source", "random",
-             "--wire-source", "OBJECT", "--edge-angle", "0.2"),
-            dict(use_fill=True, fill_shading="MATCAP", matcap="clay_brown", fill_color_source="RANDOM",
-                 wire_color_source="OBJECT", edge_angle=0.2),
+            (
+                "--fill",
+                "--shading",
+                "matcap",
+                "--matcap",
+                "clay_brown",
+                "--fill-source",
+                "random",
+                "--wire-source",
+                "OBJECT",
+                "--edge-angle",
+                "0.2",
+            ),
+            dict(
+                use_fill=True,
+                fill_shading="MATCAP",
+                matcap="clay_brown",
+                fill_color_source="RANDOM",
+                wire_color_source="OBJECT",
+                edge_angle=0.2,
+            ),
             {},
             id="shading-and-colour-sources",
         ),
@@ -281,7 +355,9 @@ def _text_file(tmp_path: Path) -> Path:
             lambda t: [_no_camera_blend(t), "-o", t / "out.png", "--camera", "Nope"], "no camera named", id="bad-camera"
         ),
         pytest.param(lambda t: ["--demo", "-o", _text_file(t) / "out.png"], "cannot write", id="unwritable-output"),
-        pytest.param(lambda t: ["--demo", "-o", t / "out.png", "--thickness", "-1"], "out of range", id="bad-thickness"),
+        pytest.param(
+            lambda t: ["--demo", "-o", t / "out.png", "--thickness", "-1"], "out of range", id="bad-thickness"
+        ),
         pytest.param(lambda t: ["--demo", "-o", t / "out.png", "--wire-color", "1,0"], "--wire-color", id="bad-colour"),
         pytest.param(lambda t: ["--demo", "-o", t / "out.png", "--frames", "5-2"], "--frames", id="bad-frames"),
         pytest.param(lambda t: ["--demo", "-o", t / "out.xyz"], "unknown image type", id="bad-extension"),
@@ -310,7 +386,12 @@ def test_blender_form_without_an_open_file_is_an_error(tmp_path):
         """
     )
     result = subprocess.run(
-        [sys.executable, "-c", script], cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S,
+        [sys.executable, "-c", script],
+        cwd=tmp_path,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
         check=False,
     )
     assert result.returncode == 2
@@ -340,7 +421,12 @@ def test_a_failing_render_exits_1_with_a_clear_line(tmp_path):
         """
     )
     result = subprocess.run(
-        [sys.executable, "-c", script], cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S,
+        [sys.executable, "-c", script],
+        cwd=tmp_path,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
         check=False,
     )
     assert result.returncode == 1, result.stdout + result.stderr

@@ -83,8 +83,9 @@ def test_animation_renders_the_scene_range_with_its_step_to_the_scene_path(tmp_p
 
 def test_start_end_and_jump_override_the_range(tmp_path, capsys):
     blend = _animated_blend(tmp_path, step=2)
-    code, out, err = run(capsys, "render", blend, "-s", 2, "-e", 4, "-j", 1, "-o", tmp_path / "f_##.png",
-                         "--progress", "json")
+    code, out, err = run(
+        capsys, "render", blend, "-s", 2, "-e", 4, "-j", 1, "-o", tmp_path / "f_##.png", "--progress", "json"
+    )
     assert code == 0, err
     assert [r["frame"] for r in _json_records(out)] == [2, 3, 4]
     assert sorted(p.name for p in tmp_path.glob("f_*.png")) == ["f_02.png", "f_03.png", "f_04.png"]

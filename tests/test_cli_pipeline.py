@@ -72,8 +72,11 @@ def leftovers(folder: Path) -> list[str]:
 
 def _start(*args, env=None) -> subprocess.Popen:
     return subprocess.Popen(
-        [sys.executable, str(RENDER_SCRIPT), *map(str, args)], env=env or _env(),
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        [sys.executable, str(RENDER_SCRIPT), *map(str, args)],
+        env=env or _env(),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
 
 
@@ -87,8 +90,9 @@ def _wait_for_first_frame(proc: subprocess.Popen) -> dict:
 
 
 @pytest.mark.parametrize("signum, code, name", [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")])
-@pytest.mark.parametrize("options", [pytest.param((), id="animation-render"),
-                                     pytest.param(("--no-overwrite",), id="frame-by-frame")])
+@pytest.mark.parametrize(
+    "options", [pytest.param((), id="animation-render"), pytest.param(("--no-overwrite",), id="frame-by-frame")]
+)
 def test_a_signal_stops_after_the_frame_with_one_line(tmp_path, signum, code, name, options):
     size = (48, 36)
     blend = _blend(tmp_path, size=size, frames=(1, 400))
@@ -204,12 +208,20 @@ def _run_with_a_broken_engine(tmp_path: Path, *args) -> subprocess.CompletedProc
             solidwire_addon.unregister()
         """
     )
-    return subprocess.run([sys.executable, "-c", script], cwd=tmp_path, check=False, env=_env(), capture_output=True, text=True,
-                          timeout=TIMEOUT_S)
+    return subprocess.run(
+        [sys.executable, "-c", script],
+        cwd=tmp_path,
+        check=False,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+    )
 
 
-@pytest.mark.parametrize("placeholder", [pytest.param(True, id="frame-by-frame"),
-                                         pytest.param(False, id="animation-render")])
+@pytest.mark.parametrize(
+    "placeholder", [pytest.param(True, id="frame-by-frame"), pytest.param(False, id="animation-render")]
+)
 def test_a_failed_frame_removes_its_placeholder_and_the_folders_it_made(tmp_path, placeholder):
     blend = _blend(tmp_path, use_placeholder=placeholder)
     result = _run_with_a_broken_engine(tmp_path, blend, "-o", tmp_path / "new" / "deeper" / "f_##.png", "-a")
@@ -226,15 +238,28 @@ def test_a_failed_frame_removes_its_placeholder_and_the_folders_it_made(tmp_path
     "make_args, expected",
     [
         pytest.param(lambda t: [t / "missing.blend", "-o", t / "out" / "a" / "f.png"], "does not exist", id="missing"),
-        pytest.param(lambda t: [_blend(t), "-o", t / "out" / "a" / "f.png", "--preset", "Nope"], "no preset named",
-                     id="bad-preset"),
-        pytest.param(lambda t: [_blend(t), "-o", t / "out" / "a" / "f_#.png", "-f", "5..2"], "ends before it starts",
-                     id="backwards-range"),
+        pytest.param(
+            lambda t: [_blend(t), "-o", t / "out" / "a" / "f.png", "--preset", "Nope"],
+            "no preset named",
+            id="bad-preset",
+        ),
+        pytest.param(
+            lambda t: [_blend(t), "-o", t / "out" / "a" / "f_#.png", "-f", "5..2"],
+            "ends before it starts",
+            id="backwards-range",
+        ),
     ],
 )
 def test_a_failed_run_creates_no_folder(tmp_path, make_args, expected):
-    result = subprocess.run([sys.executable, str(RENDER_SCRIPT), *map(str, make_args(tmp_path))], cwd=tmp_path,
-                            check=False, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S)
+    result = subprocess.run(
+        [sys.executable, str(RENDER_SCRIPT), *map(str, make_args(tmp_path))],
+        cwd=tmp_path,
+        check=False,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+    )
     lines = meaningful_lines(result.stderr)
     assert result.returncode == 2 and len(lines) == 1 and expected in lines[0], result.stderr
     assert not (tmp_path / "out").exists()
@@ -307,8 +332,9 @@ def test_a_single_image_format_says_that_passes_are_dropped(tmp_path, capsys):
     blend = _multilayer_blend(tmp_path)
     code, _stdout, err = command(capsys, blend, "-o", tmp_path / "shot_####.png", "-f", 1)
     assert code == 0
-    assert err == [("solidwire: note: '.png' holds one image: the scene's passes Depth are not written; "
-                    "-o NAME.exr keeps them")], err
+    assert err == [
+        ("solidwire: note: '.png' holds one image: the scene's passes Depth are not written; -o NAME.exr keeps them")
+    ], err
     assert_complete_png(tmp_path / "shot_0001.png", (48, 36))
 
 
@@ -370,16 +396,30 @@ def test_the_wrapper_sees_the_presets_saved_in_blender(tmp_path):
         env = _env()
         env["BLENDER_USER_RESOURCES"] = os.environ["BLENDER_USER_RESOURCES"]
         result = subprocess.run(
-            [sys.executable, str(RENDER_SCRIPT), str(_blend(tmp_path)), "-o", str(tmp_path / "look.png"),
-             "--preset", "farm look"], check=False, env=env, capture_output=True, text=True, timeout=TIMEOUT_S)
+            [
+                sys.executable,
+                str(RENDER_SCRIPT),
+                str(_blend(tmp_path)),
+                "-o",
+                str(tmp_path / "look.png"),
+                "--preset",
+                "farm look",
+            ],
+            check=False,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT_S,
+        )
         assert result.returncode == 0, result.stderr
         assert (tmp_path / "look.png").is_file()
     finally:
         saved.unlink()
 
 
-@pytest.mark.parametrize("options", [pytest.param((), id="animation-render"),
-                                     pytest.param(("--no-overwrite",), id="frame-by-frame")])
+@pytest.mark.parametrize(
+    "options", [pytest.param((), id="animation-render"), pytest.param(("--no-overwrite",), id="frame-by-frame")]
+)
 def test_braces_in_the_output_path_are_written_as_they_are(tmp_path, capsys, options):
     """Blender 5 reads "{name}" in an output path as a template variable; the
     path given with -o is a plain path."""
@@ -398,9 +438,25 @@ def test_runs_of_frames_go_through_blenders_animation_render(tmp_path):
     blend = _blend(tmp_path)
 
     def blender_saved_lines(name: str, *options) -> list[str]:
-        result = subprocess.run([sys.executable, str(RENDER_SCRIPT), str(blend), "-o", str(tmp_path / name),
-                                 "-s", "1", "-e", "3", *options], check=False, env=_env(), capture_output=True, text=True,
-                                timeout=TIMEOUT_S)
+        result = subprocess.run(
+            [
+                sys.executable,
+                str(RENDER_SCRIPT),
+                str(blend),
+                "-o",
+                str(tmp_path / name),
+                "-s",
+                "1",
+                "-e",
+                "3",
+                *options,
+            ],
+            check=False,
+            env=_env(),
+            capture_output=True,
+            text=True,
+            timeout=TIMEOUT_S,
+        )
         assert result.returncode == 0, result.stderr
         return [line for line in result.stdout.splitlines() if "Saved: '" in line and cli.TEMP_SUFFIX in line]
 

@@ -228,12 +228,21 @@ def test_wire_hidden_where_beauty_shows_a_nearer_surface(tmp_path):
 def _state(scene):
     r, im = scene.render, scene.render.image_settings
     return {
-        "engine": r.engine, "filepath": r.filepath, "ext": r.use_file_extension,
-        "motion": r.use_motion_blur, "border": r.use_border, "film": r.film_transparent,
-        "comp": r.use_compositing, "seq": r.use_sequencer,
-        "media": getattr(im, "media_type", None), "format": im.file_format, "mode": im.color_mode,
-        "depth": im.color_depth, "codec": im.exr_codec,
-        "z": scene.view_layers[0].use_pass_z, "fill": scene.solidwire.use_fill,
+        "engine": r.engine,
+        "filepath": r.filepath,
+        "ext": r.use_file_extension,
+        "motion": r.use_motion_blur,
+        "border": r.use_border,
+        "film": r.film_transparent,
+        "comp": r.use_compositing,
+        "seq": r.use_sequencer,
+        "media": getattr(im, "media_type", None),
+        "format": im.file_format,
+        "mode": im.color_mode,
+        "depth": im.color_depth,
+        "codec": im.exr_codec,
+        "z": scene.view_layers[0].use_pass_z,
+        "fill": scene.solidwire.use_fill,
         "samples": scene.cycles.samples,
     }
 
@@ -403,8 +412,10 @@ def test_sidebar_menu_lists_the_engines():
 
     scene = occlusion_scene()
     menu = bpy.types.SOLIDWIRE_MT_render_wire_over
-    for engine, expected in (("SOLIDWIRE", ["CYCLES", "BLENDER_EEVEE", "BLENDER_WORKBENCH"]),
-                             ("CYCLES", ["SCENE", "CYCLES", "BLENDER_EEVEE", "BLENDER_WORKBENCH"])):
+    for engine, expected in (
+        ("SOLIDWIRE", ["CYCLES", "BLENDER_EEVEE", "BLENDER_WORKBENCH"]),
+        ("CYCLES", ["SCENE", "CYCLES", "BLENDER_EEVEE", "BLENDER_WORKBENCH"]),
+    ):
         scene.render.engine = engine
         layout = Layout()
         menu.draw(SimpleNamespace(layout=layout), SimpleNamespace(scene=scene))
@@ -416,8 +427,13 @@ def test_sidebar_menu_lists_the_engines():
 
 
 def _cli(*args):
-    return subprocess.run([sys.executable, str(ROOT / "scripts" / "render.py"), *args],
-                          capture_output=True, text=True, timeout=300, check=False)
+    return subprocess.run(
+        [sys.executable, str(ROOT / "scripts" / "render.py"), *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
 
 
 def test_cli_over(tmp_path):
@@ -432,7 +448,8 @@ def test_cli_over(tmp_path):
     assert [line for line in run.stdout.splitlines() if "Saved:" in line] == [f"Saved: '{out}'"], run.stdout
     assert [line for line in run.stdout.splitlines() if line.startswith("solidwire: rendered")] == [
         f"solidwire: rendered {out} (96x54) in " + line.split(" in ")[-1]
-        for line in run.stdout.splitlines() if line.startswith("solidwire: rendered")
+        for line in run.stdout.splitlines()
+        if line.startswith("solidwire: rendered")
     ] and "solidwire: rendered" in run.stdout
 
 

@@ -73,8 +73,12 @@ def _mixed_scene(scene):
     twin.scale = (-1.0, 1.0, 1.0)
     scene.collection.objects.link(twin)
     hexagon = scenes.from_pydata(
-        scene, "Hexagon", [(np.cos(a), np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]],
-        [tuple(range(6))], location=(-2.0, 6.0, 2.0), rotation_euler=(1.2, 0.3, 0.0),
+        scene,
+        "Hexagon",
+        [(np.cos(a), np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]],
+        [tuple(range(6))],
+        location=(-2.0, 6.0, 2.0),
+        rotation_euler=(1.2, 0.3, 0.0),
     )
     hexagon.data.materials.append(bpy.data.materials.new("Red"))
     rng = np.random.default_rng(7)
@@ -90,12 +94,15 @@ def _mixed_scene(scene):
 LOOKS = {
     "wire_only": {},
     "studio_fill": dict(use_fill=True, fill_shading="STUDIO", diagonal_mode="DASHED"),
-    "matcap_materials": dict(use_fill=True, fill_shading="MATCAP", fill_color_source="MATERIAL",
-                             wire_color_source="RANDOM"),
-    "world_thickness_fade_culling": dict(thickness_mode="WORLD", use_fade=True, use_backface_culling=True,
-                                          use_fill=True),
-    "classes_density_angle": dict(use_boundary_edges=True, use_sharp_edges=True, use_density_fade=True,
-                                  edge_angle=20.0, use_fill=True),
+    "matcap_materials": dict(
+        use_fill=True, fill_shading="MATCAP", fill_color_source="MATERIAL", wire_color_source="RANDOM"
+    ),
+    "world_thickness_fade_culling": dict(
+        thickness_mode="WORLD", use_fade=True, use_backface_culling=True, use_fill=True
+    ),
+    "classes_density_angle": dict(
+        use_boundary_edges=True, use_sharp_edges=True, use_density_fade=True, edge_angle=20.0, use_fill=True
+    ),
     "hidden_lines_silhouettes": dict(use_hidden_lines=True, use_silhouettes=True, use_fill=True),
 }
 INSTANCED_LOOKS = ("wire_only", "studio_fill")
@@ -168,8 +175,10 @@ def test_deferred_and_direct_meshes_share_one_surface(output_dir, monkeypatch):
         meshes = sorted({id(item.mesh) for item in everything})
         chosen = set(meshes[::2])
         halves.append((len(chosen), len(meshes)))
-        return ([item for item in everything if id(item.mesh) in chosen],
-                [item for item in everything if id(item.mesh) not in chosen])
+        return (
+            [item for item in everything if id(item.mesh) in chosen],
+            [item for item in everything if id(item.mesh) not in chosen],
+        )
 
     monkeypatch.setattr(draw, "split_deferred", every_other_mesh)
     mixed = scenes.render_multilayer_exr(scene, output_dir / "deferred_mixed.exr")
@@ -201,8 +210,14 @@ def _camera_view():
     view_matrix = np.eye(4)
     view_matrix[2, 3] = -10.0  # the unit box 10 units ahead
     near, far = 0.1, 100.0
-    projection = np.array([[2.0, 0, 0, 0], [0, 2.0, 0, 0],
-                           [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1.0, 0]])
+    projection = np.array(
+        [
+            [2.0, 0, 0, 0],
+            [0, 2.0, 0, 0],
+            [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)],
+            [0, 0, -1.0, 0],
+        ]
+    )
     return View(view_matrix, projection, (0, 0, 1000, 1000))
 
 

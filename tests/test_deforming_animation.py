@@ -44,14 +44,18 @@ def armature_tube(scene, collapse: bool = False):
     """A smooth tube of quads bent by a two-bone armature; with ``collapse``,
     one quad at the joint has an edge collapsed (two corners on one spot):
     its split is too close to call in every frame."""
-    tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
-        bm, cap_ends=False, segments=16, radius1=0.5, radius2=0.5, depth=4.0))
+    tube = scenes.mesh_object(
+        scene,
+        "Tube",
+        lambda bm: bmesh.ops.create_cone(bm, cap_ends=False, segments=16, radius1=0.5, radius2=0.5, depth=4.0),
+    )
     mesh = tube.data
     # Rings of quads along z, so the bend shows on many faces.
     bm = bmesh.new()
     bm.from_mesh(mesh)
-    bmesh.ops.subdivide_edges(bm, edges=[e for e in bm.edges if abs(e.verts[0].co.z - e.verts[1].co.z) > 1.0],
-                              cuts=11, use_grid_fill=False)
+    bmesh.ops.subdivide_edges(
+        bm, edges=[e for e in bm.edges if abs(e.verts[0].co.z - e.verts[1].co.z) > 1.0], cuts=11, use_grid_fill=False
+    )
     bm.to_mesh(mesh)
     bm.free()
     for poly in mesh.polygons:
@@ -84,12 +88,16 @@ def difference_report(measured, expected) -> dict:
     return reference._statistics(np.abs(measured - expected).max(axis=-1).ravel())
 
 
-@pytest.mark.parametrize("build, setup_min", [
-    (shape_key_monkey, draw.SETUP_TABLE_MIN),  # cage edges: an outline table, never the pre-pass
-    (armature_tube, draw.SETUP_TABLE_MIN),
-    (armature_tube, 1),
-    (armature_tube_collapsed, draw.SETUP_TABLE_MIN),  # a quad split Blender settles every frame
-], ids=["shape_key", "armature", "armature_setup_prepass", "armature_degenerate_quad"])
+@pytest.mark.parametrize(
+    "build, setup_min",
+    [
+        (shape_key_monkey, draw.SETUP_TABLE_MIN),  # cage edges: an outline table, never the pre-pass
+        (armature_tube, draw.SETUP_TABLE_MIN),
+        (armature_tube, 1),
+        (armature_tube_collapsed, draw.SETUP_TABLE_MIN),  # a quad split Blender settles every frame
+    ],
+    ids=["shape_key", "armature", "armature_setup_prepass", "armature_degenerate_quad"],
+)
 def test_deformation_uploads_positions_and_normals_only(build, setup_min, monkeypatch, output_dir):
     # The set-up pre-pass (big tri/quad meshes in a direct draw; here forced
     # on a small one, with the render's surface pass drawn directly) keeps a
@@ -221,8 +229,9 @@ def test_normals_that_follow_the_positions_are_not_checksummed(monkeypatch, outp
     then a sharp edge) still re-extracts."""
     reads = []
     real_read_normals = extract.read_normals
-    monkeypatch.setattr(extract, "read_normals", lambda mesh, domain: (reads.append(domain),
-                                                                       real_read_normals(mesh, domain))[1])
+    monkeypatch.setattr(
+        extract, "read_normals", lambda mesh, domain: (reads.append(domain), real_read_normals(mesh, domain))[1]
+    )
     scene = default_look_scene()
     monkey = scenes.monkey(scene, "Flat", subdivisions=1, rotation=(0.2, 0.0, 0.5))
     scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0.0, 0.0, 0.0))

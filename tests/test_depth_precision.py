@@ -27,11 +27,18 @@ def _panel_scene(clip_start: float, clip_end: float, ortho: bool):
     # The camera looks at the wall at an angle (depth varies across both
     # planes, so ties are not settled by equal depths); the panel is drawn
     # first, so the wall must lose on depth alone.
-    scenes.add_camera(scene, location=(-6.0, 0.0, 2.0), target=(0.5, DISTANCE, 0.3), clip=(clip_start, clip_end),
-                      ortho_scale=14.0 if ortho else None, lens=35.0)
+    scenes.add_camera(
+        scene,
+        location=(-6.0, 0.0, 2.0),
+        target=(0.5, DISTANCE, 0.3),
+        clip=(clip_start, clip_end),
+        ortho_scale=14.0 if ortho else None,
+        lens=35.0,
+    )
     upright = (math.pi / 2, 0.0, 0.0)
-    scenes.grid(scene, "Panel", x_segments=3, y_segments=3, size=4.0, location=(0.7, DISTANCE - GAP, 0.3),
-                rotation=upright)
+    scenes.grid(
+        scene, "Panel", x_segments=3, y_segments=3, size=4.0, location=(0.7, DISTANCE - GAP, 0.3), rotation=upright
+    )
     scenes.grid(scene, "Wall", x_segments=12, y_segments=12, size=12.0, location=(0.0, DISTANCE, 0.0), rotation=upright)
     bpy.context.view_layer.update()
     return scene

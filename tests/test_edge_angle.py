@@ -25,10 +25,21 @@ def _coplanar_ngons(scene):
     # Two hexagons and a quad in one plane (their shared edges are flat),
     # folded against a third n-gon at 60 degrees (that edge stays drawn).
     verts = [
-        (0, 0, 0), (1, -0.6, 0), (2, 0, 0), (2, 1, 0), (1, 1.6, 0), (0, 1, 0),  # hexagon A
-        (3, -0.6, 0), (4, 0, 0), (4, 1, 0), (3, 1.6, 0),  # hexagon B shares 2-3
-        (1, 2.6, 0), (2, 2.6, 0),  # quad 4-3-... above
-        (-0.8, -0.3, 0.7), (-0.9, 1.2, 0.8), (-0.5, 0.5, 1.4),  # pentagon folded up at 0-5
+        (0, 0, 0),
+        (1, -0.6, 0),
+        (2, 0, 0),
+        (2, 1, 0),
+        (1, 1.6, 0),
+        (0, 1, 0),  # hexagon A
+        (3, -0.6, 0),
+        (4, 0, 0),
+        (4, 1, 0),
+        (3, 1.6, 0),  # hexagon B shares 2-3
+        (1, 2.6, 0),
+        (2, 2.6, 0),  # quad 4-3-... above
+        (-0.8, -0.3, 0.7),
+        (-0.9, 1.2, 0.8),
+        (-0.5, 0.5, 1.4),  # pentagon folded up at 0-5
     ]
     faces = [(0, 1, 2, 3, 4, 5), (2, 6, 7, 8, 9, 3), (4, 3, 11, 10), (5, 0, 12, 14, 13)]
     scenes.from_pydata(scene, "Ngons", verts, faces)

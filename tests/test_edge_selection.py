@@ -49,7 +49,8 @@ def test_a_region_walks_every_drawn_edge_around_it():
     count = int(arrays.edge_flags[0]) >> extract.NGON_SHIFT
     block = arrays.region_table[start : start + edge_select.TEXELS_PER_SEGMENT * count : 2]
     assert sorted(map(tuple, block[:, :2].astype(int).tolist())) == sorted(
-        [(0, 1), (1, 2), (4, 5), (5, 6), (0, 4), (2, 6)])
+        [(0, 1), (1, 2), (4, 5), (5, 6), (0, 4), (2, 6)]
+    )
     assert (block[:, 2] == 0).all()
     # The hidden edge is neither a line nor a diagonal of the triangles that own it.
     tri_edges = [tuple(sorted((int(t[i]), int(t[(i + 1) % 3])))) for t in arrays.triangles[:4] for i in range(3)]
@@ -94,12 +95,15 @@ def test_an_edge_of_several_classes_gets_a_segment_per_class():
     arrays, corner_vert, offsets, corner_edge, verts, index = _strip(1)
     classes = np.zeros(len(verts), np.int64)
     classes[index[(0, 1)]] = edge_select.CLASS_BIT["sharp"] | edge_select.CLASS_BIT["seam"]
-    edge_select.select_edges(arrays, corner_vert, offsets, corner_edge,
-                             edge_select.EdgeInputs(verts, None, classes, boundary_class=False))
+    edge_select.select_edges(
+        arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, None, classes, boundary_class=False)
+    )
     styles = arrays.region_table[0::2]
     bottom = styles[(styles[:, 0] == 0) & (styles[:, 1] == 1), 2]
-    assert sorted(bottom.tolist()) == [1 + edge_select.EDGE_CLASSES.index("sharp"),
-                                       1 + edge_select.EDGE_CLASSES.index("seam")]
+    assert sorted(bottom.tolist()) == [
+        1 + edge_select.EDGE_CLASSES.index("sharp"),
+        1 + edge_select.EDGE_CLASSES.index("seam"),
+    ]
     assert sorted(styles[:, 2].tolist()).count(0) == 3
 
 
@@ -132,12 +136,23 @@ def _marked_cube(scene):
 
 
 CLASS_LOOK = dict(
-    use_boundary_edges=True, boundary_thickness=3.0, boundary_color=(1.0, 0.0, 0.0, 1.0),
-    use_sharp_edges=True, sharp_thickness=4.0, sharp_color=(0.0, 1.0, 0.0, 1.0),
-    use_seam_edges=True, seam_thickness=2.5, seam_pattern="DASHED", seam_color=(0.0, 0.0, 1.0, 1.0),
-    use_crease_edges=True, crease_thickness=0.5, crease_pattern="DOTTED",
-    use_freestyle_edges=True, freestyle_thickness=5.0,
-    pattern_period=10.0, thickness=1.0,
+    use_boundary_edges=True,
+    boundary_thickness=3.0,
+    boundary_color=(1.0, 0.0, 0.0, 1.0),
+    use_sharp_edges=True,
+    sharp_thickness=4.0,
+    sharp_color=(0.0, 1.0, 0.0, 1.0),
+    use_seam_edges=True,
+    seam_thickness=2.5,
+    seam_pattern="DASHED",
+    seam_color=(0.0, 0.0, 1.0, 1.0),
+    use_crease_edges=True,
+    crease_thickness=0.5,
+    crease_pattern="DOTTED",
+    use_freestyle_edges=True,
+    freestyle_thickness=5.0,
+    pattern_period=10.0,
+    thickness=1.0,
 )
 
 
@@ -195,8 +210,9 @@ def test_regions_give_clean_corners_where_edges_are_hidden(output_dir):
 
 @pytest.mark.parametrize("diagonals", ["HIDDEN", "SOLID"])
 def test_density_fade_matches_the_reference(diagonals, output_dir):
-    scene = scenes.empty_scene(220, 160, use_density_fade=True, density_fade_length=24.0, diagonal_mode=diagonals,
-                               thickness=1.0)
+    scene = scenes.empty_scene(
+        220, 160, use_density_fade=True, density_fade_length=24.0, diagonal_mode=diagonals, thickness=1.0
+    )
     scenes.grid(scene, x_segments=48, y_segments=48, size=8.0)
     scenes.add_camera(scene, location=(0.0, -6.5, 1.6), target=(0.0, 1.0, 0.0))
     report = accuracy.measure(scene, f"density_fade_{diagonals.lower()}", output_dir)
@@ -218,13 +234,16 @@ def _subdivided_monkey(scene, levels=2):
     return monkey
 
 
-@pytest.mark.parametrize("look", [
-    dict(),
-    dict(edge_angle=math.radians(25.0)),
-    dict(use_density_fade=True, density_fade_length=30.0, diagonal_mode="DASHED"),
-    dict(use_silhouettes=True, use_boundary_edges=True, boundary_thickness=2.5),
-    dict(use_hidden_lines=True, use_seam_edges=True),
-])
+@pytest.mark.parametrize(
+    "look",
+    [
+        dict(),
+        dict(edge_angle=math.radians(25.0)),
+        dict(use_density_fade=True, density_fade_length=30.0, diagonal_mode="DASHED"),
+        dict(use_silhouettes=True, use_boundary_edges=True, boundary_thickness=2.5),
+        dict(use_hidden_lines=True, use_seam_edges=True),
+    ],
+)
 def test_cage_edges_match_the_reference(look, output_dir):
     """The lines of a subdivided mesh come from its cage edges, running along
     the smooth surface (the reference finds them on its own, through an

@@ -122,14 +122,25 @@ def test_blenders_generic_panels_offer_solidwire():
     # Every panel Workbench gets that is marked for any engine, SolidWire gets too.
     generic = {name for name in workbench if "BLENDER_RENDER" in getattr(bpy.types, name).COMPAT_ENGINES}
     assert generic - {"RENDER_PT_simplify"} <= solidwire, sorted(generic - solidwire)
-    for needed in ("DATA_PT_lens", "DATA_PT_camera", "DATA_PT_vertex_groups", "DATA_PT_shape_keys",
-                   "DATA_PT_uv_texture", "OBJECT_PT_visibility", "WORLD_PT_context_world"):
+    for needed in (
+        "DATA_PT_lens",
+        "DATA_PT_camera",
+        "DATA_PT_vertex_groups",
+        "DATA_PT_shape_keys",
+        "DATA_PT_uv_texture",
+        "OBJECT_PT_visibility",
+        "WORLD_PT_context_world",
+    ):
         assert needed in solidwire, needed
     # Engine-specific panels (not marked for any engine) stay hidden, apart
     # from the film's transparency switch.
     specific = {name for name in solidwire if "BLENDER_RENDER" not in getattr(bpy.types, name).COMPAT_ENGINES}
-    assert specific <= {"CYCLES_RENDER_PT_film_transparency", "RENDER_PT_eevee_film", "RENDER_PT_solidwire",
-                        "VIEWLAYER_PT_solidwire_passes"}, sorted(specific)
+    assert specific <= {
+        "CYCLES_RENDER_PT_film_transparency",
+        "RENDER_PT_eevee_film",
+        "RENDER_PT_solidwire",
+        "VIEWLAYER_PT_solidwire_passes",
+    }, sorted(specific)
     print(f"panels in {sorted(TABS)}: SOLIDWIRE {len(solidwire)}, BLENDER_WORKBENCH {len(workbench)}")
 
 

@@ -12,7 +12,16 @@ import pytest
 from solidwire_addon.core import extract
 from tests.support import scenes
 
-FIELDS = ("positions", "centre", "triangles", "edge_flags", "triangle_polygons", "bounds_min", "bounds_max", "ngon_corners")
+FIELDS = (
+    "positions",
+    "centre",
+    "triangles",
+    "edge_flags",
+    "triangle_polygons",
+    "bounds_min",
+    "bounds_max",
+    "ngon_corners",
+)
 
 
 def assert_same_arrays(fast: extract.MeshArrays, reference: extract.MeshArrays) -> None:
@@ -147,8 +156,11 @@ def _quad_grid(n: int = 12, seed: int = 1):
     rng = np.random.default_rng(seed)
     xs, ys = np.meshgrid(np.arange(n + 1, dtype=np.float32), np.arange(n + 1, dtype=np.float32))
     positions = np.stack([xs.ravel(), ys.ravel(), rng.uniform(-0.05, 0.05, (n + 1) ** 2)], axis=1).astype(np.float32)
-    faces = [(j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i)
-             for j in range(n) for i in range(n)]
+    faces = [
+        (j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i)
+        for j in range(n)
+        for i in range(n)
+    ]
     corner_vert = np.array(faces, dtype=np.int32).ravel()
     offsets = np.arange(0, len(corner_vert) + 1, 4, dtype=np.int32)
     return positions, corner_vert, offsets
@@ -206,7 +218,7 @@ def test_reposition_asks_blender_about_a_quad_too_close_to_call():
     undecided in every frame; its split comes from Blender's triangles, as at
     extraction, instead of sending the whole mesh to a full extraction."""
     positions, corner_vert, offsets = _quad_grid()
-    q = corner_vert[4 * 30: 4 * 31]
+    q = corner_vert[4 * 30 : 4 * 31]
     positions[q[2]] = positions[q[1]]
 
     def blender_tris(flipped):
@@ -214,6 +226,7 @@ def test_reposition_asks_blender_about_a_quad_too_close_to_call():
             face = np.asarray(tri_indices) // 2
             corners = [0, 1, 3] if flipped else [0, 1, 2]
             return 4 * face[:, None] + np.array(corners)
+
         return lookup
 
     arrays = extract.build_arrays_fast(positions, corner_vert, offsets, blender_tris=blender_tris(False))
@@ -236,12 +249,14 @@ def test_corner_table_refilled_from_new_normals_equals_a_fresh_one():
     arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
     rng = np.random.default_rng(4)
     materials = rng.integers(0, 3, len(offsets) - 1).astype(np.int32)
-    first = extract.corner_table(arrays, corner_vert, offsets, rng.normal(size=(len(corner_vert), 3)).astype(np.float32),
-                                 materials)
+    first = extract.corner_table(
+        arrays, corner_vert, offsets, rng.normal(size=(len(corner_vert), 3)).astype(np.float32), materials
+    )
     normals = rng.normal(size=(len(corner_vert), 3)).astype(np.float32)
     refilled = extract.fill_corner_table(arrays.corner_rows, arrays.triangle_polygons, normals, materials)
-    fresh = extract.corner_table(extract.build_arrays_fast(positions, corner_vert, offsets), corner_vert, offsets,
-                                 normals, materials)
+    fresh = extract.corner_table(
+        extract.build_arrays_fast(positions, corner_vert, offsets), corner_vert, offsets, normals, materials
+    )
     np.testing.assert_array_equal(refilled, fresh)
     assert not np.array_equal(refilled, first)
     # Each triangle corner carries the normal of its own polygon corner.
@@ -303,7 +318,9 @@ def test_reposition_refuses_what_changes_the_triangles():
     assert extract.reposition(arrays, positions, corner_vert, regrouped) is None
     hexagon = np.array([(np.cos(a), np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]], dtype=np.float32)
     ngon = extract.build_arrays_fast(
-        hexagon, np.arange(6, dtype=np.int32), np.array([0, 6], dtype=np.int32),
+        hexagon,
+        np.arange(6, dtype=np.int32),
+        np.array([0, 6], dtype=np.int32),
         blender_tris=lambda rows: np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]])[rows],
     )
     assert ngon.quads is None

@@ -61,8 +61,9 @@ def test_every_normal_domain_matches_reference(output_dir):
     from solidwire_addon.blender import runtime
     from solidwire_addon.core import extract
 
-    scene = scenes.empty_scene(200, 150, use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.7, 0.6),
-                               fill_color_source="MATERIAL")
+    scene = scenes.empty_scene(
+        200, 150, use_fill=True, fill_shading="STUDIO", fill_color=(0.8, 0.7, 0.6), fill_color_source="MATERIAL"
+    )
     scene.solidwire.wire_color = (0.05, 0.05, 0.05, 1.0)
     smooth = scenes.uv_sphere(scene, "Smooth", location=(-1.6, 0.0, 0.0), radius=0.7)
     flat = scenes.monkey(scene, "Flat", subdivisions=1, location=(0.2, 0.0, 0.0), rotation=(0.2, 0.0, 0.5))
@@ -142,9 +143,15 @@ def _colour_scene(**settings):
     return scene
 
 
-@pytest.mark.parametrize("fill_source, wire_source", [
-    ("OBJECT", "SINGLE"), ("MATERIAL", "OBJECT"), ("RANDOM", "RANDOM"), ("SINGLE", "OBJECT"),
-])
+@pytest.mark.parametrize(
+    "fill_source, wire_source",
+    [
+        ("OBJECT", "SINGLE"),
+        ("MATERIAL", "OBJECT"),
+        ("RANDOM", "RANDOM"),
+        ("SINGLE", "OBJECT"),
+    ],
+)
 def test_colour_sources_match_reference(fill_source, wire_source, output_dir):
     scene = _colour_scene(fill_color_source=fill_source, wire_color_source=wire_source, fill_color=(0.6, 0.6, 0.6))
     report, _rgba, ref = _measure(scene, f"colors_{fill_source.lower()}_{wire_source.lower()}", output_dir)

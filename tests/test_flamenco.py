@@ -37,8 +37,20 @@ OUTPUT = "/farm/renders/sh010/######"
 SETTING_TYPES = {"string": str, "int32": int, "float": (int, float), "bool": bool}
 SETTING_SUBTYPES = {"file_path", "dir_path", "file_name", "hashed_file_path"}
 SETTING_VISIBILITY = {"visible", "hidden", "submission", "web"}
-SETTING_FIELDS = {"key", "type", "subtype", "choices", "propargs", "description", "default",
-                  "eval", "evalInfo", "visible", "required", "editable"}
+SETTING_FIELDS = {
+    "key",
+    "type",
+    "subtype",
+    "choices",
+    "propargs",
+    "description",
+    "default",
+    "eval",
+    "evalInfo",
+    "visible",
+    "required",
+    "editable",
+}
 
 
 def _harness(action: str, job: dict | None = None, script: Path = SCRIPT) -> dict:
@@ -47,7 +59,10 @@ def _harness(action: str, job: dict | None = None, script: Path = SCRIPT) -> dic
     proc = subprocess.run(
         [NODE, str(HARNESS), str(script), action],
         input=json.dumps(job) if job is not None else "",
-        capture_output=True, text=True, timeout=TIMEOUT_S, env=env,
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+        env=env,
         check=False,
     )
     assert proc.returncode == 0, f"harness failed ({proc.returncode}):\n{proc.stderr}"
@@ -94,12 +109,16 @@ def frame_runs(task: dict) -> list[tuple[int, int]]:
 
 
 def test_script_parses():
-    proc = subprocess.run([NODE, "--check", str(SCRIPT)], capture_output=True, text=True, timeout=TIMEOUT_S, check=False)
+    proc = subprocess.run(
+        [NODE, "--check", str(SCRIPT)], capture_output=True, text=True, timeout=TIMEOUT_S, check=False
+    )
     assert proc.returncode == 0, proc.stderr
 
 
 def test_harness_parses():
-    proc = subprocess.run([NODE, "--check", str(HARNESS)], capture_output=True, text=True, timeout=TIMEOUT_S, check=False)
+    proc = subprocess.run(
+        [NODE, "--check", str(HARNESS)], capture_output=True, text=True, timeout=TIMEOUT_S, check=False
+    )
     assert proc.returncode == 0, proc.stderr
 
 
@@ -143,8 +162,17 @@ def test_job_type_settings_have_the_fields_flamenco_requires(job_type):
 
 def test_job_type_declares_the_settings_the_script_reads(job_type):
     settings = {setting["key"]: setting for setting in job_type["settings"]}
-    for key in ("frames", "chunk_size", "mode", "over_engine", "preset", "render_output_root",
-                "render_output_path", "blendfile", "format"):
+    for key in (
+        "frames",
+        "chunk_size",
+        "mode",
+        "over_engine",
+        "preset",
+        "render_output_root",
+        "render_output_path",
+        "blendfile",
+        "format",
+    ):
         assert key in settings, key
     for key in ("frames", "blendfile", "render_output_root", "mode"):
         assert settings[key].get("required") is True, key
@@ -249,8 +277,23 @@ def test_solidwire_command_line():
     assert params["blendfile"] == BLEND
     # -j 1: every frame of the range, whatever frame step the scene was saved with.
     assert params["args"] == ["-E", "SOLIDWIRE", "-o", OUTPUT, "-s", "11", "-e", "20", "-j", "1", "-a"]
-    assert argv(command) == ["{blender}", "{blenderArgs}", "-b", BLEND,
-                             "-E", "SOLIDWIRE", "-o", OUTPUT, "-s", "11", "-e", "20", "-j", "1", "-a"]
+    assert argv(command) == [
+        "{blender}",
+        "{blenderArgs}",
+        "-b",
+        BLEND,
+        "-E",
+        "SOLIDWIRE",
+        "-o",
+        OUTPUT,
+        "-s",
+        "11",
+        "-e",
+        "20",
+        "-j",
+        "1",
+        "-a",
+    ]
 
 
 def test_solidwire_is_the_default_mode():
@@ -285,8 +328,25 @@ def test_wire_over_command_line():
     # The command line takes the image format from -o's extension; without a
     # format setting the job asks for PNG.
     assert argv(command) == [
-        "{blender}", "{blenderArgs}", "-c", "solidwire", "render", BLEND,
-        "-o", OUTPUT + ".png", "-s", "11", "-e", "20", "-j", "1", "-a", "--over", "CYCLES", "--progress", "json",
+        "{blender}",
+        "{blenderArgs}",
+        "-c",
+        "solidwire",
+        "render",
+        BLEND,
+        "-o",
+        OUTPUT + ".png",
+        "-s",
+        "11",
+        "-e",
+        "20",
+        "-j",
+        "1",
+        "-a",
+        "--over",
+        "CYCLES",
+        "--progress",
+        "json",
     ]
 
 
@@ -296,7 +356,7 @@ def test_wire_over_arguments_follow_the_command():
     tasks = compiled_tasks(frames="3-4", mode="WIRE_OVER", over_engine="BLENDER_EEVEE", preset="Blueprint")
     args = argv(tasks[0]["commands"][0])
     command_at = args.index("-c")
-    assert args[command_at:command_at + 4] == ["-c", "solidwire", "render", BLEND]
+    assert args[command_at : command_at + 4] == ["-c", "solidwire", "render", BLEND]
     assert option(args, "-s") == "3" and option(args, "-e") == "4"
     assert option(args, "-j") == "1"
     assert option(args, "--over") == "BLENDER_EEVEE"
@@ -340,10 +400,19 @@ def test_preset_file():
     assert option(tasks[0]["commands"][0]["parameters"]["args"], "--preset") == "/farm/presets/ink.json"
 
 
-@pytest.mark.parametrize("fmt,extension", [
-    ("PNG", ".png"), ("JPEG", ".jpg"), ("TIFF", ".tif"), ("OPEN_EXR", ".exr"),
-    ("OPEN_EXR_MULTILAYER", ".exr"), ("WEBP", ".webp"), ("BMP", ".bmp"), ("png", ".png"),
-])
+@pytest.mark.parametrize(
+    "fmt,extension",
+    [
+        ("PNG", ".png"),
+        ("JPEG", ".jpg"),
+        ("TIFF", ".tif"),
+        ("OPEN_EXR", ".exr"),
+        ("OPEN_EXR_MULTILAYER", ".exr"),
+        ("WEBP", ".webp"),
+        ("BMP", ".bmp"),
+        ("png", ".png"),
+    ],
+)
 def test_command_line_output_gets_the_format_extension(fmt, extension):
     result = compile_job(mode="WIRE_OVER", over_engine="CYCLES", format=fmt)
     assert result["ok"], result.get("error")
@@ -396,33 +465,36 @@ def test_other_fields_in_output_path_are_left_alone():
 # -- Bad settings -------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("settings,mentions", [
-    ({"frames": ""}, "frames"),
-    ({"frames": "   "}, "frames"),
-    ({"frames": None}, "frames"),
-    ({"frames": "10-1"}, "backwards"),
-    ({"frames": "1-"}, "frames"),
-    ({"frames": "a-b"}, "frames"),
-    ({"frames": "1,,3"}, "frames"),
-    ({"frames": "-5"}, "frames"),
-    ({"frames": "1-3\n5"}, "frames"),
-    ({"frames": "1-99999999999"}, "frames"),
-    ({"chunk_size": 0}, "chunk_size"),
-    ({"chunk_size": -3}, "chunk_size"),
-    ({"chunk_size": 2.5}, "chunk_size"),
-    ({"chunk_size": "ten"}, "chunk_size"),
-    ({"mode": "CYCLES"}, "mode"),
-    ({"mode": "WIREFRAME"}, "mode"),
-    ({"mode": "WIRE_OVER", "over_engine": "LUXCORE"}, "over_engine"),
-    ({"preset": "--thickness"}, "preset"),
-    ({"preset": "a\nb"}, "preset"),
-    ({"blendfile": ""}, "blendfile"),
-    ({"blendfile": None}, "blendfile"),
-    ({"render_output_path": ""}, "render_output_path"),
-    ({"format": "FFMPEG"}, "FFMPEG"),
-    ({"mode": "WIRE_OVER", "format": "TARGA"}, "format"),
-    ({"preset": "Blueprint", "format": "HDR"}, "format"),
-])
+@pytest.mark.parametrize(
+    "settings,mentions",
+    [
+        ({"frames": ""}, "frames"),
+        ({"frames": "   "}, "frames"),
+        ({"frames": None}, "frames"),
+        ({"frames": "10-1"}, "backwards"),
+        ({"frames": "1-"}, "frames"),
+        ({"frames": "a-b"}, "frames"),
+        ({"frames": "1,,3"}, "frames"),
+        ({"frames": "-5"}, "frames"),
+        ({"frames": "1-3\n5"}, "frames"),
+        ({"frames": "1-99999999999"}, "frames"),
+        ({"chunk_size": 0}, "chunk_size"),
+        ({"chunk_size": -3}, "chunk_size"),
+        ({"chunk_size": 2.5}, "chunk_size"),
+        ({"chunk_size": "ten"}, "chunk_size"),
+        ({"mode": "CYCLES"}, "mode"),
+        ({"mode": "WIREFRAME"}, "mode"),
+        ({"mode": "WIRE_OVER", "over_engine": "LUXCORE"}, "over_engine"),
+        ({"preset": "--thickness"}, "preset"),
+        ({"preset": "a\nb"}, "preset"),
+        ({"blendfile": ""}, "blendfile"),
+        ({"blendfile": None}, "blendfile"),
+        ({"render_output_path": ""}, "render_output_path"),
+        ({"format": "FFMPEG"}, "FFMPEG"),
+        ({"mode": "WIRE_OVER", "format": "TARGA"}, "format"),
+        ({"preset": "Blueprint", "format": "HDR"}, "format"),
+    ],
+)
 def test_bad_settings_are_refused(settings, mentions):
     result = compile_job(**settings)
     assert result["ok"] is False, f"{settings} compiled to {result.get('tasks')}"
@@ -482,7 +554,9 @@ def test_tasks_hold_the_frames_flamencos_chunker_gives(frames, chunk):
 )
 def test_the_stand_in_offers_what_the_manager_offers(tmp_path, body, works):
     script = tmp_path / "probe.js"
-    script.write_text("const JOB_TYPE = {label: 'Probe', settings: []};\n"
-                      f"function compileJob(job) {{ {body}; }}\n", encoding="utf-8")
+    script.write_text(
+        f"const JOB_TYPE = {{label: 'Probe', settings: []}};\nfunction compileJob(job) {{ {body}; }}\n",
+        encoding="utf-8",
+    )
     result = _harness("compile", {"name": "probe", "settings": {}}, script=script)
     assert result["ok"] is works, result

@@ -14,7 +14,8 @@ def _hair_and_points(scene, *, ortho=False):
     """Strands (poly and Catmull-Rom, radius from 0 to wide), a point cloud
     and a cube in front of part of both."""
     strand_scenes.hair(
-        scene, "Hair",
+        scene,
+        "Hair",
         [
             [(-2.0, 0.5, -1.0), (-2.0, 0.5, 0.0), (-1.5, 0.8, 1.0), (-1.7, 0.5, 2.0)],
             [(1.0, 1.0, -1.0), (1.2, 0.5, 0.0), (1.5, 0.0, 0.5), (2.0, -0.5, 1.0), (2.5, -1.0, 1.2)],
@@ -25,8 +26,12 @@ def _hair_and_points(scene, *, ortho=False):
         types=[strand_scenes.POLY, strand_scenes.POLY, strand_scenes.CATMULL_ROM, strand_scenes.POLY],
         resolution=5,
     )
-    strand_scenes.point_cloud(scene, "Points", [(0.0, 0.0, 1.4), (1.0, 1.5, 1.5), (-1.0, 1.0, 0.5), (0.5, -1.5, -0.5),
-                                                (-0.2, 1.6, 0.0), (2.0, 1.0, -0.8)], 0.15)
+    strand_scenes.point_cloud(
+        scene,
+        "Points",
+        [(0.0, 0.0, 1.4), (1.0, 1.5, 1.5), (-1.0, 1.0, 0.5), (0.5, -1.5, -0.5), (-0.2, 1.6, 0.0), (2.0, 1.0, -0.8)],
+        0.15,
+    )
     scenes.cube(scene, size=1.5, rotation=(0.0, 0.0, 0.3))
     scenes.add_camera(scene, location=(6.0, -6.0, 4.0), target=(0.0, 0.0, 0.2), ortho_scale=7.0 if ortho else None)
 
@@ -385,11 +390,21 @@ def test_bezier_curves_match_reference(output_dir):
     """Bezier curves with handles are drawn as Blender evaluates them (the
     cubic through the handles, radius linear), open and closed."""
     scene = scenes.empty_scene(200, 150, thickness=1.5)
-    points = [[(-2.0, 0.0, -1.0), (0.0, 0.0, 1.0), (2.0, 0.0, -1.0)], [(-1.0, 0.5, 0.0), (1.0, 0.5, 0.0), (0.0, 0.5, 1.5)]]
+    points = [
+        [(-2.0, 0.0, -1.0), (0.0, 0.0, 1.0), (2.0, 0.0, -1.0)],
+        [(-1.0, 0.5, 0.0), (1.0, 0.5, 0.0), (0.0, 0.5, 1.5)],
+    ]
     left = [(-2.5, 0.0, -1.5), (-1.0, 0.0, 1.0), (2.0, 0.0, 0.0), (-1.0, 0.5, -0.5), (1.5, 0.5, -0.5), (0.8, 0.5, 1.6)]
     right = [(-1.5, 0.0, -0.5), (1.0, 0.0, 1.0), (2.5, 0.0, -1.5), (-1.0, 0.5, 0.5), (0.5, 0.5, 0.5), (-0.8, 0.5, 1.4)]
-    hair = strand_scenes.hair(scene, "Bezier", points, [np.array([0.0, 0.05, 0.0]), 0.0],
-                              types=[strand_scenes.BEZIER] * 2, resolution=8, handles=(left, right))
+    hair = strand_scenes.hair(
+        scene,
+        "Bezier",
+        points,
+        [np.array([0.0, 0.05, 0.0]), 0.0],
+        types=[strand_scenes.BEZIER] * 2,
+        resolution=8,
+        handles=(left, right),
+    )
     hair.data.attributes.new("cyclic", "BOOLEAN", "CURVE").data.foreach_set("value", np.array([False, True]))
     scenes.add_camera(scene, location=(0.0, -7.0, 0.3), target=(0.0, 0.0, 0.2))
     _rgba, ref, report = _measure(scene, "hair_bezier", output_dir)

@@ -51,7 +51,9 @@ def leftovers() -> dict:
     keymap_items = []
     if keyconfig is not None:
         for keymap in keyconfig.keymaps:
-            keymap_items += [f"{keymap.name}:{k.idname}" for k in keymap.keymap_items if k.idname.startswith("solidwire.")]
+            keymap_items += [
+                f"{keymap.name}:{k.idname}" for k in keymap.keymap_items if k.idname.startswith("solidwire.")
+            ]
     compat = []
     for name in dir(bpy.types):
         engines = getattr(getattr(bpy.types, name, None), "COMPAT_ENGINES", None)
@@ -69,12 +71,17 @@ def leftovers() -> dict:
         "app handlers": [f"{name}:{f.__name__}" for name, funcs in _handler_lists() for f in funcs if _ours(f)],
         "draw handler": [overlay._handle] if overlay._handle is not None else [],
         "keymap items": keymap_items + [repr(k) for k in ops._keymap_items],
-        "panel appends": [f for p in ("VIEW3D_PT_overlay", "OBJECT_PT_visibility") for f in ui.appended_draw_functions(p)],
+        "panel appends": [
+            f for p in ("VIEW3D_PT_overlay", "OBJECT_PT_visibility") for f in ui.appended_draw_functions(p)
+        ],
         "compat panels": compat,
         "timers": [f.__name__ for f in _addon_functions() if bpy.app.timers.is_registered(f)],
         "exit hook": ["_at_exit"] if _exit_hook_registered() else [],
-        "GPU objects": [path for path in robustness.scan_module_state(robustness.is_gpu_object)
-                        if not path.startswith(SHADER_PROGRAMS)],
+        "GPU objects": [
+            path
+            for path in robustness.scan_module_state(robustness.is_gpu_object)
+            if not path.startswith(SHADER_PROGRAMS)
+        ],
         "messages said": list(log._said),
     }
 
@@ -117,8 +124,17 @@ def test_registered_state_is_measurable(output_dir):
     'nothing left' checks below can fail)."""
     _render_small(output_dir / "lifecycle_probe.exr")
     state = _measure()
-    for kind in ("classes", "bpy.types", "properties", "app handlers", "draw handler", "panel appends", "compat panels",
-                 "exit hook", "GPU objects"):
+    for kind in (
+        "classes",
+        "bpy.types",
+        "properties",
+        "app handlers",
+        "draw handler",
+        "panel appends",
+        "compat panels",
+        "exit hook",
+        "GPU objects",
+    ):
         assert state[kind], f"cannot see {kind} while registered: {state}"
 
 
@@ -170,12 +186,18 @@ def test_process_exits_cleanly_after_rendering_while_registered(tmp_path):
         from tests.support import scenes, robustness
         solidwire_addon.register()
         scene = scenes.empty_scene(32, 24); scenes.cube(scene); scenes.add_camera(scene)
-        robustness.render_exr(scene, {str(tmp_path / 'exit.exr')!r})
+        robustness.render_exr(scene, {str(tmp_path / "exit.exr")!r})
         print("RENDERED")
     """
     env = dict(os.environ, BLENDER_USER_RESOURCES=str(tmp_path / "user"))
-    result = subprocess.run([sys.executable, "-c", textwrap.dedent(script)], capture_output=True, text=True,
-                            timeout=300, env=env, check=False)
+    result = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(script)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+        check=False,
+    )
     assert "RENDERED" in result.stdout
     assert result.returncode == 0, result.stderr[-2000:]
 
@@ -310,9 +332,24 @@ def test_the_test_order_that_crashed_the_driver_passes(tmp_path):
         pytest.skip("already inside the crash-order run")
     env = dict(os.environ, SOLIDWIRE_INNER_RUN="1", BLENDER_USER_RESOURCES=str(tmp_path / "user"))
     result = subprocess.run(
-        [sys.executable, "-X", "faulthandler", "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly",
-         *CRASH_ORDER],
-        cwd=ROOT, env=env, capture_output=True, text=True, timeout=600,
+        [
+            sys.executable,
+            "-X",
+            "faulthandler",
+            "-m",
+            "pytest",
+            "-q",
+            "-p",
+            "no:cacheprovider",
+            "-p",
+            "no:randomly",
+            *CRASH_ORDER,
+        ],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
         check=False,
     )
     assert result.returncode == 0, (result.stdout + result.stderr)[-3000:]

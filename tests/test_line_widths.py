@@ -24,9 +24,18 @@ def _classed_cube(scene, name="Cube", **kwargs):
 @pytest.mark.parametrize("mode", ["PIXELS", "DEPTH", "WORLD"])
 @pytest.mark.parametrize("override", [False, True])
 def test_class_widths_follow_the_wire(mode, override, output_dir):
-    scene = scenes.empty_scene(200, 150, thickness=1.5, use_sharp_edges=True, sharp_thickness=4.0,
-                               thickness_mode=mode, thickness_far=0.75, thickness_depth_start=4.0,
-                               thickness_depth_end=9.0, world_thickness=0.03)
+    scene = scenes.empty_scene(
+        200,
+        150,
+        thickness=1.5,
+        use_sharp_edges=True,
+        sharp_thickness=4.0,
+        thickness_mode=mode,
+        thickness_far=0.75,
+        thickness_depth_start=4.0,
+        thickness_depth_end=9.0,
+        world_thickness=0.03,
+    )
     cube = _classed_cube(scene)
     scenes.cube(scene, "Other", size=1.0, location=(0.0, 2.5, -0.5))  # the scene's own widths
     if override:
@@ -44,8 +53,14 @@ def test_an_override_thickness_takes_the_ui_scale(output_dir):
 
     def overlay_alpha(pixel_size: float, own_thickness: float = 4.0):
         bpy.ops.wm.read_factory_settings(use_empty=True)
-        scene = scenes.empty_scene(160, 120, thickness=2.0 / pixel_size, softness=1.0 / pixel_size, use_sharp_edges=True,
-                                   sharp_thickness=3.0 / pixel_size)
+        scene = scenes.empty_scene(
+            160,
+            120,
+            thickness=2.0 / pixel_size,
+            softness=1.0 / pixel_size,
+            use_sharp_edges=True,
+            sharp_thickness=3.0 / pixel_size,
+        )
         cube = _classed_cube(scene)
         cube.solidwire.use_override = True
         cube.solidwire.thickness = own_thickness / pixel_size

@@ -20,12 +20,26 @@ WIDTH, HEIGHT = 120, 80
 @pytest.mark.parametrize(
     "variant",
     [
-        shaders.ShaderVariant(use_fill=True, shading=shaders.SHADING_STUDIO, item_colors=True, material_colors=True,
-                              write_aovs=True, write_view_depth=True, linear_depth=True),
-        shaders.ShaderVariant(use_fill=True, shading=shaders.SHADING_MATCAP, item_colors=True, clip_planes=True,
-                              depth_bias=1e-5),
-        shaders.ShaderVariant(use_fill=True, shading=shaders.SHADING_STUDIO, item_colors=True, clip_planes=True,
-                              instanced=True, depth_bias=1e-5),
+        shaders.ShaderVariant(
+            use_fill=True,
+            shading=shaders.SHADING_STUDIO,
+            item_colors=True,
+            material_colors=True,
+            write_aovs=True,
+            write_view_depth=True,
+            linear_depth=True,
+        ),
+        shaders.ShaderVariant(
+            use_fill=True, shading=shaders.SHADING_MATCAP, item_colors=True, clip_planes=True, depth_bias=1e-5
+        ),
+        shaders.ShaderVariant(
+            use_fill=True,
+            shading=shaders.SHADING_STUDIO,
+            item_colors=True,
+            clip_planes=True,
+            instanced=True,
+            depth_bias=1e-5,
+        ),
         shaders.ShaderVariant(use_fill=True, clip_planes=True, write_aovs=True, ngons=True),
     ],
 )
@@ -54,8 +68,7 @@ def test_override_fill_is_shaded_and_passes_are_written():
     plain.pass_index, styled.pass_index = 3, 7
     depsgraph = bpy.context.evaluated_depsgraph_get()
     extra: dict = {}
-    rgba, _depth = engine.render_scene(depsgraph, (WIDTH, HEIGHT), extra_passes=("IndexOB", "Normal"),
-                                      extra_out=extra)
+    rgba, _depth = engine.render_scene(depsgraph, (WIDTH, HEIGHT), extra_passes=("IndexOB", "Normal"), extra_out=extra)
     index = extra["IndexOB"][..., 0]
     on_plain, on_styled = index == 3, index == 7
     assert on_plain.sum() > 200 and on_styled.sum() > 200
@@ -73,8 +86,9 @@ def test_override_colours_feed_the_colour_sources():
     """With a per-item colour table (wire source RANDOM), an overridden
     object's SINGLE fill is its override's; material colours and IndexMA
     read their own tables in one draw."""
-    scene, plain, styled = _two_cubes(use_fill=True, fill_shading="FLAT", fill_color=(0.8, 0.8, 0.8),
-                                      wire_color_source="RANDOM")
+    scene, plain, styled = _two_cubes(
+        use_fill=True, fill_shading="FLAT", fill_color=(0.8, 0.8, 0.8), wire_color_source="RANDOM"
+    )
     scene.solidwire.wire_color = (0.0, 0.0, 0.0, 0.0)
     _override(styled, (1.0, 0.0, 0.0), wire=(0.0, 0.0, 0.0, 0.0))
     depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -82,7 +96,7 @@ def test_override_colours_feed_the_colour_sources():
     rgba, _depth = engine.render_scene(depsgraph, (WIDTH, HEIGHT), extra_passes=("IndexOB",), extra_out=extra)
     covered = rgba[..., 3] > 0.99
     left = covered.copy()
-    left[:, WIDTH // 2:] = False
+    left[:, WIDTH // 2 :] = False
     right = covered.copy()
     right[:, : WIDTH // 2] = False
     assert np.allclose(rgba[left][:, :3], 0.8, atol=0.01)

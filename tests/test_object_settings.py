@@ -104,8 +104,9 @@ def test_instances_take_the_settings_of_the_object_they_instance():
 
     depsgraph = bpy.context.evaluated_depsgraph_get()
     runtime.begin_frame()
-    items, _seen, _ms = gather.gather(depsgraph, runtime.mesh_cache,
-                                      object_settings=gather.ObjectSettings(gather.SHOW_IN_RENDER, bpy.data.objects))
+    items, _seen, _ms = gather.gather(
+        depsgraph, runtime.mesh_cache, object_settings=gather.ObjectSettings(gather.SHOW_IN_RENDER, bpy.data.objects)
+    )
     assert len(items) == 41
     styles = [item.style for item in items]
     assert sum(s is not None and s.thickness == 3.0 for s in styles) == 20
@@ -131,11 +132,14 @@ def test_overlay_honours_show_in_viewport():
     depsgraph = bpy.context.evaluated_depsgraph_get()
     for show, expected in ((gather.SHOW_IN_VIEWPORT, 2), (gather.SHOW_IN_RENDER, 2)):
         runtime.begin_frame()
-        items, _seen, _ms = gather.gather(depsgraph, runtime.mesh_cache, object_settings=gather.ObjectSettings(show, bpy.data.objects))
+        items, _seen, _ms = gather.gather(
+            depsgraph, runtime.mesh_cache, object_settings=gather.ObjectSettings(show, bpy.data.objects)
+        )
         assert len(items) == expected
     # The older opt-out is the viewport switch.
     shown.solidwire_exclude = True
     runtime.begin_frame()
-    items, _seen, _ms = gather.gather(depsgraph, runtime.mesh_cache,
-                                      object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects))
+    items, _seen, _ms = gather.gather(
+        depsgraph, runtime.mesh_cache, object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects)
+    )
     assert len(items) == 1

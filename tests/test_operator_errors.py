@@ -43,17 +43,35 @@ def _fails(operator, expected: str, capfd, **kwargs) -> str:
 def test_wire_over_checks_the_output_path_before_rendering(scene, tmp_path, capfd):
     a_file = tmp_path / "file.txt"
     a_file.write_text("x")
-    _fails(bpy.ops.solidwire.render_wire_over, "is a file, not a folder", capfd,
-           engine="BLENDER_WORKBENCH", filepath=str(a_file / "out.png"), show_result=False)
-    _fails(bpy.ops.solidwire.render_wire_over, "is a directory", capfd,
-           engine="BLENDER_WORKBENCH", filepath=str(tmp_path), show_result=False)
+    _fails(
+        bpy.ops.solidwire.render_wire_over,
+        "is a file, not a folder",
+        capfd,
+        engine="BLENDER_WORKBENCH",
+        filepath=str(a_file / "out.png"),
+        show_result=False,
+    )
+    _fails(
+        bpy.ops.solidwire.render_wire_over,
+        "is a directory",
+        capfd,
+        engine="BLENDER_WORKBENCH",
+        filepath=str(tmp_path),
+        show_result=False,
+    )
     if os.geteuid() != 0:  # root writes anywhere
         locked = tmp_path / "locked"
         locked.mkdir()
         locked.chmod(0o555)
         try:
-            _fails(bpy.ops.solidwire.render_wire_over, "cannot write to", capfd,
-                   engine="BLENDER_WORKBENCH", filepath=str(locked / "out.png"), show_result=False)
+            _fails(
+                bpy.ops.solidwire.render_wire_over,
+                "cannot write to",
+                capfd,
+                engine="BLENDER_WORKBENCH",
+                filepath=str(locked / "out.png"),
+                show_result=False,
+            )
         finally:
             locked.chmod(0o755)
 
@@ -61,22 +79,28 @@ def test_wire_over_checks_the_output_path_before_rendering(scene, tmp_path, capf
 def test_wire_over_checks_engine_camera_and_format_before_rendering(scene, tmp_path, capfd):
     path = str(tmp_path / "out.png")
     scene.render.engine = "SOLIDWIRE"
-    _fails(bpy.ops.solidwire.render_wire_over, "SolidWire itself", capfd, engine="SCENE", filepath=path,
-           show_result=False)
+    _fails(
+        bpy.ops.solidwire.render_wire_over, "SolidWire itself", capfd, engine="SCENE", filepath=path, show_result=False
+    )
     scene.render.engine = "BLENDER_WORKBENCH"
     image = scene.render.image_settings
     if hasattr(image, "media_type"):
         image.media_type = "VIDEO"
     image.file_format = "FFMPEG"
-    _fails(bpy.ops.solidwire.render_wire_over, "is a video", capfd, engine="SCENE", filepath=path,
-           show_result=False)
+    _fails(bpy.ops.solidwire.render_wire_over, "is a video", capfd, engine="SCENE", filepath=path, show_result=False)
 
 
 def test_wire_over_without_camera(tmp_path, capfd, monkeypatch):
     scene = scenes.empty_scene(32, 24)
     scene.render.engine = "BLENDER_WORKBENCH"
-    _fails(bpy.ops.solidwire.render_wire_over, "has no camera", capfd, engine="SCENE",
-           filepath=str(tmp_path / "out.png"), show_result=False)
+    _fails(
+        bpy.ops.solidwire.render_wire_over,
+        "has no camera",
+        capfd,
+        engine="SCENE",
+        filepath=str(tmp_path / "out.png"),
+        show_result=False,
+    )
 
 
 def test_preset_operators_fail_with_one_line(scene, capfd, monkeypatch):
@@ -99,5 +123,9 @@ def test_an_unexpected_exception_is_one_line(scene, capfd, monkeypatch):
 
     monkeypatch.setattr(presets, "apply", broken)
     builtin = presets.builtin_presets()[0].name
-    _fails(bpy.ops.solidwire.preset_apply, "Apply SolidWire Preset failed: ValueError: settings on fire second line",
-           capfd, name=builtin)
+    _fails(
+        bpy.ops.solidwire.preset_apply,
+        "Apply SolidWire Preset failed: ValueError: settings on fire second line",
+        capfd,
+        name=builtin,
+    )

@@ -71,7 +71,9 @@ class FakeViewport:
                     mesh.vertices.foreach_get("co", coords)
                     tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
                     mesh.loop_triangles.foreach_get("vertices", tris)
-                    batch = batch_for_shader(shader, "TRIS", {"pos": coords.reshape(-1, 3)}, indices=tris.reshape(-1, 3))
+                    batch = batch_for_shader(
+                        shader, "TRIS", {"pos": coords.reshape(-1, 3)}, indices=tris.reshape(-1, 3)
+                    )
                     gpu.matrix.load_matrix(view_matrix @ obj_eval.matrix_world)
                     shader.bind()
                     shader.uniform_float("color", (0.5, 0.5, 0.5, 1.0))
@@ -311,8 +313,11 @@ def test_frame_filter_answers_as_the_filter_once_per_object(monkeypatch):
     for obj in scene.objects:
         obj.select_set(obj is selected)
     view_layer = bpy.context.view_layer
-    for state in (overlay_state.ViewportState(), overlay_state.ViewportState(only_selected=True),
-                  overlay_state.ViewportState(draw_edit_mode=False)):
+    for state in (
+        overlay_state.ViewportState(),
+        overlay_state.ViewportState(only_selected=True),
+        overlay_state.ViewportState(draw_edit_mode=False),
+    ):
         plan = overlay_state.plan_overlay(state)
         plain = overlay.object_filter(plan, view_layer)
         per_frame = overlay.frame_object_filter(plan, view_layer)

@@ -185,8 +185,12 @@ def lut_lookup(lut, colors) -> np.ndarray:
     def texel(node):
         return lut.display[node[:, 2], node[:, 1], node[:, 0]].astype(np.float64)
 
-    return ((1.0 - f_max) * texel(i) + (f_max - f_mid) * texel(i + largest)
-            + (f_mid - f_min) * texel(i + 1 - smallest) + f_min * texel(i + 1))
+    return (
+        (1.0 - f_max) * texel(i)
+        + (f_max - f_mid) * texel(i + largest)
+        + (f_mid - f_min) * texel(i + 1 - smallest)
+        + f_min * texel(i + 1)
+    )
 
 
 # Measured error of the table against Blender's exact transform (bpy 5.0.1,
@@ -325,14 +329,18 @@ def test_blender_merges_overlays_in_a_2_2_power_space():
 
     # The bpy module's binary: bpy/__init__.so (.pyd) above the scripts'
     # bpy package that ``import bpy`` ends up with.
-    binaries = [found for parent in Path(bpy.__file__).resolve().parents
-                for pattern in ("__init__*.so", "__init__*.pyd") for found in parent.glob(pattern)]
+    binaries = [
+        found
+        for parent in Path(bpy.__file__).resolve().parents
+        for pattern in ("__init__*.so", "__init__*.pyd")
+        for found in parent.glob(pattern)
+    ]
     for path in binaries:
         with open(path, "rb") as file, mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ) as data:
             at = data.find(b"col += col_overlay")
             if at < 0:
                 continue
-            merge = data[max(at - 600, 0): at + 200]
+            merge = data[max(at - 600, 0) : at + 200]
             assert b"2.2)" in merge[:600] and b"1.0 / 2.2" in merge[600:], merge.decode("latin1")
             assert display_transform.OVERLAY_MERGE_GAMMA == 2.2
             return
@@ -342,12 +350,25 @@ def test_blender_merges_overlays_in_a_2_2_power_space():
 @pytest.mark.parametrize(
     "variant",
     [
-        shaders.ShaderVariant(use_fill=True, shading=shaders.SHADING_STUDIO, item_colors=True, clip_planes=True,
-                              instanced=True, depth_bias=1e-5, display_transform=True),
-        shaders.ShaderVariant(use_fill=True, shading=shaders.SHADING_MATCAP, ngons=True, depth_bias=1e-5,
-                              display_transform=True),
-        shaders.ShaderVariant(hidden_pass=True, diagonals=shaders.DIAGONALS_PATTERN, use_fade=True,
-                              depth_bias=1e-5, display_transform=True),
+        shaders.ShaderVariant(
+            use_fill=True,
+            shading=shaders.SHADING_STUDIO,
+            item_colors=True,
+            clip_planes=True,
+            instanced=True,
+            depth_bias=1e-5,
+            display_transform=True,
+        ),
+        shaders.ShaderVariant(
+            use_fill=True, shading=shaders.SHADING_MATCAP, ngons=True, depth_bias=1e-5, display_transform=True
+        ),
+        shaders.ShaderVariant(
+            hidden_pass=True,
+            diagonals=shaders.DIAGONALS_PATTERN,
+            use_fade=True,
+            depth_bias=1e-5,
+            display_transform=True,
+        ),
     ],
     ids=["instanced_clipped_studio", "matcap_ngons", "hidden_pass"],
 )
@@ -366,8 +387,11 @@ def test_the_render_path_has_no_display_transform(monkeypatch):
     used = []
     real_get, real_fins = shaders.get, shaders.get_silhouette
     monkeypatch.setattr(shaders, "get", lambda variant: used.append(variant) or real_get(variant))
-    monkeypatch.setattr(shaders, "get_silhouette",
-                        lambda variant, overlay_bias=0.0: used.append(variant) or real_fins(variant, overlay_bias))
+    monkeypatch.setattr(
+        shaders,
+        "get_silhouette",
+        lambda variant, overlay_bias=0.0: used.append(variant) or real_fins(variant, overlay_bias),
+    )
     rgba, _depth = engine.render_scene(bpy.context.evaluated_depsgraph_get(), (WIDTH, HEIGHT))
     assert rgba[..., 3].max() > 0.9
     assert used and not any(variant.display_transform for variant in used)

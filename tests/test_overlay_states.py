@@ -132,8 +132,13 @@ def test_handler_reads_each_region_state():
 
     def context(region_3d):
         return SimpleNamespace(
-            scene=scene, space_data=space, region=object(), region_data=region_3d,
-            screen=None, area=None, preferences=preferences,
+            scene=scene,
+            space_data=space,
+            region=object(),
+            region_data=region_3d,
+            screen=None,
+            area=None,
+            preferences=preferences,
         )
 
     clipped = overlay.viewport_state(context(SimpleNamespace(use_clip_planes=True, clip_planes=planes)))
@@ -183,8 +188,11 @@ def _occluder_scene():
 
 @pytest.mark.parametrize(
     "state",
-    [ViewportState(xray=True, xray_alpha=0.5), ViewportState(xray=True, xray_alpha=0.0),
-     ViewportState(shading=WIREFRAME, xray=True, xray_alpha=0.5)],
+    [
+        ViewportState(xray=True, xray_alpha=0.5),
+        ViewportState(xray=True, xray_alpha=0.0),
+        ViewportState(shading=WIREFRAME, xray=True, xray_alpha=0.5),
+    ],
     ids=["solid_xray_half", "solid_xray_zero", "wireframe_xray"],
 )
 def test_xray_sees_through_blender_depth(state):
@@ -347,8 +355,13 @@ def test_handler_reads_this_viewports_own_switch():
 
     def state(area):
         context = SimpleNamespace(
-            scene=scene, space_data=None, region=object(), region_data=region_3d,
-            screen=screen, area=area, preferences=bpy.context.preferences,
+            scene=scene,
+            space_data=None,
+            region=object(),
+            region_data=region_3d,
+            screen=screen,
+            area=area,
+            preferences=bpy.context.preferences,
         )
         return overlay_state.plan_overlay(overlay.viewport_state(context))
 
@@ -376,8 +389,13 @@ def test_nothing_to_draw_leaves_the_viewport_untouched():
     assert (before_depth < 1.0).any()
     plan = overlay_state.plan_overlay(ViewportState(xray=True, xray_alpha=0.5))
     assert not plan.scene_depth
-    stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), plan=plan,
-                                  object_filter=overlay.object_filter(plan, bpy.context.view_layer))
+    stats = viewport.draw_overlay(
+        depsgraph,
+        view,
+        scene.solidwire.snapshot(),
+        plan=plan,
+        object_filter=overlay.object_filter(plan, bpy.context.view_layer),
+    )
     assert stats["objects_drawn"] == 0
     assert np.array_equal(depth(), before_depth)
     assert np.array_equal(viewport.rgba(), before_rgba)

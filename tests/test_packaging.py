@@ -39,7 +39,9 @@ NEVER_SHIPPED_PREFIXES = ("tests/", "scripts/", ".ci/", "docs/", ".venv/", "dist
 def blender_ext(*args) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, str(BLENDER_EXT), *map(str, args)],
-        capture_output=True, text=True, timeout=TIMEOUT_S,
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
         check=False,
     )
 
@@ -83,10 +85,12 @@ def test_zip_holds_the_add_on_and_nothing_else(extension_zip):
     assert not missing, f"not in the zip: {sorted(missing)}"
     assert any(name.startswith("shaders/") and name.endswith(".glsl") for name in names)
     leaked = sorted(
-        name for name in names
+        name
+        for name in names
         if name.split("/")[0] not in SHIPPED_TOP_LEVEL
         or name.startswith(NEVER_SHIPPED_PREFIXES)
-        or "__pycache__" in name or name.endswith((".pyc", ".blend1", ".zip"))
+        or "__pycache__" in name
+        or name.endswith((".pyc", ".blend1", ".zip"))
     )
     assert not leaked, f"development files in the zip: {leaked}"
     # The benchmark's published-method variants stay in the repository.
@@ -158,15 +162,26 @@ def test_zip_installs_enables_renders_and_disables(extension_zip, tmp_path, outp
     for name in ("installed_cube.png", "installed_demo.png"):
         (output_dir / name).unlink(missing_ok=True)
     result = subprocess.run(
-        [sys.executable, "-c", _INSTALL_AND_RENDER, str(extension_zip), str(ROOT),
-         str(ROOT / "scripts" / "render.py"), str(output_dir)],
-        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=TIMEOUT_S,
+        [
+            sys.executable,
+            "-c",
+            _INSTALL_AND_RENDER,
+            str(extension_zip),
+            str(ROOT),
+            str(ROOT / "scripts" / "render.py"),
+            str(output_dir),
+        ],
+        cwd=tmp_path,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
         check=False,
     )
     assert result.returncode == 0, result.stdout + result.stderr
     assert "SolidWire skips" not in result.stderr, result.stderr
     (line,) = [line for line in result.stdout.splitlines() if line.startswith("REPORT ")]
-    report = json.loads(line[len("REPORT "):])
+    report = json.loads(line[len("REPORT ") :])
 
     assert "bl_ext.user_default.solidwire" in report["modules"]
     assert "solidwire_addon" not in report["modules"], "the repository copy was imported"

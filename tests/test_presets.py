@@ -101,7 +101,9 @@ def test_every_builtin_preset_renders_differently():
 
 def snapshot_of(preset) -> dict:
     return {
-        key: [round(c, 6) for c in value] if isinstance(value, tuple) else (round(value, 6) if isinstance(value, float) else value)
+        key: [round(c, 6) for c in value]
+        if isinstance(value, tuple)
+        else (round(value, 6) if isinstance(value, float) else value)
         for key, value in preset.values.items()
     }
 
@@ -179,9 +181,15 @@ CORRUPT = {
     "short colour": (json.dumps(_document(wire_color=[1, 0, 0])), "'wire_color' must be a list of 4 numbers"),
     "colour out of range": (json.dumps(_document(fill_color=[2, 0, 0, 1])), "components must lie in 0..1"),
     "NaN": (json.dumps(_document()).replace('"thickness": 1.0', '"thickness": NaN'), "'NaN' is not allowed"),
-    "duplicate key": ('{"solidwire_preset": 1, "name": "A", "name": "B", "settings": {"thickness": 1}}', "appears twice"),
+    "duplicate key": (
+        '{"solidwire_preset": 1, "name": "A", "name": "B", "settings": {"thickness": 1}}',
+        "appears twice",
+    ),
     "wrong version": (json.dumps(_document() | {"solidwire_preset": 2}), "'solidwire_preset' must be 1"),
-    "no settings": (json.dumps({"solidwire_preset": 1, "name": "Empty", "settings": {}}), "'settings' must be a non-empty"),
+    "no settings": (
+        json.dumps({"solidwire_preset": 1, "name": "Empty", "settings": {}}),
+        "'settings' must be a non-empty",
+    ),
     "huge file": (json.dumps(_document() | {"description": "x" * 200_000}), "larger than 64 KiB"),
 }
 
@@ -221,7 +229,9 @@ def test_partial_preset_sets_only_its_keys_and_mode_before_duty():
     """diagonal_mode's update resets pattern_duty; a preset's own duty wins."""
     scene = scenes.empty_scene()
     scene.solidwire.thickness = 3.0
-    preset = presets.parse(json.dumps({"solidwire_preset": 1, "name": "P", "settings": {"pattern_duty": 0.7, "diagonal_mode": "DOTTED"}}))
+    preset = presets.parse(
+        json.dumps({"solidwire_preset": 1, "name": "P", "settings": {"pattern_duty": 0.7, "diagonal_mode": "DOTTED"}})
+    )
     presets.apply(preset, scene.solidwire)
     assert scene.solidwire.diagonal_mode == "DOTTED"
     assert scene.solidwire.pattern_duty == pytest.approx(0.7)
@@ -252,14 +262,14 @@ def test_presets_of_older_versions_move_to_the_presets_folder_once(monkeypatch, 
     from_a_checkout = presets.user_dir()
     monkeypatch.setattr(presets, "__package__", "bl_ext.user_default.solidwire.solidwire_addon")
     monkeypatch.setattr(presets, "_migrated", set())
-    extension_dir = Path(bpy.utils.extension_path_user("bl_ext.user_default.solidwire", path="presets",
-                                                       create=True))
+    extension_dir = Path(bpy.utils.extension_path_user("bl_ext.user_default.solidwire", path="presets", create=True))
     config_dir = Path(bpy.utils.user_resource("CONFIG")) / "solidwire_presets"
     config_dir.mkdir(parents=True, exist_ok=True)
     old_look = presets.to_json("Old Look", {"thickness": 2.5})
     (extension_dir / "old_look.json").write_text(old_look, encoding="utf-8")
-    (config_dir / "checkout_look.json").write_text(presets.to_json("Checkout Look", {"thickness": 4.0}),
-                                                   encoding="utf-8")
+    (config_dir / "checkout_look.json").write_text(
+        presets.to_json("Checkout Look", {"thickness": 4.0}), encoding="utf-8"
+    )
     (user_dir / "kept.json").write_text(presets.to_json("Kept", {"thickness": 1.0}), encoding="utf-8")
     (config_dir / "kept.json").write_text(presets.to_json("Kept", {"thickness": 9.0}), encoding="utf-8")
     try:
@@ -457,7 +467,6 @@ class MenuLayout:
     def separator(self):
         pass
 
-
     def prop(self, data, name, text=""):
         assert name in data.bl_rna.properties, name
         self.entries.append(("prop", text or name, None))
@@ -479,21 +488,28 @@ def test_presets_menu_has_import_and_export(user_dir):
     applied = [(text, props.name) for idname, text, props in menu.entries if idname == "solidwire.preset_apply"]
     assert applied[-1] == ("線画", "線画")
     assert [idname for idname, _text, _props in menu.entries[-2:]] == [
-        "solidwire.preset_import", "solidwire.preset_export"]
+        "solidwire.preset_import",
+        "solidwire.preset_export",
+    ]
 
 
 # --------------------------------------------------- names: built-ins, look-alikes
 
 
-@pytest.mark.parametrize("name", ["Blueprint", "blueprint", "  BLUEPRINT  ", "Fade into Distance",
-                                  "fade-into-distance", "FADE_INTO_DISTANCE"])
+@pytest.mark.parametrize(
+    "name",
+    ["Blueprint", "blueprint", "  BLUEPRINT  ", "Fade into Distance", "fade-into-distance", "FADE_INTO_DISTANCE"],
+)
 def test_a_user_preset_cannot_take_a_builtin_name(name, user_dir):
     """Refused, not renamed: a preset saved under a name other than the one
     typed would be a surprise, and one name meaning two looks (menu,
     --preset, farm jobs) would be worse. The message names the built-in."""
     scenes.empty_scene()
-    with pytest.raises(RuntimeError, match=r"is the name of the built-in preset '(Blueprint|Fade into Distance)'; "
-                                           "choose another name") as caught:
+    with pytest.raises(
+        RuntimeError,
+        match=r"is the name of the built-in preset '(Blueprint|Fade into Distance)'; "
+        "choose another name",
+    ) as caught:
         bpy.ops.solidwire.preset_add(name=name)
     assert "\n" not in str(caught.value).strip()
     assert list(user_dir.iterdir()) == []
@@ -535,8 +551,7 @@ def test_the_add_dialog_says_what_saving_would_do(user_dir):
 
     def dialog(name, overwrite=False):
         layout = MenuLayout()
-        operator = SimpleNamespace(layout=layout, name=name, overwrite=overwrite, preset_description="",
-                                   bl_rna=rna)
+        operator = SimpleNamespace(layout=layout, name=name, overwrite=overwrite, preset_description="", bl_rna=rna)
         ops.SOLIDWIRE_OT_preset_add.draw(operator, bpy.context)
         return layout
 
@@ -562,8 +577,15 @@ def test_find_and_remove_accept_the_name_up_to_case(user_dir):
 # ------------------------------------------------------------ non-ASCII names
 
 
-@pytest.mark.parametrize("name, filename", [("Böse Linien", "böse_linien.json"), ("線画", "線画.json"),
-                                            ("Ünïcödé — Look", "ünïcödé_look.json"), ("हिन्दी", "हिन्दी.json")])
+@pytest.mark.parametrize(
+    "name, filename",
+    [
+        ("Böse Linien", "böse_linien.json"),
+        ("線画", "線画.json"),
+        ("Ünïcödé — Look", "ünïcödé_look.json"),
+        ("हिन्दी", "हिन्दी.json"),
+    ],
+)
 def test_non_ascii_names_keep_their_letters(name, filename, user_dir):
     scene = scenes.empty_scene()
     props = scene.solidwire
@@ -644,7 +666,10 @@ def test_export_a_chosen_preset_keeps_its_meaning(user_dir, tmp_path):
     exported = presets.load(path)
     builtin = presets.find(FADE)
     assert (exported.values, exported.description, exported.from_scene) == (
-        builtin.values, builtin.description, builtin.from_scene)
+        builtin.values,
+        builtin.description,
+        builtin.from_scene,
+    )
     # Importing it under its own name would shadow the built-in: refused.
     with pytest.raises(presets.PresetError, match="is the name of the built-in preset 'Fade into Distance'"):
         presets.import_file(path)
@@ -658,7 +683,9 @@ def test_export_and_import_operators(user_dir, tmp_path):
     target = tmp_path / "mine.json"
     assert bpy.ops.solidwire.preset_export(filepath=str(target), name="Operator Look") == {"FINISHED"}
     assert presets.load(target).values["thickness"] == 6.0
-    assert bpy.ops.solidwire.preset_export(filepath=str(tmp_path / "blueprint.json"), preset="Blueprint") == {"FINISHED"}
+    assert bpy.ops.solidwire.preset_export(filepath=str(tmp_path / "blueprint.json"), preset="Blueprint") == {
+        "FINISHED"
+    }
     assert presets.load(tmp_path / "blueprint.json").values == presets.find("Blueprint").values
 
     assert bpy.ops.solidwire.preset_import(filepath=str(target)) == {"FINISHED"}
@@ -672,10 +699,14 @@ def test_export_and_import_operators(user_dir, tmp_path):
 
     with pytest.raises(RuntimeError, match="is the name of the built-in preset 'Blueprint'"):
         bpy.ops.solidwire.preset_import(filepath=str(tmp_path / "blueprint.json"))
-    assert bpy.ops.solidwire.preset_import(filepath=str(tmp_path / "blueprint.json"), name="My Blueprint") == {"FINISHED"}
+    assert bpy.ops.solidwire.preset_import(filepath=str(tmp_path / "blueprint.json"), name="My Blueprint") == {
+        "FINISHED"
+    }
     with pytest.raises(RuntimeError, match="cannot export preset: no preset named 'Nope'"):
         bpy.ops.solidwire.preset_export(filepath=str(tmp_path / "x.json"), preset="Nope")
-    with pytest.raises(RuntimeError, match="cannot export preset: x.json: cannot write \\(No such file or directory\\)"):
+    with pytest.raises(
+        RuntimeError, match="cannot export preset: x.json: cannot write \\(No such file or directory\\)"
+    ):
         bpy.ops.solidwire.preset_export(filepath=str(tmp_path / "missing" / "x.json"))
 
 

@@ -62,8 +62,13 @@ def test_an_ngon_cage_keeps_its_whole_outline(level, diagonals, output_dir):
     """A cylinder's 16-gon caps under subdivision: each cap is one region of
     16 * 2^level drawn edges around a fan of child faces."""
     scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5, diagonal_mode=diagonals)
-    tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
-        bm, cap_ends=True, cap_tris=False, segments=16, radius1=1.0, radius2=1.0, depth=1.6))
+    tube = scenes.mesh_object(
+        scene,
+        "Tube",
+        lambda bm: bmesh.ops.create_cone(
+            bm, cap_ends=True, cap_tris=False, segments=16, radius1=1.0, radius2=1.0, depth=1.6
+        ),
+    )
     _subdivided(tube, level)
     scenes.add_camera(scene, location=(2.2, -3.4, 3.0), target=(0, 0, 0))
     report = accuracy.measure(scene, f"regions_ngon_cap_level{level}", output_dir)
@@ -119,8 +124,14 @@ def test_edge_classes_on_large_regions(case, output_dir):
     """Edge classes with their own width, colour and pattern on regions of
     more than a hundred edges: the strongest line per pixel decides the
     style, with each class's pattern running along its own edges."""
-    look = dict(use_sharp_edges=True, sharp_thickness=3.0, sharp_pattern="DASHED",
-                use_boundary_edges=True, boundary_thickness=2.5, thickness=1.0)
+    look = dict(
+        use_sharp_edges=True,
+        sharp_thickness=3.0,
+        sharp_pattern="DASHED",
+        use_boundary_edges=True,
+        boundary_thickness=2.5,
+        thickness=1.0,
+    )
     if case == "cage":
         scene = scenes.empty_scene(200, 150, use_cage_edges=True, **look)
         obj = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
@@ -162,8 +173,10 @@ def test_the_edge_distance_pass_walks_regions_whole(output_dir):
     assert "region_line_entries" not in solidwire_addon.stats()
 
 
-@pytest.mark.parametrize("look", [dict(), dict(use_sharp_edges=True, sharp_pattern="DASHED", sharp_thickness=3.0),
-                                  dict(use_hidden_lines=True)])
+@pytest.mark.parametrize(
+    "look",
+    [dict(), dict(use_sharp_edges=True, sharp_pattern="DASHED", sharp_thickness=3.0), dict(use_hidden_lines=True)],
+)
 def test_the_overlay_draws_region_lines_as_the_render_does(look, output_dir):
     """The viewport overlay draws the same region lines over the viewport's
     own depth, compared with the engine's image as the overlay tests do."""
@@ -177,8 +190,14 @@ def test_the_overlay_draws_region_lines_as_the_render_does(look, output_dir):
     for edge in cube.data.edges[:4]:
         edge.use_edge_sharp = True
     _subdivided(cube, 3)
-    tube = scenes.mesh_object(scene, "Tube", lambda bm: bmesh.ops.create_cone(
-        bm, cap_ends=True, cap_tris=False, segments=12, radius1=0.6, radius2=0.6, depth=1.0), location=(1.6, 0.4, 0))
+    tube = scenes.mesh_object(
+        scene,
+        "Tube",
+        lambda bm: bmesh.ops.create_cone(
+            bm, cap_ends=True, cap_tris=False, segments=12, radius1=0.6, radius2=0.6, depth=1.0
+        ),
+        location=(1.6, 0.4, 0),
+    )
     _subdivided(tube, 2)
     scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0.5, 0, 0))
     depsgraph = bpy.context.evaluated_depsgraph_get()

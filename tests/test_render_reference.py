@@ -26,15 +26,35 @@ def _floor_and_wall(scene):
 def _mixed_mesh(scene):
     # Triangles, quads (convex, concave, non-planar) and n-gons in one mesh.
     verts = [
-        (0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0),  # quad
-        (2, 0, 0), (2.5, 1, 0),  # triangle 1-4-5 and 1-5-2
-        (-1.5, 0, 0), (-2.2, 0.7, 0.2), (-1.8, 1.5, 0), (-0.9, 1.6, -0.1), (-0.6, 0.8, 0.0),  # pentagon
-        (0, 2, 0), (1, 2, 0.4), (0.5, 2.2, 0), (0.5, 3, 0),  # concave quad (dart)
-        (2, 2, 0), (3, 2, 0), (3.2, 3, 0), (2.6, 3.6, 0), (2, 3, 0), (1.7, 2.5, 0),  # hexagon
+        (0, 0, 0),
+        (1, 0, 0),
+        (1, 1, 0),
+        (0, 1, 0),  # quad
+        (2, 0, 0),
+        (2.5, 1, 0),  # triangle 1-4-5 and 1-5-2
+        (-1.5, 0, 0),
+        (-2.2, 0.7, 0.2),
+        (-1.8, 1.5, 0),
+        (-0.9, 1.6, -0.1),
+        (-0.6, 0.8, 0.0),  # pentagon
+        (0, 2, 0),
+        (1, 2, 0.4),
+        (0.5, 2.2, 0),
+        (0.5, 3, 0),  # concave quad (dart)
+        (2, 2, 0),
+        (3, 2, 0),
+        (3.2, 3, 0),
+        (2.6, 3.6, 0),
+        (2, 3, 0),
+        (1.7, 2.5, 0),  # hexagon
     ]
     faces = [
-        (0, 1, 2, 3), (1, 4, 5), (1, 5, 2), (6, 7, 8, 9, 10),
-        (11, 12, 14, 13), (15, 16, 17, 18, 19, 20),
+        (0, 1, 2, 3),
+        (1, 4, 5),
+        (1, 5, 2),
+        (6, 7, 8, 9, 10),
+        (11, 12, 14, 13),
+        (15, 16, 17, 18, 19, 20),
     ]
     scenes.from_pydata(scene, "Mixed", verts, faces, location=(0, 0, 0))
     scenes.add_camera(scene, location=(0.5, -3.0, 5.0), target=(0.5, 1.5, 0.0), lens=35.0)
@@ -153,8 +173,11 @@ def test_opaque_film_uses_world_colour(output_dir):
     rgba = scenes.render_to_file(scene, output_dir / "opaque_film.png")
     assert np.allclose(rgba[..., 3], 1.0)
     corner = rgba[2, 2, :3]
-    expected = np.where(np.array(world.color) <= 0.0031308, np.array(world.color) * 12.92,
-                        1.055 * np.array(world.color) ** (1 / 2.4) - 0.055)
+    expected = np.where(
+        np.array(world.color) <= 0.0031308,
+        np.array(world.color) * 12.92,
+        1.055 * np.array(world.color) ** (1 / 2.4) - 0.055,
+    )
     assert np.allclose(corner, expected, atol=2e-3)
 
 
@@ -207,8 +230,20 @@ def test_ngon_and_quad_diagonals_match_reference(mode, output_dir):
     "settings",
     [
         {"thickness_mode": "WORLD", "world_thickness": 0.05},
-        {"thickness_mode": "DEPTH", "thickness": 5.0, "thickness_far": 0.5, "thickness_depth_start": 4.0, "thickness_depth_end": 14.0},
-        {"thickness_mode": "DEPTH", "thickness": 3.0, "thickness_far": 1.0, "thickness_depth_start": 6.0, "thickness_depth_end": 6.0},
+        {
+            "thickness_mode": "DEPTH",
+            "thickness": 5.0,
+            "thickness_far": 0.5,
+            "thickness_depth_start": 4.0,
+            "thickness_depth_end": 14.0,
+        },
+        {
+            "thickness_mode": "DEPTH",
+            "thickness": 3.0,
+            "thickness_far": 1.0,
+            "thickness_depth_start": 6.0,
+            "thickness_depth_end": 6.0,
+        },
     ],
     ids=["world", "depth_cue", "depth_cue_step"],
 )

@@ -282,8 +282,9 @@ def test_viewport_trusts_depsgraph_updates(monkeypatch):
     runtime.begin_frame(reuse=True)  # installs the handlers
     fingerprints = []
     real_fingerprint = gather.fingerprint
-    monkeypatch.setattr(gather, "fingerprint",
-                        lambda mesh, *more: fingerprints.append(mesh.name) or real_fingerprint(mesh, *more))
+    monkeypatch.setattr(
+        gather, "fingerprint", lambda mesh, *more: fingerprints.append(mesh.name) or real_fingerprint(mesh, *more)
+    )
 
     def frame():
         runtime.mesh_cache.reset_counters()

@@ -25,9 +25,30 @@ SOURCES = sorted(PACKAGE.rglob("*.py"))
 # Modules an add-on that needs no network, no processes and no code loading
 # has no business importing at run time.
 FORBIDDEN_MODULES = {
-    "socket", "ssl", "urllib", "urllib3", "requests", "http", "httpx", "aiohttp", "ftplib", "smtplib", "poplib",
-    "imaplib", "telnetlib", "xmlrpc", "websocket", "websockets", "subprocess", "multiprocessing", "pty", "pickle",
-    "marshal", "shelve", "ctypes", "webbrowser",
+    "socket",
+    "ssl",
+    "urllib",
+    "urllib3",
+    "requests",
+    "http",
+    "httpx",
+    "aiohttp",
+    "ftplib",
+    "smtplib",
+    "poplib",
+    "imaplib",
+    "telnetlib",
+    "xmlrpc",
+    "websocket",
+    "websockets",
+    "subprocess",
+    "multiprocessing",
+    "pty",
+    "pickle",
+    "marshal",
+    "shelve",
+    "ctypes",
+    "webbrowser",
 }
 FORBIDDEN_CALLS = {"eval", "exec", "compile", "__import__", "execfile"}
 # What each manifest permission is for, and the evidence of its use in code.
@@ -73,14 +94,17 @@ def test_addon_sources_import_no_network_process_or_code_loading_modules():
 
 def test_scanner_sees_a_forbidden_import():
     """The scan above can fail (a test that cannot fail is no test)."""
-    tree = ast.parse("import socket\nfrom urllib.request import urlopen\nimportlib.import_module('subprocess')\neval('1')")
+    tree = ast.parse(
+        "import socket\nfrom urllib.request import urlopen\nimportlib.import_module('subprocess')\neval('1')"
+    )
     assert {"socket", "urllib", "subprocess"} <= _imports(tree)
     assert "eval" in _calls(tree)
 
 
 def test_loaded_addon_modules_hold_no_network_module():
-    held = robustness.scan_module_state(lambda v: getattr(v, "__name__", "").split(".")[0] in FORBIDDEN_MODULES
-                                        and type(v).__name__ == "module")
+    held = robustness.scan_module_state(
+        lambda v: getattr(v, "__name__", "").split(".")[0] in FORBIDDEN_MODULES and type(v).__name__ == "module"
+    )
     assert held == []
 
 
@@ -162,7 +186,10 @@ def _hostile(marker: Path) -> dict:
         "code as a key": json.dumps(document | {"settings": {code: 1.0}}),
         "python preset file": f"import os\nos.system('touch {marker}')\nbpy.context.scene.solidwire.thickness = 9\n",
         "dunder keys": json.dumps(document | {"__class__": "x", "settings": {"__dict__": {}}}),
-        "deeply nested": '{"solidwire_preset": 1, "name": "Deep", "settings": {"thickness": ' + "[" * 25_000 + "]" * 25_000 + "}}",
+        "deeply nested": '{"solidwire_preset": 1, "name": "Deep", "settings": {"thickness": '
+        + "[" * 25_000
+        + "]" * 25_000
+        + "}}",
         "huge number": json.dumps(document).replace("2.0", "1" + "0" * 5000),
         "huge file": json.dumps(document | {"description": "y" * 70_000}),
         "wrong types everywhere": json.dumps({"solidwire_preset": "1", "name": ["x"], "settings": [1, 2]}),
@@ -194,8 +221,10 @@ def test_code_in_a_name_is_only_text(tmp_path):
     marker = tmp_path / MARKER
     code = _code(marker)[:60]
     path = tmp_path / "named.json"
-    path.write_text(json.dumps({"solidwire_preset": 1, "name": code, "description": _code(marker),
-                                "settings": {"thickness": 2.0}}), encoding="utf-8")
+    path.write_text(
+        json.dumps({"solidwire_preset": 1, "name": code, "description": _code(marker), "settings": {"thickness": 2.0}}),
+        encoding="utf-8",
+    )
     preset = presets.load(path)
     assert preset.name == code.strip()
     scene = scenes.empty_scene(32, 24)

@@ -34,8 +34,9 @@ def _rss_mb() -> float:
 
 
 def _animated_scene(frames: int):
-    scene = scenes.empty_scene(96, 72, thickness=1.5, diagonal_mode="DASHED", use_fade=True, fade_start=4.0,
-                               fade_end=14.0)
+    scene = scenes.empty_scene(
+        96, 72, thickness=1.5, diagonal_mode="DASHED", use_fade=True, fade_start=4.0, fade_end=14.0
+    )
     scene.frame_start, scene.frame_end = 1, frames
     monkey = scenes.monkey(scene, "Waving", subdivisions=1)
     wave = monkey.modifiers.new("Wave", "WAVE")
@@ -98,8 +99,9 @@ def test_soak_animation_memory_is_flat(tmp_path, output_dir):
         "meshes_extracted_per_frame_median": sorted(s["meshes_extracted"] for s in samples)[FRAMES // 2],
     }
     print("\nSOAK", json.dumps(summary))
-    (output_dir / "soak.json").write_text(json.dumps({"summary": summary, "samples": samples[:: max(FRAMES // 100, 1)]},
-                                                     indent=1))
+    (output_dir / "soak.json").write_text(
+        json.dumps({"summary": summary, "samples": samples[:: max(FRAMES // 100, 1)]}, indent=1)
+    )
 
     # The deforming mesh really is re-extracted every frame (else: no soak).
     assert summary["meshes_extracted_per_frame_median"] >= 1

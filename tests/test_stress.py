@@ -81,11 +81,15 @@ def test_nvidia2007_fails_on_near_plane_scene():
     off_silhouette = ~ref.on_silhouette
     glitch = np.abs(nvidia - kakadu)[off_silhouette]
     assert np.count_nonzero(glitch > 2.0 / 255.0) > 0
-    assert np.abs(kakadu - ref.intensity)[off_silhouette][glitch > 2.0 / 255.0].mean() < glitch[glitch > 2.0 / 255.0].mean()
+    assert (
+        np.abs(kakadu - ref.intensity)[off_silhouette][glitch > 2.0 / 255.0].mean()
+        < glitch[glitch > 2.0 / 255.0].mean()
+    )
 
 
-@pytest.mark.parametrize("method", ["nvidia2007", "kakadu_clip", "barycentric", "offset_lines", "offset_lines_2x",
-                                    "fill_only"])
+@pytest.mark.parametrize(
+    "method", ["nvidia2007", "kakadu_clip", "barycentric", "offset_lines", "offset_lines_2x", "fill_only"]
+)
 def test_method_variants_render_finite_images(method):
     """Every developer method compiles, draws and returns finite values."""
     scene = scenes.empty_scene(320, 180, diagonal_mode="SOLID")

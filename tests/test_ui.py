@@ -194,8 +194,12 @@ def test_sidebar_panel_draws_every_setting(context):
         assert name in drawn, name
     # The active object's own settings, the override's values greyed while it is off.
     assert layout.greyed_props(context.object.solidwire) == {
-        "show_in_viewport": False, "show_in_render": False, "use_override": False,
-        "wire_color": True, "thickness": True, "fill_color": True,
+        "show_in_viewport": False,
+        "show_in_render": False,
+        "use_override": False,
+        "wire_color": True,
+        "thickness": True,
+        "fill_color": True,
     }
     assert "solidwire.fade_from_visible" in layout.operators
 
@@ -214,8 +218,17 @@ def test_rows_that_do_not_apply_are_greyed_not_hidden(context):
         assert greyed[name], f"{name} should be greyed"
     assert not greyed["thickness"]
 
-    for name in ("hidden_alpha", "hidden_period", "hidden_duty", "world_thickness", "thickness_far",
-                 "density_fade_length", "seam_color", "sharp_thickness", "boundary_pattern"):
+    for name in (
+        "hidden_alpha",
+        "hidden_period",
+        "hidden_duty",
+        "world_thickness",
+        "thickness_far",
+        "density_fade_length",
+        "seam_color",
+        "sharp_thickness",
+        "boundary_pattern",
+    ):
         assert greyed[name], f"{name} should be greyed"
 
     props.use_fill, props.diagonal_mode, props.use_fade, props.show_overlay = True, "DASHED", True, True
@@ -231,7 +244,10 @@ def test_rows_that_do_not_apply_are_greyed_not_hidden(context):
     props.thickness_mode = "WORLD"
     greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
     assert {name for name, g in greyed.items() if g} == {
-        "thickness", "thickness_far", "thickness_depth_start", "thickness_depth_end"
+        "thickness",
+        "thickness_far",
+        "thickness_depth_start",
+        "thickness_depth_end",
     }
     props.use_hidden_lines, props.thickness_mode = False, "PIXELS"
     props.use_density_fade = False
@@ -354,8 +370,15 @@ def test_view_layer_passes_panel(context):
     assert ui.VIEWLAYER_PT_solidwire_passes.poll(ctx)
     assert not ui.VIEWLAYER_PT_solidwire_passes.poll(SimpleNamespace(engine="CYCLES", view_layer=view_layer))
     drawn = draw_with(ui.VIEWLAYER_PT_solidwire_passes.draw, ctx).greyed_props()
-    assert set(drawn) == {"use_pass_z", "use_pass_normal", "use_pass_object_index", "use_pass_material_index",
-                          "use_pass_wire", "use_pass_hidden_wire", "use_pass_edge_distance"}
+    assert set(drawn) == {
+        "use_pass_z",
+        "use_pass_normal",
+        "use_pass_object_index",
+        "use_pass_material_index",
+        "use_pass_wire",
+        "use_pass_hidden_wire",
+        "use_pass_edge_distance",
+    }
     # Switching a pass asks Blender for the engine's passes again (no error headless).
     view_layer.solidwire.use_pass_wire = True
     view_layer.solidwire.use_pass_wire = False

@@ -190,8 +190,9 @@ def flat_colours(view_transform: str):
     """(Blender's Solid colour, SolidWire's fill colour as the screen shows
     it, the scene's display transform of the colour), each (N, 3) in 0..1
     over the inner pixels of a cube, for one flat scene-linear colour."""
-    scene = scenes.empty_scene(WIDTH, HEIGHT, use_fill=True, fill_shading="FLAT", fill_color=FLAT_COLOR,
-                               wire_color=(0.0, 0.0, 0.0, 0.0))
+    scene = scenes.empty_scene(
+        WIDTH, HEIGHT, use_fill=True, fill_shading="FLAT", fill_color=FLAT_COLOR, wire_color=(0.0, 0.0, 0.0, 0.0)
+    )
     scene.view_settings.view_transform = view_transform
     scenes.add_camera(scene, location=(6.0, -5.0, 4.0))
     cube = scenes.cube(scene, "Cube", size=2.4)

@@ -187,9 +187,11 @@ def fmt_err(value):
 
 def write_markdown(results, meta, path: Path):
     lines = [
-        (f"Machine: {meta['machine']}. Frame {meta['size'][0]}x{meta['size'][1]}; time = median ms per frame over "
-        f"{meta['frames']} frames after {meta['warmup']} warm-up frames, GPU synchronised (CPU timings on llvmpipe). "
-        f"Error vs the float64 reference on {meta['reference_rows']}, silhouette samples excluded."),
+        (
+            f"Machine: {meta['machine']}. Frame {meta['size'][0]}x{meta['size'][1]}; time = median ms per frame over "
+            f"{meta['frames']} frames after {meta['warmup']} warm-up frames, GPU synchronised (CPU timings on llvmpipe). "
+            f"Error vs the float64 reference on {meta['reference_rows']}, silhouette samples excluded."
+        ),
         "",
         "| scene | method | ms/frame | x fill_only | mean abs dI | p99.9 abs dI | max abs dI | px > 2/255 |",
         "|---|---|---:|---:|---:|---:|---:|---:|",
@@ -233,9 +235,7 @@ def targets_summary(results):
             entry[f"lower_{metric}_than_exact"] = [
                 r["method"] for r in others if r["error"][metric] < ex["error"][metric]
             ]
-        entry["dominates_exact"] = [
-            r["method"] for r in others if r["ms"] < ex["ms"] and key(r) <= key(ex)
-        ]
+        entry["dominates_exact"] = [r["method"] for r in others if r["ms"] < ex["ms"] and key(r) <= key(ex)]
         entry["exact_on_pareto_front"] = not entry["dominates_exact"]
         summary[scene_name] = entry
     return summary
@@ -259,8 +259,13 @@ def plot(results, path: Path, meta):
                 if not r.get("error") or r["method"] == "fill_only":
                     continue
                 ax.scatter(
-                    r["ms"], max(r["error"][metric], floor), marker=markers.get(r["method"], "o"),
-                    color=colour, s=46, edgecolors="black", linewidths=0.4,
+                    r["ms"],
+                    max(r["error"][metric], floor),
+                    marker=markers.get(r["method"], "o"),
+                    color=colour,
+                    s=46,
+                    edgecolors="black",
+                    linewidths=0.4,
                 )
         ax.set_xscale("log")
         # Ticks at 1, 2, 5 x 10^k in plain numbers: over less than two
@@ -275,11 +280,16 @@ def plot(results, path: Path, meta):
         ax.grid(True, which="both", lw=0.3, alpha=0.5)
     from matplotlib.lines import Line2D
 
-    handles = [Line2D([], [], marker=markers.get(m, "o"), ls="", color="grey", markeredgecolor="black", label=m)
-               for m in [*methods.ALL_METHODS, "peer_workbench_wireframe"] if m != "fill_only"]
+    handles = [
+        Line2D([], [], marker=markers.get(m, "o"), ls="", color="grey", markeredgecolor="black", label=m)
+        for m in [*methods.ALL_METHODS, "peer_workbench_wireframe"]
+        if m != "fill_only"
+    ]
     handles += [Line2D([], [], marker="o", ls="", color=c, label=s) for c, s in zip(colours, scene_names)]
     fig.legend(handles=handles, loc="center right", fontsize=8, frameon=False)
-    fig.suptitle(f"SolidWire benchmark: time vs error, {meta['size'][0]}x{meta['size'][1]} ({meta['machine']})", fontsize=10)
+    fig.suptitle(
+        f"SolidWire benchmark: time vs error, {meta['size'][0]}x{meta['size'][1]} ({meta['machine']})", fontsize=10
+    )
     fig.tight_layout(rect=(0, 0, 0.83, 0.95))
     fig.savefig(path, dpi=80)
     plt.close(fig)
@@ -311,8 +321,14 @@ def crops(images: dict, path: Path, crop=(220, 150), zoom=3):
     fig, axes = plt.subplots(1, len(names), figsize=(3.2 * len(names), 2.6))
     for ax, name in zip(np.atleast_1d(axes), names):
         tile = images[name][y0 : y0 + ch, x0 : x0 + cw]
-        ax.imshow(np.repeat(np.repeat(tile, zoom, 0), zoom, 1), origin="lower", cmap="gray", vmin=0, vmax=1,
-                  interpolation="nearest")
+        ax.imshow(
+            np.repeat(np.repeat(tile, zoom, 0), zoom, 1),
+            origin="lower",
+            cmap="gray",
+            vmin=0,
+            vmax=1,
+            interpolation="nearest",
+        )
         ax.set_title(name, fontsize=9)
         ax.set_xticks([])
         ax.set_yticks([])
@@ -345,9 +361,13 @@ def main(argv=None):
     parser.add_argument("--no-peers", action="store_true", help="skip Workbench and Freestyle")
     parser.add_argument("--out", default=str(ROOT / "out" / "bench"))
     parser.add_argument("--docs", metavar="DIR", help="also copy the two pictures there (e.g. docs/, for the manual)")
-    parser.add_argument("--engines", action="append", metavar="WxH",
-                        help="also time F12 against Blender's own engines at this size, with the SolidWire frame "
-                        "stage by stage (scripts/bench_engines.py; repeatable)")
+    parser.add_argument(
+        "--engines",
+        action="append",
+        metavar="WxH",
+        help="also time F12 against Blender's own engines at this size, with the SolidWire frame "
+        "stage by stage (scripts/bench_engines.py; repeatable)",
+    )
     args = parser.parse_args(argv)
 
     width, height = (int(v) for v in args.size.lower().split("x"))
@@ -399,8 +419,11 @@ def main(argv=None):
             start = time.perf_counter()
             rows = np.arange(row_step // 2, height, row_step)
             ref = reference.render_reference(scene, depsgraph, size=(width, height), rows=rows)
-            print(f"bench: {scene_name}: {triangles} triangles; reference on {len(rows)} rows "
-                  f"in {time.perf_counter() - start:.1f} s", flush=True)
+            print(
+                f"bench: {scene_name}: {triangles} triangles; reference on {len(rows)} rows "
+                f"in {time.perf_counter() - start:.1f} s",
+                flush=True,
+            )
 
         rows_out = []
         measured = time_methods(method_list, items, view, settings, turning, base, warmup, frames)
@@ -417,9 +440,12 @@ def main(argv=None):
             if scene_name == "near_plane" and method in ("nvidia2007", "kakadu_clip", "exact"):
                 crop_images[method] = intensity
             e = row["error"] or {}
-            print(f"bench: {scene_name:11s} {method:16s} {row['ms']:9.2f} ms  mean {e.get('mean', float('nan')):.2e} "
-                  f"p99.9 {e.get('p999', float('nan')):.2e} max {e.get('max', float('nan')):.3f} "
-                  f">2/255 {e.get('over_2_255', '-')}", flush=True)
+            print(
+                f"bench: {scene_name:11s} {method:16s} {row['ms']:9.2f} ms  mean {e.get('mean', float('nan')):.2e} "
+                f"p99.9 {e.get('p999', float('nan')):.2e} max {e.get('max', float('nan')):.3f} "
+                f">2/255 {e.get('over_2_255', '-')}",
+                flush=True,
+            )
 
         if not args.no_peers and scene_name in ("teapot", "bunny", "suzanne_1m", "near_plane"):
             repeats = 2 if args.quick else 3
@@ -431,14 +457,31 @@ def main(argv=None):
                 err = error_numbers(alpha, ref) if (shading == "WIREFRAME" and alpha.max() > 0) else None
                 if shading == "WIREFRAME" and alpha.max() == 0:
                     print("bench: note: Workbench Wireframe returned an empty image here; time only", flush=True)
-                rows_out.append({"method": f"peer_workbench_{shading.lower()}", "ms": statistics.median(times),
-                                 "ms_all": times, "error": err, "triangles": triangles})
-                print(f"bench: {scene_name:11s} workbench {shading:9s} {statistics.median(times):9.2f} ms "
-                      f"(whole bpy.ops.render.render)", flush=True)
+                rows_out.append(
+                    {
+                        "method": f"peer_workbench_{shading.lower()}",
+                        "ms": statistics.median(times),
+                        "ms_all": times,
+                        "error": err,
+                        "triangles": triangles,
+                    }
+                )
+                print(
+                    f"bench: {scene_name:11s} workbench {shading:9s} {statistics.median(times):9.2f} ms "
+                    f"(whole bpy.ops.render.render)",
+                    flush=True,
+                )
             if scene_name == "teapot":
                 times, _alpha = render_engine_peer(scene, "CYCLES", None, 1, out_dir, freestyle=True)
-                rows_out.append({"method": "peer_freestyle_cycles_1spp", "ms": times[0], "ms_all": times,
-                                 "error": None, "triangles": triangles})
+                rows_out.append(
+                    {
+                        "method": "peer_freestyle_cycles_1spp",
+                        "ms": times[0],
+                        "ms_all": times,
+                        "error": None,
+                        "triangles": triangles,
+                    }
+                )
                 print(f"bench: teapot      freestyle (Cycles 1 spp) {times[0]:9.2f} ms", flush=True)
         results[scene_name] = rows_out
         methods.release()
@@ -450,8 +493,9 @@ def main(argv=None):
         from scripts import bench_engines
 
         engine_size = tuple(int(v) for v in text.lower().split("x"))
-        engine_lines += bench_engines.run(engine_size, subdivisions=5, repeats=2 if args.quick else 5,
-                                          freestyle=not args.no_peers)
+        engine_lines += bench_engines.run(
+            engine_size, subdivisions=5, repeats=2 if args.quick else 5, freestyle=not args.no_peers
+        )
         print("\n".join(engine_lines), flush=True)
     if engine_lines:
         data["engines_markdown"] = engine_lines
@@ -473,8 +517,10 @@ def main(argv=None):
             if (out_dir / name).exists():
                 shutil.copyfile(out_dir / name, docs / f"bench_{name}")
     print(json.dumps(summary, indent=1))
-    print(f"bench: wrote {out_dir}/results.json, results.md, time_vs_error.png"
-          + (", near_plane_crops.png" if crop_images else ""))
+    print(
+        f"bench: wrote {out_dir}/results.json, results.md, time_vs_error.png"
+        + (", near_plane_crops.png" if crop_images else "")
+    )
     solidwire_addon.unregister()
     return 0
 

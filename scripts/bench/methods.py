@@ -163,7 +163,9 @@ def _method_create_info(method: str, variant):
 
     common = shaders.read_source("common.glsl")
     info.vertex_source(common + own("pull_vert.glsl") + own(f"{files}_vert.glsl"))
-    info.fragment_source(common + shaders.read_source("line_style.glsl") + own("output_frag.glsl") + own(f"{files}_frag.glsl"))
+    info.fragment_source(
+        common + shaders.read_source("line_style.glsl") + own("output_frag.glsl") + own(f"{files}_frag.glsl")
+    )
     return info
 
 
@@ -191,7 +193,9 @@ def _draw(items, view, settings, method: str, **kwargs):
     return draw_mod.draw(items, view, settings, program=program, **kwargs)
 
 
-def draw_method(items, view, settings, method: str, *, write_view_depth: bool = False, cull: bool = True, line_width: float = 1.0):
+def draw_method(
+    items, view, settings, method: str, *, write_view_depth: bool = False, cull: bool = True, line_width: float = 1.0
+):
     """Draw ``items`` with ``method`` into the bound framebuffer (no
     supersampling here: that is a render-target matter, see Renderer)."""
     base, _factor = base_method(method)
@@ -202,8 +206,15 @@ def draw_method(items, view, settings, method: str, *, write_view_depth: bool = 
     stats = _draw(items, view, settings, "fill_only", write_view_depth=write_view_depth, cull=cull)
     gpu.state.line_width_set(line_width)
     try:
-        _draw(items, view, settings, "offset_lines", write_view_depth=write_view_depth, cull=cull,
-              depth_bias=LINE_DEPTH_OFFSET)
+        _draw(
+            items,
+            view,
+            settings,
+            "offset_lines",
+            write_view_depth=write_view_depth,
+            cull=cull,
+            depth_bias=LINE_DEPTH_OFFSET,
+        )
     finally:
         gpu.state.line_width_set(1.0)
     return stats

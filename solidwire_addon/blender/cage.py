@@ -49,17 +49,43 @@ SUBDIVISION_TYPES = frozenset({"SUBSURF", "MULTIRES"})
 # move vertices or write data layers only. One of these after a subdivision
 # keeps its edge order; any other enabled modifier after it makes the answer
 # unknowable (None). (bpy 5.0 names; unknown names are simply not listed.)
-TOPOLOGY_KEEPING_TYPES = frozenset({
-    # Deform
-    "ARMATURE", "CAST", "CURVE", "DISPLACE", "HOOK", "LAPLACIANDEFORM", "LATTICE", "MESH_DEFORM",
-    "SHRINKWRAP", "SIMPLE_DEFORM", "SMOOTH", "CORRECTIVE_SMOOTH", "LAPLACIANSMOOTH", "SURFACE_DEFORM",
-    "WARP", "WAVE", "MESH_CACHE",
-    # Data only (normals, UVs, weights, transferred layers)
-    "NORMAL_EDIT", "WEIGHTED_NORMAL", "UV_PROJECT", "UV_WARP", "VERTEX_WEIGHT_EDIT", "VERTEX_WEIGHT_MIX",
-    "VERTEX_WEIGHT_PROXIMITY", "DATA_TRANSFER",
-    # Physics that pass the mesh through (deform only)
-    "CLOTH", "SOFT_BODY", "COLLISION", "SURFACE", "PARTICLE_SYSTEM",
-})
+TOPOLOGY_KEEPING_TYPES = frozenset(
+    {
+        # Deform
+        "ARMATURE",
+        "CAST",
+        "CURVE",
+        "DISPLACE",
+        "HOOK",
+        "LAPLACIANDEFORM",
+        "LATTICE",
+        "MESH_DEFORM",
+        "SHRINKWRAP",
+        "SIMPLE_DEFORM",
+        "SMOOTH",
+        "CORRECTIVE_SMOOTH",
+        "LAPLACIANSMOOTH",
+        "SURFACE_DEFORM",
+        "WARP",
+        "WAVE",
+        "MESH_CACHE",
+        # Data only (normals, UVs, weights, transferred layers)
+        "NORMAL_EDIT",
+        "WEIGHTED_NORMAL",
+        "UV_PROJECT",
+        "UV_WARP",
+        "VERTEX_WEIGHT_EDIT",
+        "VERTEX_WEIGHT_MIX",
+        "VERTEX_WEIGHT_PROXIMITY",
+        "DATA_TRANSFER",
+        # Physics that pass the mesh through (deform only)
+        "CLOTH",
+        "SOFT_BODY",
+        "COLLISION",
+        "SURFACE",
+        "PARTICLE_SYSTEM",
+    }
+)
 
 MAX_LEVEL = 11  # Subdivision Surface's own limit
 
@@ -279,7 +305,13 @@ def cage_key(obj, render: bool):
         if md.type == "SUBSURF":
             entry += (int(md.levels), int(md.render_levels), bool(md.show_only_control_edges))
         elif md.type == "MULTIRES":
-            entry += (int(md.levels), int(md.render_levels), int(md.sculpt_levels), int(md.total_levels),
-                      bool(md.use_sculpt_base_mesh), bool(md.show_only_control_edges))
+            entry += (
+                int(md.levels),
+                int(md.render_levels),
+                int(md.sculpt_levels),
+                int(md.total_levels),
+                bool(md.use_sculpt_base_mesh),
+                bool(md.show_only_control_edges),
+            )
         parts.append(entry)
     return tuple(parts)

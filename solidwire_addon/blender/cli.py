@@ -186,7 +186,8 @@ def _frame_list(text: str) -> list[tuple[Relative, Relative]]:
         except ValueError:
             raise argparse.ArgumentTypeError(
                 f"'{text}' is not a frame list (N, A..B or a comma list of them; +N and -N count from "
-                "the scene's start and end)") from None
+                "the scene's start and end)"
+            ) from None
     return items
 
 
@@ -197,9 +198,14 @@ def _frame_step(text: str) -> int:
 
 # Options whose value may start with "-" (Blender's "-f -1"): argparse would
 # read such a value as an option, so it is joined to its long option first.
-_SIGNED_VALUE_OPTIONS = {"-f": "--render-frame", "--render-frame": "--render-frame",
-                         "-s": "--frame-start", "--frame-start": "--frame-start",
-                         "-e": "--frame-end", "--frame-end": "--frame-end"}
+_SIGNED_VALUE_OPTIONS = {
+    "-f": "--render-frame",
+    "--render-frame": "--render-frame",
+    "-s": "--frame-start",
+    "--frame-start": "--frame-start",
+    "-e": "--frame-end",
+    "--frame-end": "--frame-end",
+}
 
 
 def _join_signed_values(arguments: list[str]) -> list[str]:
@@ -207,8 +213,12 @@ def _join_signed_values(arguments: list[str]) -> list[str]:
     while index < len(arguments):
         word = arguments[index]
         option = _SIGNED_VALUE_OPTIONS.get(word)
-        if option is not None and index + 1 < len(arguments) and arguments[index + 1].startswith("-") \
-                and arguments[index + 1][1:2].isdigit():
+        if (
+            option is not None
+            and index + 1 < len(arguments)
+            and arguments[index + 1].startswith("-")
+            and arguments[index + 1][1:2].isdigit()
+        ):
             joined.append(f"{option}={arguments[index + 1]}")
             index += 2
             continue
@@ -221,19 +231,27 @@ def _add_setting_option(group, setting: schema.Setting) -> None:
     """The option of one schema setting (its flag, parser and help)."""
     help_text = setting.description[0].lower() + setting.description[1:]
     if setting.kind == schema.BOOL:
-        group.add_argument(setting.flag, dest=setting.name, action=argparse.BooleanOptionalAction,
-                           default=None, help=help_text)
+        group.add_argument(
+            setting.flag, dest=setting.name, action=argparse.BooleanOptionalAction, default=None, help=help_text
+        )
     elif setting.kind == schema.ENUM:
         # Upper-case identifiers take any case; names (matcaps) as written.
         upper = all(choice == choice.upper() for choice in setting.choices)
-        group.add_argument(setting.flag, dest=setting.name, choices=setting.choices,
-                           type=str.upper if upper else str, help=help_text)
+        group.add_argument(
+            setting.flag, dest=setting.name, choices=setting.choices, type=str.upper if upper else str, help=help_text
+        )
     elif setting.kind == schema.COLOR:
-        group.add_argument(setting.flag, dest=setting.name, type=_color, metavar="R,G,B[,A]",
-                           help=help_text + " (0..1 or #RRGGBB)")
+        group.add_argument(
+            setting.flag, dest=setting.name, type=_color, metavar="R,G,B[,A]", help=help_text + " (0..1 or #RRGGBB)"
+        )
     else:
-        group.add_argument(setting.flag, dest=setting.name, type=_finite_float,
-                           metavar=_METAVARS.get(setting.subtype, "X"), help=help_text)
+        group.add_argument(
+            setting.flag,
+            dest=setting.name,
+            type=_finite_float,
+            metavar=_METAVARS.get(setting.subtype, "X"),
+            help=help_text,
+        )
 
 
 def build_parser(prog: str = "solidwire render") -> argparse.ArgumentParser:
@@ -244,23 +262,46 @@ def build_parser(prog: str = "solidwire render") -> argparse.ArgumentParser:
     )
     parser.add_argument("blend", nargs="?", metavar="SCENE.blend", help="the .blend file to render")
     parser.add_argument(
-        "-o", "--output", metavar="PATH",
+        "-o",
+        "--output",
+        metavar="PATH",
         help="image file to write (.png, .jpg, .tif, .exr, .webp, .bmp); '#' characters become the frame "
-             "number, '//' is the .blend's folder (default: the scene's output path and format)",
+        "number, '//' is the .blend's folder (default: the scene's output path and format)",
     )
     parser.add_argument("--scene", metavar="NAME", help="scene to render (default: the file's active scene)")
     parser.add_argument("--camera", metavar="NAME", help="camera object to render from (default: the scene camera)")
 
     frames = parser.add_argument_group("frames (as Blender's own command line spells them)")
-    frames.add_argument("-f", "--render-frame", dest="frame_list", type=_frame_list, metavar="N",
-                        help="render frame N ('A..B' and comma lists too; +N counts from the scene's start, "
-                             "-N from its end: -f -1 is the last frame)")
-    frames.add_argument("-a", "--render-anim", dest="animation", action="store_true",
-                        help="render the scene's frame range with its frame step")
-    frames.add_argument("-s", "--frame-start", type=_relative_frame, metavar="N",
-                        help="first frame of the range (implies -a; +N/-N relative to the scene's start)")
-    frames.add_argument("-e", "--frame-end", type=_relative_frame, metavar="N",
-                        help="last frame of the range (implies -a; +N/-N relative to the scene's end)")
+    frames.add_argument(
+        "-f",
+        "--render-frame",
+        dest="frame_list",
+        type=_frame_list,
+        metavar="N",
+        help="render frame N ('A..B' and comma lists too; +N counts from the scene's start, "
+        "-N from its end: -f -1 is the last frame)",
+    )
+    frames.add_argument(
+        "-a",
+        "--render-anim",
+        dest="animation",
+        action="store_true",
+        help="render the scene's frame range with its frame step",
+    )
+    frames.add_argument(
+        "-s",
+        "--frame-start",
+        type=_relative_frame,
+        metavar="N",
+        help="first frame of the range (implies -a; +N/-N relative to the scene's start)",
+    )
+    frames.add_argument(
+        "-e",
+        "--frame-end",
+        type=_relative_frame,
+        metavar="N",
+        help="last frame of the range (implies -a; +N/-N relative to the scene's end)",
+    )
     frames.add_argument("-j", "--frame-jump", type=_frame_step, metavar="N", help="frame step (implies -a)")
     frames.add_argument("--frames", type=_frame_range, metavar="A-B", help="frame or frame range (older spelling)")
 
@@ -270,40 +311,73 @@ def build_parser(prog: str = "solidwire render") -> argparse.ArgumentParser:
         if setting.flag:
             _add_setting_option(look, setting)
     for pair in schema.CLI_RANGES:
-        look.add_argument(pair.flag, dest=pair.flag[2:].replace("-", "_"), type=_finite_float, nargs=2,
-                          metavar=pair.metavar, help=pair.help)
+        look.add_argument(
+            pair.flag,
+            dest=pair.flag[2:].replace("-", "_"),
+            type=_finite_float,
+            nargs=2,
+            metavar=pair.metavar,
+            help=pair.help,
+        )
         if pair.off_flag:
-            look.add_argument(pair.off_flag, dest=pair.off_flag[2:].replace("-", "_"), action="store_true",
-                              help=f"switch {schema.BY_NAME[pair.enables].label.lower()} off")
+            look.add_argument(
+                pair.off_flag,
+                dest=pair.off_flag[2:].replace("-", "_"),
+                action="store_true",
+                help=f"switch {schema.BY_NAME[pair.enables].label.lower()} off",
+            )
 
     image = parser.add_argument_group("image")
     film = image.add_mutually_exclusive_group()
-    film.add_argument("--transparent", dest="transparent", action="store_true", default=None,
-                      help="transparent film (alpha where nothing is drawn)")
+    film.add_argument(
+        "--transparent",
+        dest="transparent",
+        action="store_true",
+        default=None,
+        help="transparent film (alpha where nothing is drawn)",
+    )
     film.add_argument("--opaque", dest="transparent", action="store_false", help="world colour behind the meshes")
     image.add_argument("--width", type=_positive_int, metavar="PX", help="resolution X")
     image.add_argument("--height", type=_positive_int, metavar="PX", help="resolution Y")
     image.add_argument("--percentage", type=_positive_int, metavar="PCT", help="resolution percentage")
     image.add_argument("--color-depth", choices=("8", "16"), help="bits per channel for PNG/TIFF (default 8)")
 
-    image.add_argument("--overwrite", action=argparse.BooleanOptionalAction, default=None,
-                       help="replace frames that exist (default: the scene's Overwrite setting; with "
-                            "--no-overwrite an existing frame is skipped, as Blender skips it)")
+    image.add_argument(
+        "--overwrite",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="replace frames that exist (default: the scene's Overwrite setting; with "
+        "--no-overwrite an existing frame is skipped, as Blender skips it)",
+    )
 
     report = parser.add_argument_group("progress")
-    report.add_argument("--progress", choices=("text", "json"), default="text",
-                        help="one line per frame for people (text) or one JSON object per frame (json)")
+    report.add_argument(
+        "--progress",
+        choices=("text", "json"),
+        default="text",
+        help="one line per frame for people (text) or one JSON object per frame (json)",
+    )
     report.add_argument("--print-stats", action="store_true", help="print the frame statistics after each frame")
 
     over = parser.add_argument_group("wire over a render")
-    over.add_argument("--over", metavar="ENGINE",
-                      help="render the image underneath with ENGINE (CYCLES, BLENDER_EEVEE or EEVEE, "
-                           "BLENDER_WORKBENCH or WORKBENCH, SCENE = the file's engine) and write the "
-                           "SolidWire pass composited over it")
-    over.add_argument("--over-samples", type=_positive_int, metavar="N",
-                      help="samples of the render underneath (Cycles, EEVEE; default: the scene's)")
-    over.add_argument("--over-layers", action="store_true",
-                      help="also write the two float layers as NAME.beauty.exr and NAME.wire.exr")
+    over.add_argument(
+        "--over",
+        metavar="ENGINE",
+        help="render the image underneath with ENGINE (CYCLES, BLENDER_EEVEE or EEVEE, "
+        "BLENDER_WORKBENCH or WORKBENCH, SCENE = the file's engine) and write the "
+        "SolidWire pass composited over it",
+    )
+    over.add_argument(
+        "--over-samples",
+        type=_positive_int,
+        metavar="N",
+        help="samples of the render underneath (Cycles, EEVEE; default: the scene's)",
+    )
+    over.add_argument(
+        "--over-layers",
+        action="store_true",
+        help="also write the two float layers as NAME.beauty.exr and NAME.wire.exr",
+    )
     return parser
 
 
@@ -420,7 +494,9 @@ def apply_options(scene, args) -> None:
                 for name, value, metavar in zip(pair.names, values, pair.metavar)
             )
             if second <= first:
-                raise UsageError(f"{pair.flag}: {pair.metavar[1]} ({second:g}) must be beyond {pair.metavar[0]} ({first:g})")
+                raise UsageError(
+                    f"{pair.flag}: {pair.metavar[1]} ({second:g}) must be beyond {pair.metavar[0]} ({first:g})"
+                )
             setattr(settings, pair.names[0], first)
             setattr(settings, pair.names[1], second)
             if pair.enables:
@@ -567,8 +643,12 @@ def written_passes(scene) -> list[str]:
                 continue
             for prop in owner.bl_rna.properties:
                 name = prop.identifier
-                if name.startswith("use_pass_") and name not in _NOT_PASSES and prop.type == "BOOLEAN" \
-                        and getattr(owner, name):
+                if (
+                    name.startswith("use_pass_")
+                    and name not in _NOT_PASSES
+                    and prop.type == "BOOLEAN"
+                    and getattr(owner, name)
+                ):
                     names.append(prop.name)
     return list(dict.fromkeys(names))
 
@@ -610,11 +690,15 @@ def check_scene_format(scene, over: bool) -> None:
     format the command line cannot write."""
     file_format = scene.render.image_settings.file_format
     if file_format in VIDEO_FORMATS or getattr(scene.render.image_settings, "media_type", "") == "VIDEO":
-        raise UsageError(f"the scene's output format is a video ({file_format}); the command line writes one image "
-                         "per frame: pass -o NAME_####.png (or .exr, .tif, ...)")
+        raise UsageError(
+            f"the scene's output format is a video ({file_format}); the command line writes one image "
+            "per frame: pass -o NAME_####.png (or .exr, .tif, ...)"
+        )
     if over and file_format == MULTILAYER:
-        raise UsageError("--over writes one composited image, but the scene's output format is multilayer "
-                         "OpenEXR: pass -o NAME_####.exr (single-layer) or another image type")
+        raise UsageError(
+            "--over writes one composited image, but the scene's output format is multilayer "
+            "OpenEXR: pass -o NAME_####.exr (single-layer) or another image type"
+        )
 
 
 # -- rendering -----------------------------------------------------------------
@@ -639,8 +723,9 @@ def over_renderer(scene, args):
 
     def render(scene, path, final_path):
         try:
-            composite.render_wire_over(scene, path, engine, keep_layers=args.over_layers, layers_name=final_path,
-                                       samples=args.over_samples)
+            composite.render_wire_over(
+                scene, path, engine, keep_layers=args.over_layers, layers_name=final_path, samples=args.over_samples
+            )
         except composite.CompositeError as exc:
             raise RenderFailed(f"--over {engine}: {exc}") from None
 
@@ -704,8 +789,7 @@ class Interrupts:
             os.close(write_fd)
         self._previous = {sig: signal.signal(sig, self._on_signal) for sig in self.SIGNALS}
         if self._pipe is not None:
-            threading.Thread(target=self._watch, args=(self._pipe[0],), name="solidwire-signals",
-                             daemon=True).start()
+            threading.Thread(target=self._watch, args=(self._pipe[0],), name="solidwire-signals", daemon=True).start()
         return True
 
     def uninstall(self) -> None:
@@ -762,8 +846,11 @@ class Interrupts:
     def stop_now(self, signum: int) -> None:
         self.remove_leftovers()
         try:
-            print(f"solidwire: stopped by {_signal_name(signum)} during a frame; frames already written are "
-                  "complete", file=sys.stderr, flush=True)
+            print(
+                f"solidwire: stopped by {_signal_name(signum)} during a frame; frames already written are complete",
+                file=sys.stderr,
+                flush=True,
+            )
         finally:
             os._exit(128 + signum)
 
@@ -886,8 +973,13 @@ class Progress:
         stats = runtime.stats()
         if self.args.progress == "json":
             record = {
-                "frame": frame, "index": index, "count": count, "seconds": round(seconds, 4),
-                "eta_seconds": round(eta, 3), "output": str(path), "stats": stats,
+                "frame": frame,
+                "index": index,
+                "count": count,
+                "seconds": round(seconds, 4),
+                "eta_seconds": round(eta, 3),
+                "output": str(path),
+                "stats": stats,
             }
             print(json.dumps(record), flush=True)
             return
@@ -1007,8 +1099,9 @@ def render_animation(scene, run: list[int], paths: dict, progress: Progress) -> 
             _interrupts.discard.discard(tmp)
             progress.written(frame, path, time.perf_counter() - started["time"])
         except Exception as exc:  # noqa: BLE001 - a handler must not raise: Blender would print it and go on
-            failure.append(f"frame {frame}: cannot write '{paths.get(frame, tmp)}': "
-                           f"{getattr(exc, 'strerror', None) or exc}")
+            failure.append(
+                f"frame {frame}: cannot write '{paths.get(frame, tmp)}': {getattr(exc, 'strerror', None) or exc}"
+            )
 
     def stop_reason():
         if _interrupts.signum is not None:
@@ -1046,11 +1139,15 @@ def _report_skipped(args, frame: int, index: int, count: int, path: Path) -> Non
     # Blender's line for a skipped frame, which render farms count as progress.
     print(f'skipping existing frame "{path}"', flush=True)
     if args.progress == "json":
-        print(json.dumps({"frame": frame, "index": index, "count": count, "skipped": True, "output": str(path)}),
-              flush=True)
+        print(
+            json.dumps({"frame": frame, "index": index, "count": count, "skipped": True, "output": str(path)}),
+            flush=True,
+        )
     else:
-        print(f"solidwire: frame {index} of {count} (frame {frame}) skipped: '{path}' exists and overwriting is "
-              "off", flush=True)
+        print(
+            f"solidwire: frame {index} of {count} (frame {frame}) skipped: '{path}' exists and overwriting is off",
+            flush=True,
+        )
 
 
 def _format_stat(value) -> str:
@@ -1092,9 +1189,11 @@ def run(arguments: list[str], *, prog: str = "solidwire render", build_demo=None
     if scene.render.use_multiview and scene.render.image_settings.views_format == "INDIVIDUAL":
         # Blender then writes one file per view (NAME_L, NAME_R), not the
         # frame's one file, which the command line writes and renames.
-        raise UsageError(f"scene '{scene.name}' renders stereo views to separate files, which the command line "
-                         "does not write: choose Stereo 3D in the output's Views Format, or render with "
-                         "blender -b SCENE.blend -E SOLIDWIRE -a")
+        raise UsageError(
+            f"scene '{scene.name}' renders stereo views to separate files, which the command line "
+            "does not write: choose Stereo 3D in the output's Views Format, or render with "
+            "blender -b SCENE.blend -E SOLIDWIRE -a"
+        )
     renderer = over_renderer(scene, args)  # before the engine is set: --over SCENE
     # Blender's own rules for an existing frame: skipped unless overwriting
     # (render.use_overwrite, or --overwrite / --no-overwrite for this run);
@@ -1122,8 +1221,12 @@ def main(arguments: list[str], **kwargs) -> int:
         print(f"solidwire: error: {exc}", file=sys.stderr, flush=True)
         return EXIT_USAGE
     except Interrupted as exc:
-        print(f"solidwire: stopped by {_signal_name(exc.signum)} after {exc.done} of {exc.total} frames; "
-              "frames already written are complete", file=sys.stderr, flush=True)
+        print(
+            f"solidwire: stopped by {_signal_name(exc.signum)} after {exc.done} of {exc.total} frames; "
+            "frames already written are complete",
+            file=sys.stderr,
+            flush=True,
+        )
         return 128 + exc.signum
     except KeyboardInterrupt:  # only where no handler could be installed
         print("solidwire: stopped by SIGINT", file=sys.stderr, flush=True)

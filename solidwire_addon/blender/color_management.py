@@ -199,8 +199,11 @@ def build(scene) -> DisplayLUT:
 def _can_build_now() -> bool:
     """As matcap decoding (blender/matcap_files.py): without an interface,
     in the main thread and not inside a render's GPU context."""
-    return (bpy.app.background and threading.current_thread() is threading.main_thread()
-            and shaders.current_gl_context() != "render-engine")
+    return (
+        bpy.app.background
+        and threading.current_thread() is threading.main_thread()
+        and shaders.current_gl_context() != "render-engine"
+    )
 
 
 def cached(key) -> DisplayLUT | None:
@@ -224,9 +227,11 @@ def _build_and_store(scene, key) -> DisplayLUT | None:
         return _store(scene.name, build(scene))
     except Exception as exc:  # noqa: BLE001 - the overlay still draws, scene-linear
         _failed.add(key)
-        warn_once(("display lut", type(exc).__name__, str(exc)),
-                  f"SolidWire: the overlay could not apply the scene's colour management "
-                  f"({type(exc).__name__}: {one_line(exc)}); it shows scene-linear colours")
+        warn_once(
+            ("display lut", type(exc).__name__, str(exc)),
+            f"SolidWire: the overlay could not apply the scene's colour management "
+            f"({type(exc).__name__}: {one_line(exc)}); it shows scene-linear colours",
+        )
         return None
 
 

@@ -106,6 +106,7 @@ def resolve_engine(scene, name: str | None) -> str:
 
 # -- OpenEXR -------------------------------------------------------------------
 
+
 def alpha_over(wire: np.ndarray, beauty: np.ndarray) -> np.ndarray:
     """Premultiplied ``wire`` over premultiplied ``beauty``."""
     wire = np.asarray(wire, dtype=np.float32)
@@ -170,8 +171,14 @@ def preserved(*owners_and_names):
 
 _IMAGE_SETTINGS = ("media_type", "file_format", "color_mode", "color_depth", "exr_codec", "color_management")
 _RENDER_SETTINGS = (
-    "engine", "filepath", "use_file_extension", "use_motion_blur", "use_border",
-    "film_transparent", "use_compositing", "use_sequencer",
+    "engine",
+    "filepath",
+    "use_file_extension",
+    "use_motion_blur",
+    "use_border",
+    "film_transparent",
+    "use_compositing",
+    "use_sequencer",
 )
 
 
@@ -273,8 +280,15 @@ def check_inputs(scene, engine=None, *, depth: bool = False) -> str:
     return resolve_engine(scene, engine)
 
 
-def render_layers(scene, engine=None, *, view_layer=None, samples: int | None = None, depth: bool = False,
-                  keep_exr: Path | None = None) -> Layers:
+def render_layers(
+    scene,
+    engine=None,
+    *,
+    view_layer=None,
+    samples: int | None = None,
+    depth: bool = False,
+    keep_exr: Path | None = None,
+) -> Layers:
     """Render the beauty with ``engine`` (default: the scene's) and the wire
     with SolidWire, and composite them. Restores every setting it touches.
 
@@ -334,8 +348,10 @@ def _composite(beauty_exr: dict, wire_exr: dict, layer_name: str, engine: str, d
     beauty = _combined(beauty_exr, layer_name, engine)
     wire = _combined(wire_exr, layer_name, ENGINE_ID)
     if beauty.shape != wire.shape:
-        raise CompositeError(f"the beauty ({beauty.shape[1]}x{beauty.shape[0]}) and the wire "
-                             f"({wire.shape[1]}x{wire.shape[0]}) differ in size")
+        raise CompositeError(
+            f"the beauty ({beauty.shape[1]}x{beauty.shape[0]}) and the wire "
+            f"({wire.shape[1]}x{wire.shape[0]}) differ in size"
+        )
     result = Layers(beauty, wire, alpha_over(wire, beauty), engine)
     if depth:
         result.beauty_depth = _depth(beauty_exr, layer_name)
@@ -360,8 +376,9 @@ def _combined(channels: dict, layer: str, engine: str) -> np.ndarray:
         if rgba is not None:
             return rgba
     layers = sorted({key.rsplit(".", 2)[0] for key in channels})
-    raise CompositeError(f"the {engine} render holds no Combined pass for view layer '{layer}' "
-                         f"(layers: {', '.join(layers) or 'none'})")
+    raise CompositeError(
+        f"the {engine} render holds no Combined pass for view layer '{layer}' (layers: {', '.join(layers) or 'none'})"
+    )
 
 
 def _depth(channels: dict, layer: str) -> np.ndarray | None:
@@ -369,8 +386,7 @@ def _depth(channels: dict, layer: str) -> np.ndarray | None:
     return None if z is None else z[..., 0]
 
 
-def render_wire_over(scene, filepath, engine=None, *, keep_layers: bool = False, layers_name=None,
-                     **kwargs) -> Layers:
+def render_wire_over(scene, filepath, engine=None, *, keep_layers: bool = False, layers_name=None, **kwargs) -> Layers:
     """Render the wire over ``engine``'s render and write the composite to
     ``filepath`` in the scene's output format (plus ``NAME.beauty.exr`` and
     ``NAME.wire.exr`` beside it with ``keep_layers``; NAME from

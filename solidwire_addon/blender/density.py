@@ -95,8 +95,9 @@ def on_screen_lengths(items, view: View) -> np.ndarray:
     else:
         lo = np.stack([mesh.centre + mesh.bounds_min for mesh in mesh_list])[which]  # (N, 3)
         hi = np.stack([mesh.centre + mesh.bounds_max for mesh in mesh_list])[which]
-        corners = np.stack([np.where(np.array(bits, dtype=bool), hi, lo)
-                            for bits in np.ndindex(2, 2, 2)], axis=1)  # (N, 8, 3)
+        corners = np.stack(
+            [np.where(np.array(bits, dtype=bool), hi, lo) for bits in np.ndindex(2, 2, 2)], axis=1
+        )  # (N, 8, 3)
         to_view_z = np.einsum("j,njk->nk", view.view_matrix[2], matrices)  # (N, 4): view z row
         depth = -(np.einsum("nk,nck->nc", to_view_z[:, :3], corners) + to_view_z[:, 3:4])  # (N, 8)
         nearest = depth.min(axis=1)
@@ -137,5 +138,8 @@ def fade_dense_items(items, view: View, settings) -> int:
 
 
 def needs_lengths(settings) -> bool:
-    return bool(getattr(settings, "use_object_density_fade", False)) and math.isfinite(
-        float(settings.density_fade_length)) and float(settings.density_fade_length) > 0.0
+    return (
+        bool(getattr(settings, "use_object_density_fade", False))
+        and math.isfinite(float(settings.density_fade_length))
+        and float(settings.density_fade_length) > 0.0
+    )

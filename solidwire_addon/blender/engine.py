@@ -101,9 +101,13 @@ class PreparedFrame:
         # The view lets gather skip extracting meshes that are wholly off-screen.
         self.extra_passes = tuple(extra_passes)
         object_settings = gather.ObjectSettings(
-            gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes)
+            gather.SHOW_IN_RENDER, bpy.data.objects, pass_index=passes.OBJECT_INDEX_PASS in self.extra_passes
+        )
         self.items, self.seen, self.ms_extract = gather.gather(
-            depsgraph, runtime.mesh_cache, view=self.view, should_stop=should_stop,
+            depsgraph,
+            runtime.mesh_cache,
+            view=self.view,
+            should_stop=should_stop,
             object_settings=object_settings,
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
             edge_lengths=density.needs_lengths(self.settings),
@@ -114,8 +118,11 @@ class PreparedFrame:
         # Measured on the whole frame's view, so every tile fades alike.
         density.fade_dense_items(self.items, self.view, self.settings)
         # Hair and point clouds (blender/strands.py), drawn by the same passes.
-        self.strands = strands.gather_strands(depsgraph, object_settings=gather.ObjectSettings(
-            gather.SHOW_IN_RENDER, bpy.data.objects), colors=colors.needs_item_colors(self.settings))
+        self.strands = strands.gather_strands(
+            depsgraph,
+            object_settings=gather.ObjectSettings(gather.SHOW_IN_RENDER, bpy.data.objects),
+            colors=colors.needs_item_colors(self.settings),
+        )
         self.draw_stats = None
         self.ms_draw = 0.0
 
@@ -129,9 +136,15 @@ class PreparedFrame:
         width, height = self.view.width, self.view.height
         view = self.view if tuple(region) == (0, 0, width, height) else sub_view(self.view, region)
         start = time.perf_counter()
-        rgba, depth, stats, extra = passes.render_passes(self.items, view, self.settings,
-                                                         extra_passes=self.extra_passes, keep_readback=keep_readback,
-                                                         read_depth=read_depth, strands=self.strands)
+        rgba, depth, stats, extra = passes.render_passes(
+            self.items,
+            view,
+            self.settings,
+            extra_passes=self.extra_passes,
+            keep_readback=keep_readback,
+            read_depth=read_depth,
+            strands=self.strands,
+        )
         self.ms_draw += (time.perf_counter() - start) * 1000.0
         if self.draw_stats is None:
             self.draw_stats = stats
@@ -141,8 +154,7 @@ class PreparedFrame:
         runtime.end_frame(self.frame, self.draw_stats or DrawStats(), self.ms_extract, self.ms_draw, self.seen)
 
 
-def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None, extra_passes=(),
-                 extra_out=None):
+def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None, extra_passes=(), extra_out=None):
     """Render ``depsgraph``'s scene from its camera in one piece: (rgba
     premultiplied over the film, view depth), or None when ``should_stop()``
     said so. ``region`` (x0, y0, w, h) in pixels of the full frame draws that
@@ -183,7 +195,8 @@ def passes_of(view_layer) -> tuple:
     (``view_layer.solidwire``)."""
     props = getattr(view_layer, "solidwire", None)
     return tuple(
-        p.name for p in schema.RENDER_PASSES
+        p.name
+        for p in schema.RENDER_PASSES
         if (props is not None or not p.own) and getattr(props if p.own else view_layer, p.switch)
     )
 
@@ -236,16 +249,20 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
     def _render_frame(self, depsgraph, size, region, layer_name) -> None:
         """Extract once, then draw and hand over the region tile by tile."""
         self.update_stats("SolidWire", f"{layer_name} | extracting meshes")
-        frame = PreparedFrame(depsgraph, size, should_stop=self.test_break,
-                              extra_passes=extra_passes_of(depsgraph.view_layer))
+        frame = PreparedFrame(
+            depsgraph, size, should_stop=self.test_break, extra_passes=extra_passes_of(depsgraph.view_layer)
+        )
         for line in frame.messages:
             self.report({"WARNING"}, line)
         tiles = list(tiles_of(region))
         for number, tile in enumerate(tiles, start=1):
             if self.test_break():
                 return  # cancelled (Esc): Blender keeps what it had
-            self.update_stats("SolidWire", f"{layer_name} | drawing {len(frame.items)} objects"
-                              + (f", tile {number} of {len(tiles)}" if len(tiles) > 1 else ""))
+            self.update_stats(
+                "SolidWire",
+                f"{layer_name} | drawing {len(frame.items)} objects"
+                + (f", tile {number} of {len(tiles)}" if len(tiles) > 1 else ""),
+            )
             self.update_progress(0.1 + 0.9 * (number - 1) / len(tiles))
             # The tile goes into Blender's result before the next is drawn,
             # so its readback can live in buffers that are reused.

@@ -77,10 +77,15 @@ class ObjectSettings:
                     if repairs:
                         values.update({name: fixed for name, (_stored, fixed) in repairs.items()})
                         setting_repair.store(props, repairs, defer=self.show == SHOW_IN_VIEWPORT)
-                        self.messages += [setting_repair.message(f"object '{obj_orig.name}'", name, *pair)
-                                          for name, pair in repairs.items()]
-                    style = Style(tuple(float(c) for c in values["wire_color"]), float(values["thickness"]),
-                                  tuple(float(c) for c in values["fill_color"]))
+                        self.messages += [
+                            setting_repair.message(f"object '{obj_orig.name}'", name, *pair)
+                            for name, pair in repairs.items()
+                        ]
+                    style = Style(
+                        tuple(float(c) for c in values["wire_color"]),
+                        float(values["thickness"]),
+                        tuple(float(c) for c in values["fill_color"]),
+                    )
             if self.show == SHOW_IN_VIEWPORT and getattr(obj_orig, "solidwire_exclude", False):
                 shown = False
             known = self._known[uid] = (shown, style, int(getattr(obj_orig, "pass_index", 0)))
@@ -100,11 +105,7 @@ class SeenKeys(set):
 def _is_plain(obj_orig) -> bool:
     """Its evaluated mesh is its mesh datablock as is (shared by duplicates)."""
     data = obj_orig.data
-    return (
-        len(obj_orig.modifiers) == 0
-        and getattr(data, "shape_keys", None) is None
-        and obj_orig.mode != "EDIT"
-    )
+    return len(obj_orig.modifiers) == 0 and getattr(data, "shape_keys", None) is None and obj_orig.mode != "EDIT"
 
 
 def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute_colors: bool = False):
@@ -177,11 +178,23 @@ def item_source(obj) -> ItemSource:
 NO_SELECTION = edge_select.Selection()
 
 
-def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bool | None = None, view=None,
-           should_stop=None, corners: bool = False, colors: bool = False, attribute_colors: bool = False,
-           edges: edge_select.Selection = NO_SELECTION,
-           object_settings: ObjectSettings | None = None, materials: bool = False, edge_lengths: bool = False,
-           tessellation: bool = False):
+def gather(
+    depsgraph,
+    cache: MeshCache,
+    *,
+    object_filter=None,
+    trust_updates: bool | None = None,
+    view=None,
+    should_stop=None,
+    corners: bool = False,
+    colors: bool = False,
+    attribute_colors: bool = False,
+    edges: edge_select.Selection = NO_SELECTION,
+    object_settings: ObjectSettings | None = None,
+    materials: bool = False,
+    edge_lengths: bool = False,
+    tessellation: bool = False,
+):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
     ``object_filter(original_object) -> bool`` lets a target skip objects
@@ -215,8 +228,16 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
     (outlines.py)."""
     if trust_updates is None:
         trust_updates = depsgraph.mode == "VIEWPORT"
-    frame = _FrameGather(depsgraph, cache, trust_updates=trust_updates, view=view, corners=corners,
-                         edges=edges, outlines=not tessellation, attribute_colors=attribute_colors)
+    frame = _FrameGather(
+        depsgraph,
+        cache,
+        trust_updates=trust_updates,
+        view=view,
+        corners=corners,
+        edges=edges,
+        outlines=not tessellation,
+        attribute_colors=attribute_colors,
+    )
     items: list[DrawItem] = []
     for instance in depsgraph.object_instances:
         obj = instance.object
@@ -233,8 +254,13 @@ def gather(depsgraph, cache: MeshCache, *, object_filter=None, trust_updates: bo
             continue
         if edge_lengths and getattr(mesh, "edge_length", None) is None:
             mesh.edge_length = frame.edge_length_of(obj)
-        item = DrawItem(mesh, np.array(instance.matrix_world, dtype=np.float64), frame.source_of(obj) if colors else None,
-                        style, pass_index)
+        item = DrawItem(
+            mesh,
+            np.array(instance.matrix_world, dtype=np.float64),
+            frame.source_of(obj) if colors else None,
+            style,
+            pass_index,
+        )
         if materials:
             item.materials = _materials_of(obj, obj.data, obj.data.as_pointer(), frame.face_slots)
         # Blender's Solid shading writes the depth of objects drawn solid,
@@ -274,8 +300,18 @@ class _FrameGather:
     because every instance so far lay outside the view, colour-source inputs
     and material slots read once per object/mesh."""
 
-    def __init__(self, depsgraph, cache: MeshCache, *, trust_updates: bool, view, corners: bool,
-                 edges: edge_select.Selection, outlines: bool = True, attribute_colors: bool = False):
+    def __init__(
+        self,
+        depsgraph,
+        cache: MeshCache,
+        *,
+        trust_updates: bool,
+        view,
+        corners: bool,
+        edges: edge_select.Selection,
+        outlines: bool = True,
+        attribute_colors: bool = False,
+    ):
         self.cache = cache
         self.mode = depsgraph.mode
         self.trust = (depsgraph.as_pointer(), runtime.epoch) if trust_updates else None
@@ -317,7 +353,10 @@ class _FrameGather:
                 try:
                     key, uids = self._key(obj, pointer, parent)
                 except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
-                    warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
+                    warn_once(
+                        ("object", obj.name),
+                        f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}",
+                    )
                     key = None
                 if key is not None:
                     if self.view_projection is not None and key not in self.cache:
@@ -350,11 +389,25 @@ class _FrameGather:
     def _resolve_safely(self, obj, data, pointer, key, uids):
         try:
             edges, cage_key = self._edges_for(obj)
-            mesh, ms = _mesh_for(obj, data, pointer, key, uids, self.cache, self.trust, self.versions,
-                                 self.corners, edges, self.mode == "RENDER", outline=cage_key == OUTLINE_KEY,
-                                 attribute_colors=self.attribute_colors)
+            mesh, ms = _mesh_for(
+                obj,
+                data,
+                pointer,
+                key,
+                uids,
+                self.cache,
+                self.trust,
+                self.versions,
+                self.corners,
+                edges,
+                self.mode == "RENDER",
+                outline=cage_key == OUTLINE_KEY,
+                attribute_colors=self.attribute_colors,
+            )
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
-            warn_once(("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
+            warn_once(
+                ("object", obj.name), f"SolidWire skips object '{obj.name}': {type(exc).__name__}: {one_line(exc)}"
+            )
             return None
         self.ms_extract += ms
         return mesh
@@ -468,9 +521,21 @@ def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
     return key, uids
 
 
-def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=False,
-              edges: edge_select.Selection = NO_SELECTION, render: bool = False, outline: bool = False,
-              attribute_colors: bool = False):
+def _mesh_for(
+    obj,
+    data,
+    pointer,
+    key,
+    uids,
+    cache,
+    trust,
+    versions,
+    corners=False,
+    edges: edge_select.Selection = NO_SELECTION,
+    render: bool = False,
+    outline: bool = False,
+    attribute_colors: bool = False,
+):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated
     mesh. ``outline``: the drawn mask is outlines.py's (``edges.use_cage``
     says a mask is passed), not the cage's."""
@@ -495,8 +560,9 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
         positions, corner_vert, corner_inputs = context
         try:
             source_mesh = get_source()
-            arrays = extract.extract_mesh(source_mesh, positions=positions, corner_vert=corner_vert,
-                                          corners=corner_inputs if corners else None)
+            arrays = extract.extract_mesh(
+                source_mesh, positions=positions, corner_vert=corner_vert, corners=corner_inputs if corners else None
+            )
             if edges.active:
                 face_offsets = extract.read_face_offsets(source_mesh)
                 cage_edges = None
@@ -505,12 +571,20 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
                 elif edges.use_cage:
                     cage_edges = cage.cage_edges(obj.original, source_mesh, render=render)
                 edge_select.apply_to_mesh(
-                    arrays, source_mesh, corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
-                    face_offsets, edges, cage_edges)
+                    arrays,
+                    source_mesh,
+                    corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
+                    face_offsets,
+                    edges,
+                    cage_edges,
+                )
             if attribute_colors:
                 extract.attach_attribute_colors(
-                    arrays, source_mesh, corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
-                    extract.read_face_offsets(source_mesh))
+                    arrays,
+                    source_mesh,
+                    corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
+                    extract.read_face_offsets(source_mesh),
+                )
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
             return None
@@ -531,8 +605,13 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
     def reposition(entry, context):
         positions, corner_vert, corner_inputs = context
         source_mesh = get_source()
-        moved = extract.reposition(entry, positions, corner_vert, extract.read_face_offsets(source_mesh),
-                                   extract.blender_triangles(source_mesh))
+        moved = extract.reposition(
+            entry,
+            positions,
+            corner_vert,
+            extract.read_face_offsets(source_mesh),
+            extract.blender_triangles(source_mesh),
+        )
         if moved is None or not corners:
             return moved
         normals, materials, domain = corner_inputs
@@ -543,16 +622,21 @@ def _mesh_for(obj, data, pointer, key, uids, cache, trust, versions, corners=Fal
         # The normals follow the deformation; which corner each triangle
         # corner is does not (same faces, same triangles; the domain is part
         # of the fingerprint's topology).
-        return (*moved, extract.fill_corner_table(entry.corner_rows, entry.triangle_polygons_cpu, normals, materials,
-                                                  domain))
+        return (
+            *moved,
+            extract.fill_corner_table(entry.corner_rows, entry.triangle_polygons_cpu, normals, materials, domain),
+        )
 
     try:
         # A deformation re-uploads positions (and corner normals) only, unless
         # the edge selection follows the positions (edge angle): then which
         # edges are drawn may change, and the mesh is extracted again.
         mesh, _extracted = cache.get_validated(
-            key, fast, lambda: fingerprint(get_source(), corners, edges.classes, attribute_colors),
-            make_arrays, None if edges.follows_positions else reposition
+            key,
+            fast,
+            lambda: fingerprint(get_source(), corners, edges.classes, attribute_colors),
+            make_arrays,
+            None if edges.follows_positions else reposition,
         )
     finally:
         if in_edit_mode and source:

@@ -116,8 +116,11 @@ def _can_decode_now() -> bool:
     """Decoding renders a scratch scene, so never inside a render (a render
     started from a render deadlocks Blender 5.3) nor off the main thread;
     in a UI session it waits for a timer (outside any draw)."""
-    return (bpy.app.background and threading.current_thread() is threading.main_thread()
-            and shaders.current_gl_context() != "render-engine")
+    return (
+        bpy.app.background
+        and threading.current_thread() is threading.main_thread()
+        and shaders.current_gl_context() != "render-engine"
+    )
 
 
 def prepare(name: str) -> None:

@@ -73,11 +73,14 @@ def one_line_errors(method):
     # Blender checks the argument count of execute (self, context) and
     # invoke (self, context, event), so the wrapper keeps it.
     if method.__code__.co_argcount == 3:
+
         def guarded(self, context, event):
             return run(self, context, event)
     else:
+
         def guarded(self, context):
             return run(self, context)
+
     return functools.wraps(method)(guarded)
 
 
@@ -140,7 +143,9 @@ def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
 def fade_view(context):
     """(view matrix, 3D View space or None) that fade ranges are measured
     from: the current 3D View, else the scene camera; None with neither."""
-    space = context.space_data if getattr(context, "space_data", None) and context.space_data.type == "VIEW_3D" else None
+    space = (
+        context.space_data if getattr(context, "space_data", None) and context.space_data.type == "VIEW_3D" else None
+    )
     # From the sidebar the current region is not the 3D region itself:
     # fall back to the space's main 3D region.
     region_3d = getattr(context, "region_data", None) or getattr(space, "region_3d", None)
@@ -247,8 +252,9 @@ class SOLIDWIRE_OT_preset_apply(bpy.types.Operator):
         return {"FINISHED"}
 
 
-OVERWRITE_HELP = ("Replace your preset of the same name (names that differ only in case, spaces or "
-                  "punctuation are the same preset)")
+OVERWRITE_HELP = (
+    "Replace your preset of the same name (names that differ only in case, spaces or punctuation are the same preset)"
+)
 
 
 def draw_name_check(layout, operator) -> None:
@@ -298,8 +304,9 @@ class SOLIDWIRE_OT_preset_add(bpy.types.Operator):
     def execute(self, context):
         global active_preset_name
         try:
-            path = presets.save(self.name, _solidwire(context), description=self.preset_description,
-                                overwrite=self.overwrite)
+            path = presets.save(
+                self.name, _solidwire(context), description=self.preset_description, overwrite=self.overwrite
+            )
         except (presets.PresetError, OSError) as exc:
             self.report({"ERROR"}, f"SolidWire: cannot save preset: {exc}")
             return {"CANCELLED"}
@@ -386,7 +393,9 @@ class SOLIDWIRE_OT_preset_export(bpy.types.Operator, ExportHelper):
     filename_ext = ".json"
     filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
     preset: StringProperty(
-        name="Preset", description="Preset to export (empty: the current settings)", search=_preset_names,
+        name="Preset",
+        description="Preset to export (empty: the current settings)",
+        search=_preset_names,
     )
     name: StringProperty(name="Name", description="Name the current settings get in the file")
     preset_description: StringProperty(name="Description", description="Description written with the current settings")
@@ -421,8 +430,13 @@ class SOLIDWIRE_OT_preset_export(bpy.types.Operator, ExportHelper):
             self.report({"ERROR"}, "SolidWire: cannot export preset: no file chosen")
             return {"CANCELLED"}
         try:
-            path = export_preset_file(bpy.path.abspath(self.filepath), _solidwire(context), preset=self.preset,
-                                      name=self.name or _default_export_name(), description=self.preset_description)
+            path = export_preset_file(
+                bpy.path.abspath(self.filepath),
+                _solidwire(context),
+                preset=self.preset,
+                name=self.name or _default_export_name(),
+                description=self.preset_description,
+            )
         except (presets.PresetError, OSError) as exc:
             self.report({"ERROR"}, f"SolidWire: cannot export preset: {one_line(exc)}")
             return {"CANCELLED"}
@@ -453,8 +467,9 @@ class SOLIDWIRE_OT_preset_import(bpy.types.Operator, ImportHelper):
             self.report({"ERROR"}, "SolidWire: cannot import preset: no file chosen")
             return {"CANCELLED"}
         try:
-            preset = presets.import_file(Path(bpy.path.abspath(self.filepath)), name=self.name,
-                                         overwrite=self.overwrite)
+            preset = presets.import_file(
+                Path(bpy.path.abspath(self.filepath)), name=self.name, overwrite=self.overwrite
+            )
         except (presets.PresetError, OSError) as exc:
             self.report({"ERROR"}, f"SolidWire: cannot import preset: {one_line(exc)}")
             return {"CANCELLED"}

@@ -43,18 +43,22 @@ class SOLIDWIRE_OT_render_wire_over(bpy.types.Operator):
     bl_label = "Render Wire Over"
     bl_options = {"REGISTER"}
 
-    engine: EnumProperty(name="Engine", description="Engine of the render underneath the wire",
-                         items=ENGINE_ITEMS, default="SCENE")
+    engine: EnumProperty(
+        name="Engine", description="Engine of the render underneath the wire", items=ENGINE_ITEMS, default="SCENE"
+    )
     filepath: StringProperty(
-        name="File Path", subtype="FILE_PATH",
+        name="File Path",
+        subtype="FILE_PATH",
         description="Image to write (empty: the scene's output path with '_wire_over' added)",
     )
     keep_layers: BoolProperty(
-        name="Keep Layers", default=False,
+        name="Keep Layers",
+        default=False,
         description="Also write the two float layers (NAME.beauty.exr, NAME.wire.exr) beside the image",
     )
     show_result: BoolProperty(
-        name="Show Result", default=True,
+        name="Show Result",
+        default=True,
         description="Open the written image in an Image Editor (interactive sessions only)",
     )
 
@@ -68,8 +72,9 @@ class SOLIDWIRE_OT_render_wire_over(bpy.types.Operator):
         scene = context.scene
         path = Path(bpy.path.abspath(self.filepath)) if self.filepath else default_output_path(scene)
         try:
-            layers = composite.render_wire_over(scene, path, self.engine, keep_layers=self.keep_layers,
-                                                view_layer=context.view_layer)
+            layers = composite.render_wire_over(
+                scene, path, self.engine, keep_layers=self.keep_layers, view_layer=context.view_layer
+            )
         except composite.CompositeError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")
             return {"CANCELLED"}

@@ -56,6 +56,7 @@ def outline_mask(mesh, face_offsets: np.ndarray | None = None) -> tuple[np.ndarr
     if face_offsets is None:
         face_offsets = extract.read_face_offsets(mesh)
     verts, corner_edge = edge_select.read_edge_topology(mesh)
-    flat = edge_select.flat_edges(corner_edge, face_offsets, extract.read_face_normals(mesh), len(verts),
-                                  COPLANAR_ANGLE)
+    flat = edge_select.flat_edges(
+        corner_edge, face_offsets, extract.read_face_normals(mesh), len(verts), COPLANAR_ANGLE
+    )
     return ~flat, None

@@ -187,8 +187,9 @@ def viewport_state(context) -> overlay_state.ViewportState | None:
 SCENE_COLOR_MANAGEMENT = "scene"
 
 
-def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, plan=None,
-                       display=SCENE_COLOR_MANAGEMENT) -> dict:
+def draw_scene_overlay(
+    depsgraph, view: View, settings, *, object_filter=None, plan=None, display=SCENE_COLOR_MANAGEMENT
+) -> dict:
     """Draw the overlay of ``depsgraph``'s scene into the bound framebuffer,
     which already holds the scene's colour and depth. ``plan`` (an
     ``overlay_state.OverlayPlan``) carries the viewport state: depth source,
@@ -204,11 +205,15 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     # edit before it is drawn, and gather() re-extracts only what changed.
     frame = runtime.begin_frame(reuse=True)
     object_settings = gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects)
-    items, seen, ms_extract = gather.gather(depsgraph, runtime.mesh_cache, object_filter=object_filter,
-                                            object_settings=object_settings,
-                                            edge_lengths=density.needs_lengths(settings),
-                                            tessellation=bool(settings.show_tessellation),
-                                            **passes.gather_options(settings))
+    items, seen, ms_extract = gather.gather(
+        depsgraph,
+        runtime.mesh_cache,
+        object_filter=object_filter,
+        object_settings=object_settings,
+        edge_lengths=density.needs_lengths(settings),
+        tessellation=bool(settings.show_tessellation),
+        **passes.gather_options(settings),
+    )
     setting_repair.report_later(object_settings.messages)
     drawn = overlay_state.draw_settings(plan, settings)
     # Pixel lengths at the UI scale: the objects' own Thickness first, then
@@ -216,8 +221,12 @@ def draw_scene_overlay(depsgraph, view: View, settings, *, object_filter=None, p
     items = overlay_state.draw_items(plan, items)
     density.fade_dense_items(items, view, drawn)
     # Hair and point clouds (blender/strands.py), drawn by the same passes.
-    strand_items = strands.gather_strands(depsgraph, object_filter=object_filter, object_settings=gather.ObjectSettings(
-        gather.SHOW_IN_VIEWPORT, bpy.data.objects), colors=colors.needs_item_colors(settings))
+    strand_items = strands.gather_strands(
+        depsgraph,
+        object_filter=object_filter,
+        object_settings=gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects),
+        colors=colors.needs_item_colors(settings),
+    )
     start = time.perf_counter()
     if items or strand_items:
         stats = passes.draw_over_viewport(
@@ -263,7 +272,9 @@ def _draw_callback() -> None:
             display=color_management.display_lut(context.scene, request=True),
         )
     except Exception as exc:  # noqa: BLE001 - a draw handler must never raise
-        warn_once(("overlay", type(exc).__name__, str(exc)), f"SolidWire overlay: {type(exc).__name__}: {one_line(exc)}")
+        warn_once(
+            ("overlay", type(exc).__name__, str(exc)), f"SolidWire overlay: {type(exc).__name__}: {one_line(exc)}"
+        )
 
 
 def is_registered() -> bool:

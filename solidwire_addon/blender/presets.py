@@ -302,8 +302,10 @@ def user_presets() -> tuple[list[Preset], list[str]]:
                 continue
             clash = builtin_keys.get(name_key(preset.name))
             if clash is not None:
-                problems.append(f"{path.name}: '{preset.name}' is named like the built-in preset '{clash}' "
-                                "and is not used (import it under another name)")
+                problems.append(
+                    f"{path.name}: '{preset.name}' is named like the built-in preset '{clash}' "
+                    "and is not used (import it under another name)"
+                )
                 continue
             presets.append(preset)
     return presets, problems
@@ -413,8 +415,12 @@ def apply(preset: Preset, props, *, depth_range=None) -> str:
 
 
 def to_json(name: str, values: dict, description: str = "", from_scene: tuple = ()) -> str:
-    data = {"solidwire_preset": FORMAT_VERSION, "name": name, "description": description,
-            "settings": {key: list(v) if isinstance(v, tuple) else v for key, v in values.items()}}
+    data = {
+        "solidwire_preset": FORMAT_VERSION,
+        "name": name,
+        "description": description,
+        "settings": {key: list(v) if isinstance(v, tuple) else v for key, v in values.items()},
+    }
     if from_scene:  # only then: other presets stay readable by older versions
         data["from_scene"] = list(from_scene)
     # ensure_ascii=False: a name in any script stays readable in the file.

@@ -76,8 +76,12 @@ def make_property(setting: schema.Setting):
     if setting.kind == schema.ENUM:
         return EnumProperty(items=setting.items, default=setting.default, **common)
     limits = {}
-    for key, value in (("min", setting.minimum), ("max", setting.maximum),
-                       ("soft_min", setting.soft_min), ("soft_max", setting.soft_max)):
+    for key, value in (
+        ("min", setting.minimum),
+        ("max", setting.maximum),
+        ("soft_min", setting.soft_min),
+        ("soft_max", setting.soft_max),
+    ):
         if value is not None and abs(value) != float("inf"):
             limits[key] = value
     if setting.kind == schema.COLOR:

@@ -71,8 +71,10 @@ def message(owner: str, name: str, stored, fixed) -> str:
     """The one line that says what was repaired."""
     if isinstance(stored, float):
         return f"SolidWire: {owner} setting '{name}' is {stored:g}, not a finite number; reset to its default {fixed:g}"
-    return (f"SolidWire: {owner} setting '{name}' = {_shown(stored)} has a NaN or out-of-range component; "
-            f"reset to {_shown(fixed)}")
+    return (
+        f"SolidWire: {owner} setting '{name}' = {_shown(stored)} has a NaN or out-of-range component; "
+        f"reset to {_shown(fixed)}"
+    )
 
 
 def store(props, repairs: dict, *, defer: bool = False) -> None:

@@ -46,8 +46,9 @@ def geometry_of(obj) -> strands.StrandGeometry | None:
     radius = _read(attributes, "radius", count, 1, "value")
     cache = strands.geometry_cache
     if obj.type == "POINTCLOUD":
-        return cache.get(cache.fingerprint(strands.POINTS, positions, radius),
-                         lambda: strands.points_geometry(positions, radius))
+        return cache.get(
+            cache.fingerprint(strands.POINTS, positions, radius), lambda: strands.points_geometry(positions, radius)
+        )
     curve_count = len(data.curves)
     offsets = np.empty(curve_count + 1, dtype=np.int32)
     data.curve_offset_data.foreach_get("value", offsets)
@@ -60,15 +61,20 @@ def geometry_of(obj) -> strands.StrandGeometry | None:
         right = _read(attributes, "handle_right", count, 3, "vector")
         handles = None if left is None or right is None else (left, right)
         if handles is None:
-            warn_once(("curve handles", obj.name), f"SolidWire: '{obj.name}' has Bezier curves without handle "
-                                                   "positions; their control polygons are drawn")
+            warn_once(
+                ("curve handles", obj.name),
+                f"SolidWire: '{obj.name}' has Bezier curves without handle positions; their control polygons are drawn",
+            )
     if curve_types is not None and (curve_types == strands.NURBS).any():
-        warn_once(("curve types", obj.name), f"SolidWire: '{obj.name}' has NURBS curves; "
-                                             "their control polygons are drawn")
-    key = cache.fingerprint(strands.CURVES, positions, radius, offsets, curve_types, resolutions, cyclic,
-                            *(handles or (None, None)))
-    return cache.get(key, lambda: strands.curves_geometry(positions, radius, offsets, curve_types, resolutions,
-                                                          cyclic, handles))
+        warn_once(
+            ("curve types", obj.name), f"SolidWire: '{obj.name}' has NURBS curves; their control polygons are drawn"
+        )
+    key = cache.fingerprint(
+        strands.CURVES, positions, radius, offsets, curve_types, resolutions, cyclic, *(handles or (None, None))
+    )
+    return cache.get(
+        key, lambda: strands.curves_geometry(positions, radius, offsets, curve_types, resolutions, cyclic, handles)
+    )
 
 
 def gather_strands(depsgraph, *, object_filter=None, object_settings=None, colors: bool = False):
@@ -96,15 +102,18 @@ def gather_strands(depsgraph, *, object_filter=None, object_settings=None, color
                     warn_once(("strands empty", obj.name), f"SolidWire skips '{obj.name}': it has {what}")
                 elif geometry.dropped:
                     count = geometry.dropped
-                    warn_once(("strands nonfinite", obj.name),
-                              f"SolidWire: '{obj.name}' has {count} point{'s' if count != 1 else ''} with non-finite "
-                              "coordinates or radius, left out (with the strand segments that touch them)")
+                    warn_once(
+                        ("strands nonfinite", obj.name),
+                        f"SolidWire: '{obj.name}' has {count} point{'s' if count != 1 else ''} with non-finite "
+                        "coordinates or radius, left out (with the strand segments that touch them)",
+                    )
             geometry = by_data[pointer]
             if geometry is None:
                 continue
             source = gather.item_source(obj) if colors else None
-            items.append(strands.StrandItem(geometry, np.array(instance.matrix_world, dtype=np.float64), style,
-                                            source, obj.name))
+            items.append(
+                strands.StrandItem(geometry, np.array(instance.matrix_world, dtype=np.float64), style, source, obj.name)
+            )
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
             warn_once(("strands", obj.name), f"SolidWire skips '{obj.name}': {type(exc).__name__}: {one_line(exc)}")
     return items

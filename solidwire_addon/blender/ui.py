@@ -106,9 +106,9 @@ class SOLIDWIRE_MT_presets(bpy.types.Menu):
         if user:
             layout.separator()
             for preset in user:
-                layout.operator(ops.SOLIDWIRE_OT_preset_apply.bl_idname, text=preset.name, icon="USER").name = (
-                    preset.name
-                )
+                layout.operator(
+                    ops.SOLIDWIRE_OT_preset_apply.bl_idname, text=preset.name, icon="USER"
+                ).name = preset.name
         for problem in problems:
             layout.label(text=problem, icon="ERROR")
         layout.separator()
@@ -257,13 +257,16 @@ class VIEWLAYER_PT_solidwire_passes(bpy.types.Panel):
                 col.prop(props, setting.name)
 
 
-classes = (SOLIDWIRE_MT_presets, VIEW3D_PT_solidwire, RENDER_PT_solidwire, OBJECT_PT_solidwire,
-           VIEWLAYER_PT_solidwire_passes)
+classes = (
+    SOLIDWIRE_MT_presets,
+    VIEW3D_PT_solidwire,
+    RENDER_PT_solidwire,
+    OBJECT_PT_solidwire,
+    VIEWLAYER_PT_solidwire_passes,
+)
 
 # (Blender panel, our draw function): appended at register, removed at unregister.
-_APPENDS = (
-    ("VIEW3D_PT_overlay", draw_overlay_popover),
-)
+_APPENDS = (("VIEW3D_PT_overlay", draw_overlay_popover),)
 
 
 def register_appends() -> None:

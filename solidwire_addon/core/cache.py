@@ -98,8 +98,10 @@ class GPUMesh:
         # lines, no triangle walks anything (the draw needs no block code).
         flags = arrays.edge_flags
         self.blocks_only_for_region_lines = (
-            arrays.region_lines is not None and len(arrays.ngon_corners) == 0
-            and not np.any((flags & IN_REGION != 0) & (flags & REGION_LINES == 0)))
+            arrays.region_lines is not None
+            and len(arrays.ngon_corners) == 0
+            and not np.any((flags & IN_REGION != 0) & (flags & REGION_LINES == 0))
+        )
         # Shading normals and material indices, a texel per vertex, triangle
         # or triangle corner (normal_domain); only for a shaded or
         # per-material fill.
@@ -145,7 +147,6 @@ class GPUMesh:
             + self.ngon_corners.width * self.ngon_corners.height * 16
             + (0 if self.corners is None else self.corners.width * self.corners.height * 16)
         )
-
 
     @property
     def batch(self):
@@ -223,8 +224,12 @@ class GPUMesh:
                     copied, numbers, triangles = _provoking_triangle_numbers(len(self._local_positions), triangles)
                 if index is not None:
                     self.gpu_bytes -= self.triangle_count * 12  # the other numbering's index buffer
-                index = self._visibility_index = (by_vertex, gpu.types.GPUIndexBuf(type="TRIS", seq=triangles),
-                                                  copied, numbers)
+                index = self._visibility_index = (
+                    by_vertex,
+                    gpu.types.GPUIndexBuf(type="TRIS", seq=triangles),
+                    copied,
+                    numbers,
+                )
                 self.gpu_bytes += self.triangle_count * 12
             _by_vertex, ibo, copied, numbers = index
             positions = self._local_positions
@@ -248,8 +253,15 @@ class GPUMesh:
             self.gpu_bytes -= self._visibility_layout[1]
             self._visibility_batch = self._visibility_layout = None
 
-    def replace_positions(self, local: np.ndarray, centre, bounds_min, bounds_max, source_positions=None,
-                          corners: np.ndarray | None = None) -> None:
+    def replace_positions(
+        self,
+        local: np.ndarray,
+        centre,
+        bounds_min,
+        bounds_max,
+        source_positions=None,
+        corners: np.ndarray | None = None,
+    ) -> None:
         """New vertex positions, same faces and triangles: only the position
         table is uploaded again, and the corner table when ``corners`` (the
         corner normals follow a deformation). The triangle and outline

@@ -37,7 +37,9 @@ def random_color(name: str, saturation: float, value: float) -> tuple:
 
 
 def needs_item_colors(settings) -> bool:
-    return (bool(settings.use_fill) and settings.fill_color_source != "SINGLE") or settings.wire_color_source != "SINGLE"
+    return (
+        bool(settings.use_fill) and settings.fill_color_source != "SINGLE"
+    ) or settings.wire_color_source != "SINGLE"
 
 
 def needs_attribute_colors(settings) -> bool:

@@ -30,9 +30,9 @@ def _row_blocks(rgba: np.ndarray, plane: np.ndarray | None = None, scratch_count
     rows = max(1, BLOCK_PIXELS // max(width, 1))
     scratch = np.empty((scratch_count, min(rows, height), width), dtype=np.float32)
     for top in range(0, height, rows):
-        block = rgba[top:top + rows]
+        block = rgba[top : top + rows]
         count = len(block)
-        yield block, None if plane is None else plane[top:top + rows], scratch[:, :count]
+        yield block, None if plane is None else plane[top : top + rows], scratch[:, :count]
 
 
 def over_film(rgba: np.ndarray, film_rgb) -> None:

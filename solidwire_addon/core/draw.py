@@ -31,8 +31,9 @@ from .view import (
 )
 
 
-def shader_variant(settings, write_view_depth: bool = False, depth_bias: float = 0.0,
-                   linear_depth: bool = False) -> shaders.ShaderVariant:
+def shader_variant(
+    settings, write_view_depth: bool = False, depth_bias: float = 0.0, linear_depth: bool = False
+) -> shaders.ShaderVariant:
     """The compiled-code features ``settings`` ask for."""
     diagonals = {
         "HIDDEN": shaders.DIAGONALS_HIDDEN,
@@ -145,13 +146,14 @@ def split_deferred(items, view: View) -> tuple[list, list]:
     deferred, direct = [], []
     for group in by_mesh.values():
         mesh = group[0].mesh
-        to_clip = view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
+        to_clip = (
+            view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
+        )
         pixels = float(box_pixels(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max), view).sum())
         weight = DEFERRED_BLOCK_WEIGHT if mesh.has_ngons else 1.0
         # Multi-face regions draw their lines over the visibility record
         # (docs/image_model.md §2.6), so such a mesh is always deferred.
-        dense = (weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels
-                 or mesh.region_line_count > 0)
+        dense = weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels or mesh.region_line_count > 0
         (deferred if dense and 0 < mesh.triangle_count < DEFERRED_MAX else direct).extend(group)
     return deferred, direct
 
@@ -165,8 +167,9 @@ def styled(settings, style, show_wire: bool = True):
         # Class widths keep their ratio to the wire's (image model §3.6).
         scale = style.thickness / settings.thickness if settings.thickness > 0.0 else 1.0
         classes = {f"{name}_thickness": getattr(settings, f"{name}_thickness") * scale for name in EDGE_CLASSES}
-        settings = replace(settings, wire_color=style.wire_color, thickness=style.thickness,
-                           fill_color=style.fill_color, **classes)
+        settings = replace(
+            settings, wire_color=style.wire_color, thickness=style.thickness, fill_color=style.fill_color, **classes
+        )
     if not show_wire and settings.wire_color[3] != 0.0:
         settings = replace(settings, wire_color=(*settings.wire_color[:3], 0.0))
     return settings
@@ -231,8 +234,6 @@ def _instance_rows(object_to_view, object_to_clip, info) -> np.ndarray:
     return rows.reshape(-1, 4)
 
 
-
-
 def draw(
     items,
     view: View,
@@ -276,18 +277,29 @@ def draw(
     settings = styled(settings, None, show_wire)
     variant = shader_variant(settings, write_view_depth, depth_bias, linear_depth)
     if hidden_pass:
-        variant = replace(variant, hidden_pass=True, write_view_depth=False, shading=shaders.SHADING_FLAT,
-                          material_colors=False, attribute_colors=False)
+        variant = replace(
+            variant,
+            hidden_pass=True,
+            write_view_depth=False,
+            shading=shaders.SHADING_FLAT,
+            material_colors=False,
+            attribute_colors=False,
+        )
     if write_aovs:
         variant = replace(variant, write_aovs=True)
     if stage == RESOLVE:
         variant = replace(variant, resolve=True, linear_depth=False)
     elif stage == VISIBILITY:
-        variant = shaders.ShaderVariant(visibility=True, linear_depth=linear_depth,
-                                        triangle_ids_by_vertex=shaders.triangle_ids_by_vertex())
+        variant = shaders.ShaderVariant(
+            visibility=True, linear_depth=linear_depth, triangle_ids_by_vertex=shaders.triangle_ids_by_vertex()
+        )
     elif stage == LINES:
-        variant = shaders.ShaderVariant(region_lines_pass=True, thickness_mode=variant.thickness_mode,
-                                        edge_classes=variant.edge_classes, density_fade=variant.density_fade)
+        variant = shaders.ShaderVariant(
+            region_lines_pass=True,
+            thickness_mode=variant.thickness_mode,
+            edge_classes=variant.edge_classes,
+            density_fade=variant.density_fade,
+        )
     clip_rows = None
     if clip_planes is not None:
         variant = replace(variant, clip_planes=True)
@@ -308,7 +320,8 @@ def draw(
         if extras["matcap_image"] is None:
             variant = replace(variant, shading=shaders.SHADING_FLAT)
     if (variant.shading != shaders.SHADING_FLAT or variant.material_colors) and any(
-            item.mesh.corners is None for item in items):
+        item.mesh.corners is None for item in items
+    ):
         # Meshes gathered without their corner table (a caller that did not
         # ask for it): draw flat rather than read a missing table.
         warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
@@ -324,8 +337,7 @@ def draw(
     # keep their own object block (_set_object_block).
     bases = np.zeros(len(items), dtype=np.int64)
     if variant.item_colors:
-        table, bases = colors.color_table(items, settings,
-                                          lambda style: styled(settings, style, show_wire))
+        table, bases = colors.color_table(items, settings, lambda style: styled(settings, style, show_wire))
         extras["item_colors"] = table_texture(table)
     blocks = {None: gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))}
 
@@ -333,7 +345,8 @@ def draw(
         block = blocks.get(style)
         if block is None:
             block = blocks[style] = gpu.types.GPUUniformBuf(
-                pack_params(styled(settings, style, show_wire), view.viewport, view.projection))
+                pack_params(styled(settings, style, show_wire), view.viewport, view.projection)
+            )
         return block
 
     gpu.state.depth_test_set("NONE" if stage == RESOLVE else depth_test)
@@ -371,7 +384,7 @@ def draw(
             # (Part of the key, so that every stage parts the draws alike.)
             lines_only = ngons and getattr(mesh, "blocks_only_for_region_lines", False)
             colored = getattr(mesh, "attribute_colors", None) is not None
-            table = (setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g[4], view))
+            table = setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g[4], view)
             in_front = wholly_in_front(g[4], mesh.bounds_min, mesh.bounds_max)
             parts.setdefault((ngons, lines_only, colored, table, in_front), []).append(g)
         # The visibility and region-lines passes read neither n-gon
@@ -382,13 +395,28 @@ def draw(
             ngons, lines_only, colored, table, in_front = key
             lines_elsewhere = lines_only and variant.region_lines
             walks = ngons and not plain_stage and not lines_elsewhere
-            part_variant = replace(variant, ngons=walks, setup_table=table and not plain_stage,
-                                   in_front=in_front and not variant.visibility,
-                                   attribute_colors=variant.attribute_colors and colored and not plain_stage)
+            part_variant = replace(
+                variant,
+                ngons=walks,
+                setup_table=table and not plain_stage,
+                in_front=in_front and not variant.visibility,
+                attribute_colors=variant.attribute_colors and colored and not plain_stage,
+            )
             if lines_elsewhere and variant.edge_classes:
                 part_variant = replace(part_variant, edge_classes=False, style_colors=True)
-            _draw_groups(parts[key], part_variant, ubo, settings, program, flip, stats, extras,
-                         bases, instancing=instancing, numbering=numbering)
+            _draw_groups(
+                parts[key],
+                part_variant,
+                ubo,
+                settings,
+                program,
+                flip,
+                stats,
+                extras,
+                bases,
+                instancing=instancing,
+                numbering=numbering,
+            )
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
@@ -557,8 +585,20 @@ def release_rectangle() -> None:
     _quad_batches.clear()
 
 
-def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: DrawStats, extras=None,
-                 bases=None, *, instancing: bool = True, numbering=None) -> None:
+def _draw_groups(
+    groups,
+    variant,
+    ubo,
+    settings,
+    program,
+    flip: bool,
+    stats: DrawStats,
+    extras=None,
+    bases=None,
+    *,
+    instancing: bool = True,
+    numbering=None,
+) -> None:
     """Draw (mesh, style, world, object_to_view, object_to_clip, item
     indices, pass data) groups with one shader variant: per object, or
     instanced for meshes with many instances. ``ubo(style)`` is the
@@ -592,16 +632,26 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
             if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
                 for side in (False, True):
                     pick = mirrored_all == side
-                    instanced.append((mesh, style, object_to_view_all[pick], object_to_clip_all[pick], info_all[pick],
-                                      side))
+                    instanced.append(
+                        (mesh, style, object_to_view_all[pick], object_to_clip_all[pick], info_all[pick], side)
+                    )
             else:
-                instanced.append((mesh, style, object_to_view_all, object_to_clip_all, info_all,
-                                  bool(mirrored_all[0])))
+                instanced.append((mesh, style, object_to_view_all, object_to_clip_all, info_all, bool(mirrored_all[0])))
             continue
         for k in range(len(world)):
-            single.append((mesh, style, world[k], object_to_view_all[k], object_to_clip_all[k], info_all[k],
-                           bool(mirrored_all[k]), None if pass_index is None else float(pass_index[k]),
-                           None if materials is None else materials[k]))
+            single.append(
+                (
+                    mesh,
+                    style,
+                    world[k],
+                    object_to_view_all[k],
+                    object_to_clip_all[k],
+                    info_all[k],
+                    bool(mirrored_all[k]),
+                    None if pass_index is None else float(pass_index[k]),
+                    None if materials is None else materials[k],
+                )
+            )
     if single and variant.per_item:
         # Normal matrices and item info of every object in one texture
         # (item_table.glsl); each draw says its slot.
@@ -613,8 +663,17 @@ def _draw_groups(groups, variant, ubo, settings, program, flip: bool, stats: Dra
     object_block = None  # the render passes' per-object block (write_aovs only)
     material_tables: dict = {}  # (mesh, materials) -> triangle -> material pass index texture
     if single:
-        for slot, (mesh, style, world, object_to_view, object_to_clip, _info, mirrored, pass_index,
-                   materials) in enumerate(single):
+        for slot, (
+            mesh,
+            style,
+            world,
+            object_to_view,
+            object_to_clip,
+            _info,
+            mirrored,
+            pass_index,
+            materials,
+        ) in enumerate(single):
             if variant.setup_table:
                 # (Before each draw: so a mesh is set up for the matrix of
                 # the one object drawing it.)
@@ -656,8 +715,7 @@ def _setup_ready() -> bool:
         shaders.get_setup()
     except Exception as exc:  # noqa: BLE001 - any compile/link failure means: no pre-pass
         shaders.disable_setup()
-        warn_once(("setup",), f"SolidWire: the set-up pre-pass is not available here ({exc}); "
-                              "drawing without it")
+        warn_once(("setup",), f"SolidWire: the set-up pre-pass is not available here ({exc}); drawing without it")
         return False
     return True
 
@@ -688,8 +746,9 @@ def _run_setup(mesh, object_to_clip, block, in_front: bool = False) -> None:
     count = mesh.triangle_count
     if getattr(mesh, "setup_table", None) is None:
         rows = -(-count // shaders.SETUP_ROW_TRIANGLES)
-        mesh.setup_table = gpu.types.GPUTexture((shaders.SETUP_ROW_TRIANGLES * shaders.SETUP_TEXELS, rows),
-                                                format="RGBA32F")
+        mesh.setup_table = gpu.types.GPUTexture(
+            (shaders.SETUP_ROW_TRIANGLES * shaders.SETUP_TEXELS, rows), format="RGBA32F"
+        )
         mesh.gpu_bytes += mesh.setup_table.width * mesh.setup_table.height * 16
     setup = shaders.get_setup(in_front)
     setup.bind()
@@ -751,8 +810,9 @@ def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras, nu
     """One draw_instanced call per (mesh, style, facing) group; every
     instance's matrices in one float texture for the whole frame."""
     shader = shaders.get(replace(variant, instanced=True, setup_table=False))
-    table = table_texture(np.concatenate([_instance_rows(o2v, o2c, info)
-                                         for _mesh, _style, o2v, o2c, info, _side in groups]))
+    table = table_texture(
+        np.concatenate([_instance_rows(o2v, o2c, info) for _mesh, _style, o2v, o2c, info, _side in groups])
+    )
     shader.bind()
     bound = None
     shader.uniform_block("params", ubo(bound))

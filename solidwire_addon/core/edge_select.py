@@ -149,8 +149,9 @@ def _chain_ends(verts: np.ndarray, chain: np.ndarray | None) -> np.ndarray:
     return ends
 
 
-def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray,
-                 inputs: EdgeInputs) -> SelectionStats:
+def select_edges(
+    arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray, inputs: EdgeInputs
+) -> SelectionStats:
     """Apply ``inputs`` to ``arrays`` in place (edge flags, column 3 of
     listed triangles, ``region_table``) and say what it did."""
     stats = SelectionStats()
@@ -233,8 +234,9 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     # One segment per class of the edge (an edge with no class: one
     # ordinary segment).
     seg_style, (seg_owner, seg_edge) = _one_per_class(classes[seg_edge], seg_owner, seg_edge)
-    ends = (np.asarray(inputs.chain_ends, np.int64) if inputs.chain_ends is not None
-            else _chain_ends(verts, inputs.chain))
+    ends = (
+        np.asarray(inputs.chain_ends, np.int64) if inputs.chain_ends is not None else _chain_ends(verts, inputs.chain)
+    )
     seg_a = np.minimum(verts[seg_edge, 0], verts[seg_edge, 1])
     seg_b = np.maximum(verts[seg_edge, 0], verts[seg_edge, 1])
     chain_a, chain_b = ends[seg_edge, 0], ends[seg_edge, 1]
@@ -252,7 +254,8 @@ def select_edges(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.n
     # region-lines pass walks only that prefix (solidwire_frag.glsl).
     order = np.lexsort((seg_style != DIAGONAL_STYLE, seg_owner))
     seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style = (
-        x[order] for x in (seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style))
+        x[order] for x in (seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style)
+    )
     owners, first, count = np.unique(seg_owner, return_index=True, return_counts=True)
     if not np.array_equal(owners, block_owner):  # a block with no segment at all
         missing = np.setdiff1d(block_owner, owners)
@@ -336,8 +339,15 @@ def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, p
     stats.region_lines = len(edge)
 
 
-def _mark_own_edges(arrays: MeshArrays, verts: np.ndarray, drawn: np.ndarray, corner_vert: np.ndarray,
-                    offsets: np.ndarray, sizes: np.ndarray, corner_edge: np.ndarray) -> None:
+def _mark_own_edges(
+    arrays: MeshArrays,
+    verts: np.ndarray,
+    drawn: np.ndarray,
+    corner_vert: np.ndarray,
+    offsets: np.ndarray,
+    sizes: np.ndarray,
+    corner_edge: np.ndarray,
+) -> None:
     """A triangle's own polygon edges that are not drawn: EDGEk_REAL cleared
     and EDGEk_HIDDEN set (neither a line nor a diagonal); the same for a
     quad's edges to its 4th corner and an n-gon's outline slots."""
@@ -434,8 +444,9 @@ def _ngon_diagonals(arrays: MeshArrays, owner: np.ndarray):
     return owner[polys[poly_of]][keep], np.minimum(a, b)[keep], np.maximum(a, b)[keep]
 
 
-def flat_edges(corner_edge: np.ndarray, face_offsets: np.ndarray, face_normals: np.ndarray, edge_count: int,
-               angle: float) -> np.ndarray:
+def flat_edges(
+    corner_edge: np.ndarray, face_offsets: np.ndarray, face_normals: np.ndarray, edge_count: int, angle: float
+) -> np.ndarray:
     """(E,) True for an edge of exactly two distinct faces whose face normals
     differ by less than ``angle`` radians (the edge angle, §3.4)."""
     flat = np.zeros(edge_count, bool)
@@ -548,8 +559,14 @@ class Selection:
         return self.edge_angle > 0.0
 
 
-def apply_to_mesh(arrays: MeshArrays, mesh, corner_vert: np.ndarray, face_offsets: np.ndarray, selection: Selection,
-                  cage: tuple | None = None) -> SelectionStats:
+def apply_to_mesh(
+    arrays: MeshArrays,
+    mesh,
+    corner_vert: np.ndarray,
+    face_offsets: np.ndarray,
+    selection: Selection,
+    cage: tuple | None = None,
+) -> SelectionStats:
     """Read ``mesh``'s edges and apply ``selection`` to ``arrays``. ``cage``:
     (drawn mask, chain ids[, chain ends]) of the evaluated edges from the
     cage detection, or None (no subdivision, or cage edges off)."""
@@ -562,8 +579,14 @@ def apply_to_mesh(arrays: MeshArrays, mesh, corner_vert: np.ndarray, face_offset
         flat = flat_edges(corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle)
         drawn = ~flat if drawn is None else drawn & ~flat
     others = tuple(c for c in selection.classes if c != "boundary")
-    inputs = EdgeInputs(verts, drawn, read_edge_classes(mesh, others) if others else None,
-                        "boundary" in selection.classes, chain, chain_ends)
+    inputs = EdgeInputs(
+        verts,
+        drawn,
+        read_edge_classes(mesh, others) if others else None,
+        "boundary" in selection.classes,
+        chain,
+        chain_ends,
+    )
     if not inputs.selects_anything:
         return SelectionStats()
     return select_edges(arrays, corner_vert, face_offsets, corner_edge, inputs)

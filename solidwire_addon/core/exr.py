@@ -48,7 +48,7 @@ def _exr_headers(data: bytes, pos: int, multipart: bool):
 
 def _exr_channels(raw: bytes) -> list[tuple[str, int]]:
     channels, pos = [], 0
-    while raw[pos:pos + 1] not in (b"\0", b""):
+    while raw[pos : pos + 1] not in (b"\0", b""):
         end = raw.index(b"\0", pos)
         name = raw[pos:end].decode("latin-1")
         (pixel_type,) = struct.unpack_from("<i", raw, end + 1)
@@ -110,5 +110,3 @@ def exr_pass(channels: dict, layer: str, name: str, components: str) -> np.ndarr
 
 
 # -- images --------------------------------------------------------------------
-
-

@@ -212,7 +212,9 @@ def read_mesh(mesh) -> dict[str, np.ndarray]:
 
 def _check_vertex_count(positions: np.ndarray) -> None:
     if positions.shape[0] >= MAX_VERTICES:
-        raise ExtractError(f"mesh has {positions.shape[0]:,} vertices; SolidWire draws at most {MAX_VERTICES - 1:,} per mesh")
+        raise ExtractError(
+            f"mesh has {positions.shape[0]:,} vertices; SolidWire draws at most {MAX_VERTICES - 1:,} per mesh"
+        )
 
 
 def _triangles_from_loops(tri_loops, tri_polygons, loop_start, loop_total, corner_vert):
@@ -339,7 +341,11 @@ def _recentre(
         local = np.empty_like(positions)
         np.subtract(positions, centre, out=local, dtype=np.float64, casting="unsafe")
         return local, centre, bounds_min, bounds_max
-    counted = finite_vertex if face_vertex is None else (face_vertex if finite_vertex is None else finite_vertex & face_vertex)
+    counted = (
+        finite_vertex
+        if face_vertex is None
+        else (face_vertex if finite_vertex is None else finite_vertex & face_vertex)
+    )
     if not counted.any():
         zero = np.zeros(3)
         return np.zeros_like(positions), zero, zero.copy(), zero.copy()
@@ -417,7 +423,12 @@ def build_arrays(
     is_ngon_tri = loop_total[tri_polygons] > 4
     if is_ngon_tri.any():
         ngon_corners, block_start = _pack_ngons(
-            triangles[is_ngon_tri, :3], real[:, is_ngon_tri].T, tri_polygons[is_ngon_tri], loop_start, loop_total, corner_vert
+            triangles[is_ngon_tri, :3],
+            real[:, is_ngon_tri].T,
+            tri_polygons[is_ngon_tri],
+            loop_start,
+            loop_total,
+            corner_vert,
         )
         triangles[is_ngon_tri, 3] = block_start
         flags[is_ngon_tri] |= IS_NGON | (loop_total[tri_polygons[is_ngon_tri]] << NGON_SHIFT)
@@ -425,7 +436,15 @@ def build_arrays(
     face_vertex = _face_vertices(len(positions), triangles[:, :3].ravel())
     local, centre, bounds_min, bounds_max = _recentre(positions, finite_vertex, face_vertex=face_vertex)
     return MeshArrays(
-        local, centre, triangles, flags, tri_polygons.copy(), bounds_min, bounds_max, dropped, ngon_corners,
+        local,
+        centre,
+        triangles,
+        flags,
+        tri_polygons.copy(),
+        bounds_min,
+        bounds_max,
+        dropped,
+        ngon_corners,
         degenerate_triangles=_degenerate_count(triangles),
     )
 
@@ -555,7 +574,9 @@ def build_arrays_fast(
         tri_loops = np.empty((tri_count, 3), dtype=np.int32)
         ql = quad_loop_start[:, None] + np.where(flip[:, None], [[0, 1, 3]], [[0, 1, 2]]).astype(np.int32)
         tri_loops[quad_tri_start] = ql
-        tri_loops[quad_tri_start + 1] = quad_loop_start[:, None] + np.where(flip[:, None], [[1, 2, 3]], [[0, 2, 3]]).astype(np.int32)
+        tri_loops[quad_tri_start + 1] = quad_loop_start[:, None] + np.where(
+            flip[:, None], [[1, 2, 3]], [[0, 2, 3]]
+        ).astype(np.int32)
         if tri_faces is not None and len(tri_faces):
             tri_loops[tri_start[tri_faces]] = loop_start[tri_faces, None] + np.arange(3, dtype=np.int32)
         if ngon_faces is not None and len(ngon_faces):
@@ -619,7 +640,16 @@ def build_arrays_fast(
     face_vertex = _face_vertices(len(positions), corner_vert)
     local, centre, bounds_min, bounds_max = _recentre(positions, None, columns, face_vertex)
     arrays = MeshArrays(
-        local, centre, triangles, flags, tri_polygons, bounds_min, bounds_max, 0, ngon_corners, degenerate_triangles=_degenerate_count(triangles)
+        local,
+        centre,
+        triangles,
+        flags,
+        tri_polygons,
+        bounds_min,
+        bounds_max,
+        0,
+        ngon_corners,
+        degenerate_triangles=_degenerate_count(triangles),
     )
     if not len(ngon_corners):
         arrays.quads, arrays.quad_flip, arrays.source_positions = quads, flip, positions
@@ -627,8 +657,13 @@ def build_arrays_fast(
     return arrays
 
 
-def reposition(previous, positions: np.ndarray, corner_vert: np.ndarray, face_offsets: np.ndarray,
-               blender_tris: Callable[[np.ndarray], np.ndarray] | None = None):
+def reposition(
+    previous,
+    positions: np.ndarray,
+    corner_vert: np.ndarray,
+    face_offsets: np.ndarray,
+    blender_tris: Callable[[np.ndarray], np.ndarray] | None = None,
+):
     """(local positions, centre, bounds_min, bounds_max, source positions)
     for new vertex positions of a mesh whose faces are unchanged, or None when the new
     positions change more than positions: a quad split differently, a
@@ -762,12 +797,16 @@ def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> Mes
     ``corners``: also build the corner table (shaded fill, material colours);
     True, or the (normals, materials, domain) of :func:`read_corner_inputs` when the
     caller has them already (normals None: read here)."""
-    data = read_mesh_fast(mesh) if positions is None else {
-        "positions": positions,
-        "corner_vert": corner_vert if corner_vert is not None else read_corner_verts(mesh),
-        "face_offsets": read_face_offsets(mesh),
-        "blender_tris": blender_triangles(mesh),
-    }
+    data = (
+        read_mesh_fast(mesh)
+        if positions is None
+        else {
+            "positions": positions,
+            "corner_vert": corner_vert if corner_vert is not None else read_corner_verts(mesh),
+            "face_offsets": read_face_offsets(mesh),
+            "blender_tris": blender_triangles(mesh),
+        }
+    )
     arrays = build_arrays_fast(**data)
     if corners:
         normals, materials, domain = read_corner_inputs(mesh) if corners is True else corners
@@ -880,8 +919,14 @@ def normals_follow_geometry(domain: int) -> bool:
     return domain != NORMALS_BY_CORNER
 
 
-def corner_table(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray,
-                 normals: np.ndarray, materials: np.ndarray, domain: int = NORMALS_BY_CORNER) -> np.ndarray:
+def corner_table(
+    arrays: MeshArrays,
+    corner_vert: np.ndarray,
+    face_offsets: np.ndarray,
+    normals: np.ndarray,
+    materials: np.ndarray,
+    domain: int = NORMALS_BY_CORNER,
+) -> np.ndarray:
     """(R, 4) float32: a normal and a material index per row, the rows by
     ``domain`` (NORMALS_BY_*): one per vertex (the single material), one per
     drawn triangle (its face's normal and material), or one per corner of
@@ -940,8 +985,9 @@ def corner_rows(arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.nd
     return corner.reshape(-1).astype(np.int32)
 
 
-def fill_corner_table(rows, triangle_polygons: np.ndarray, normals: np.ndarray,
-                      materials: np.ndarray, domain: int = NORMALS_BY_CORNER) -> np.ndarray:
+def fill_corner_table(
+    rows, triangle_polygons: np.ndarray, normals: np.ndarray, materials: np.ndarray, domain: int = NORMALS_BY_CORNER
+) -> np.ndarray:
     """The corner table (see :func:`corner_table`) of ``domain``: by
     corner from the corner lookup ``rows`` of :func:`corner_rows` (one
     gather of the corner normals and the material index of each triangle's

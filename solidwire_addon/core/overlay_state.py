@@ -128,7 +128,9 @@ def keep_object(plan: OverlayPlan, obj: ObjectState) -> bool:
     return not (obj.in_edit_mode and not plan.draw_edit_mode)
 
 
-PIXEL_SETTINGS = tuple(s.name for s in schema.SETTINGS if s.kind == schema.FLOAT and s.subtype == "PIXEL" and s.in_snapshot)
+PIXEL_SETTINGS = tuple(
+    s.name for s in schema.SETTINGS if s.kind == schema.FLOAT and s.subtype == "PIXEL" and s.in_snapshot
+)
 
 
 def draw_items(plan: OverlayPlan, items):
@@ -136,9 +138,12 @@ def draw_items(plan: OverlayPlan, items):
     pixel length like the scene's, so it takes the UI scale too."""
     if plan.pixel_scale == 1.0:
         return items
-    return [item if item.style is None else
-            replace(item, style=replace(item.style, thickness=item.style.thickness * plan.pixel_scale))
-            for item in items]
+    return [
+        item
+        if item.style is None
+        else replace(item, style=replace(item.style, thickness=item.style.thickness * plan.pixel_scale))
+        for item in items
+    ]
 
 
 def draw_settings(plan: OverlayPlan, settings):

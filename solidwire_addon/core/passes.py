@@ -77,10 +77,14 @@ def gather_options(settings) -> dict:
     """What the draw items of a frame with ``settings`` must carry (keyword
     arguments of blender/gather.gather): corner tables for a shaded fill or
     material colours, colour-source inputs for per-object colours."""
-    return {"corners": draw_mod.needs_corners(settings), "colors": colors.needs_item_colors(settings),
-            "attribute_colors": colors.needs_attribute_colors(settings),
-            "edges": edge_select.Selection(float(settings.edge_angle), draw_mod.edge_classes_of(settings),
-                                           bool(settings.use_cage_edges))}
+    return {
+        "corners": draw_mod.needs_corners(settings),
+        "colors": colors.needs_item_colors(settings),
+        "attribute_colors": colors.needs_attribute_colors(settings),
+        "edges": edge_select.Selection(
+            float(settings.edge_angle), draw_mod.edge_classes_of(settings), bool(settings.use_cage_edges)
+        ),
+    }
 
 
 def render(items, view: View, settings, *, cull: bool = True):
@@ -93,8 +97,17 @@ def render(items, view: View, settings, *, cull: bool = True):
     return rgba, depth, stats
 
 
-def render_passes(items, view: View, settings, *, cull: bool = True, extra_passes=(), keep_readback: bool = False,
-                  read_depth: bool = True, strands=()):
+def render_passes(
+    items,
+    view: View,
+    settings,
+    *,
+    cull: bool = True,
+    extra_passes=(),
+    keep_readback: bool = False,
+    read_depth: bool = True,
+    strands=(),
+):
     """:func:`render` plus the render passes named in ``extra_passes`` (of
     schema.EXTRA_PASSES): (rgba, view_depth, stats, {name: (H, W, channels)}).
     A pass that is not asked for costs nothing: the surface pass gets its
@@ -165,8 +178,9 @@ def _clear(framebuffer, width: int, height: int, depth: bool = True) -> None:
 use_deferred_surface = True
 
 
-def draw_surface(targets, items, view: View, settings, *, show_wire: bool = True, aovs: bool = False,
-                 cull: bool = True):
+def draw_surface(
+    targets, items, view: View, settings, *, show_wire: bool = True, aovs: bool = False, cull: bool = True
+):
     """The surface pass into ``targets`` (cleared first): depth, the fill
     and the visible wire, and the render passes' outputs with ``aovs``.
     Meshes dense on screen are drawn deferred (docs/image_model.md §2.5,
@@ -189,8 +203,9 @@ def draw_surface(targets, items, view: View, settings, *, show_wire: bool = True
             stats.add(_deferred_surface(targets, deferred, view, settings, aovs, surface_args))
         except shaders.DeferredUnavailable as exc:
             shaders.disable_deferred()
-            warn_once(("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); "
-                                     "drawing directly")
+            warn_once(
+                ("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly"
+            )
             return draw_surface(targets, items, view, settings, show_wire=show_wire, aovs=aovs, cull=cull)
     return stats
 
@@ -218,8 +233,16 @@ def _deferred_surface(targets, items, view: View, settings, aovs: bool, surface_
         lines = _draw_region_lines(targets, items, view, settings, surface_args, stats)
     with targets.resolve_framebuffer(aovs=aovs).bind():
         gpu.state.viewport_set(0, 0, width, height)
-        draw_mod.draw(items, view, settings, stage=draw_mod.RESOLVE, visibility=targets.visible,
-                      write_view_depth=True, region_lines=lines, **surface_args)
+        draw_mod.draw(
+            items,
+            view,
+            settings,
+            stage=draw_mod.RESOLVE,
+            visibility=targets.visible,
+            write_view_depth=True,
+            region_lines=lines,
+            **surface_args,
+        )
     return stats
 
 
@@ -302,8 +325,16 @@ OVERLAY_DEPTH_BIAS = 2.0**-18
 
 
 def draw_over_viewport(
-    items, view: View, settings, *, depth_bias: float = OVERLAY_DEPTH_BIAS, scene_depth: bool = True,
-    scene_surfaces: bool = False, clip_planes=None, display=None, strands=(),
+    items,
+    view: View,
+    settings,
+    *,
+    depth_bias: float = OVERLAY_DEPTH_BIAS,
+    scene_depth: bool = True,
+    scene_surfaces: bool = False,
+    clip_planes=None,
+    display=None,
+    strands=(),
 ):
     """Draw ``items`` over a bound framebuffer that already holds the scene's
     colour and depth (a 3D viewport after its own drawing). Returns the
@@ -359,8 +390,9 @@ def draw_over_viewport(
                 # With hidden lines the surface pass only carries the fill.
                 if settings.use_hidden_lines and not settings.use_fill:
                     continue
-                surface_stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias,
-                                              show_wire=step.show_wire, **options)
+                surface_stats = draw_mod.draw(
+                    items, view, step.settings, depth_bias=depth_bias, show_wire=step.show_wire, **options
+                )
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
                 walk = {name: value for name, value in options.items() if name != "region_lines"}

@@ -32,7 +32,10 @@ def _post_init(self) -> None:
         else:
             continue
         if not ok:
-            warn_once(("setting", setting.name), f"SolidWire: setting '{setting.name}' is not a finite number ({value}); using {fixed}")
+            warn_once(
+                ("setting", setting.name),
+                f"SolidWire: setting '{setting.name}' is not a finite number ({value}); using {fixed}",
+            )
         object.__setattr__(self, setting.name, fixed)
 
 

@@ -174,6 +174,8 @@ def gl_context(name: str):
         yield
     finally:
         _context = previous
+
+
 _exit_hook_installed = False
 
 
@@ -345,8 +347,11 @@ def _create_info(variant: ShaderVariant):
     if variant.write_aovs or variant.clip_planes:
         # One typedef source holds every block's struct (a later call
         # replaces the one pulling_info set).
-        info.typedef_source(schema.param_block_glsl() + (OBJECT_BLOCK_GLSL if variant.write_aovs else "")
-                            + (CLIP_BLOCK_GLSL if variant.clip_planes else ""))
+        info.typedef_source(
+            schema.param_block_glsl()
+            + (OBJECT_BLOCK_GLSL if variant.write_aovs else "")
+            + (CLIP_BLOCK_GLSL if variant.clip_planes else "")
+        )
     if not variant.resolve:
         info.vertex_out(iface.stage_interface())  # last: the steps above add varyings
     _add_sources(info, variant, iface)
@@ -377,8 +382,12 @@ def _visibility_create_info(variant: ShaderVariant):
     compat.depth_write(info, "ANY")
     if variant.instanced:
         info.define("SW_INSTANCED", "1")
-        prologue = (f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
-                    + read_source("instancing.glsl") + read_source("common.glsl") + read_source("edge_geometry.glsl"))
+        prologue = (
+            f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
+            + read_source("instancing.glsl")
+            + read_source("common.glsl")
+            + read_source("edge_geometry.glsl")
+        )
     else:
         prologue = ""
     info.vertex_source(prologue + read_source("visibility_vert.glsl"))
@@ -410,8 +419,9 @@ def _region_lines_create_info(variant: ShaderVariant):
         info.push_constant("INT", "instance_base")
         info.sampler(3, "FLOAT_2D", "instance_table")
         info.define("SW_INSTANCED", "1")
-        prologue = (f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
-                    + read_source("instancing.glsl"))
+        prologue = f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n" + read_source(
+            "instancing.glsl"
+        )
     info.vertex_in(0, "INT", "quad_corner")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC2", "frag_line")
@@ -422,8 +432,12 @@ def _region_lines_create_info(variant: ShaderVariant):
         info.define("USE_DENSITY_FADE", "1")
     if variant.in_front:
         info.define("ALL_IN_FRONT", "1")
-    body = (read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("line_style.glsl")
-            + read_source("edge_styles.glsl"))
+    body = (
+        read_source("common.glsl")
+        + read_source("edge_geometry.glsl")
+        + read_source("line_style.glsl")
+        + read_source("edge_styles.glsl")
+    )
     info.vertex_source(prologue + body + read_source("region_lines_vert.glsl"))
     fragment_prologue = prologue.replace("gl_InstanceID", "0")  # the fragment stage transforms nothing
     info.fragment_source(fragment_prologue + body + read_source("region_lines_frag.glsl"))
@@ -539,17 +553,34 @@ def _add_sources(info, variant: ShaderVariant, iface: _Interface) -> None:
         vertex_head = fragment_head = read_source("item_table.glsl") if variant.per_item else ""
     fragment_tail = fill + _display_source(variant) + read_source("solidwire_frag.glsl")
     if variant.resolve:
-        instance_slot = (f"#define SW_INSTANCE_SLOT (instance_slot = instance_base + {INSTANCE_TEXELS} * sw_instance_id)\n"
-                         if variant.instanced else "")
+        instance_slot = (
+            f"#define SW_INSTANCE_SLOT (instance_slot = instance_base + {INSTANCE_TEXELS} * sw_instance_id)\n"
+            if variant.instanced
+            else ""
+        )
         info.vertex_source(read_source("resolve_vert.glsl"))
-        info.fragment_source(_RESOLVE_GLOBALS + iface.globals_glsl() + instance_slot
-                             + (instancing if variant.instanced else vertex_head) + common + styles
-                             + read_source("solidwire_vert.glsl") + fragment_tail + read_source("resolve_frag.glsl"))
+        info.fragment_source(
+            _RESOLVE_GLOBALS
+            + iface.globals_glsl()
+            + instance_slot
+            + (instancing if variant.instanced else vertex_head)
+            + common
+            + styles
+            + read_source("solidwire_vert.glsl")
+            + fragment_tail
+            + read_source("resolve_frag.glsl")
+        )
         return
-    info.vertex_source("#define SW_VERTEX_ID gl_VertexID\n" + vertex_head + common + styles
-                       + read_source("solidwire_vert.glsl"))
-    info.fragment_source("#define SW_FRONT_FACING gl_FrontFacing\n#define SW_INV_CLIP_W gl_FragCoord.w\n"
-                         + fragment_head + common + styles + fragment_tail)
+    info.vertex_source(
+        "#define SW_VERTEX_ID gl_VertexID\n" + vertex_head + common + styles + read_source("solidwire_vert.glsl")
+    )
+    info.fragment_source(
+        "#define SW_FRONT_FACING gl_FrontFacing\n#define SW_INV_CLIP_W gl_FragCoord.w\n"
+        + fragment_head
+        + common
+        + styles
+        + fragment_tail
+    )
 
 
 # The resolve pass's stand-ins for the vertex stage's inputs and the
@@ -673,8 +704,9 @@ def get_setup(in_front: bool = False):
         info.local_group_size(SETUP_GROUP_SIZE)
         info.define("SETUP_TEXELS", str(SETUP_TEXELS))
         info.define("SETUP_ROW_TRIANGLES", str(SETUP_ROW_TRIANGLES))
-        info.compute_source(read_source("common.glsl") + read_source("edge_geometry.glsl")
-                            + read_source("setup_comp.glsl"))
+        info.compute_source(
+            read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("setup_comp.glsl")
+        )
         shader = _keep(_cache, key, gpu.shader.create_from_info(info))
     return shader
 
@@ -692,9 +724,13 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
     """The fin shader; ``overlay_bias`` > 0 gives the viewport-overlay form
     (colour output, fixed-function occlusion; see silhouette_frag.glsl),
     with the variant's display transform."""
-    key = ShaderVariant(use_fade=variant.use_fade, thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
-                        linear_depth=variant.linear_depth and not overlay_bias,
-                        display_transform=variant.display_transform and bool(overlay_bias))
+    key = ShaderVariant(
+        use_fade=variant.use_fade,
+        thickness_mode=variant.thickness_mode,
+        depth_bias=overlay_bias,
+        linear_depth=variant.linear_depth and not overlay_bias,
+        display_transform=variant.display_transform and bool(overlay_bias),
+    )
     shader = _cache.get((_context, "silhouette", key))
     if shader is None:
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
@@ -724,8 +760,9 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
             add_display_transform(info)
         common = read_source("common.glsl") + read_source("edge_geometry.glsl")
         info.vertex_source(common + read_source("silhouette_vert.glsl"))
-        info.fragment_source(common + read_source("line_style.glsl") + _display_source(key)
-                             + read_source("silhouette_frag.glsl"))
+        info.fragment_source(
+            common + read_source("line_style.glsl") + _display_source(key) + read_source("silhouette_frag.glsl")
+        )
         shader = _keep(_cache, (_context, "silhouette", key), gpu.shader.create_from_info(info))
     return shader
 
@@ -741,11 +778,18 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
     buffer occludes; see strand_frag.glsl), with the variant's display
     transform; otherwise the render form (colour and (depth, weight)
     outputs, occluded by the ``scene_depth`` texture)."""
-    key = (bool(points), ShaderVariant(use_fade=variant.use_fade, use_fill=variant.use_fill and bool(points),
-                                       thickness_mode=variant.thickness_mode, depth_bias=overlay_bias,
-                                       display_transform=variant.display_transform and bool(overlay_bias),
-                                       clip_planes=variant.clip_planes and bool(overlay_bias),
-                                       shading=variant.shading if points and variant.use_fill else SHADING_FLAT))
+    key = (
+        bool(points),
+        ShaderVariant(
+            use_fade=variant.use_fade,
+            use_fill=variant.use_fill and bool(points),
+            thickness_mode=variant.thickness_mode,
+            depth_bias=overlay_bias,
+            display_transform=variant.display_transform and bool(overlay_bias),
+            clip_planes=variant.clip_planes and bool(overlay_bias),
+            shading=variant.shading if points and variant.use_fill else SHADING_FLAT,
+        ),
+    )
     shader = _cache.get((_context, "strand", key))
     if shader is None:
         flags = key[1]
@@ -793,8 +837,9 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             info.define("SHADING", str(flags.shading))
             if flags.shading == SHADING_MATCAP:
                 info.sampler(6, "FLOAT_2D", "matcap_image")
-            shading_source = ("#define SW_FRONT_FACING true\nvec3 shading_normal;\nvec4 item_info;\n"
-                              + read_source("fill_shading.glsl"))
+            shading_source = "#define SW_FRONT_FACING true\nvec3 shading_normal;\nvec4 item_info;\n" + read_source(
+                "fill_shading.glsl"
+            )
         if flags.display_transform:
             add_display_transform(info)
         if flags.clip_planes:

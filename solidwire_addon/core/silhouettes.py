@@ -83,8 +83,16 @@ def edge_table(mesh):
     return mesh.silhouette_edges
 
 
-def draw_silhouettes(items, view, settings, scene_depth_texture=None, *, overlay_bias: float = 0.0,
-                     linear_depth: bool = False, display=None) -> None:
+def draw_silhouettes(
+    items,
+    view,
+    settings,
+    scene_depth_texture=None,
+    *,
+    overlay_bias: float = 0.0,
+    linear_depth: bool = False,
+    display=None,
+) -> None:
     """Draw the outer halves into the bound framebuffer.
 
     Render: an R32F intensity target with its own depth buffer cleared to 1,

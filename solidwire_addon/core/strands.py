@@ -107,13 +107,19 @@ def catmull_rom(points: np.ndarray, resolution: int, cyclic: bool) -> np.ndarray
         ext = np.concatenate([points[..., -1:, :], points, points[..., :2, :]], axis=-2)
         segments = n
     else:
-        ext = np.concatenate([2.0 * points[..., :1, :] - points[..., 1:2, :], points,
-                              2.0 * points[..., -1:, :] - points[..., -2:-1, :]], axis=-2)
+        ext = np.concatenate(
+            [2.0 * points[..., :1, :] - points[..., 1:2, :], points, 2.0 * points[..., -1:, :] - points[..., -2:-1, :]],
+            axis=-2,
+        )
         segments = n - 1
     t = np.arange(resolution, dtype=np.float64) / resolution
     t2, t3 = t * t, t * t * t
-    weights = (0.5 * (-t3 + 2.0 * t2 - t), 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0), 0.5 * (-3.0 * t3 + 4.0 * t2 + t),
-               0.5 * (t3 - t2))
+    weights = (
+        0.5 * (-t3 + 2.0 * t2 - t),
+        0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
+        0.5 * (-3.0 * t3 + 4.0 * t2 + t),
+        0.5 * (t3 - t2),
+    )
     i = np.arange(segments)
     out = sum(w[:, None] * ext[..., i + k, None, :] for k, w in enumerate(weights))  # (..., segments, res, k)
     out = out.reshape(*points.shape[:-2], segments * resolution, points.shape[-1])
@@ -166,14 +172,15 @@ def bezier(points: np.ndarray, left: np.ndarray, right: np.ndarray, resolution: 
     s_ = 1.0 - t
     p0, p3 = points[..., cur, None, :3], points[..., nxt, None, :3]
     p1, p2 = np.asarray(right, np.float64)[..., cur, None, :], np.asarray(left, np.float64)[..., nxt, None, :]
-    xyz = s_ ** 3 * p0 + 3.0 * s_ * s_ * t * p1 + 3.0 * s_ * t * t * p2 + t ** 3 * p3
+    xyz = s_**3 * p0 + 3.0 * s_ * s_ * t * p1 + 3.0 * s_ * t * t * p2 + t**3 * p3
     r = points[..., cur, None, 3:] * s_ + points[..., nxt, None, 3:] * t
     out = np.concatenate([xyz, r], axis=-1).reshape(*points.shape[:-2], len(cur) * resolution, 4)
     return np.concatenate([out, points[..., :1, :] if cyclic else points[..., -1:, :]], axis=-2)
 
 
-def curves_geometry(positions, radius=None, offsets=None, curve_types=None, resolutions=None,
-                    cyclic=None, handles=None) -> StrandGeometry | None:
+def curves_geometry(
+    positions, radius=None, offsets=None, curve_types=None, resolutions=None, cyclic=None, handles=None
+) -> StrandGeometry | None:
     """Strands of a Curves datablock: ``positions`` (P, 3) control points,
     ``radius`` (P,) (None: 0), ``offsets`` (C + 1,) first point of each
     curve, per curve ``curve_types``, ``resolutions`` and ``cyclic`` (None:
@@ -190,8 +197,11 @@ def curves_geometry(positions, radius=None, offsets=None, curve_types=None, reso
     values = np.concatenate([positions, radius[:, None]], axis=1)
     sizes = np.diff(offsets)
     kinds = np.full(curve_count, CATMULL_ROM) if curve_types is None else np.asarray(curve_types, np.int64)
-    res = (np.full(curve_count, DEFAULT_RESOLUTION) if resolutions is None
-           else np.maximum(np.asarray(resolutions, np.int64), 1))
+    res = (
+        np.full(curve_count, DEFAULT_RESOLUTION)
+        if resolutions is None
+        else np.maximum(np.asarray(resolutions, np.int64), 1)
+    )
     closed = np.zeros(curve_count, bool) if cyclic is None else np.asarray(cyclic, bool)
     # How each curve is evaluated: 1 Catmull-Rom, 2 Bezier, 0 its control polygon.
     method = np.where((kinds == CATMULL_ROM) & (sizes >= 2), 1, 0)
@@ -274,8 +284,13 @@ class GeometryCache:
 
     @staticmethod
     def fingerprint(kind: str, *arrays) -> tuple:
-        return (kind, *((None if a is None else (a.shape, str(a.dtype), zlib.crc32(np.ascontiguousarray(a).view(np.uint8))))
-                        for a in arrays))
+        return (
+            kind,
+            *(
+                (None if a is None else (a.shape, str(a.dtype), zlib.crc32(np.ascontiguousarray(a).view(np.uint8))))
+                for a in arrays
+            ),
+        )
 
     def get(self, key, make):
         """The geometry of ``key`` (a fingerprint), made by ``make()`` when
@@ -353,8 +368,7 @@ def _radius_scale(matrix: np.ndarray) -> float:
     return det ** (1.0 / 3.0) if np.isfinite(det) else 0.0
 
 
-def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0, display=None,
-          clip_planes=None) -> int:
+def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0, display=None, clip_planes=None) -> int:
     """Draw ``items`` into the bound framebuffer (the caller sets blending
     and the depth test). Returns the number of items drawn."""
     variant = shader_variant(settings)
@@ -388,8 +402,9 @@ def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0,
                 shader = shaders.get_strand(kind == POINTS, variant, overlay_bias)
                 shader.bind()
                 if overlay_bias:
-                    shader.uniform_float("proj_z", [float(proj[2][2]), float(proj[2][3]), float(proj[3][2]),
-                                                    float(proj[3][3])])
+                    shader.uniform_float(
+                        "proj_z", [float(proj[2][2]), float(proj[2][3]), float(proj[3][2]), float(proj[3][3])]
+                    )
                     if variant.display_transform:
                         bind_display_transform(shader, display)
                     if clip_block is not None:
@@ -403,8 +418,9 @@ def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0,
             if block is None:
                 item_settings = styled(settings, item.style)
                 wire, fill, _materials = colors.item_colors(item.source, item_settings)
-                item_settings = replace(item_settings, wire_color=(*wire, item_settings.wire_color[3]),
-                                        fill_color=tuple(fill))
+                item_settings = replace(
+                    item_settings, wire_color=(*wire, item_settings.wire_color[3]), fill_color=tuple(fill)
+                )
                 block = blocks[key] = gpu.types.GPUUniformBuf(pack_params(item_settings, view.viewport, proj))
             shader.uniform_block("params", block)
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
@@ -429,8 +445,7 @@ def composite_render(rgba, depth, surface_targets, view, settings, items):
     try:
         return _composite_render(rgba, depth, surface_targets, view, settings, items)
     except Exception as exc:  # noqa: BLE001 - the meshes' image must survive
-        warn_once(("strands draw", type(exc).__name__), f"SolidWire: hair and point clouds not drawn: "
-                                                        f"{one_line(exc)}")
+        warn_once(("strands draw", type(exc).__name__), f"SolidWire: hair and point clouds not drawn: {one_line(exc)}")
         return rgba, depth
 
 
@@ -475,6 +490,7 @@ def draw_over_viewport(items, view, settings, depth_bias: float, display=None, c
     try:
         return _draw(items, view, settings, overlay_bias=depth_bias, display=display, clip_planes=clip_planes)
     except Exception as exc:  # noqa: BLE001 - the meshes' overlay must survive
-        warn_once(("strands overlay", type(exc).__name__), f"SolidWire: hair and point clouds not drawn: "
-                                                          f"{one_line(exc)}")
+        warn_once(
+            ("strands overlay", type(exc).__name__), f"SolidWire: hair and point clouds not drawn: {one_line(exc)}"
+        )
         return 0

@@ -43,7 +43,15 @@ import bpy
 import numpy as np
 
 SILHOUETTE_OFFSET = 0.01  # px, SPEC 1.5
-OFFSETS = np.array([[0.0, 0.0], [SILHOUETTE_OFFSET, 0.0], [-SILHOUETTE_OFFSET, 0.0], [0.0, SILHOUETTE_OFFSET], [0.0, -SILHOUETTE_OFFSET]])
+OFFSETS = np.array(
+    [
+        [0.0, 0.0],
+        [SILHOUETTE_OFFSET, 0.0],
+        [-SILHOUETTE_OFFSET, 0.0],
+        [0.0, SILHOUETTE_OFFSET],
+        [0.0, -SILHOUETTE_OFFSET],
+    ]
+)
 PAIR_CHUNK = 400_000
 
 
@@ -137,8 +145,10 @@ def _object_colors(obj, s, npoly, material_index):
     elif fill_source == "RANDOM":
         faces[:] = np.array(_hsv_name_color(obj.name, 0.5, 0.8))
     elif fill_source == "MATERIAL":
-        slots = [fill if slot.material is None else np.array(slot.material.diffuse_color[:3], dtype=np.float64)
-                 for slot in obj.material_slots]
+        slots = [
+            fill if slot.material is None else np.array(slot.material.diffuse_color[:3], dtype=np.float64)
+            for slot in obj.material_slots
+        ]
         if slots:
             faces[:] = np.array(slots)[np.clip(material_index, 0, len(slots) - 1)]
     return faces, wire
@@ -181,8 +191,12 @@ def _flat_edges(mesh, loop_poly, real_a, real_b, angle) -> set:
 # Edge classes in style order (style k + 1 is class k), with Blender's
 # attribute names; the reference reads Blender's data on its own.
 EDGE_CLASSES = ("boundary", "sharp", "crease", "seam", "freestyle")
-_CLASS_ATTRIBUTES = {"sharp": ("sharp_edge",), "crease": ("crease_edge",), "seam": ("uv_seam", ".uv_seam"),
-                     "freestyle": ("freestyle_edge",)}
+_CLASS_ATTRIBUTES = {
+    "sharp": ("sharp_edge",),
+    "crease": ("crease_edge",),
+    "seam": ("uv_seam", ".uv_seam"),
+    "freestyle": ("freestyle_edge",),
+}
 PATTERN_DUTY = {"SOLID": 1.0, "DOTTED": 0.25, "DASHED": 0.5}
 # Tessellated sources (image model §3.9), and their coplanar angle.
 TESSELLATED_TYPES = ("FONT", "CURVE", "SURFACE", "META")
@@ -202,9 +216,13 @@ def _cage_masks(depsgraph, s) -> dict:
     for obj in bpy.context.scene.objects:
         if obj.type != "MESH" or obj.mode == "EDIT":
             continue
-        subdivides = [m for m in obj.modifiers if m.type in ("SUBSURF", "MULTIRES")
-                      and (m.show_render if render else m.show_viewport)
-                      and (m.render_levels if render else m.levels) > 0]
+        subdivides = [
+            m
+            for m in obj.modifiers
+            if m.type in ("SUBSURF", "MULTIRES")
+            and (m.show_render if render else m.show_viewport)
+            and (m.render_levels if render else m.levels) > 0
+        ]
         if subdivides and "__reference_cage" not in obj.data.attributes:
             attribute = obj.data.attributes.new("__reference_cage", "INT", "EDGE")
             attribute.data.foreach_set("value", np.arange(1, len(obj.data.edges) + 1, dtype=np.int32))
@@ -248,8 +266,16 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
         # (§1.3); vectorised for the big meshes of the stress scenes.
         pairs = np.unique(np.stack([loop_poly, corner_edge], axis=1), axis=0)
         a, b = ev[pairs[:, 1]].min(axis=1), ev[pairs[:, 1]].max(axis=1)
-        return {"key": np.arange(npoly), "owner": pairs[:, 0], "a": a, "b": b, "style": np.zeros(len(a), np.int64),
-                "chain_a": a, "chain_b": b, "hidden": set()}
+        return {
+            "key": np.arange(npoly),
+            "owner": pairs[:, 0],
+            "a": a,
+            "b": b,
+            "style": np.zeros(len(a), np.int64),
+            "chain_a": a,
+            "chain_b": b,
+            "hidden": set(),
+        }
     uses = np.bincount(corner_edge, minlength=ne)
     drawn = np.ones(ne, bool)
     for e in range(ne):
@@ -266,8 +292,11 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
         if name == "boundary":
             bits[uses == 1] |= 1 << k
             continue
-        if name == "freestyle" and mesh.attributes.get("freestyle_edge") is None and hasattr(mesh.edges[0] if ne else None,
-                                                                                            "use_freestyle_mark"):
+        if (
+            name == "freestyle"
+            and mesh.attributes.get("freestyle_edge") is None
+            and hasattr(mesh.edges[0] if ne else None, "use_freestyle_mark")
+        ):
             bits[[e for e in range(ne) if mesh.edges[e].use_freestyle_mark]] |= 1 << k  # Blender 4.x
             continue
         for attr_name in _CLASS_ATTRIBUTES[name]:
@@ -341,8 +370,16 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
             cb.append(chain_ends[e][1])
     hidden = {(int(min(ev[e])), int(max(ev[e]))) for e in np.flatnonzero(~drawn)}
     as_array = lambda x: np.array(x, np.int64)
-    return {"key": key, "owner": as_array(owner), "a": as_array(a), "b": as_array(b), "style": as_array(style),
-            "chain_a": as_array(ca), "chain_b": as_array(cb), "hidden": hidden}
+    return {
+        "key": key,
+        "owner": as_array(owner),
+        "a": as_array(a),
+        "b": as_array(b),
+        "style": as_array(style),
+        "chain_a": as_array(ca),
+        "chain_b": as_array(cb),
+        "hidden": hidden,
+    }
 
 
 def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
@@ -398,7 +435,9 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         nxt = start[loop_poly] + (loop_idx - start[loop_poly] + 1) % total[loop_poly]
         real_a, real_b = loop_vert[loop_idx], loop_vert[nxt]
         # Diagonals: triangle edges that are not polygon edges of that polygon.
-        key_real = set(zip(loop_poly.tolist(), np.minimum(real_a, real_b).tolist(), np.maximum(real_a, real_b).tolist()))
+        key_real = set(
+            zip(loop_poly.tolist(), np.minimum(real_a, real_b).tolist(), np.maximum(real_a, real_b).tolist())
+        )
         diag = set()
         half_edges: dict = {}  # real edge -> third vertices of its triangles
         for t in range(ntri):  # small meshes only (reference)
@@ -737,8 +776,10 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
         win = (h[..., :2] / h[..., 3:4] + 1.0) * 0.5 * np.array([width, height])
         a, b, c = win[:, 0], win[:, 1], win[:, 2]
         area2 = np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
-        longest = np.max(np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1),
-                                   np.linalg.norm(a - c, axis=1)]), axis=0)
+        longest = np.max(
+            np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1), np.linalg.norm(a - c, axis=1)]),
+            axis=0,
+        )
         altitude = np.where(longest > 0, area2 / np.maximum(longest, 1e-300), 0.0)
     thin = np.flatnonzero(front & np.isfinite(win).all(axis=(1, 2)) & (altitude < SLIVER_PX) & (longest > 0))
     out = []
@@ -754,9 +795,17 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
             continue
         gx, gy = np.meshgrid(xs + 0.5, ys + 0.5)
         pts = np.stack([gx.ravel(), gy.ravel()], axis=1)
-        dist = np.min(np.stack([_segment_distance(pts, np.broadcast_to(win[k, i], pts.shape),
-                                                  np.broadcast_to(win[k, (i + 1) % 3], pts.shape))[0]
-                                for i in range(3)]), axis=0)
+        dist = np.min(
+            np.stack(
+                [
+                    _segment_distance(
+                        pts, np.broadcast_to(win[k, i], pts.shape), np.broadcast_to(win[k, (i + 1) % 3], pts.shape)
+                    )[0]
+                    for i in range(3)
+                ]
+            ),
+            axis=0,
+        )
         near = dist <= SLIVER_REACH_PX
         if near.any():
             pix = row_of[gy.ravel()[near].astype(int)] * width + gx.ravel()[near].astype(int)
@@ -850,8 +899,9 @@ def _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select):
 TIE_PX = 1e-3
 
 
-def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False, want_index=False,
-                            ties=None):
+def _min_distance_per_pixel(
+    pix_face, pix_xy, geo, wa, wb, valid, select, want_along=False, want_index=False, ties=None
+):
     """For every pixel: min distance to the selected edges of its own face
     (edge_face == pix_face; for lines, pass the faces' block keys). With a
     dict as ``ties``, ties["tied"] marks pixels whose nearest line is tied
@@ -875,7 +925,8 @@ def _min_distance_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, want_a
             runner_up = np.flatnonzero(~keep)  # a second (or later) line of the same pixel
             runner_up = runner_up[keep[runner_up - 1]]  # the second one only
             tied = (d[runner_up] - d[runner_up - 1] <= TIE_PX) & (
-                np.abs(np.abs(along[runner_up]) - np.abs(along[runner_up - 1])) > TIE_PX)
+                np.abs(np.abs(along[runner_up]) - np.abs(along[runner_up - 1])) > TIE_PX
+            )
             ties["tied"][pair_pix[runner_up[tied]]] = True
     return (best, best_along, best_index) if want_index else (best, best_along)
 
@@ -917,8 +968,9 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
         name = EDGE_CLASSES[style - 1] if style else None
         pattern = getattr(s, f"{name}_pattern") if name else "SOLID"
         style_ties = {}
-        d, _along, _index = _min_distance_per_pixel(keys, pix_xy, geo, wa, wb, valid, select,
-                                                    want_along=False, want_index=True, ties=style_ties)
+        d, _along, _index = _min_distance_per_pixel(
+            keys, pix_xy, geo, wa, wb, valid, select, want_along=False, want_index=True, ties=style_ties
+        )
         d_real = np.minimum(d_real, d)
         width_px = _class_width(s, name, thickness) if name else thickness
         duty = PATTERN_DUTY[pattern]
@@ -930,6 +982,7 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
                 w = width_px if np.isscalar(width_px) else width_px[pair_pix]
                 v = profile(d_pair, w, softness) * density(pair_edge)
                 return v * pattern_mask(np.abs(along_pair), float(s.pattern_period), duty) if duty < 1.0 else v
+
             v = _max_value_per_pixel(keys, pix_xy, geo, wa, wb, valid, select, faded)
         else:
             v = profile(d, width_px, softness)
@@ -991,7 +1044,9 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
     ones = np.ones((len(a), 1))
 
     def side(o):
-        m = np.stack([np.hstack([a, ones]), np.hstack([b, ones]), np.hstack([o, ones]), np.tile(eye, (len(a), 1))], axis=1)
+        m = np.stack(
+            [np.hstack([a, ones]), np.hstack([b, ones]), np.hstack([o, ones]), np.tile(eye, (len(a), 1))], axis=1
+        )
         return np.linalg.det(m)
 
     side_f = side(geo.sil_third[:, 0])
@@ -1091,8 +1146,9 @@ def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj) 
     return flagged
 
 
-def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha,
-                          undecided=None):
+def _hidden_line_coverage(
+    s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha, undecided=None
+):
     """Alpha of the hidden-line layer per pixel (image model §5.4): every
     face hit behind the visible surface contributes
     a_k = wire_alpha * hidden_alpha * P(d_real) * dash(t) * fade(z_k), with
@@ -1120,8 +1176,9 @@ def _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, va
         return coverage
     xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
     hidden_ties = {}
-    d, along = _min_distance_per_pixel(geo.face_key[f], xy, geo, wa, wb, valid, geo.edge_real, want_along=True,
-                                       ties=hidden_ties)
+    d, along = _min_distance_per_pixel(
+        geo.face_key[f], xy, geo, wa, wb, valid, geo.edge_real, want_along=True, ties=hidden_ties
+    )
     if undecided is not None:
         undecided[pix[hidden_ties["tied"]]] = True
     a = profile(d, _thickness_at(s, z, proj, height, geo.face_thickness[f]), float(s.softness))
@@ -1172,8 +1229,9 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
         softness = float(s.softness)
         thickness = _thickness_at(s, depth[covered], proj, height, geo.face_thickness[pix_face])
-        value, d_real, winner, density, tied = _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width,
-                                                               height, thickness, softness)
+        value, d_real, winner, density, tied = _line_intensity(
+            s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height, thickness, softness
+        )
         on_silhouette[covered[tied]] = True
         d_real_all[covered] = d_real
         winner_all[covered] = winner
@@ -1181,8 +1239,16 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         if mode != "HIDDEN":
             diag_ties = {}
             d_diag, along, _index = _min_distance_per_pixel(
-                pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, want_along=(mode in ("DOTTED", "DASHED")),
-                want_index=True, ties=diag_ties,
+                pix_face,
+                pix_xy,
+                geo,
+                wa,
+                wb,
+                valid,
+                ~geo.edge_real,
+                want_along=(mode in ("DOTTED", "DASHED")),
+                want_index=True,
+                ties=diag_ties,
             )
             if mode in ("DOTTED", "DASHED"):
                 on_silhouette[covered[diag_ties["tied"]]] = True
@@ -1204,8 +1270,22 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         value *= _fade(s, depth[covered])
         if hidden_lines:
             wire_alpha = float(s.wire_color[3])
-            hidden = _hidden_line_coverage(s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height,
-                                           wire_alpha, undecided=on_silhouette)
+            hidden = _hidden_line_coverage(
+                s,
+                all_hits,
+                face,
+                depth,
+                rows,
+                width,
+                geo,
+                wa,
+                wb,
+                valid,
+                proj,
+                height,
+                wire_alpha,
+                undecided=on_silhouette,
+            )
             on_silhouette |= _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj)
             hidden_all = hidden
             # The visible wire over the hidden lines ("over" with one colour),
@@ -1335,7 +1415,9 @@ def error_report(measured: np.ndarray, ref: ReferenceResult) -> dict:
     return {
         **_statistics(d),
         "silhouette_pixels": int(np.count_nonzero(ref.on_silhouette)),
-        "silhouette_max": float(np.nan_to_num(diff[ref.on_silhouette], nan=1.0).max()) if ref.on_silhouette.any() else 0.0,
+        "silhouette_max": float(np.nan_to_num(diff[ref.on_silhouette], nan=1.0).max())
+        if ref.on_silhouette.any()
+        else 0.0,
         "nan": nan,
     }
 

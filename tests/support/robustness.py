@@ -31,8 +31,9 @@ def render_exr(scene, path: Path) -> np.ndarray:
     32-bit float OpenEXR file, and read it back: (H, W, 4) float32, bottom row
     first, premultiplied (alpha = wire alpha * I on a transparent film). Unlike
     a PNG, the file keeps NaN and Inf, so a poisoned pixel cannot hide."""
-    path = scenes.render_still(scene, path, file_format="OPEN_EXR", color_mode="RGBA", color_depth="32",
-                               exr_codec="ZIP")
+    path = scenes.render_still(
+        scene, path, file_format="OPEN_EXR", color_mode="RGBA", color_depth="32", exr_codec="ZIP"
+    )
     image = bpy.data.images.load(str(path), check_existing=False)
     try:
         width, height = image.size
@@ -48,7 +49,9 @@ def lines_of(text: str, needle: str) -> list[str]:
 
 
 def addon_modules() -> list[types.ModuleType]:
-    return [m for name, m in sorted(sys.modules.items()) if name == "solidwire_addon" or name.startswith("solidwire_addon.")]
+    return [
+        m for name, m in sorted(sys.modules.items()) if name == "solidwire_addon" or name.startswith("solidwire_addon.")
+    ]
 
 
 def _walk(value, path, found, predicate, depth, seen):

@@ -16,9 +16,15 @@ from mathutils import Vector
 
 # The look of the image model's sections 1.2-1.4 (no shading, no colour
 # sources, no fill): what the accuracy tests measure unless they ask for more.
-CORE_LOOK = dict(use_fill=False, fill_shading="FLAT", fill_color=(1.0, 1.0, 1.0),
-                 fill_color_source="SINGLE", wire_color_source="SINGLE", use_cage_edges=False,
-                 use_object_density_fade=False)
+CORE_LOOK = dict(
+    use_fill=False,
+    fill_shading="FLAT",
+    fill_color=(1.0, 1.0, 1.0),
+    fill_color_source="SINGLE",
+    wire_color_source="SINGLE",
+    use_cage_edges=False,
+    use_object_density_fade=False,
+)
 
 
 def empty_scene(width: int = 160, height: int = 120, *, transparent: bool = True, **solidwire):
@@ -313,8 +319,9 @@ def frame_object(scene, obj, *, lens: float = 50.0, azimuth: float = -60.0, elev
     half_fov = math.atan(0.5 * sensor * min(r.resolution_y / r.resolution_x, 1.0) / lens)
     distance = radius / math.sin(half_fov) / fill
     location = Vector(orbit_location(distance, azimuth, elevation)) + centre
-    return add_camera(scene, location=tuple(location), target=tuple(centre), lens=lens,
-                      clip=(distance * 0.01, distance * 10.0))
+    return add_camera(
+        scene, location=tuple(location), target=tuple(centre), lens=lens, clip=(distance * 0.01, distance * 10.0)
+    )
 
 
 def teapot_scene(scene):
@@ -368,7 +375,12 @@ def slivers_scene(scene):
     for i in range(n):
         x0 = (i - n / 2) * width
         base = len(verts)
-        verts += [(x0, -length / 2, 0.0), (x0 + width, -length / 2, 0.0), (x0 + width, length / 2, 0.0), (x0, length / 2, 0.0)]
+        verts += [
+            (x0, -length / 2, 0.0),
+            (x0 + width, -length / 2, 0.0),
+            (x0 + width, length / 2, 0.0),
+            (x0, length / 2, 0.0),
+        ]
         faces += [(base, base + 1, base + 2), (base, base + 2, base + 3)]
     from_pydata(scene, "Slivers", verts, faces, rotation_euler=(0.0, 0.0, 0.5))
     add_camera(scene, location=(0.0, -0.5, 9.0), target=(0.0, 0.0, 0.0), lens=50.0)

@@ -57,15 +57,25 @@ def catmull_rom(points, resolution, cyclic):
     n = len(points)
     if n < 2 or resolution <= 1:
         return points
-    ext = (np.concatenate([points[-1:], points, points[:2]]) if cyclic
-           else np.concatenate([2 * points[:1] - points[1:2], points, 2 * points[-1:] - points[-2:-1]]))
+    ext = (
+        np.concatenate([points[-1:], points, points[:2]])
+        if cyclic
+        else np.concatenate([2 * points[:1] - points[1:2], points, 2 * points[-1:] - points[-2:-1]])
+    )
     out = []
     for i in range(n if cyclic else n - 1):
-        p0, p1, p2, p3 = ext[i:i + 4]
+        p0, p1, p2, p3 = ext[i : i + 4]
         for k in range(resolution):
             t = k / resolution
-            out.append(0.5 * ((2 * p1) + (-p0 + p2) * t + (2 * p0 - 5 * p1 + 4 * p2 - p3) * t * t
-                              + (-p0 + 3 * p1 - 3 * p2 + p3) * t ** 3))
+            out.append(
+                0.5
+                * (
+                    (2 * p1)
+                    + (-p0 + p2) * t
+                    + (2 * p0 - 5 * p1 + 4 * p2 - p3) * t * t
+                    + (-p0 + 3 * p1 - 3 * p2 + p3) * t**3
+                )
+            )
     out.append(points[0] if cyclic else points[-1])
     return np.array(out)
 
@@ -79,8 +89,12 @@ def bezier(points, left, right, resolution, cyclic):
         j = (i + 1) % n
         for k in range(resolution):
             t = k / resolution
-            xyz = ((1 - t) ** 3 * points[i, :3] + 3 * (1 - t) ** 2 * t * right[i] + 3 * (1 - t) * t * t * left[j]
-                   + t ** 3 * points[j, :3])
+            xyz = (
+                (1 - t) ** 3 * points[i, :3]
+                + 3 * (1 - t) ** 2 * t * right[i]
+                + 3 * (1 - t) * t * t * left[j]
+                + t**3 * points[j, :3]
+            )
             out.append(np.append(xyz, (1 - t) * points[i, 3] + t * points[j, 3]))
     out.append(points[0] if cyclic else points[-1])
     return np.array(out)
@@ -128,7 +142,7 @@ def primitives(depsgraph, show="show_in_render"):
         res = _attribute(data, "resolution", ncurves, 1, "value", np.int32)
         cyc = _attribute(data, "cyclic", ncurves, 1, "value", bool)
         for c in range(ncurves):
-            ctrl = np.concatenate([pos[offsets[c]:offsets[c + 1]], rad[offsets[c]:offsets[c + 1], None]], axis=1)
+            ctrl = np.concatenate([pos[offsets[c] : offsets[c + 1]], rad[offsets[c] : offsets[c + 1], None]], axis=1)
             closed = bool(cyc[c]) if cyc is not None else False
             kind = int(types[c]) if types is not None else 0
             left = _attribute(data, "handle_left", count, 3, "vector")
@@ -137,12 +151,19 @@ def primitives(depsgraph, show="show_in_render"):
                 ev = catmull_rom(ctrl, int(res[c]) if res is not None else 12, closed)
                 pairs = [(i, i + 1) for i in range(len(ev) - 1)]
             elif kind == 2 and len(ctrl) >= 2 and left is not None and right is not None:
-                ev = bezier(ctrl, left[offsets[c]:offsets[c + 1]], right[offsets[c]:offsets[c + 1]],
-                            int(res[c]) if res is not None else 12, closed)
+                ev = bezier(
+                    ctrl,
+                    left[offsets[c] : offsets[c + 1]],
+                    right[offsets[c] : offsets[c + 1]],
+                    int(res[c]) if res is not None else 12,
+                    closed,
+                )
                 pairs = [(i, i + 1) for i in range(len(ev) - 1)]
             else:
                 ev = ctrl
-                pairs = [(i, i + 1) for i in range(len(ev) - 1)] + ([(len(ev) - 1, 0)] if closed and len(ev) > 2 else [])
+                pairs = [(i, i + 1) for i in range(len(ev) - 1)] + (
+                    [(len(ev) - 1, 0)] if closed and len(ev) > 2 else []
+                )
             for i, j in pairs:
                 if np.isfinite(ev[i]).all() and np.isfinite(ev[j]).all():
                     segments.append((ev[i, :3], ev[j, :3], max(ev[i, 3], 0.0), max(ev[j, 3], 0.0), matrix, obj.name))
@@ -211,8 +232,14 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
         ra, rb = ra * scale, rb * scale
         ta = fa / (fa - fb) if fa < 0 else 0.0
         tb = fb / (fb - fa) if fb < 0 else 0.0
-        ka, kb, za, zb, ra, rb = (ka + ta * (kb - ka), kb + tb * (ka - kb), za + ta * (zb - za), zb + tb * (za - zb),
-                                  ra + ta * (rb - ra), rb + tb * (ra - rb))
+        ka, kb, za, zb, ra, rb = (
+            ka + ta * (kb - ka),
+            kb + tb * (ka - kb),
+            za + ta * (zb - za),
+            zb + tb * (za - zb),
+            ra + ta * (rb - ra),
+            rb + tb * (ra - rb),
+        )
         wa_, wb_ = window(ka), window(kb)
         reach = max(h, ra * ppu / ka[3], rb * ppu / kb[3]) + 2 * soft + 1
         x0, x1, y0, y1 = pixel_box(np.minimum(wa_, wb_) - reach, np.maximum(wa_, wb_) + reach)
@@ -260,5 +287,7 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
 
 def error_report(measured, ref: StrandReference) -> dict:
     """SPEC 1.5 numbers of ``measured`` against the combined reference."""
-    return reference.error_report(measured, reference.ReferenceResult(
-        ref.intensity, ref.on_silhouette, ref.mesh.face, ref.mesh.depth, ref.mesh.rows))
+    return reference.error_report(
+        measured,
+        reference.ReferenceResult(ref.intensity, ref.on_silhouette, ref.mesh.face, ref.mesh.depth, ref.mesh.rows),
+    )

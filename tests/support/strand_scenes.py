@@ -8,8 +8,9 @@ import numpy as np
 CATMULL_ROM, POLY, BEZIER = 0, 1, 2
 
 
-def hair(scene, name, curves, radii=None, *, types=None, resolution=None, handles=None, location=(0, 0, 0),
-         scale=(1, 1, 1)):
+def hair(
+    scene, name, curves, radii=None, *, types=None, resolution=None, handles=None, location=(0, 0, 0), scale=(1, 1, 1)
+):
     """A Curves object with one curve per (n, 3) array of ``curves``;
     ``radii`` one (n,) array (or None) per curve; ``types`` per curve
     (default POLY); ``handles`` (left, right) (P, 3) positions of every
@@ -21,8 +22,12 @@ def hair(scene, name, curves, radii=None, *, types=None, resolution=None, handle
         positions = np.concatenate([np.asarray(c, dtype=np.float32) for c in curves])
         data.attributes["position"].data.foreach_set("vector", positions.ravel())
         if radii is not None:
-            values = np.concatenate([np.full(n, 0.0) if r is None else np.broadcast_to(np.asarray(r, float), (n,))
-                                     for n, r in zip(sizes, radii)]).astype(np.float32)
+            values = np.concatenate(
+                [
+                    np.full(n, 0.0) if r is None else np.broadcast_to(np.asarray(r, float), (n,))
+                    for n, r in zip(sizes, radii)
+                ]
+            ).astype(np.float32)
             data.attributes.new("radius", "FLOAT", "POINT").data.foreach_set("value", values)
         kinds = [POLY] * len(curves) if types is None else list(types)
         # (set_types: a foreach_set on the INT8 attribute overruns its buffer.)
@@ -33,7 +38,8 @@ def hair(scene, name, curves, radii=None, *, types=None, resolution=None, handle
         if handles is not None:
             for attribute, values in zip(("handle_left", "handle_right"), handles):
                 data.attributes.new(attribute, "FLOAT_VECTOR", "POINT").data.foreach_set(
-                    "vector", np.asarray(values, dtype=np.float32).ravel())
+                    "vector", np.asarray(values, dtype=np.float32).ravel()
+                )
         if resolution is not None:
             data.attributes.new("resolution", "INT", "CURVE").data.foreach_set("value", [resolution] * len(curves))
     obj = bpy.data.objects.new(name, data)

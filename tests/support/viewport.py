@@ -82,10 +82,15 @@ class HeadlessViewport:
         view_layer = view_layer or bpy.context.view_layer
         view_layer.depsgraph.update()
         try:
-            self.offscreen.draw_view3d(scene, view_layer, self.space, self.region,
-                                       Matrix(self.view.view_matrix.tolist()),
-                                       Matrix(self.view.projection.tolist()),
-                                       do_color_management=True)
+            self.offscreen.draw_view3d(
+                scene,
+                view_layer,
+                self.space,
+                self.region,
+                Matrix(self.view.view_matrix.tolist()),
+                Matrix(self.view.projection.tolist()),
+                do_color_management=True,
+            )
         except (RuntimeError, SystemError, TypeError) as exc:
             raise ViewportUnavailable(f"draw_view3d failed: {exc}") from exc
 
