@@ -230,7 +230,10 @@ def table(results) -> list[str]:
 
 # -- where SolidWire's overlay frame goes -------------------------------------------
 
-PASS_NAMES = ("depth pre-pass", "surface pass (wire + fill)", "third pass", "fourth pass")
+# The overlay's draw calls by their stage (draw_mod.draw's ``stage``); a
+# call without one is the surface pass, or the depth pre-pass before it
+# where Blender's depth does not hold the surfaces.
+STAGE_NAMES = {"visibility": "region-lines record", "lines": "region lines", None: "surface pass"}
 
 
 class OverlayProbe:
@@ -240,7 +243,7 @@ class OverlayProbe:
     and puts it back on exit."""
 
     def __init__(self):
-        self.calls: list[tuple[float, float]] = []
+        self.calls: list[tuple[str, float, float]] = []
 
     def __enter__(self):
         self._original = draw_mod.draw
@@ -251,7 +254,8 @@ class OverlayProbe:
             result = probe._original(*args, **kwargs)
             recorded = time.perf_counter()
             gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "UBYTE")
-            probe.calls.append(((recorded - start) * 1000.0, (time.perf_counter() - recorded) * 1000.0))
+            name = STAGE_NAMES.get(kwargs.get("stage"), str(kwargs.get("stage")))
+            probe.calls.append((name, (recorded - start) * 1000.0, (time.perf_counter() - recorded) * 1000.0))
             return result
 
         draw_mod.draw = timed
@@ -296,10 +300,12 @@ def profile(kind: str, level: int, size, repeats: int) -> list[str]:
                     "SolidWire: gather + validate / extract (stats ms_extract)": stats["ms_extract"],
                     "SolidWire: upload (stats ms_upload)": stats["ms_upload"],
                 }
-                for name, (cpu, gpu_ms) in zip(PASS_NAMES, probe.calls):
-                    stages[f"SolidWire: {name}, Python / draw calls"] = cpu
-                    stages[f"SolidWire: {name}, GPU (waited for)"] = gpu_ms
-                accounted = stats["ms_extract"] + stats["ms_upload"] + sum(c + g for c, g in probe.calls)
+                for name, cpu, gpu_ms in probe.calls:
+                    key = f"SolidWire: {name}, Python / draw calls"
+                    stages[key] = stages.get(key, 0.0) + cpu
+                    key = f"SolidWire: {name}, GPU (waited for)"
+                    stages[key] = stages.get(key, 0.0) + gpu_ms
+                accounted = stats["ms_extract"] + stats["ms_upload"] + sum(c + g for _n, c, g in probe.calls)
                 stages["SolidWire: the rest (display LUT, frame begin/end)"] = overlay_ms - accounted
                 total = sum(stages.values())
                 if best is None or total < best[0]:
