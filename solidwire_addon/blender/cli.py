@@ -46,7 +46,8 @@ import bpy
 from ..core import compat, output, schema
 from ..core.ids import ENGINE_ID, EXTENSION_ID
 from ..core.log import one_line
-from . import composite, ops, presets, runtime
+from . import composite, presets, runtime
+from .fade_range import camera_fade_range
 
 EXIT_USAGE = 2
 EXIT_FAILURE = 1
@@ -459,7 +460,7 @@ def apply_preset(settings, text: str) -> None:
         raise UsageError(f"--preset: {presets.unknown_preset_message(text, names)}") from None
     except presets.PresetError as exc:
         raise UsageError(f"--preset: {exc}") from None
-    presets.apply(preset, settings, depth_range=lambda: ops.camera_fade_range(settings.id_data))
+    presets.apply(preset, settings, depth_range=lambda: camera_fade_range(settings.id_data))
 
 
 def apply_options(scene, args) -> None:
