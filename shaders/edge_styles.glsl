@@ -1,8 +1,9 @@
 /* SolidWire line styles of the exact path (docs/image_model.md §3.6-§3.7):
- * style 0 is the wire; styles 1..5 are the edge classes in the order of
- * core/edge_select.py EDGE_CLASSES (boundary, sharp, crease, seam,
- * Freestyle), each with its own colour, width (relative to the wire's)
- * and pattern duty from the parameter block. */
+ * style 0 is the wire; styles 1.. are the edge classes in the order of
+ * core/schema.py EDGE_CLASS_STYLES, each with its own colour, width
+ * (relative to the wire's) and pattern duty from the parameter block; the
+ * loader puts the per-style lookups (schema.style_lookup_glsl) before this
+ * file. */
 
 /* A class's half width where the wire's is `wire_half_thickness`: its own
  * width scaled as the wire's is scaled from the Thickness in the parameter
@@ -11,15 +12,10 @@
 float style_half_thickness(int style, float wire_half_thickness)
 {
 #if STYLE_COUNT > 1
-  float own = 0.0;
-  switch (style) {
-    case 1: own = params.boundary_half_thickness; break;
-    case 2: own = params.sharp_half_thickness; break;
-    case 3: own = params.crease_half_thickness; break;
-    case 4: own = params.seam_half_thickness; break;
-    case 5: own = params.freestyle_half_thickness; break;
-    default: return wire_half_thickness;
+  if (style < 1 || style > CLASS_STYLE_COUNT) {
+    return wire_half_thickness;
   }
+  float own = style_own_half_thickness(style);
 #  if THICKNESS_MODE != 0
   if (params.half_thickness > 0.0) {
     own *= wire_half_thickness / params.half_thickness;
@@ -30,32 +26,6 @@ float style_half_thickness(int style, float wire_half_thickness)
   return wire_half_thickness;
 #endif
 }
-
-#if STYLE_COUNT > 1 || defined(STYLE_COLORS)
-float style_duty(int style)
-{
-  switch (style) {
-    case 1: return params.boundary_duty;
-    case 2: return params.sharp_duty;
-    case 3: return params.crease_duty;
-    case 4: return params.seam_duty;
-    case 5: return params.freestyle_duty;
-  }
-  return 1.0;
-}
-
-vec4 style_color(int style)
-{
-  switch (style) {
-    case 1: return params.boundary_color;
-    case 2: return params.sharp_color;
-    case 3: return params.crease_color;
-    case 4: return params.seam_color;
-    case 5: return params.freestyle_color;
-  }
-  return params.wire_color;
-}
-#endif
 
 #ifdef USE_DENSITY_FADE
 /* Density fade: full above the length L, nothing below L / 2, linear in

@@ -151,6 +151,7 @@ def test_the_parameter_block_is_the_schemas():
 
 def test_every_block_member_the_shaders_read_exists():
     sources = "".join(p.read_text(encoding="utf-8") for p in shaders.SHADER_DIR.glob("*.glsl"))
+    sources += schema.style_lookup_glsl()  # generated GLSL the loader adds
     used = set(re.findall(r"\bparams\.(\w+)", sources))
     declared = {m.glsl for m in schema.PARAM_BLOCK}
     assert used <= declared, sorted(used - declared)
@@ -283,3 +284,27 @@ def test_render_passes_come_from_one_table():
         tree = ast.parse((PACKAGE / module).read_text(encoding="utf-8"))
         literals = {n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
         assert not literals & spelled, f"{module} spells out {sorted(literals & spelled)}: use core.schema"
+
+
+def test_edge_classes_are_defined_once_and_the_shaders_lookups_follow():
+    """The edge classes and their style order come from the schema: the
+    edge selection's list, the shader's style count and its per-style
+    lookups (generated, one case per class in order, each reading a block
+    member that exists); no GLSL file spells a class's member itself."""
+    from solidwire_addon.core import edge_select
+
+    assert edge_select.EDGE_CLASSES == schema.EDGE_CLASS_NAMES
+    assert schema.STYLE_COUNT == 1 + len(schema.EDGE_CLASS_NAMES)
+    glsl = schema.style_lookup_glsl()
+    members = {m.glsl for m in schema.PARAM_BLOCK}
+    for suffix in ("half_thickness", "duty", "color"):
+        cases = re.findall(rf"case (\d+): return params\.(\w+)_{suffix};", glsl)
+        assert [(int(k), name) for k, name in cases] == [
+            (k + 1, name) for k, name in enumerate(schema.EDGE_CLASS_NAMES)
+        ]
+        assert {f"{name}_{suffix}" for _k, name in cases} <= members
+    assert shaders.edge_styles_source().startswith(glsl)
+    for path in shaders.SHADER_DIR.glob("*.glsl"):
+        text = path.read_text(encoding="utf-8")
+        spelled = [name for name in schema.EDGE_CLASS_NAMES if f"params.{name}_" in text]
+        assert not spelled, f"{path.name} reads {spelled} itself: use the generated lookups"

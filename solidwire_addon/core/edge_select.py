@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import schema
 from .extract import (
     EDGE0_HIDDEN,
     EDGE0_REAL,
@@ -50,8 +51,9 @@ from .extract import (
 )
 
 # Edge classes, in style order: style k + 1 is class k (style 0 is the
-# ordinary wire). The order is part of the shader interface (line_style.glsl).
-EDGE_CLASSES = ("boundary", "sharp", "crease", "seam", "freestyle")
+# ordinary wire), defined once in the schema, which also writes the
+# shaders' per-style lookups (schema.style_lookup_glsl).
+EDGE_CLASSES = schema.EDGE_CLASS_NAMES
 CLASS_BIT = {name: 1 << k for k, name in enumerate(EDGE_CLASSES)}
 # Style of a diagonal segment in a region block (n-gon diagonals).
 DIAGONAL_STYLE = 15

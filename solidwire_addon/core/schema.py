@@ -958,6 +958,41 @@ PARAM_BLOCK: tuple[BlockMember, ...] = _param_block()
 PARAM_FLOATS = sum(4 if m.glsl_type == "vec4" else 1 for m in PARAM_BLOCK)
 
 
+EDGE_CLASS_NAMES = tuple(edge_class[0] for edge_class in EDGE_CLASS_STYLES)
+# Line styles: 0 the wire, k + 1 the class EDGE_CLASS_NAMES[k].
+STYLE_COUNT = 1 + len(EDGE_CLASS_NAMES)
+
+
+def style_lookup_glsl() -> str:
+    """The GLSL lookups of each line style's width, pattern duty and colour
+    in the parameter block (shaders/edge_styles.glsl uses them), one case
+    per edge class in EDGE_CLASS_STYLES order."""
+
+    def lookup(glsl_type: str, function: str, member: str, fallback: str) -> list[str]:
+        cases = [f"    case {k + 1}: return params.{name}_{member};" for k, name in enumerate(EDGE_CLASS_NAMES)]
+        return [
+            f"{glsl_type} {function}(int style)",
+            "{",
+            "  switch (style) {",
+            *cases,
+            "  }",
+            f"  return {fallback};",
+            "}",
+        ]
+
+    lines = [
+        "/* Generated from solidwire_addon/core/schema.py (EDGE_CLASS_STYLES): style k + 1 is class k. */",
+        f"#define CLASS_STYLE_COUNT {len(EDGE_CLASS_NAMES)}",
+        "#if STYLE_COUNT > 1 || defined(STYLE_COLORS)",
+        *lookup("float", "style_own_half_thickness", "half_thickness", "params.half_thickness"),
+        *lookup("float", "style_duty", "duty", "1.0"),
+        *lookup("vec4", "style_color", "color", "params.wire_color"),
+        "#endif",
+        "",
+    ]
+    return "\n".join(lines)
+
+
 def param_block_glsl() -> str:
     """The GLSL declaration of the parameter block's struct."""
     lines = ["/* Generated from solidwire_addon/core/schema.py (PARAM_BLOCK); std140. */", "struct SolidWireParams {"]

@@ -198,6 +198,12 @@ def read_source(name: str, directory: Path = SHADER_DIR) -> str:
         raise RuntimeError(f"SolidWire shader file missing: {path.name} ({exc.strerror})") from None
 
 
+def edge_styles_source() -> str:
+    """shaders/edge_styles.glsl after the per-style lookups the schema
+    generates (one definition of the edge classes and their order)."""
+    return schema.style_lookup_glsl() + read_source("edge_styles.glsl")
+
+
 def uses_uniform(shader, name: str) -> bool:
     """Whether the compiled ``shader`` kept uniform ``name`` (the compiler
     drops one a variant does not read, and setting it then fails)."""
@@ -333,7 +339,7 @@ def _create_info(variant: ShaderVariant):
         info.define("USE_NGONS", "1")
         info.define("SEGMENT_SLOTS", str(SEGMENT_SLOTS))
         info.define("PROVOKING_CORNERS", str(_provoking_corners()))
-    info.define("STYLE_COUNT", "6" if variant.edge_classes else "1")
+    info.define("STYLE_COUNT", str(schema.STYLE_COUNT if variant.edge_classes else 1))
     if variant.style_colors:
         info.define("STYLE_COLORS", "1")
     if variant.density_fade:
@@ -427,7 +433,7 @@ def _region_lines_create_info(variant: ShaderVariant):
     info.fragment_out(0, "VEC2", "frag_line")
     compat.depth_write(info, "ANY")
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
-    info.define("STYLE_COUNT", "6" if variant.edge_classes else "1")
+    info.define("STYLE_COUNT", str(schema.STYLE_COUNT if variant.edge_classes else 1))
     if variant.density_fade:
         info.define("USE_DENSITY_FADE", "1")
     if variant.in_front:
@@ -436,7 +442,7 @@ def _region_lines_create_info(variant: ShaderVariant):
         read_source("common.glsl")
         + read_source("edge_geometry.glsl")
         + read_source("line_style.glsl")
-        + read_source("edge_styles.glsl")
+        + edge_styles_source()
     )
     info.vertex_source(prologue + body + read_source("region_lines_vert.glsl"))
     fragment_prologue = prologue.replace("gl_InstanceID", "0")  # the fragment stage transforms nothing
@@ -543,7 +549,7 @@ def _add_sources(info, variant: ShaderVariant, iface: _Interface) -> None:
     The SW_ names stand for the builtins a stage reads (resolve_frag.glsl
     supplies its own)."""
     common = read_source("common.glsl") + read_source("edge_geometry.glsl")
-    styles = read_source("line_style.glsl") + read_source("edge_styles.glsl")
+    styles = read_source("line_style.glsl") + edge_styles_source()
     fill = read_source("fill_shading.glsl")
     if variant.instanced:
         instancing = read_source("instancing.glsl")
