@@ -308,3 +308,26 @@ def test_edge_classes_are_defined_once_and_the_shaders_lookups_follow():
         text = path.read_text(encoding="utf-8")
         spelled = [name for name in schema.EDGE_CLASS_NAMES if f"params.{name}_" in text]
         assert not spelled, f"{path.name} reads {spelled} itself: use the generated lookups"
+
+
+def test_sampler_slots_are_one_table():
+    """Every sampler of the add-on's shaders is declared through the one
+    table of slots (shaders.SAMPLERS), never with a literal slot; slots stay
+    within the 16 texture units every backend offers a stage."""
+    tree = ast.parse((PACKAGE / "core" / "shaders.py").read_text(encoding="utf-8"))
+    direct = [
+        node.lineno
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "sampler"
+    ]
+    assert len(direct) == 1, f"info.sampler called outside add_sampler at lines {direct}"
+    declared = [
+        node.args[1].value
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and node.func.id == "add_sampler"
+        and isinstance(node.args[1], ast.Constant)
+    ]
+    assert set(declared) == set(shaders.SAMPLERS), set(declared) ^ set(shaders.SAMPLERS)
+    assert all(0 <= slot < 16 for slot, _kind in shaders.SAMPLERS.values())

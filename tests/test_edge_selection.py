@@ -262,3 +262,21 @@ def test_cage_edges_match_the_reference(look, output_dir):
     everything = reference.render_reference(scene, settings=every_edge)
     ref = reference.render_reference(scene)
     assert ref.intensity.sum() < 0.6 * everything.intensity.sum()
+
+
+def test_a_region_too_large_to_walk_keeps_all_its_lines_for_the_region_lines_pass():
+    """Past WALK_LIMIT drawn edges a region's faces walk their own edges
+    (where a pixel walks at all), while the region-lines table still holds
+    every drawn edge of the region."""
+    columns = edge_select.WALK_LIMIT  # 2 * columns + 2 drawn edges: over the limit
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(columns)
+    drawn = np.ones(len(verts), bool)
+    top = columns + 1
+    for x in range(1, columns):
+        drawn[index[(x, top + x)]] = False
+    edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    assert len(arrays.region_lines) // 2 == 2 * columns + 2
+    # Every triangle reads the region lines; its own block holds at most its
+    # quad's four edges.
+    assert ((arrays.edge_flags & extract.REGION_LINES) != 0).all()
+    assert ((arrays.edge_flags >> extract.NGON_SHIFT) <= 4).all()

@@ -60,6 +60,14 @@ DIAGONAL_STYLE = 15
 # Texels per segment in the region table: (lower id, upper id, style, 0)
 # and (chain end, chain end, 0, 0) for the density fade.
 TEXELS_PER_SEGMENT = 2
+# The block walk — what a pixel does where the region-lines pass does not
+# run: the Edge Distance pass, hidden lines, the overlay inside a clipping
+# region, a backend without the deferred surface — takes a region whole up
+# to this many drawn edges (a cage face subdivided five times); a larger
+# region is walked face by face there, so that those paths' cost per pixel
+# stays bounded (docs/image_model.md §2.6). The lines of the image never
+# are: the region-lines pass has no limit.
+WALK_LIMIT = 128
 # Texels per region line (shaders/region_lines_vert.glsl): (lower id, upper
 # id, style, region) and (chain end, chain end, other region or NO_REGION, 0).
 TEXELS_PER_REGION_LINE = 2
@@ -199,13 +207,18 @@ def select_edges(
         styled_face = np.bincount(corner_face, weights=(classes[corner_edge] != 0), minlength=face_count) > 0
     walked = walked_region[label]
     ngon_face = sizes > 4
+    # A region too large to walk (see WALK_LIMIT): its faces' blocks hold
+    # their own drawn edges (the walk is then face by face); the region-lines
+    # pass still draws the whole region.
+    region_edges = np.bincount(pairs[:, 0], minlength=face_count) if len(pairs) else np.zeros(face_count, np.int64)
+    too_large = walked & (region_edges[label] > WALK_LIMIT)
     # Owner of each listed face's block: its region's block (id = the region
     # label), or a block of its own (id = face_count + face) holding its
-    # region's drawn edges (or, outside a walked region, its own) plus its
-    # own n-gon diagonals: a diagonal belongs to its face only (§1.3).
-    # -1: a plain face, drawn from its own edges.
+    # region's drawn edges (or, outside a walked region or in one too large
+    # to walk, its own) plus its own n-gon diagonals: a diagonal belongs to
+    # its face only (§1.3). -1: a plain face, drawn from its own edges.
     faces = np.arange(face_count)
-    own_block = (walked & ngon_face) | (~walked & styled_face)
+    own_block = (walked & (ngon_face | too_large)) | (~walked & styled_face)
     owner = np.where(own_block, face_count + faces, np.where(walked, label, -1))
 
     _mark_own_edges(arrays, verts, drawn, np.asarray(corner_vert), offsets, sizes, corner_edge)
@@ -217,7 +230,7 @@ def select_edges(
     by_label = pairs[np.argsort(pairs[:, 0], kind="stable")] if len(pairs) else pairs.reshape(0, 2)
     block_owner = np.unique(owner[listed_face])
     block_face = np.where(block_owner >= face_count, block_owner - face_count, block_owner)
-    from_region = walked[block_face]
+    from_region = walked[block_face] & ~too_large[block_face]
     # Region-fed blocks: every drawn edge of the region.
     region_owner, region_label = block_owner[from_region], label[block_face[from_region]]
     lo = np.searchsorted(by_label[:, 0], region_label, side="left")

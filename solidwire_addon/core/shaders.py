@@ -42,8 +42,6 @@ SETUP_TEXELS = 7
 # (4095 texels wide, under the 16384 limit for 9.5M triangles).
 SETUP_ROW_TRIANGLES = 585
 SETUP_MAX_TRIANGLES = SETUP_ROW_TRIANGLES * 16384
-# Sampler slot of the set-up table, above the display LUT's.
-SETUP_TABLE_SLOT = 9
 SETUP_GROUP_SIZE = 64  # compute invocations per work group, one per triangle
 
 CLIP_PLANES = 6  # as many as Blender's clipping region (RegionView3D.clip_planes)
@@ -214,6 +212,41 @@ def uses_uniform(shader, name: str) -> bool:
     return True
 
 
+# Every sampler's (slot, kind), defined once. Names that share a slot are
+# never declared in one program: a mesh table and the fin / strand tables
+# (slot 1), the outline table, the region-lines table and the scene depth
+# (2), the instanced and per-object item tables (3), the corner table and
+# the per-triangle regions (4).
+SAMPLERS = {
+    "vertex_positions": (0, "FLOAT_2D"),
+    "triangle_vertices": (1, "FLOAT_2D"),
+    "silhouette_edges": (1, "FLOAT_2D"),
+    "strand_segments": (1, "FLOAT_2D"),
+    "ngon_corners": (2, "FLOAT_2D"),
+    "region_lines": (2, "FLOAT_2D"),
+    "scene_depth": (2, "DEPTH_2D"),
+    "instance_table": (3, "FLOAT_2D"),
+    "item_table": (3, "FLOAT_2D"),
+    "corner_table": (4, "FLOAT_2D"),
+    "triangle_regions": (4, "FLOAT_2D"),
+    "item_colors": (5, "FLOAT_2D"),
+    "matcap_image": (6, "FLOAT_2D"),
+    "triangle_material": (7, "FLOAT_2D"),
+    "display_lut": (8, "FLOAT_3D"),
+    "setup_table": (9, "FLOAT_2D"),
+    "visibility": (10, "FLOAT_2D"),
+    "triangle_flag_table": (11, "FLOAT_2D"),
+    "region_line_image": (12, "FLOAT_2D"),
+    "attribute_colors": (13, "FLOAT_2D"),
+}
+
+
+def add_sampler(info, name: str) -> None:
+    """Declare sampler ``name`` in create-info ``info`` at its slot (SAMPLERS)."""
+    slot, kind = SAMPLERS[name]
+    info.sampler(slot, kind, name)
+
+
 def pulling_info(*, push_matrices: bool = True):
     """Create-info with what every SolidWire shader shares: the parameter
     block (generated from the schema), the position table (vertex pulling)
@@ -225,7 +258,7 @@ def pulling_info(*, push_matrices: bool = True):
     if push_matrices:
         info.push_constant("MAT4", "object_to_clip")
         info.push_constant("VEC4", "object_to_view_z")
-    info.sampler(0, "FLOAT_2D", "vertex_positions")
+    add_sampler(info, "vertex_positions")
     return info
 
 
@@ -289,7 +322,7 @@ def _create_info(variant: ShaderVariant):
     info = pulling_info(push_matrices=not variant.instanced)
     if variant.instanced:
         info.push_constant("INT", "instance_base")
-        info.sampler(3, "FLOAT_2D", "instance_table")
+        add_sampler(info, "instance_table")
         iface.flat("INT", "instance_slot")
     if variant.clip_planes:
         # A block of their own, not push constants: those stay within the
@@ -299,13 +332,13 @@ def _create_info(variant: ShaderVariant):
         iface.smooth("VEC4", "clip_distance_a")
         iface.smooth("VEC2", "clip_distance_b")
         info.define("USE_CLIP_PLANES", "1")
-    info.sampler(1, "FLOAT_2D", "triangle_vertices")
-    info.sampler(2, "FLOAT_2D", "ngon_corners")
+    add_sampler(info, "triangle_vertices")
+    add_sampler(info, "ngon_corners")
     _add_fill_and_colours(info, iface, variant)
     if variant.setup_table:
         if variant.ngons or variant.instanced:
             raise ValueError("the set-up table is for non-instanced tri/quad meshes")
-        info.sampler(SETUP_TABLE_SLOT, "FLOAT_2D", "setup_table")
+        add_sampler(info, "setup_table")
         info.define("SETUP_TABLE", "1")
         info.define("SETUP_TEXELS", str(SETUP_TEXELS))
         info.define("SETUP_ROW_TRIANGLES", str(SETUP_ROW_TRIANGLES))
@@ -316,13 +349,13 @@ def _create_info(variant: ShaderVariant):
         info.vertex_in(0, "INT", "rect_corner")
         info.push_constant("INT", "draw_number")
         info.push_constant("VEC4", "resolve_rect")
-        info.sampler(RESOLVE_VISIBILITY_SLOT, "FLOAT_2D", "visibility")
-        info.sampler(RESOLVE_FLAGS_SLOT, "FLOAT_2D", "triangle_flag_table")
+        add_sampler(info, "visibility")
+        add_sampler(info, "triangle_flag_table")
         info.define("RESOLVE_PASS", "1")
     else:
         info.vertex_in(0, "INT", "edge_flags")
     if variant.region_lines:
-        info.sampler(REGION_LINE_IMAGE_SLOT, "FLOAT_2D", "region_line_image")
+        add_sampler(info, "region_line_image")
         info.define("REGION_LINE_IMAGE", "1")
     output_and_feature_defines(info, variant)
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
@@ -379,7 +412,7 @@ def _visibility_create_info(variant: ShaderVariant):
     if variant.instanced:
         iface.flat("FLOAT", "visible_instance")
         info.push_constant("INT", "instance_base")
-        info.sampler(3, "FLOAT_2D", "instance_table")
+        add_sampler(info, "instance_table")
     info.vertex_in(0, "VEC3", "position")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_visible")
@@ -412,10 +445,10 @@ def _region_lines_create_info(variant: ShaderVariant):
     iface.flat("VEC2", "line_regions")
     iface.flat("FLOAT", "line_chain")
     info = pulling_info(push_matrices=not variant.instanced)
-    info.sampler(1, "FLOAT_2D", "triangle_vertices")  # bound with every mesh (draw._bind_mesh), unread
-    info.sampler(2, "FLOAT_2D", "region_lines")
-    info.sampler(4, "FLOAT_2D", "triangle_regions")
-    info.sampler(RESOLVE_VISIBILITY_SLOT, "FLOAT_2D", "visibility")
+    add_sampler(info, "triangle_vertices")  # bound with every mesh (draw._bind_mesh), unread
+    add_sampler(info, "region_lines")
+    add_sampler(info, "triangle_regions")
+    add_sampler(info, "visibility")
     info.push_constant("INT", "draw_number")
     info.push_constant("INT", "line_count")
     info.push_constant("VEC2", "clip_w_of_depth")
@@ -423,7 +456,7 @@ def _region_lines_create_info(variant: ShaderVariant):
     if variant.instanced:
         iface.flat("FLOAT", "line_instance")
         info.push_constant("INT", "instance_base")
-        info.sampler(3, "FLOAT_2D", "instance_table")
+        add_sampler(info, "instance_table")
         info.define("SW_INSTANCED", "1")
         prologue = f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n" + read_source(
             "instancing.glsl"
@@ -486,10 +519,10 @@ def _add_fill_and_colours(info, iface, variant: ShaderVariant) -> None:
         if not variant.instanced:
             # normal_to_view / item_info come from item_table (item_table.glsl).
             info.push_constant("INT", "item_slot")
-            info.sampler(3, "FLOAT_2D", "item_table")
+            add_sampler(info, "item_table")
         info.define("PER_ITEM", "1")
     if variant.uses_corners:
-        info.sampler(4, "FLOAT_2D", "corner_table")
+        add_sampler(info, "corner_table")
         # Where the mesh's normals live (extract.NORMALS_BY_*): a row of the
         # corner table per vertex, triangle or triangle corner.
         info.push_constant("INT", "normal_domain")
@@ -497,30 +530,25 @@ def _add_fill_and_colours(info, iface, variant: ShaderVariant) -> None:
         iface.smooth("VEC3", "shading_normal")
     info.define("SHADING", str(variant.shading))
     if variant.shading == SHADING_MATCAP:
-        info.sampler(6, "FLOAT_2D", "matcap_image")
+        add_sampler(info, "matcap_image")
     if variant.item_colors:
-        info.sampler(5, "FLOAT_2D", "item_colors")
+        add_sampler(info, "item_colors")
         info.define("ITEM_COLORS", "1")
         iface.flat("VEC3", "item_wire")
         iface.flat("VEC3", "item_fill")
     if variant.material_colors:
         info.define("MATERIAL_COLORS", "1")
     if variant.attribute_colors:
-        info.sampler(ATTRIBUTE_COLORS_SLOT, "FLOAT_2D", "attribute_colors")
+        add_sampler(info, "attribute_colors")
         info.push_constant("INT", "attribute_domain")
         info.define("ATTRIBUTE_COLORS", "1")
         iface.smooth("VEC3", "attribute_fill")
 
 
-# Sampler slot of the display LUT, above every slot the exact path and the
-# fin pass use.
-DISPLAY_LUT_SLOT = 8
-
-
 def add_display_transform(info) -> None:
     """The overlay's colour management (core/display_transform.py): the LUT,
     the shaper constants and the merge power."""
-    info.sampler(DISPLAY_LUT_SLOT, "FLOAT_3D", "display_lut")
+    add_sampler(info, "display_lut")
     info.push_constant("VEC2", "display_shaper")
     info.define("DISPLAY_TRANSFORM", "1")
     info.define("OVERLAY_MERGE_GAMMA", repr(float(display_transform.OVERLAY_MERGE_GAMMA)))
@@ -536,7 +564,7 @@ def _add_render_pass_outputs(info, iface) -> None:
     # the instanced variant does not have them (draw.py draws object by
     # object when passes are written).
     info.uniform_buf(1, "SolidWireObject", "object_params")
-    info.sampler(7, "FLOAT_2D", "triangle_material")
+    add_sampler(info, "triangle_material")
     iface.flat("FLOAT", "material_pass_index")
     info.fragment_out(2, "VEC4", "frag_aov")
     info.fragment_out(3, "VEC4", "frag_normal")
@@ -602,11 +630,6 @@ vec4 sw_triangle_ids;
 #define SW_FRONT_FACING sw_front_facing
 #define SW_INV_CLIP_W sw_inv_clip_w
 """
-# Sampler slots of the resolve pass, above the set-up table's.
-RESOLVE_VISIBILITY_SLOT = 10
-RESOLVE_FLAGS_SLOT = 11
-REGION_LINE_IMAGE_SLOT = 12
-ATTRIBUTE_COLORS_SLOT = 13
 
 
 # Per-object values of the render passes (std140): the columns of the normal
@@ -705,7 +728,7 @@ def get_setup(in_front: bool = False):
         if in_front:
             info.define("ALL_IN_FRONT", "1")
         info.push_constant("INT", "triangle_count")
-        info.sampler(1, "FLOAT_2D", "triangle_vertices")
+        add_sampler(info, "triangle_vertices")
         info.image(0, "RGBA32F", "FLOAT_2D", "setup_table", qualifiers={"WRITE"})
         info.local_group_size(SETUP_GROUP_SIZE)
         info.define("SETUP_TEXELS", str(SETUP_TEXELS))
@@ -747,8 +770,8 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         iface.flat("VEC2", "fin_view_depth")
         info = pulling_info()
         info.push_constant("INT", "edge_count")
-        info.sampler(1, "FLOAT_2D", "silhouette_edges")
-        info.sampler(2, "DEPTH_2D", "scene_depth")
+        add_sampler(info, "silhouette_edges")
+        add_sampler(info, "scene_depth")
         info.vertex_in(0, "INT", "quad_corner")
         info.vertex_out(iface)
         if key.depth_bias:
@@ -817,7 +840,7 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
         # the overlay's proj_z and display_shaper (draw_range draws exactly
         # the primitives there are, so no count is needed).
         info.push_constant("VEC4", "strand_view")  # px per unit at w = 1, radius scale
-        info.sampler(1, "FLOAT_2D", "strand_segments")
+        add_sampler(info, "strand_segments")
         info.vertex_in(0, "INT", "strand_corner")
         info.vertex_out(iface)
         info.fragment_out(0, "VEC4", "frag_color")
@@ -825,7 +848,7 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             info.push_constant("VEC4", "proj_z")  # P[2][2], P[2][3], P[3][2], P[3][3]
             info.define("STRAND_OVERLAY", repr(float(flags.depth_bias)))
         else:
-            info.sampler(2, "DEPTH_2D", "scene_depth")
+            add_sampler(info, "scene_depth")
             info.fragment_out(1, "VEC4", "frag_info")
         compat.depth_write(info, "ANY")
         info.define("THICKNESS_MODE", str(flags.thickness_mode))
@@ -842,7 +865,7 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             # declared here as plain globals the fragment stage sets.
             info.define("SHADING", str(flags.shading))
             if flags.shading == SHADING_MATCAP:
-                info.sampler(6, "FLOAT_2D", "matcap_image")
+                add_sampler(info, "matcap_image")
             shading_source = "#define SW_FRONT_FACING true\nvec3 shading_normal;\nvec4 item_info;\n" + read_source(
                 "fill_shading.glsl"
             )
