@@ -39,7 +39,8 @@ def build_scene(path: Path, size: tuple[int, int]) -> Path:
     from tests.support import scenes
 
     scene = scenes.empty_scene(*size)
-    monkey = scenes.monkey(scene)
+    monkey = scenes.monkey(scene, subdivisions=1)
+    scenes.cube(scene, "Cube", size=1.0, location=(2.2, 0.8, -0.5))
     scenes.add_camera(scene)
     for frame, z in ((1, 0.0), (200, 6.28)):
         monkey.rotation_euler.z = z
@@ -70,6 +71,21 @@ def engine_anim(blend: Path, out: Path, frames: int) -> float:
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     scene = bpy.context.scene
     scene.render.engine = "SOLIDWIRE"
+    scene.render.filepath = str(out / "f_####")
+    scene.frame_start, scene.frame_end = 1, frames
+    start = time.perf_counter()
+    bpy.ops.render.render(animation=True, scene=scene.name)
+    return time.perf_counter() - start
+
+
+def workbench_anim(blend: Path, out: Path, frames: int) -> float:
+    """Blender's Workbench on the same frames: flat lighting, single colour
+    (its cheapest look), as ``blender -b SCENE.blend -E BLENDER_WORKBENCH -a``."""
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    scene = bpy.context.scene
+    scene.render.engine = "BLENDER_WORKBENCH"
+    scene.display.shading.light = "FLAT"
+    scene.display.shading.color_type = "SINGLE"
     scene.render.filepath = str(out / "f_####")
     scene.frame_start, scene.frame_end = 1, frames
     start = time.perf_counter()
@@ -164,8 +180,9 @@ def main() -> None:
             work = Path(folder)
             with quiet():
                 blend = build_scene(work / "scene.blend", tuple(args.size))
-            engine, command, single = [], [], []
+            engine, command, single, workbench = [], [], [], []
             for _ in range(args.repeats):
+                workbench.append(per_frame(workbench_anim, blend, work, 5, 5 + args.frames))
                 engine.append(per_frame(engine_anim, blend, work, 5, 5 + args.frames))
                 command.append(per_frame(command_line, blend, work, 5, 5 + args.frames))
                 single.append(per_frame(frame_by_frame, blend, work, 5, 5 + args.frames))
@@ -175,13 +192,14 @@ def main() -> None:
             }
     finally:
         solidwire_addon.unregister()
-    e, c, f = (statistics.median(values) * 1000 for values in (engine, command, single))
+    e, c, f, w = (statistics.median(values) * 1000 for values in (engine, command, single, workbench))
     width, height = args.size
     print(f"| path ({width}x{height}, {args.frames} frames, median of {args.repeats}) | ms per frame | vs `-a` |")
     print("|---|---|---|")
     print(f"| `-E SOLIDWIRE -a` (Blender's animation render) | {e:.1f} | 1.00 |")
     print(f"| command line, `-s 1 -e N` (runs drawn by Blender's animation render) | {c:.1f} | {c / e:.2f} |")
     print(f"| command line, frame by frame (`--no-overwrite`, placeholders, `--over`) | {f:.1f} | {f / e:.2f} |")
+    print(f"| for scale: Workbench, flat lighting (`-E BLENDER_WORKBENCH -a`) | {w:.1f} | {w / e:.2f} |")
     print()
     print("| stage (cProfile, so slower than above; inclusive) | animation | frame by frame |")
     print("|---|---|---|")

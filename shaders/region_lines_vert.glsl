@@ -21,6 +21,12 @@ void main()
 {
   int entry = gl_VertexID / 6;
   int corner = quad_corner;
+  if (entry >= line_count) {
+    /* The batch's padding (an instanced draw draws all of it): read no
+     * table past its end. */
+    gl_Position = COLLAPSED;
+    return;
+  }
   vec4 head = fetch_texel(region_lines, 2 * entry);
   vec4 tail = fetch_texel(region_lines, 2 * entry + 1);
   vec4 a = vertex_clip(head.x), b = vertex_clip(head.y);
@@ -29,7 +35,7 @@ void main()
   /* The surface's own set-up (lower id first, so patterns run from the
    * lower-id end): the same bits as a block walk would compute. */
   edge_setup(a, b, line, span);
-  if (entry >= line_count || dot(line.xy, line.xy) == 0.0) {
+  if (dot(line.xy, line.xy) == 0.0) {
     gl_Position = COLLAPSED; /* wholly behind the near plane, or a point */
     return;
   }
