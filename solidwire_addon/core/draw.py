@@ -9,7 +9,7 @@ run, in which order and with which blending is the pass plan's business
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import gpu
 import numpy as np
@@ -175,12 +175,52 @@ def styled(settings, style, show_wire: bool = True):
     return settings
 
 
+@dataclass
+class DrawGroup:
+    """The visible instances of one GPU mesh with one style: their
+    float64-composed matrices, stacked (N, 4, 4)."""
+
+    mesh: object  # core.cache.GPUMesh
+    style: object  # view.Style or None
+    world: np.ndarray
+    object_to_view: np.ndarray
+    object_to_clip: np.ndarray
+    indices: np.ndarray  # (N,) the items' indices in the draw's list
+    pass_index: np.ndarray | None = None  # (N,) IndexOB values (render passes only)
+    materials: list | None = None  # per instance, DrawItem.materials (render passes only)
+
+
+@dataclass
+class SingleDraw:
+    """One object drawn on its own (one draw call)."""
+
+    mesh: object
+    style: object
+    world: np.ndarray  # (4, 4)
+    object_to_view: np.ndarray
+    object_to_clip: np.ndarray
+    info: np.ndarray  # (4,) item info: colour-table base, mirrored
+    mirrored: bool
+    pass_index: float | None
+    materials: tuple | None
+
+
+@dataclass
+class InstancedDraw:
+    """Instances of one mesh, style and facing in one draw_instanced call."""
+
+    mesh: object
+    style: object
+    object_to_view: np.ndarray  # (N, 4, 4)
+    object_to_clip: np.ndarray
+    info: np.ndarray  # (N, 4)
+    mirrored: bool
+
+
 def _groups(items, view: View, cull: bool, stats: DrawStats, pass_indices: bool = False):
     """Items grouped by GPU mesh and style with their float64-composed
-    matrices, culled (vectorised over each group). Yields (mesh, style,
-    world (N,4,4), object_to_view, object_to_clip, item indices (N,),
-    (pass indices (N,), materials) or (None, None)) with only the visible
-    instances."""
+    matrices, culled (vectorised over each group): DrawGroups holding only
+    the visible instances."""
     by_mesh: dict = {}
     for index, item in enumerate(items):
         # Plain items key by mesh alone: no tuple per item on the common path.
@@ -207,7 +247,7 @@ def _groups(items, view: View, cull: bool, stats: DrawStats, pass_indices: bool 
                     pass_index = pass_index[keep]
                     materials = [m for m, k in zip(materials, keep) if k]
         if len(world):
-            yield mesh, style, world, object_to_view, object_to_clip, indices, (pass_index, materials)
+            yield DrawGroup(mesh, style, world, object_to_view, object_to_clip, indices, pass_index, materials)
 
 
 def normal_to_view(object_to_view: np.ndarray) -> np.ndarray:
@@ -373,19 +413,21 @@ def draw(
         numbering = _DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view)
         draws_of = {}
         for g in groups:
-            draws_of[id(g[0])] = draws_of.get(id(g[0]), 0) + len(g[2])
+            draws_of[id(g.mesh)] = draws_of.get(id(g.mesh), 0) + len(g.world)
         # One variant per part; parts in a fixed order (both deferred stages
         # must draw, and so number, alike; the visibility stage itself reads
         # no table and sets nothing up).
         parts: dict = {}
         for g in groups:
-            mesh = g[0]
+            mesh = g.mesh
             ngons = program.supports_ngons and mesh.has_ngons
             # (Part of the key, so that every stage parts the draws alike.)
             lines_only = ngons and getattr(mesh, "blocks_only_for_region_lines", False)
             colored = getattr(mesh, "attribute_colors", None) is not None
-            table = setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g[4], view)
-            in_front = wholly_in_front(g[4], mesh.bounds_min, mesh.bounds_max)
+            table = (
+                setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g.object_to_clip, view)
+            )
+            in_front = wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max)
             parts.setdefault((ngons, lines_only, colored, table, in_front), []).append(g)
         # The visibility and region-lines passes read neither n-gon
         # outlines nor the set-up table; a draw that reads the region lines
@@ -599,9 +641,8 @@ def _draw_groups(
     instancing: bool = True,
     numbering=None,
 ) -> None:
-    """Draw (mesh, style, world, object_to_view, object_to_clip, item
-    indices, pass data) groups with one shader variant: per object, or
-    instanced for meshes with many instances. ``ubo(style)`` is the
+    """Draw DrawGroups with one shader variant: per object (SingleDraw), or
+    instanced for meshes with many instances (InstancedDraw). ``ubo(style)`` is the
     parameter block of a style; ``numbering`` makes the draw calls
     (_DrawNumbers)."""
     extras = extras or {}
@@ -617,63 +658,63 @@ def _draw_groups(
     shader.uniform_block("params", ubo(bound))
     _bind_extras(shader, variant, extras)
     numbering.bind(shader)
-    instanced = []  # (mesh, style, object_to_view, object_to_clip, info, mirrored) drawn with draw_instanced
-    # (mesh, style, world, object_to_view, object_to_clip, info, mirrored, pass index, materials) drawn one by one
-    single = []
-    for mesh, style, world, object_to_view_all, object_to_clip_all, indices, (pass_index, materials) in groups:
-        mirrored_all = (np.linalg.det(world[:, :3, :3]) < 0.0) != flip
-        info_all = np.zeros((len(world), 4))
+    instanced: list[InstancedDraw] = []
+    single: list[SingleDraw] = []
+    for group in groups:
+        mirrored_all = (np.linalg.det(group.world[:, :3, :3]) < 0.0) != flip
+        info_all = np.zeros((len(group.world), 4))
         if bases is not None and len(bases):
-            info_all[:, 0] = bases[indices]
+            info_all[:, 0] = bases[group.indices]
         info_all[:, 1] = mirrored_all
         # (The instanced variant has no per-object pass values: with passes
         # every object is drawn on its own.)
-        if instancing and len(world) >= INSTANCING_MIN:
-            if settings.use_backface_culling and mirrored_all.any() and not mirrored_all.all():
-                for side in (False, True):
-                    pick = mirrored_all == side
-                    instanced.append(
-                        (mesh, style, object_to_view_all[pick], object_to_clip_all[pick], info_all[pick], side)
+        if instancing and len(group.world) >= INSTANCING_MIN:
+            sides = (
+                (False, True)
+                if settings.use_backface_culling and 0 < mirrored_all.sum() < len(mirrored_all)
+                else (None,)
+            )
+            for side in sides:
+                pick = slice(None) if side is None else mirrored_all == side
+                facing = bool(mirrored_all[0]) if side is None else side
+                instanced.append(
+                    InstancedDraw(
+                        group.mesh,
+                        group.style,
+                        group.object_to_view[pick],
+                        group.object_to_clip[pick],
+                        info_all[pick],
+                        facing,
                     )
-            else:
-                instanced.append((mesh, style, object_to_view_all, object_to_clip_all, info_all, bool(mirrored_all[0])))
+                )
             continue
-        for k in range(len(world)):
+        for k in range(len(group.world)):
             single.append(
-                (
-                    mesh,
-                    style,
-                    world[k],
-                    object_to_view_all[k],
-                    object_to_clip_all[k],
+                SingleDraw(
+                    group.mesh,
+                    group.style,
+                    group.world[k],
+                    group.object_to_view[k],
+                    group.object_to_clip[k],
                     info_all[k],
                     bool(mirrored_all[k]),
-                    None if pass_index is None else float(pass_index[k]),
-                    None if materials is None else materials[k],
+                    None if group.pass_index is None else float(group.pass_index[k]),
+                    None if group.materials is None else group.materials[k],
                 )
             )
     if single and variant.per_item:
         # Normal matrices and item info of every object in one texture
         # (item_table.glsl); each draw says its slot.
         rows = np.zeros((len(single), shaders.ITEM_TEXELS, 4), dtype=np.float32)
-        rows[:, :3, :] = np.swapaxes(normal_to_view(np.stack([entry[3] for entry in single])), 1, 2)[:, :3, :]
-        rows[:, 3, :] = np.stack([entry[5] for entry in single])
+        rows[:, :3, :] = np.swapaxes(normal_to_view(np.stack([d.object_to_view for d in single])), 1, 2)[:, :3, :]
+        rows[:, 3, :] = np.stack([d.info for d in single])
         item_table = table_texture(rows.reshape(-1, 4))  # kept alive until the draws are done
         shader.uniform_sampler("item_table", item_table)
     object_block = None  # the render passes' per-object block (write_aovs only)
     material_tables: dict = {}  # (mesh, materials) -> triangle -> material pass index texture
     if single:
-        for slot, (
-            mesh,
-            style,
-            world,
-            object_to_view,
-            object_to_clip,
-            _info,
-            mirrored,
-            pass_index,
-            materials,
-        ) in enumerate(single):
+        for slot, one in enumerate(single):
+            mesh, style, mirrored, object_to_clip = one.mesh, one.style, one.mirrored, one.object_to_clip
             if variant.setup_table:
                 # (Before each draw: so a mesh is set up for the matrix of
                 # the one object drawing it.)
@@ -687,12 +728,12 @@ def _draw_groups(
             if settings.use_backface_culling and not resolving:
                 gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
             if variant.write_aovs:
-                object_block = _set_object_block(shader, object_block, world, bool(mirrored), pass_index)
-                shader.uniform_sampler("triangle_material", _material_table(mesh, materials, material_tables))
+                object_block = _set_object_block(shader, object_block, one.world, mirrored, one.pass_index)
+                shader.uniform_sampler("triangle_material", _material_table(mesh, one.materials, material_tables))
             if uses_matrix:
                 shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             if uses_view_depth:
-                shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
+                shader.uniform_float("object_to_view_z", one.object_to_view[2].astype(np.float32).tolist())
             if variant.per_item:
                 shader.uniform_int("item_slot", slot)
             _bind_mesh(shader, variant, mesh)
@@ -806,13 +847,11 @@ def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_ind
     return block
 
 
-def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras, numbering) -> None:
+def _draw_instanced(groups: list[InstancedDraw], variant, ubo, settings, stats: DrawStats, extras, numbering) -> None:
     """One draw_instanced call per (mesh, style, facing) group; every
     instance's matrices in one float texture for the whole frame."""
     shader = shaders.get(replace(variant, instanced=True, setup_table=False))
-    table = table_texture(
-        np.concatenate([_instance_rows(o2v, o2c, info) for _mesh, _style, o2v, o2c, info, _side in groups])
-    )
+    table = table_texture(np.concatenate([_instance_rows(g.object_to_view, g.object_to_clip, g.info) for g in groups]))
     shader.bind()
     bound = None
     shader.uniform_block("params", ubo(bound))
@@ -820,7 +859,8 @@ def _draw_instanced(groups, variant, ubo, settings, stats: DrawStats, extras, nu
     _bind_extras(shader, variant, extras or {})
     numbering.bind(shader)
     base = 0
-    for mesh, style, _o2v, object_to_clip, _info, mirrored in groups:
+    for group in groups:
+        mesh, style, object_to_clip, mirrored = group.mesh, group.style, group.object_to_clip, group.mirrored
         count = len(object_to_clip)
         if style is not bound:
             bound = style
