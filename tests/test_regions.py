@@ -212,3 +212,41 @@ def test_the_overlay_draws_region_lines_as_the_render_does(look, output_dir):
     assert rgba_engine[..., 3].max() > 0.9
     assert np.percentile(diff[off], 99.9) <= 2.0 / 255.0 + 1e-9
     assert diff[off].max() <= 0.1
+
+
+def test_the_overlay_reuses_its_region_lines_until_something_changes(output_dir):
+    """A redraw that changes nothing reuses the last region-lines image; a
+    moved vertex, another view or another setting draws them again, and
+    every frame equals a fresh one."""
+    from solidwire_addon.blender import runtime
+    from solidwire_addon.blender.views import camera_view
+    from tests.test_overlay import FakeViewport
+
+    width, height = 160, 120
+    scene = scenes.empty_scene(width, height, use_cage_edges=True, thickness=1.5)
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    _subdivided(cube, 3)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+
+    def redraw():
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        view = camera_view(scene, depsgraph, (width, height))
+        viewport = FakeViewport(width, height)
+        viewport.depth_pass(depsgraph, view, [cube])
+        stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
+        return viewport.rgba()[..., 3], stats
+
+    first, stats = redraw()
+    assert stats.get("region_line_entries", 0) > 0 and not stats.get("region_lines_reused")
+    again, stats = redraw()
+    assert stats.get("region_lines_reused") == 1 and np.array_equal(first, again)
+    scene.solidwire.thickness = 3.0  # another setting
+    thicker, stats = redraw()
+    assert not stats.get("region_lines_reused") and not np.array_equal(first, thicker)
+    cube.data.vertices[0].co.z += 0.3  # a moved vertex (the cage, so the surface moves)
+    cube.data.update()
+    moved, stats = redraw()
+    assert not stats.get("region_lines_reused") and not np.array_equal(thicker, moved)
+    runtime.mesh_cache.clear()  # a fresh frame draws the same image
+    fresh, _stats = redraw()
+    assert np.array_equal(moved, fresh)

@@ -10,6 +10,7 @@ longer seen, which frees their GPU memory.
 
 from __future__ import annotations
 
+import itertools
 import time
 
 import gpu
@@ -69,10 +70,17 @@ def _provoking_triangle_numbers(vertex_count: int, triangles: np.ndarray):
     return copied_vertices, numbers, out_triangles
 
 
+_serials = itertools.count(1)
+
+
 class GPUMesh:
     """GPU resources of one extracted mesh."""
 
     def __init__(self, arrays: MeshArrays):
+        # Which mesh and which of its shapes this is (``version`` counts
+        # position uploads): what a cached image drawn from it depends on.
+        self.serial = next(_serials)
+        self.version = 0
         self.triangle_count = arrays.triangle_count
         self.centre = arrays.centre
         self.bounds_min = arrays.bounds_min - arrays.centre
@@ -274,6 +282,7 @@ class GPUMesh:
         if corners is not None and self.corners is not None:
             self.corners = table_texture(corners)
         self._drop_visibility_batch()  # made again from the new positions on first use
+        self.version += 1
         self._local_positions = positions[:, :3]
         self.centre = centre
         self.bounds_min = bounds_min - centre

@@ -37,7 +37,7 @@ from .schema import (
     OBJECT_INDEX_PASS,
     WIRE_PASS,
 )
-from .targets import BACKGROUND_DEPTH, read_texture, targets_for
+from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, targets_for
 from .view import View
 
 SURFACE, HIDDEN, WIRE, SILHOUETTES = "surface", "hidden", "wire", "silhouettes"
@@ -269,19 +269,49 @@ def _overlay_region_lines(items, view: View, settings, stats):
     meshes with multi-face regions at the region's size (own depth:
     Blender's depth buffer cannot be read back here), then the region-lines
     pass over it. The overlay's surface pass reads the result where its
-    depth test lets a region's triangle through: our own depth pre-pass
-    (of every mesh) makes our nearest surface the only one that passes, and
-    where that is a region's triangle, the record holds it too. So the
-    record needs no other mesh."""
+    depth test lets a region's triangle through: the depth it tests against
+    (Blender's, or our own pre-pass of every mesh) lets only the nearest
+    surface pass, and where that is a region's triangle, the record holds it
+    too. So the record needs no other mesh.
+
+    A redraw that changes nothing the lines depend on (the view, the
+    settings, which meshes in which shape where) reuses the last image of
+    that viewport size: a viewport redraws far more often than its scene
+    changes."""
     items = [item for item in items if item.mesh.region_line_count]
-    targets = targets_for(view.width, view.height)
+    targets = overlay_targets_for(view.width, view.height)
+    key = _overlay_lines_key(items, view, settings)
+    if key is not None and targets.lines_key == key and targets.lines is not None:
+        stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
+        stats.extra["region_lines_reused"] = 1
+        return targets.lines
+    targets.lines_key = None
     framebuffer = targets.visibility_framebuffer()
     with framebuffer.bind():
         _clear(framebuffer, view.width, view.height)
         draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY, linear_depth=True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
-    return _draw_region_lines(targets, items, view, settings, {"linear_depth": True}, stats)
+    lines = _draw_region_lines(targets, items, view, settings, {"linear_depth": True}, stats)
+    targets.lines_key = key
+    return lines
+
+
+def _overlay_lines_key(items, view: View, settings):
+    """What the overlay's region lines depend on, or None when that cannot
+    be told (a setting that does not hash): each mesh by its serial and
+    shape version (cache.GPUMesh), its matrix and style, the view and the
+    settings."""
+    try:
+        return (
+            view.view_matrix.tobytes(),
+            view.projection.tobytes(),
+            tuple(view.viewport),
+            hash(settings),
+            tuple((item.mesh.serial, item.mesh.version, item.matrix.tobytes(), item.style) for item in items),
+        )
+    except (TypeError, AttributeError):
+        return None
 
 
 def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:

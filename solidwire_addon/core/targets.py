@@ -44,6 +44,7 @@ class Targets:
         self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
         self.outer = self.outer_depth = None  # silhouette targets, made on first use
         self.lines = None  # the region lines' (intensity, style), made on first use
+        self.lines_key = None  # what the overlay's lines were drawn for (passes._overlay_lines_key)
         self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
         self.visible = None  # the deferred surface's visibility record, made on first use
         self.kept_readback = None  # [colour, view depth] gpu Buffers, made on first read(keep=True)
@@ -157,6 +158,25 @@ def targets_for(width: int, height: int) -> Targets:
     return _targets
 
 
+# The viewport overlay's own targets (its region lines), apart from the
+# render's: what the overlay keeps between redraws (passes.draw_over_viewport)
+# must survive an F12 render of the same size. Keyed by size, so a second
+# viewport of another size does not evict the first.
+_overlay_targets: dict[tuple[int, int], Targets] = {}
+OVERLAY_TARGET_SIZES = 4  # viewports kept at once
+
+
+def overlay_targets_for(width: int, height: int) -> Targets:
+    targets = _overlay_targets.pop((width, height), None)
+    if targets is None:
+        while len(_overlay_targets) >= OVERLAY_TARGET_SIZES:
+            _overlay_targets.pop(next(iter(_overlay_targets)))  # the least recently used
+        targets = Targets(width, height)
+    _overlay_targets[(width, height)] = targets  # most recently used last
+    return targets
+
+
 def release() -> None:
     global _targets
     _targets = None
+    _overlay_targets.clear()
