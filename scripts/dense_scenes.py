@@ -254,12 +254,9 @@ def main(argv=None) -> int:
         cells.append(("Demo, Fade Dense Objects off", image[..., :3]))
         image, _covered = render(scene, size=CELL)
         cells.append(("Demo, default look (identical)", image[..., :3]))
-        preset_gallery.write(
-            preset_gallery.compose(cells, columns=2, cell=CELL), cells, args.output, columns=2, cell=CELL
-        )
+        preset_gallery.write_sheet(cells, args.output, columns=2, cell=CELL)
     finally:
         solidwire_addon.unregister()
-    print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")
     return 0
 
 

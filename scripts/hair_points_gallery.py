@@ -87,12 +87,9 @@ def main(argv=None) -> int:
         scene = build_scene()
         with tempfile.TemporaryDirectory(prefix="solidwire-gallery-") as folder:
             cells = render_cells(scene, Path(folder))
-        preset_gallery.write(
-            preset_gallery.compose(cells, columns=2, cell=CELL), cells, args.output, columns=2, cell=CELL
-        )
+        preset_gallery.write_sheet(cells, args.output, columns=2, cell=CELL)
     finally:
         solidwire_addon.unregister()
-    print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")
     return 0
 
 

@@ -31,7 +31,7 @@ import numpy as np
 
 # isort: split
 import solidwire_addon
-from scripts import hair_points_gallery, preset_gallery
+from scripts import hair_points_gallery, outlines_gallery, preset_gallery
 from solidwire_addon.blender import engine
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from tests.support import scenes, strand_scenes
@@ -46,43 +46,22 @@ def _subdivided_mesh(scene):
 
 
 def _text(scene):
-    data = bpy.data.curves.new("Text", "FONT")
-    data.body = "SoW"
-    data.extrude = 0.08
-    data.bevel_depth = 0.02
-    data.align_x = "CENTER"
-    text = bpy.data.objects.new("Text", data)
-    scene.collection.objects.link(text)
-    text.rotation_euler = (math.radians(70), 0.0, 0.0)
+    outlines_gallery.text(scene)
     scenes.add_camera(scene, location=(0.6, -4.0, 1.6), target=(0.0, 0.0, 0.3), lens=50.0)
 
 
 def _curve(scene):
-    bpy.ops.curve.primitive_bezier_circle_add(radius=1.0)
-    ring = bpy.context.active_object
-    ring.data.dimensions = "2D"
-    ring.data.fill_mode = "BOTH"
-    ring.data.extrude = 0.15
-    ring.data.bevel_depth = 0.05
-    ring.rotation_euler = (math.radians(55), 0.0, math.radians(20))
+    outlines_gallery.filled_curve(scene)
     scenes.add_camera(scene, location=(0.0, -5.6, 2.4), target=(0.0, 0.0, 0.0), lens=50.0)
 
 
 def _surface(scene):
-    bpy.ops.surface.primitive_nurbs_surface_sphere_add(radius=1.0)
-    sphere = bpy.context.active_object
-    sphere.data.resolution_u = sphere.data.resolution_v = 3
+    outlines_gallery.nurbs_sphere(scene)
     scenes.add_camera(scene, location=(1.5, -4.4, 2.2), target=(0.0, 0.0, 0.0), lens=50.0)
 
 
 def _metaballs(scene):
-    bpy.ops.object.metaball_add(radius=1.0)
-    balls = bpy.context.active_object
-    balls.data.resolution = 0.25
-    balls.data.render_resolution = 0.25  # F12 uses the render resolution
-    element = balls.data.elements.new()
-    element.co = (1.1, 0.0, 0.3)
-    element.radius = 0.8
+    outlines_gallery.metaballs(scene)
     scenes.add_camera(scene, location=(0.6, -4.5, 2.0), target=(0.5, 0.0, 0.0), lens=55.0)
 
 
@@ -165,12 +144,9 @@ def main(argv=None) -> int:
     try:
         with tempfile.TemporaryDirectory(prefix="solidwire-gallery-") as folder:
             cells = render_cells(Path(folder))
-        preset_gallery.write(
-            preset_gallery.compose(cells, columns=2, cell=CELL), cells, args.output, columns=2, cell=CELL
-        )
+        preset_gallery.write_sheet(cells, args.output, columns=2, cell=CELL)
     finally:
         solidwire_addon.unregister()
-    print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")
     return 0
 
 

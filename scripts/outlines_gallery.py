@@ -26,19 +26,20 @@ from solidwire_addon.blender.gpu_context import ensure_gpu
 CELL = (320, 240)
 
 
-def _text(scene):
+def text(scene):
+    """A bevelled, extruded "SoW" standing up (the geometry alone)."""
     data = bpy.data.curves.new("Text", "FONT")
     data.body = "SoW"
     data.extrude = 0.08
     data.bevel_depth = 0.02
     data.align_x = "CENTER"
-    text = bpy.data.objects.new("Text", data)
-    scene.collection.objects.link(text)
-    text.rotation_euler = (math.radians(70), 0.0, 0.0)
-    dense_scenes._camera(scene, (0.6, -3.2, 1.4), (0.0, 0.0, 0.3), lens=45.0)
+    obj = bpy.data.objects.new("Text", data)
+    scene.collection.objects.link(obj)
+    obj.rotation_euler = (math.radians(70), 0.0, 0.0)
 
 
-def _curve(scene):
+def filled_curve(scene):
+    """A filled 2D Bezier circle, extruded and bevelled."""
     bpy.ops.curve.primitive_bezier_circle_add(radius=1.0)
     ring = bpy.context.active_object
     ring.data.dimensions = "2D"
@@ -46,39 +47,45 @@ def _curve(scene):
     ring.data.extrude = 0.15
     ring.data.bevel_depth = 0.05
     ring.rotation_euler = (math.radians(55), 0.0, math.radians(20))
-    dense_scenes._camera(scene, (0.0, -4.2, 1.8), (0.0, 0.0, 0.0), lens=50.0)
 
 
-def _surface(scene):
+def nurbs_sphere(scene):
+    """A NURBS sphere at a low resolution."""
     bpy.ops.surface.primitive_nurbs_surface_sphere_add(radius=1.0)
     sphere = bpy.context.active_object
     sphere.data.resolution_u = sphere.data.resolution_v = 3
-    dense_scenes._camera(scene, (1.5, -4.0, 2.0), (0.0, 0.0, 0.0), lens=50.0)
 
 
-def _metaballs(scene):
+def metaballs(scene):
+    """Two metaballs melting together (viewport and render resolution alike)."""
     bpy.ops.object.metaball_add(radius=1.0)
     balls = bpy.context.active_object
-    balls.data.resolution = 0.25
+    balls.data.resolution = balls.data.render_resolution = 0.25
     element = balls.data.elements.new()
     element.co = (1.1, 0.0, 0.3)
     element.radius = 0.8
-    dense_scenes._camera(scene, (0.6, -4.5, 2.0), (0.5, 0.0, 0.0), lens=50.0)
 
 
-SOURCES = (("Text", _text), ("Filled curve, bevel", _curve), ("NURBS sphere", _surface), ("Metaballs", _metaballs))
+# (label, geometry, camera location, target, lens)
+SOURCES = (
+    ("Text", text, (0.6, -3.2, 1.4), (0.0, 0.0, 0.3), 45.0),
+    ("Filled curve, bevel", filled_curve, (0.0, -4.2, 1.8), (0.0, 0.0, 0.0), 50.0),
+    ("NURBS sphere", nurbs_sphere, (1.5, -4.0, 2.0), (0.0, 0.0, 0.0), 50.0),
+    ("Metaballs", metaballs, (0.6, -4.5, 2.0), (0.5, 0.0, 0.0), 50.0),
+)
 
 
 def render_cells() -> list:
     ensure_gpu()
     rows: list = [[], []]
-    for label, build in SOURCES:
+    for label, build, location, target, lens in SOURCES:
         scene = dense_scenes._fresh_scene(*CELL)
         scene.render.film_transparent = False
         world = bpy.data.worlds.new("World")
         world.color = (0.18, 0.2, 0.23)
         scene.world = world
         build(scene)
+        dense_scenes._camera(scene, location, target, lens=lens)
         for row, show in enumerate((False, True)):
             scene.solidwire.show_tessellation = show
             rgba, _depth = engine.render_scene(bpy.context.evaluated_depsgraph_get(), CELL)
@@ -92,14 +99,9 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     solidwire_addon.register()
     try:
-        cells = render_cells()
-        columns = len(SOURCES)
-        preset_gallery.write(
-            preset_gallery.compose(cells, columns=columns, cell=CELL), cells, args.output, columns=columns, cell=CELL
-        )
+        preset_gallery.write_sheet(render_cells(), args.output, columns=len(SOURCES), cell=CELL)
     finally:
         solidwire_addon.unregister()
-    print(f"wrote {args.output} ({args.output.stat().st_size // 1024} KiB)")
     return 0
 
 

@@ -139,6 +139,13 @@ def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS, cell=CEL
     image.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE).save(path, optimize=True)
 
 
+def write_sheet(cells, output: Path, *, columns: int, cell) -> None:
+    """Compose ``cells`` (label, image) into one labelled sheet, write it to
+    ``output`` and say where and how big."""
+    write(compose(cells, columns=columns, cell=cell), cells, output, columns=columns, cell=cell)
+    print(f"wrote {output} ({output.stat().st_size // 1024} KiB)")
+
+
 def _write_with_blender(sheet: np.ndarray, path: Path) -> None:
     height, width, _ = sheet.shape
     image = bpy.data.images.new("solidwire_gallery", width, height, alpha=False)
