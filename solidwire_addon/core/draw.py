@@ -764,17 +764,17 @@ def _setup_ready() -> bool:
 def _setup_size(mesh, stage, object_to_clip, view: View) -> bool:
     """Whether a draw of ``mesh`` gains from the set-up pre-pass (and its
     table fits in a texture). A direct draw sets a triangle up at each of
-    its corners: the pre-pass pays from SETUP_TABLE_MIN triangles on. The
-    deferred resolve sets it up once per pixel it shows: the pre-pass pays
-    where the draw's window box holds more pixels than the mesh has
-    triangles (a pixel's set-up and a pre-pass invocation cost about the
-    same; a box is about half covered)."""
+    its corners: the pre-pass pays from SETUP_TABLE_MIN triangles on.
+
+    The deferred stages never use it: the resolve sets a triangle up once
+    per pixel it shows instead. (The pre-pass would pay there where a draw's
+    window box holds more pixels than the mesh has triangles, but a compute
+    dispatch between the resolve's draws crashed llvmpipe inside the
+    dispatch, reproducibly after a long run of renders in one process; the
+    direct draws' pre-pass runs outside any deferred stage.)"""
     if mesh.triangle_count > shaders.SETUP_MAX_TRIANGLES:
         return False
-    if stage is None:
-        return mesh.triangle_count >= SETUP_TABLE_MIN
-    pixels = box_pixels(window_boxes(object_to_clip, mesh.bounds_min, mesh.bounds_max), view).sum()
-    return 0.5 * pixels > mesh.triangle_count
+    return stage is None and mesh.triangle_count >= SETUP_TABLE_MIN
 
 
 def _run_setup(mesh, object_to_clip, block, in_front: bool = False) -> None:
