@@ -20,7 +20,7 @@ float view_depth_of(vec3 p)
 
 /* The quad corner `corner` (0..5: (a,-), (b,-), (b,+), (a,-), (b,+), (a,+))
  * around window points wa -> wb, `reach` px on every side. */
-vec4 quad_corner(vec2 wa, vec2 wb, float reach, int corner)
+vec4 quad_corner_position(vec2 wa, vec2 wb, float reach, int corner)
 {
   vec2 dir = wb - wa;
   float len = length(dir);
@@ -62,7 +62,7 @@ vec2 joint_normal(float neighbour, vec2 win_a, vec2 win_b, bool clipped, bool at
 void main()
 {
   int prim = gl_VertexID / 6;
-  int corner = strand_corner;
+  int corner = quad_corner;
 #ifdef STRAND_POINTS
   vec4 point = fetch_texel(vertex_positions, prim);
   vec4 c = object_to_clip * vec4(point.xyz, 1.0);
@@ -82,7 +82,7 @@ void main()
 #  endif
   disc_extra = vec2(radius, 1.0 / c.w);
   float reach = radius_px + max(half_thickness_at(depth, 1.0 / c.w), 0.0) + 2.0 * params.softness + 1.0;
-  gl_Position = quad_corner(centre, centre, reach, corner);
+  gl_Position = quad_corner_position(centre, centre, reach, corner);
 #else
   vec4 ids = fetch_texel(strand_segments, prim);
   vec4 pa = fetch_texel(vertex_positions, int(ids.x));
@@ -116,6 +116,6 @@ void main()
   seg_split = vec4(joint_normal(ids.z, win_a, win_b, ta > 0.0, true),
                    joint_normal(ids.w, win_a, win_b, tb > 0.0, false));
 #  endif
-  gl_Position = quad_corner(win_a, win_b, reach, corner);
+  gl_Position = quad_corner_position(win_a, win_b, reach, corner);
 #endif
 }

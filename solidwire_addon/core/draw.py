@@ -592,8 +592,8 @@ _quad_batches: dict[int, object] = {}
 def quad_batch(count: int):
     """Six corners (two triangles, ``quad_corner`` 0..5) for each of at
     least ``count`` screen-space quads whose shader pulls everything else:
-    the silhouette fins and the region lines. Shared by every draw of the
-    same size class (the next power of two)."""
+    the silhouette fins, the region lines, hair segments and points. Shared
+    by every draw of the same size class (the next power of two)."""
     size = 1 << max(int(count - 1).bit_length(), 6)
     batch = _quad_batches.get(size)
     if batch is None:

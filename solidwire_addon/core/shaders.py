@@ -841,7 +841,7 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
         # the primitives there are, so no count is needed).
         info.push_constant("VEC4", "strand_view")  # px per unit at w = 1, radius scale
         add_sampler(info, "strand_segments")
-        info.vertex_in(0, "INT", "strand_corner")
+        info.vertex_in(0, "INT", "quad_corner")
         info.vertex_out(iface)
         info.fragment_out(0, "VEC4", "frag_color")
         if flags.depth_bias:

@@ -31,7 +31,7 @@ import numpy as np
 
 from . import colors, matcaps, shaders
 from .cache import table_texture
-from .draw import bind_display_transform, clip_space_planes, shader_variant, styled
+from .draw import bind_display_transform, clip_space_planes, quad_batch, shader_variant, styled
 from .log import one_line, warn_once
 from .settings import pack_params
 from .targets import read_texture
@@ -316,23 +316,6 @@ geometry_cache = GeometryCache()
 # -- drawing ---------------------------------------------------------------------
 
 
-_batches: dict[int, object] = {}
-
-
-def _batch(count: int):
-    """Six corners per primitive (two triangles), shared by every draw of
-    the same size class (next power of two)."""
-    size = 1 << max(int(count - 1).bit_length(), 6)
-    batch = _batches.get(size)
-    if batch is None:
-        fmt = gpu.types.GPUVertFormat()
-        fmt.attr_add(id="strand_corner", comp_type="I32", len=1, fetch_mode="INT")
-        vbo = gpu.types.GPUVertBuf(fmt, 6 * size)
-        vbo.attr_fill("strand_corner", np.tile(np.arange(6, dtype=np.int32), size))
-        batch = _batches[size] = gpu.types.GPUBatch(type="TRIS", buf=vbo)
-    return batch
-
-
 class _Targets:
     """The render's strand layer: colour, (view depth, weight) and a depth
     buffer holding the winner key, one set per size."""
@@ -356,7 +339,6 @@ def _targets_for(width: int, height: int) -> _Targets:
 
 def release() -> None:
     """Drop every GPU object of this module (add-on unregister)."""
-    _batches.clear()
     _targets.clear()
     geometry_cache.clear()
 
@@ -430,7 +412,7 @@ def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0,
             shader.uniform_sampler("vertex_positions", point_table)
             if segment_table is not None:
                 shader.uniform_sampler("strand_segments", segment_table)
-            _batch(geometry.count).draw_range(shader, elem_start=0, elem_count=6 * geometry.count)
+            quad_batch(geometry.count).draw_range(shader, elem_start=0, elem_count=6 * geometry.count)
             drawn += 1
     return drawn
 
