@@ -1,11 +1,19 @@
 /* Region lines, vertex stage (docs/image_model.md §2.6): one screen-space
- * quad (two triangles, six corners) per entry of `region_lines` around the
- * window segment of its near-clipped edge, widened by the reach of the
- * entry's line style. The entry is gl_VertexID / 6; an instanced draw
- * repeats every entry for each instance. */
+ * quad (two triangles, six corners) per *run* of the `region_lines` table:
+ * up to RUN_SEGMENTS (1, 2, 4 or 8) consecutive entries of one chain (a cage edge cut by
+ * subdivision), one style and one pair of regions. The quad covers every
+ * entry's window segment widened by the reach of the style's line; each
+ * segment's own set-up goes to the fragment stage, which takes the
+ * strongest of the run's lines. A rasteriser then pays for one primitive
+ * per run instead of one per segment, and the overlapping caps of a chain's
+ * short segments are shaded once. The run is gl_VertexID / 6; its texel
+ * (first entry's texel, entries) leads the table. An instanced draw repeats
+ * every run for each instance. */
 
 /* Outside the clip volume: the rasteriser drops the triangle. */
 const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
+/* An unused slot of the run: a line so far away that its profile is 0. */
+const vec4 NO_SEGMENT = vec4(0.0, 0.0, 1.0e6, 0.0);
 
 /* The window length of an edge's near-clipped projection (the density
  * fade's chain length). */
@@ -17,61 +25,133 @@ float projected_length(float id_a, float id_b)
   return span.y - span.x;
 }
 
-void main()
+/* What the quad of a run is built from, segment by segment. */
+struct RunBox {
+  vec2 along;    /* the frame: the run's chord (or its first drawn segment) ... */
+  vec2 across;   /* ... and its normal */
+  vec2 low;      /* (along, across) bounds of the segments' window points */
+  vec2 high;
+  float reach;   /* the widest reach of the run's segments */
+  bool oriented; /* the frame is set */
+  bool drawn;    /* a segment was drawn */
+};
+
+/* Set up the segment of the entry at `texel` (`used`: the run has it) into
+ * `line_out` (line, span start) and `end_out` (span end), and widen `box`
+ * by it. */
+void run_segment(int texel, bool used, float half_width, inout RunBox box, out vec4 line_out, out float end_out)
 {
-  int entry = gl_VertexID / 6;
-  int corner = quad_corner;
-  if (entry >= line_count) {
-    /* The batch's padding (an instanced draw draws all of it): read no
-     * table past its end. */
-    gl_Position = COLLAPSED;
+  line_out = NO_SEGMENT;
+  end_out = 0.0;
+  if (!used) {
     return;
   }
-  vec4 head = fetch_texel(region_lines, 2 * entry);
-  vec4 tail = fetch_texel(region_lines, 2 * entry + 1);
-  vec4 a = vertex_clip(head.x), b = vertex_clip(head.y);
+  vec4 entry = fetch_texel(region_lines, texel);
+  vec4 a = vertex_clip(entry.x), b = vertex_clip(entry.y);
   vec3 line;
   vec2 span;
   /* The surface's own set-up (lower id first, so patterns run from the
    * lower-id end): the same bits as a block walk would compute. */
   edge_setup(a, b, line, span);
   if (dot(line.xy, line.xy) == 0.0) {
-    gl_Position = COLLAPSED; /* wholly behind the near plane, or a point */
+    return; /* wholly behind the near plane, or a point */
+  }
+  line_out = vec4(line, span.x);
+  end_out = span.y;
+  /* The widest the style's line can be here, plus its 2s fall-off (the
+   * profile is 0 beyond it) and a hundredth of a pixel for rounding: every
+   * sample the profile reaches lies inside the quad. */
+#if THICKNESS_MODE == 1
+  float depth_a = a.z + a.w, depth_b = b.z + b.w;
+  vec4 a_front = (depth_a < 0.0) ? mix(a, b, depth_a / (depth_a - depth_b)) : a;
+  vec4 b_front = (depth_b < 0.0) ? mix(b, a, depth_b / (depth_b - depth_a)) : b;
+  half_width = style_half_thickness(line_style, params.world_half_thickness_px / max(min(a_front.w, b_front.w), 1e-6));
+#endif
+  box.reach = max(box.reach, half_width + 2.0 * params.softness + 0.01);
+  vec2 dir = vec2(-line.y, line.x);
+  vec2 foot = -line.z * line.xy; /* the line's point nearest the centre */
+  if (!box.oriented) {
+    box.along = dir;
+    box.across = line.xy;
+    box.oriented = true;
+  }
+  box.drawn = true;
+  vec2 wa = foot + span.x * dir, wb = foot + span.y * dir;
+  vec2 qa = vec2(dot(wa, box.along), dot(wa, box.across));
+  vec2 qb = vec2(dot(wb, box.along), dot(wb, box.across));
+  box.low = min(box.low, min(qa, qb));
+  box.high = max(box.high, max(qa, qb));
+}
+
+void main()
+{
+  int run = gl_VertexID / 6;
+  int corner = quad_corner;
+  if (run >= line_count) {
+    /* The batch's padding (an instanced draw draws all of it): read no
+     * table past its end. */
+    gl_Position = COLLAPSED;
     return;
   }
-  line_equation = line;
-  line_span = span;
+  vec4 run_texel = fetch_texel(region_lines, run);
+  int first = int(run_texel.x);
+  int count = int(run_texel.y);
+  vec4 head = fetch_texel(region_lines, first);
+  vec4 tail = fetch_texel(region_lines, first + 1);
   line_style = int(head.z);
   line_regions = vec2(head.w, tail.z);
 #ifdef USE_DENSITY_FADE
-  line_chain = projected_length(tail.x, tail.y);
+  line_chain = projected_length(tail.x, tail.y); /* one chain per run */
 #else
   line_chain = 0.0;
 #endif
 #ifdef SW_INSTANCED
   line_instance = float(gl_InstanceID);
 #endif
+  run_length = count;
 
-  /* The widest the style's line can be here, plus its 2s fall-off (the
-   * profile is 0 beyond it) and a hundredth of a pixel for rounding: every
-   * sample the profile reaches lies inside the quad, and no more. */
-  float depth_a = a.z + a.w, depth_b = b.z + b.w;
-  vec4 a_front = (depth_a < 0.0) ? mix(a, b, depth_a / (depth_a - depth_b)) : a;
-  vec4 b_front = (depth_b < 0.0) ? mix(b, a, depth_b / (depth_b - depth_a)) : b;
-  float half_width = max(params.half_thickness, params.half_thickness_far);
-#if THICKNESS_MODE == 1
-  half_width = params.world_half_thickness_px / max(min(a_front.w, b_front.w), 1e-6);
+  float half_width = style_half_thickness(line_style, max(params.half_thickness, params.half_thickness_far));
+  RunBox box = RunBox(vec2(1.0, 0.0), vec2(0.0, 1.0), vec2(1e30), vec2(-1e30), 0.0, false, false);
+  /* The frame along the chord from the first segment's middle to the
+   * last's: a chain's box is then as narrow as its bend (the first
+   * segment's direction, where the chord is not in front of the camera or
+   * is too short to say). */
+  vec4 last = fetch_texel(region_lines, first + 2 * (count - 1));
+  vec4 from = vertex_clip(head.x) + vertex_clip(head.y), to = vertex_clip(last.x) + vertex_clip(last.y);
+  if (count > 1 && from.w > 0.0 && to.w > 0.0) {
+    vec2 chord = window_point(to) - window_point(from);
+    if (dot(chord, chord) > 1.0) {
+      box.along = normalize(chord);
+      box.across = vec2(-box.along.y, box.along.x);
+      box.oriented = true;
+    }
+  }
+  /* RUN_SEGMENTS (1, 2, 4 or 8): the most a run of this mesh holds. */
+  run_segment(first, count > 0, half_width, box, run_line0, run_ends0.x);
+#if RUN_SEGMENTS > 1
+  run_segment(first + 2, count > 1, half_width, box, run_line1, run_ends0.y);
 #endif
-  half_width = style_half_thickness(line_style, half_width);
-  float reach = half_width + 2.0 * params.softness + 0.01;
+#if RUN_SEGMENTS > 2
+  run_segment(first + 4, count > 2, half_width, box, run_line2, run_ends0.z);
+  run_segment(first + 6, count > 3, half_width, box, run_line3, run_ends0.w);
+#endif
+#if RUN_SEGMENTS > 4
+  run_segment(first + 8, count > 4, half_width, box, run_line4, run_ends1.x);
+  run_segment(first + 10, count > 5, half_width, box, run_line5, run_ends1.y);
+  run_segment(first + 12, count > 6, half_width, box, run_line6, run_ends1.z);
+  run_segment(first + 14, count > 7, half_width, box, run_line7, run_ends1.w);
+#endif
+  if (!box.drawn) {
+    gl_Position = COLLAPSED;
+    return;
+  }
 
-  vec2 dir = vec2(-line.y, line.x);
-  vec2 foot = -line.z * line.xy + viewport_centre(); /* the line's point nearest the centre */
-  vec2 wa = foot + span.x * dir, wb = foot + span.y * dir;
-  vec2 normal = line.xy;
-  /* corners 0..5: (a,-), (b,-), (b,+), (a,-), (b,+), (a,+) */
-  bool at_b = (corner == 1 || corner == 2 || corner == 4);
+  /* The box around every segment's window points, widened by the reach,
+   * holds every segment's reach. */
+  vec2 low = box.low - box.reach, high = box.high + box.reach;
+  /* corners 0..5: (low,low), (high,low), (high,high), (low,low), (high,high), (low,high) */
+  bool at_high = (corner == 1 || corner == 2 || corner == 4);
   bool plus = (corner == 2 || corner == 4 || corner == 5);
-  vec2 w = (at_b ? wb + dir * reach : wa - dir * reach) + normal * (plus ? reach : -reach);
+  vec2 w = viewport_centre() + box.along * (at_high ? high.x : low.x) + box.across * (plus ? high.y : low.y);
   gl_Position = vec4((w - params.viewport.xy) / params.viewport.zw * 2.0 - 1.0, 0.0, 1.0);
 }

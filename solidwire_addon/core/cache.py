@@ -16,6 +16,7 @@ import time
 import gpu
 import numpy as np
 
+from .edge_select import TEXELS_PER_REGION_LINE
 from .extract import IN_REGION, REGION_LINES, MeshArrays
 
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
@@ -130,6 +131,8 @@ class GPUMesh:
         # The lines of multi-face regions and each triangle's region
         # (edge_select._region_lines), uploaded on first use (region_tables).
         self._region_lines_cpu = arrays.region_lines
+        self._region_line_runs_cpu = arrays.region_line_runs
+        self.region_run_segments = arrays.region_run_segments
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
         # The set-up pre-pass's output for big meshes (draw._run_setup), made
@@ -195,13 +198,24 @@ class GPUMesh:
         lines = self._region_lines_cpu
         return 0 if lines is None else len(lines) // 2
 
+    @property
+    def region_run_count(self) -> int:
+        """Runs of the region-lines table: the quads the pass draws."""
+        runs = self._region_line_runs_cpu
+        return 0 if runs is None else len(runs)
+
     def region_tables(self):
         """(region-lines table, per-triangle region table) as textures
-        (docs/image_model.md §2.6), made on first use."""
+        (docs/image_model.md §2.6), made on first use. The first holds the
+        runs (a texel each: the texel of the run's first entry, its
+        entries), then the entries."""
         if self._region_tables is None:
             regions = np.zeros((self.triangle_count, 4), np.float32)
             regions[:, 0] = self._triangle_regions_cpu
-            self._region_tables = (table_texture(self._region_lines_cpu), table_texture(regions))
+            runs = self._region_line_runs_cpu.copy()
+            runs[:, 0] = len(runs) + TEXELS_PER_REGION_LINE * runs[:, 0]
+            lines = np.concatenate([runs, self._region_lines_cpu])
+            self._region_tables = (table_texture(lines), table_texture(regions))
             self.gpu_bytes += sum(t.width * t.height * 16 for t in self._region_tables)
         return self._region_tables
 

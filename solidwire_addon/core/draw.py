@@ -428,13 +428,14 @@ def draw(
                 setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g.object_to_clip, view)
             )
             in_front = wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max)
-            parts.setdefault((ngons, lines_only, colored, table, in_front), []).append(g)
+            runs = getattr(mesh, "region_run_segments", 1)  # the region-lines pass's segments per quad
+            parts.setdefault((ngons, lines_only, colored, table, in_front, runs), []).append(g)
         # The visibility and region-lines passes read neither n-gon
         # outlines nor the set-up table; a draw that reads the region lines
         # needs no block code for a mesh whose blocks only hold them.
         plain_stage = variant.visibility or variant.region_lines_pass
         for key in sorted(parts):
-            ngons, lines_only, colored, table, in_front = key
+            ngons, lines_only, colored, table, in_front, runs = key
             lines_elsewhere = lines_only and variant.region_lines
             walks = ngons and not plain_stage and not lines_elsewhere
             part_variant = replace(
@@ -443,6 +444,7 @@ def draw(
                 setup_table=table and not plain_stage,
                 in_front=in_front and not variant.visibility,
                 attribute_colors=variant.attribute_colors and colored and not plain_stage,
+                run_segments=runs if variant.region_lines_pass else 1,
             )
             if lines_elsewhere and variant.edge_classes:
                 part_variant = replace(part_variant, edge_classes=False, style_colors=True)
@@ -560,7 +562,7 @@ class _DrawNumbers:
             return
         self.count += 1
         if self.stage == LINES:
-            count = mesh.region_line_count
+            count = mesh.region_run_count
             if count:
                 shader.uniform_int("draw_number", self.count)
                 lines, regions = mesh.region_tables()

@@ -72,6 +72,13 @@ WALK_LIMIT = 128
 # id, style, region) and (chain end, chain end, other region or NO_REGION, 0).
 TEXELS_PER_REGION_LINE = 2
 NO_REGION = -1.0
+# The most entries a run of the region-lines pass holds
+# (shaders/region_lines_vert.glsl): consecutive entries of one chain, style
+# and pair of regions drawn as one quad. A cage edge at level 5 is a chain
+# of 32 short segments whose quads would mostly overlap, and a rasteriser
+# pays per primitive and per covered pixel. Eight segments fill 40 varying
+# components, within every backend's limit.
+RUN_SEGMENTS = 8
 
 
 @dataclass
@@ -328,7 +335,7 @@ def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, p
     keep = lines_face[pairs[:, 0]] if len(pairs) else np.zeros(0, bool)
     pairs = pairs[keep]
     if not len(pairs):
-        arrays.region_lines = None
+        arrays.region_lines = arrays.region_line_runs = None
         return
     pairs = pairs[np.lexsort((pairs[:, 0], pairs[:, 1]))]  # by edge, then region
     edge, region = pairs[:, 1], pairs[:, 0]
@@ -343,6 +350,10 @@ def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, p
     edge, region, partner = edge[head], region[head], partner[head]
     # One entry per class of the edge (an edge with no class: one entry).
     style, (edge, region, partner) = _one_per_class(classes[edge], edge, region, partner)
+    # By style, then edge: a chain's entries of one class follow each other
+    # (_line_runs).
+    order = np.argsort(style, kind="stable")
+    style, edge, region, partner = style[order], edge[order], region[order], partner[order]
     table = np.zeros((TEXELS_PER_REGION_LINE * len(edge), 4), np.float32)
     table[0::2, 0] = np.minimum(verts[edge, 0], verts[edge, 1])
     table[0::2, 1] = np.maximum(verts[edge, 0], verts[edge, 1])
@@ -351,7 +362,43 @@ def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, p
     table[1::2, 0], table[1::2, 1] = ends[edge, 0], ends[edge, 1]
     table[1::2, 2] = np.where(partner >= 0, partner, NO_REGION)
     arrays.region_lines = table
+    arrays.region_line_runs, arrays.region_run_segments = _line_runs(ends[edge], style, region, partner)
     stats.region_lines = len(edge)
+
+
+def _line_runs(chain_ends: np.ndarray, style: np.ndarray, region: np.ndarray, partner: np.ndarray):
+    """((R, 4) float32 runs of the region-lines table: (first entry,
+    entries, 0, 0); the most entries a run holds, 1, 2, 4 or 8). A run is
+    consecutive entries with the same chain, style and regions, drawn as
+    one quad by the region-lines pass. A cage edge's pieces are consecutive
+    edges (blender/cage.py), so a chain's entries follow each other in the
+    table's edge order. The run length is the power of two that holds the
+    chains most entries are in (up to RUN_SEGMENTS): the pass's shader
+    carries that many segments to every pixel, which is wasted on the
+    single edges of an angle threshold."""
+    count = len(style)
+    same = np.zeros(count, bool)
+    if count > 1:
+        same[1:] = (
+            (chain_ends[1:] == chain_ends[:-1]).all(axis=1)
+            & (style[1:] == style[:-1])
+            & (region[1:] == region[:-1])
+            & (partner[1:] == partner[:-1])
+        )
+    group_start = np.flatnonzero(~same)
+    group_size = np.diff(np.append(group_start, count))
+    # The group size at which half of the entries are in groups no larger.
+    sizes = np.sort(group_size)
+    typical = sizes[np.searchsorted(np.cumsum(sizes), count / 2.0)]
+    length = 1
+    while length < min(typical, RUN_SEGMENTS):
+        length *= 2
+    rank = np.arange(count) - np.repeat(group_start, group_size)
+    first = np.flatnonzero(rank % length == 0)
+    runs = np.zeros((len(first), 4), np.float32)
+    runs[:, 0] = first
+    runs[:, 1] = np.diff(np.append(first, count))
+    return runs, length
 
 
 def _mark_own_edges(

@@ -83,6 +83,11 @@ class MeshArrays:
     # no multi-face region.
     region_lines: np.ndarray = None
     triangle_regions: np.ndarray = None
+    # Runs of that table drawn as one quad each (edge_select._line_runs):
+    # (R, 4) float32 (first entry, entries, 0, 0), and the most entries a
+    # run holds (1, 2, 4 or 8).
+    region_line_runs: np.ndarray = None
+    region_run_segments: int = 1
     # The ATTRIBUTE fill source: the active colour attribute as (R, 4)
     # float32 scene-linear RGBA rows, one per vertex (attribute_domain
     # NORMALS_BY_VERTEX) or per triangle corner (NORMALS_BY_CORNER); None:

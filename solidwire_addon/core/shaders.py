@@ -123,6 +123,9 @@ class ShaderVariant:
     # pass's image for those regions' triangles.
     region_lines_pass: bool = False
     region_lines: bool = False
+    # Region-lines pass only: segments per quad (1, 2, 4 or 8; the mesh's
+    # cache.GPUMesh.region_run_segments).
+    run_segments: int = 1
     # A surface pass that measures no line of a class itself (every class
     # line comes from the region-lines pass) but colours the winning style:
     # the class colours without the per-style distance code (STYLE_COLORS).
@@ -436,11 +439,18 @@ def _visibility_create_info(variant: ShaderVariant):
 
 def _region_lines_create_info(variant: ShaderVariant):
     """The region-lines pass (region_lines_vert/frag.glsl): a quad per
-    entry of the mesh's region-lines table, the exact distance per
-    fragment, the strongest line per pixel kept through the depth test."""
+    run of the mesh's region-lines table, the exact distance to each of its
+    segments per fragment, the strongest line per pixel kept through the
+    depth test."""
     iface = gpu.types.GPUStageInterfaceInfo("solidwire_region_lines_iface")
-    iface.flat("VEC3", "line_equation")
-    iface.flat("VEC2", "line_span")
+    # Each segment of a run: (line, span start) and its span end, four ends
+    # to a varying (at most 8 segments: 40 components). Only as many as the
+    # mesh's runs hold: a rasteriser pays for the varyings at every pixel.
+    for j in range(variant.run_segments):
+        iface.flat("VEC4", f"run_line{j}")
+    for j in range((variant.run_segments + 3) // 4):
+        iface.flat("VEC4", f"run_ends{j}")
+    iface.flat("INT", "run_length")
     iface.flat("INT", "line_style")
     iface.flat("VEC2", "line_regions")
     iface.flat("FLOAT", "line_chain")
@@ -466,6 +476,7 @@ def _region_lines_create_info(variant: ShaderVariant):
     info.fragment_out(0, "VEC2", "frag_line")
     compat.depth_write(info, "ANY")
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
+    info.define("RUN_SEGMENTS", str(variant.run_segments))
     info.define("STYLE_COUNT", str(schema.STYLE_COUNT if variant.edge_classes else 1))
     if variant.density_fade:
         info.define("USE_DENSITY_FADE", "1")
