@@ -415,6 +415,8 @@ def _mark_own_edges(
     quad's edges to its 4th corner and an n-gon's outline slots."""
     if drawn.all():
         return
+    if _mark_quad_rows(arrays, drawn, corner_vert, sizes, corner_edge):
+        return
     vertex_count = np.int64(max(arrays.vertex_count, int(verts.max()) + 1))
     sorted_keys = []  # the hidden edges' vertex-pair keys, sorted on first use
 
@@ -472,6 +474,51 @@ def _mark_own_edges(
         marks = np.zeros(len(arrays.ngon_corners), dtype=np.int32)
         marks[slot] = hidden(arrays.ngon_corners[slot], arrays.ngon_corners[slot_next])
         arrays.ngon_hidden = marks
+
+
+def _mark_quad_rows(
+    arrays: MeshArrays, drawn: np.ndarray, corner_vert: np.ndarray, sizes: np.ndarray, corner_edge: np.ndarray
+) -> bool:
+    """_mark_own_edges for a mesh of quads only (what a subdivision makes)
+    whose triangle rows are those extract.build_arrays_fast writes: quad i
+    as rows 2i and 2i + 1, starting at its corner 0 and 2, or 3 and 1 where
+    the quad is split along its other diagonal. Each row's edges are then
+    its quad's corner edges in a known order: a few column picks instead of
+    finding every row's corners. False (nothing done) for any other mesh."""
+    face_count = len(sizes)
+    if face_count == 0 or arrays.triangle_count != 2 * face_count or sizes.min() != 4 or sizes.max() != 4:
+        return False
+    tri, flags = arrays.triangles, arrays.edge_flags
+    quad = np.asarray(corner_vert).reshape(face_count, 4)
+    even, odd = tri[0::2], tri[1::2]
+    flip = even[:, 0] != quad[:, 0]
+    faces = np.arange(face_count, dtype=arrays.triangle_polygons.dtype)
+    if not (
+        np.array_equal(arrays.triangle_polygons[0::2], faces)
+        and np.array_equal(arrays.triangle_polygons[1::2], faces)
+        and np.array_equal(even[:, 0], np.where(flip, quad[:, 3], quad[:, 0]))
+        and np.array_equal(even[:, 1], np.where(flip, quad[:, 0], quad[:, 1]))
+        and np.array_equal(odd[:, 0], np.where(flip, quad[:, 1], quad[:, 2]))
+        and (
+            (flags & (EDGE0_REAL | EDGE1_REAL | HAS_QUAD_CORNER | IS_NGON))
+            == (EDGE0_REAL | EDGE1_REAL | HAS_QUAD_CORNER)
+        ).all()
+    ):
+        return False
+    hidden = ~drawn[np.asarray(corner_edge).reshape(face_count, 4)]  # the edge leaving each corner
+    # A row starting at corner r: its edges 0, 1 and its quad edges 3, 4
+    # leave corners r, r + 1, r + 2, r + 3.
+    for rows, plain, flipped in ((slice(0, None, 2), 0, 3), (slice(1, None, 2), 2, 1)):
+        h = [np.where(flip, hidden[:, (flipped + k) % 4], hidden[:, (plain + k) % 4]) for k in range(4)]
+        clear = h[0] * np.int32(EDGE0_REAL) | h[1] * np.int32(EDGE1_REAL)
+        marks = (
+            h[0] * np.int32(EDGE0_HIDDEN)
+            | h[1] * np.int32(EDGE0_HIDDEN << 1)
+            | h[2] * np.int32(EDGE3_HIDDEN)
+            | h[3] * np.int32(EDGE4_HIDDEN)
+        )
+        flags[rows] = (flags[rows] & ~clear) | marks
+    return True
 
 
 def _corner_in_polygon(vertex, start, size, corner_vert) -> np.ndarray:
