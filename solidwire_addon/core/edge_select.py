@@ -122,11 +122,35 @@ def _face_of_corner(sizes: np.ndarray) -> np.ndarray:
 
 def _region_labels(face_count: int, f1: np.ndarray, f2: np.ndarray) -> np.ndarray:
     """Connected components of faces joined by the pairs (f1, f2): each face's
-    label is the smallest face id of its component. Hooking plus pointer
-    jumping: a few passes over the pairs even for a long chain of faces."""
-    label = np.arange(face_count, dtype=np.int64)
+    label is the smallest face id of its component.
+
+    Runs of consecutive face ids joined pair by pair are one component each
+    from the start (a subdivision lays a cage face's children out row by
+    row, so a region's rows are such runs, found in one pass); the
+    components are then found over the runs, a few thousand nodes where
+    there were a million faces."""
+    low, high = np.minimum(f1, f2), np.maximum(f1, f2)
+    follows = high == low + 1
+    next_joined = np.zeros(face_count, bool)
+    next_joined[low[follows]] = True  # face f and f + 1 are joined
+    starts_run = np.ones(face_count, bool)
+    starts_run[1:] = ~next_joined[:-1]
+    run_of_face = np.cumsum(starts_run) - 1
+    run_start = np.flatnonzero(starts_run)
+    across = ~follows
+    run_label = _components(len(run_start), run_of_face[low[across]], run_of_face[high[across]])
+    # Runs are numbered in face order: the smallest run is the smallest face.
+    return run_start[run_label][run_of_face]
+
+
+def _components(count: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Connected components of the nodes 0..count-1 joined by the pairs
+    (a, b): each node's label is the smallest node of its component.
+    Hooking plus pointer jumping: a few passes over the pairs even for a
+    long chain of nodes."""
+    label = np.arange(count, dtype=np.int64)
     while True:
-        l1, l2 = label[f1], label[f2]  # roots: every label points at one
+        l1, l2 = label[a], label[b]  # roots: every label points at one
         differ = l1 != l2
         if not differ.any():
             return label
@@ -294,7 +318,11 @@ def select_edges(
 
     tri_owner = owner[arrays.triangle_polygons]
     listed = tri_owner >= 0
-    at = np.searchsorted(owners, tri_owner[listed])
+    # Each listed triangle's block: a lookup by owner (owners lie in
+    # [0, 2 F)), far cheaper than a search per triangle.
+    block_of_owner = np.zeros(2 * face_count, np.int64)
+    block_of_owner[owners] = np.arange(len(owners))
+    at = block_of_owner[tri_owner[listed]]
     flags = arrays.edge_flags
     keep = ~(HAS_QUAD_CORNER | IS_NGON | REGION_LINES | (-1 << NGON_SHIFT))
     flags[listed] = (flags[listed] & keep) | IN_REGION | (count[at].astype(np.int32) << NGON_SHIFT)
