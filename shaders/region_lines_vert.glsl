@@ -1,14 +1,14 @@
 /* Region lines, vertex stage (docs/image_model.md §2.6): one screen-space
  * quad (two triangles, six corners) per *run* of the `region_lines` table:
- * up to RUN_SEGMENTS (1, 2, 4 or 8) consecutive entries of one chain (a cage edge cut by
- * subdivision), one style and one pair of regions. The quad covers every
- * entry's window segment widened by the reach of the style's line; each
- * segment's own set-up goes to the fragment stage, which takes the
- * strongest of the run's lines. A rasteriser then pays for one primitive
- * per run instead of one per segment, and the overlapping caps of a chain's
- * short segments are shaded once. The run is gl_VertexID / 6; its texel
- * (first entry's texel, entries) leads the table. An instanced draw repeats
- * every run for each instance. */
+ * up to RUN_SEGMENTS (1, 2, 4 or 8) consecutive entries of one chain (a
+ * cage edge cut by subdivision), one style and one pair of regions. The
+ * quad covers every entry's window segment widened by the reach of the
+ * style's line; each segment's own set-up goes to the fragment stage, which
+ * takes the strongest of the run's lines. A rasteriser then pays for one
+ * primitive per run instead of one per segment, and the overlapping caps of
+ * a chain's short segments are shaded once. The run is gl_VertexID / 6;
+ * its texel (first entry's texel, entries) leads the table. An instanced
+ * draw repeats every run for each instance. */
 
 /* Outside the clip volume: the rasteriser drops the triangle. */
 const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
@@ -116,16 +116,20 @@ void main()
    * last's: a chain's box is then as narrow as its bend (the first
    * segment's direction, where the chord is not in front of the camera or
    * is too short to say). */
-  vec4 last = fetch_texel(region_lines, first + 2 * (count - 1));
-  vec4 from = vertex_clip(head.x) + vertex_clip(head.y), to = vertex_clip(last.x) + vertex_clip(last.y);
-  if (count > 1 && from.w > 0.0 && to.w > 0.0) {
-    vec2 chord = window_point(to) - window_point(from);
-    if (dot(chord, chord) > 1.0) {
-      box.along = normalize(chord);
-      box.across = vec2(-box.along.y, box.along.x);
-      box.oriented = true;
+#if RUN_SEGMENTS > 1
+  if (count > 1) {
+    vec4 last = fetch_texel(region_lines, first + 2 * (count - 1));
+    vec4 from = vertex_clip(head.x) + vertex_clip(head.y), to = vertex_clip(last.x) + vertex_clip(last.y);
+    if (from.w > 0.0 && to.w > 0.0) {
+      vec2 chord = window_point(to) - window_point(from);
+      if (dot(chord, chord) > 1.0) {
+        box.along = normalize(chord);
+        box.across = vec2(-box.along.y, box.along.x);
+        box.oriented = true;
+      }
     }
   }
+#endif
   /* RUN_SEGMENTS (1, 2, 4 or 8): the most a run of this mesh holds. */
   run_segment(first, count > 0, half_width, box, run_line0, run_ends0.x);
 #if RUN_SEGMENTS > 1

@@ -107,6 +107,58 @@ def test_an_edge_of_several_classes_gets_a_segment_per_class():
     assert sorted(styles[:, 2].tolist()).count(0) == 3
 
 
+def _runs(arrays):
+    """[(first entry, entries)] of the region-lines table's runs."""
+    return [(int(first), int(count)) for first, count in arrays.region_line_runs[:, :2]]
+
+
+def test_consecutive_pieces_of_a_chain_share_a_quad():
+    """The region-lines pass draws runs of up to RUN_SEGMENTS consecutive
+    entries of one chain, style and pair of regions as one quad: a strip
+    whose long sides are two chains (as a cage edge's pieces, numbered one
+    after another) has runs of eight, four and single side edges."""
+    columns = 20
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(columns)
+    top = columns + 1
+    bottom = [index[(x, x + 1)] for x in range(columns)]
+    upper = [index[(top + x, top + x + 1)] for x in range(columns)]
+    # Number the edges as a subdivision does: each chain's pieces in a row.
+    order = bottom + upper + [e for e in range(len(verts)) if e not in set(bottom + upper)]
+    renumber = np.empty(len(verts), np.int64)
+    renumber[order] = np.arange(len(verts))
+    verts, corner_edge = verts[order], renumber[corner_edge]
+    chain = np.arange(len(verts)) + 2
+    chain[:columns], chain[columns : 2 * columns] = 0, 1
+    drawn = np.ones(len(verts), bool)
+    drawn[2 * columns :] = False  # the verticals: one region (but the two ends stay drawn)
+    drawn[[renumber[index[(0, top)]], renumber[index[(columns, top + columns)]]]] = True
+    edge_select.select_edges(
+        arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn, chain=chain)
+    )
+    lines = arrays.region_lines.reshape(-1, 2, 4)
+    assert len(lines) == 2 * columns + 2
+    runs = _runs(arrays)
+    assert arrays.region_run_segments == edge_select.RUN_SEGMENTS
+    assert sorted(count for _, count in runs) == [1, 1, 4, 4, 8, 8, 8, 8]
+    # The runs cover the table once, in order, each one chain, style and
+    # pair of regions.
+    assert [first for first, _ in runs] == list(np.cumsum([0] + [count for _, count in runs[:-1]]))
+    for first, count in runs:
+        run = lines[first : first + count]
+        assert (run[:, 1, :2] == run[0, 1, :2]).all()  # chain ends
+        assert (run[:, 0, 2:] == run[0, 0, 2:]).all() and (run[:, 1, 2] == run[0, 1, 2]).all()
+
+
+def test_edges_that_are_their_own_chains_are_one_quad_each():
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(6)
+    drawn = np.ones(len(verts), bool)
+    for x in range(1, 6):
+        drawn[index[(x, 7 + x)]] = False
+    edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    assert arrays.region_run_segments == 1
+    assert _runs(arrays) == [(k, 1) for k in range(len(arrays.region_lines) // 2)]
+
+
 def test_chain_ends_are_the_ends_of_the_path():
     verts = np.array([[0, 4], [4, 5], [5, 1], [1, 7]])
     ends = edge_select._chain_ends(verts, np.array([0, 0, 0, 1]))
