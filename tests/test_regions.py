@@ -57,6 +57,39 @@ def test_faces_smaller_than_a_pixel(output_dir):
     _assert_region_lines_drawn()
 
 
+@pytest.mark.parametrize("mode", ["PIXELS", "WORLD", "DEPTH"])
+def test_runs_of_cage_edge_pieces_in_every_thickness_mode(mode, output_dir):
+    """The region-lines pass draws up to eight consecutive pieces of a cage
+    edge as one quad (image model §2.6): the same image as a quad per piece,
+    with widths that vary along the run (scene-unit and depth thickness),
+    the density fade over the whole cage edge and a dashed class whose
+    dashes run along each piece."""
+    scene = scenes.empty_scene(
+        220,
+        160,
+        use_cage_edges=True,
+        thickness=1.5,
+        thickness_mode=mode,
+        thickness_far=0.5,
+        thickness_depth_start=4.0,
+        thickness_depth_end=8.0,
+        world_thickness=0.04,
+        use_density_fade=True,
+        density_fade_length=30.0,
+        use_sharp_edges=True,
+        sharp_thickness=2.5,
+    )
+    scene.solidwire.sharp_pattern = "DASHED"
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    for edge in cube.data.edges[:4]:
+        edge.use_edge_sharp = True
+    _subdivided(cube, 4)
+    scenes.add_camera(scene, location=(2.6, -3.6, 2.0), target=(0, 0, 0))
+    report = accuracy.measure(scene, f"regions_runs_{mode.lower()}", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+
+
 @pytest.mark.parametrize("level, diagonals", [(2, "SOLID"), (4, "HIDDEN")])
 def test_an_ngon_cage_keeps_its_whole_outline(level, diagonals, output_dir):
     """A cylinder's 16-gon caps under subdivision: each cap is one region of
