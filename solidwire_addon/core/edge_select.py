@@ -318,19 +318,22 @@ def select_edges(
 
     tri_owner = owner[arrays.triangle_polygons]
     listed = tri_owner >= 0
+    listed_count = int(listed.sum())
+    # Every triangle, as with cage edges: plain slices, no mask to apply.
+    rows = slice(None) if listed_count == len(listed) else listed
     # Each listed triangle's block: a lookup by owner (owners lie in
     # [0, 2 F)), far cheaper than a search per triangle.
     block_of_owner = np.zeros(2 * face_count, np.int64)
     block_of_owner[owners] = np.arange(len(owners))
-    at = block_of_owner[tri_owner[listed]]
+    at = block_of_owner[tri_owner[rows]]
     flags = arrays.edge_flags
-    keep = ~(HAS_QUAD_CORNER | IS_NGON | REGION_LINES | (-1 << NGON_SHIFT))
-    flags[listed] = (flags[listed] & keep) | IN_REGION | (count[at].astype(np.int32) << NGON_SHIFT)
-    flags[listed] |= REGION_LINES  # every listed face's lines can come from the region-lines pass
-    flags[listed] &= ~(EDGE3_HIDDEN | EDGE4_HIDDEN)
-    arrays.triangles[listed, 3] = base + TEXELS_PER_SEGMENT * first[at]
+    # Every listed face's lines can come from the region-lines pass
+    # (REGION_LINES); its quad edges are in its block instead.
+    keep = ~(HAS_QUAD_CORNER | IS_NGON | REGION_LINES | EDGE3_HIDDEN | EDGE4_HIDDEN | (-1 << NGON_SHIFT))
+    flags[rows] = (flags[rows] & keep) | IN_REGION | REGION_LINES | (count[at].astype(np.int32) << NGON_SHIFT)
+    arrays.triangles[rows, 3] = base + TEXELS_PER_SEGMENT * first[at]
     stats.regions = int((walked_region & (np.arange(face_count) == label)).sum())
-    stats.listed_triangles = int(listed.sum())
+    stats.listed_triangles = listed_count
     stats.segments = len(seg_a)
     _region_lines(arrays, verts, classes, ends, label, walked | styled_face, pairs, stats)
     return stats
