@@ -229,8 +229,19 @@ void main()
   ngon_corner_start = int(ids.w);
   vec2 w0, w1, w2;
   bool in_front, convex;
+#  ifdef NO_EDGE_SETUP
+  /* Every triangle of this draw takes its lines from the region-lines pass
+   * and draws no diagonal (ShaderVariant.no_edge_setup): no edge of its
+   * own is measured, so none is set up. */
+  edge_line0 = edge_line1 = edge_line2 = edge_line3 = edge_line4 = vec3(0.0, 0.0, NO_EDGE);
+  edge_span0 = edge_span1 = edge_span2 = edge_span3 = edge_span4 = vec2(0.0);
+  w0 = w1 = w2 = vec2(0.0);
+  in_front = false;
+  convex = false;
+#  else
   triangle_edges(c0, c1, c2, c3, ids, is_quad, edge_line0, edge_span0, edge_line1, edge_span1, edge_line2,
                  edge_span2, edge_line3, edge_span3, edge_line4, edge_span4, w0, w1, w2, in_front, convex);
+#  endif
   /* Window corners relative to the viewport centre (region segments). */
   vec2 t0 = w0 - viewport_centre(), t1 = w1 - viewport_centre(), t2 = w2 - viewport_centre();
   if (in_front) {

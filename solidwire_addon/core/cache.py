@@ -133,6 +133,12 @@ class GPUMesh:
         self._region_lines_cpu = arrays.region_lines
         self._region_line_runs_cpu = arrays.region_line_runs
         self.region_run_segments = arrays.region_run_segments
+        # Every triangle takes its lines from the region-lines pass and
+        # there is no n-gon (a cage look): a resolve that reads the pass's
+        # image sets up no triangle edge (ShaderVariant.no_edge_setup).
+        self.lines_only_from_region_pass = (
+            arrays.region_lines is not None and len(arrays.ngon_corners) == 0 and bool(np.all(flags & REGION_LINES))
+        )
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
         # The set-up pre-pass's output for big meshes (draw._run_setup), made

@@ -429,13 +429,14 @@ def draw(
             )
             in_front = wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max)
             runs = getattr(mesh, "region_run_segments", 1)  # the region-lines pass's segments per quad
-            parts.setdefault((ngons, lines_only, colored, table, in_front, runs), []).append(g)
+            image_only = getattr(mesh, "lines_only_from_region_pass", False)
+            parts.setdefault((ngons, lines_only, colored, table, in_front, runs, image_only), []).append(g)
         # The visibility and region-lines passes read neither n-gon
         # outlines nor the set-up table; a draw that reads the region lines
         # needs no block code for a mesh whose blocks only hold them.
         plain_stage = variant.visibility or variant.region_lines_pass
         for key in sorted(parts):
-            ngons, lines_only, colored, table, in_front, runs = key
+            ngons, lines_only, colored, table, in_front, runs, image_only = key
             lines_elsewhere = lines_only and variant.region_lines
             walks = ngons and not plain_stage and not lines_elsewhere
             part_variant = replace(
@@ -446,6 +447,13 @@ def draw(
                 attribute_colors=variant.attribute_colors and colored and not plain_stage,
                 run_segments=runs if variant.region_lines_pass else 1,
             )
+            if (
+                image_only
+                and variant.resolve
+                and variant.region_lines
+                and variant.diagonals == shaders.DIAGONALS_HIDDEN
+            ):
+                part_variant = replace(part_variant, no_edge_setup=not (part_variant.ngons or part_variant.setup_table))
             if lines_elsewhere and variant.edge_classes:
                 part_variant = replace(part_variant, edge_classes=False, style_colors=True)
             _draw_groups(

@@ -126,6 +126,10 @@ class ShaderVariant:
     # Region-lines pass only: segments per quad (1, 2, 4 or 8; the mesh's
     # cache.GPUMesh.region_run_segments).
     run_segments: int = 1
+    # Resolve only: every triangle of the draw takes its lines from the
+    # region-lines image and no diagonal is drawn (a cage look), so no
+    # triangle edge is set up per pixel (NO_EDGE_SETUP).
+    no_edge_setup: bool = False
     # A surface pass that measures no line of a class itself (every class
     # line comes from the region-lines pass) but colours the winning style:
     # the class colours without the per-style distance code (STYLE_COLORS).
@@ -360,6 +364,10 @@ def _create_info(variant: ShaderVariant):
     if variant.region_lines:
         add_sampler(info, "region_line_image")
         info.define("REGION_LINE_IMAGE", "1")
+    if variant.no_edge_setup:
+        if not (variant.resolve and variant.region_lines) or variant.ngons or variant.setup_table:
+            raise ValueError("only a resolve whose lines all come from the region-lines image skips the edge set-up")
+        info.define("NO_EDGE_SETUP", "1")
     output_and_feature_defines(info, variant)
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     if variant.in_front:
