@@ -30,22 +30,87 @@ from .view import (
     window_rect,
 )
 
+# Which lines a draw shows (DrawTarget.lines): the visible wire with the
+# fill, none (the fill and depth only: the surface under hidden lines), or
+# the hidden-line layer (image model §5.4: real edges behind the surface,
+# dimmed and dashed, no fill).
+WIRE_LINES, NO_LINES, HIDDEN_LINES = "wire", "none", "hidden"
 
-def shader_variant(
-    settings, write_view_depth: bool = False, depth_bias: float = 0.0, linear_depth: bool = False
-) -> shaders.ShaderVariant:
-    """The compiled-code features ``settings`` ask for."""
+# The two stages of the deferred surface (docs/image_model.md §2.5; see
+# passes.SurfacePass): VISIBILITY records which triangle of which draw
+# each pixel shows, RESOLVE runs the exact fragment stage once per pixel of
+# that record. ``stage=None`` draws directly (one pass, every fragment).
+VISIBILITY, RESOLVE = "visibility", "resolve"
+# Between the two: the lines of multi-face regions drawn over the
+# visibility record (passes._draw_region_lines, docs/image_model.md §2.6).
+LINES = "lines"
+
+
+@dataclass(frozen=True, eq=False)
+class DrawTarget:
+    """Where one draw lands and how: the one description of a draw's
+    target, from which its shader variant follows (:func:`shader_variant`).
+
+    Depth: the test and whether the draw writes depth, an NDC bias towards
+    the camera (the viewport overlay, passes.OVERLAY_DEPTH_BIAS) and whether
+    the depth written is view depth / clip end (the render's own targets,
+    LINEAR_DEPTH in solidwire_frag.glsl). ``clip_planes`` ((6, 4)
+    world-space planes of a viewport's clipping region): fragments outside
+    them are discarded. ``display`` (a display_transform.DisplayLUT,
+    viewport overlay only): the colour leaves through the scene's colour
+    management (image model §9). ``stage``: None draws directly, VISIBILITY
+    or RESOLVE one half of the deferred surface (RESOLVE reads the record
+    in ``visibility``), LINES the lines of multi-face regions over that
+    record into the bound region-lines target; ``region_lines`` is that
+    target's image, which a surface draw then reads. Outputs: the view
+    depth in a second colour target, the render passes' targets (``aovs``),
+    and which ``lines`` the colour shows (WIRE_LINES, NO_LINES,
+    HIDDEN_LINES). ``triangle_ids_by_vertex``: how the VISIBILITY stage
+    numbers triangles (options.DrawOptions)."""
+
+    depth_test: str = "LESS_EQUAL"
+    depth_write: bool = True
+    depth_bias: float = 0.0
+    linear_depth: bool = False
+    clip_planes: object = None
+    display: object = None
+    stage: str | None = None
+    visibility: object = None
+    region_lines: object = None
+    view_depth: bool = False
+    aovs: bool = False
+    lines: str = WIRE_LINES
+    triangle_ids_by_vertex: bool = False
+
+    def hidden(self) -> DrawTarget:
+        """The hidden-line layer over this target (image model §5.4): every
+        face behind the depth already in the framebuffer draws its real
+        edges dimmed and dashed, blended "over" (the caller sets the blend
+        mode). Strictly GREATER, so the visible surface itself never
+        passes: the same shader wrote that depth, so there is no z-fight.
+        With one wire colour "over" is commutative (alpha = 1 - prod(1 -
+        a_k)), so draw order does not matter. No region-lines image: the
+        layer walks every region itself."""
+        return replace(
+            self, depth_test="GREATER", depth_write=False, lines=HIDDEN_LINES, region_lines=None, view_depth=False
+        )
+
+
+def shader_variant(settings, target: DrawTarget | None = None) -> shaders.ShaderVariant:
+    """The compiled-code features of a draw of ``settings`` into ``target``
+    (per-mesh parts and missing resources refine it in :func:`draw`)."""
+    target = target or DrawTarget()
     diagonals = {
         "HIDDEN": shaders.DIAGONALS_HIDDEN,
         "SOLID": shaders.DIAGONALS_SOLID,
     }.get(settings.diagonal_mode, shaders.DIAGONALS_PATTERN)
-    return shaders.ShaderVariant(
+    variant = shaders.ShaderVariant(
         diagonals=diagonals,
         use_fill=bool(settings.use_fill),
         use_fade=bool(settings.use_fade),
-        write_view_depth=write_view_depth,
-        depth_bias=depth_bias,
-        linear_depth=linear_depth,
+        write_view_depth=target.view_depth,
+        depth_bias=target.depth_bias,
+        linear_depth=target.linear_depth,
         thickness_mode={"WORLD": shaders.THICKNESS_WORLD, "DEPTH": shaders.THICKNESS_DEPTH}.get(
             settings.thickness_mode, shaders.THICKNESS_PIXELS
         ),
@@ -56,6 +121,37 @@ def shader_variant(
         edge_classes=bool(edge_classes_of(settings)),
         density_fade=bool(settings.use_density_fade),
     )
+    if target.lines == HIDDEN_LINES:
+        variant = replace(
+            variant,
+            hidden_pass=True,
+            write_view_depth=False,
+            shading=shaders.SHADING_FLAT,
+            material_colors=False,
+            attribute_colors=False,
+        )
+    if target.aovs:
+        variant = replace(variant, write_aovs=True)
+    if target.stage == RESOLVE:
+        variant = replace(variant, resolve=True, linear_depth=False)
+    elif target.stage == VISIBILITY:
+        variant = shaders.ShaderVariant(
+            visibility=True, linear_depth=target.linear_depth, triangle_ids_by_vertex=target.triangle_ids_by_vertex
+        )
+    elif target.stage == LINES:
+        variant = shaders.ShaderVariant(
+            region_lines_pass=True,
+            thickness_mode=variant.thickness_mode,
+            edge_classes=variant.edge_classes,
+            density_fade=variant.density_fade,
+        )
+    if target.clip_planes is not None:
+        variant = replace(variant, clip_planes=True)
+    if target.region_lines is not None:
+        variant = replace(variant, region_lines=True)
+    if target.display is not None:
+        variant = replace(variant, display_transform=True)
+    return variant
 
 
 def edge_classes_of(settings) -> tuple:
@@ -109,14 +205,6 @@ INSTANCING_MIN = 16
 # corner of the vertex stage; below it the dispatch costs more than it saves.
 SETUP_TABLE_MIN = 50_000
 
-# The two stages of the deferred surface (docs/image_model.md §2.5; see
-# passes.draw_surface): VISIBILITY records which triangle of which draw
-# each pixel shows, RESOLVE runs the exact fragment stage once per pixel of
-# that record. ``stage=None`` draws directly (one pass, every fragment).
-VISIBILITY, RESOLVE = "visibility", "resolve"
-# Between the two: the lines of multi-face regions drawn over the
-# visibility record (passes._draw_region_lines, docs/image_model.md §2.6).
-LINES = "lines"
 # Triangle numbers, instances and draw numbers travel as float32 whole
 # numbers in the visibility record: exact below 2^24.
 DEFERRED_MAX = 1 << 24
@@ -274,86 +362,35 @@ def _instance_rows(object_to_view, object_to_clip, info) -> np.ndarray:
     return rows.reshape(-1, 4)
 
 
-def draw(
-    items,
-    view: View,
-    settings,
-    *,
-    write_view_depth: bool = False,
-    cull: bool = True,
-    depth_bias: float = 0.0,
-    depth_test: str = "LESS_EQUAL",
-    depth_write: bool = True,
-    hidden_pass: bool = False,
-    show_wire: bool = True,
-    write_aovs: bool = False,
-    linear_depth: bool = False,
-    clip_planes=None,
-    display=None,
-    program=EXACT,
-    stage=None,
-    visibility=None,
-    region_lines=None,
-) -> DrawStats:
-    """Draw ``items`` into the bound framebuffer with depth test and write.
+def draw(items, view: View, settings, *, target: DrawTarget | None = None, cull: bool = True, program=EXACT) -> DrawStats:
+    """Draw ``items`` into the bound framebuffer as ``target`` describes
+    (by default: depth test LESS_EQUAL and write, the visible wire).
 
     Every fragment of a face writes depth (nothing is discarded), so a wire is
     only ever seen on the face that is the visible surface there. Items with
     a style override draw with their own parameter block (one per distinct
-    style); the variant does not depend on the style. ``clip_planes``
-    ((6, 4) world-space planes of a viewport's clipping region): fragments
-    outside them are discarded. ``display`` (a display_transform.DisplayLUT,
-    viewport overlay only): the colour leaves through the scene's colour
-    management (image model §9). ``stage`` VISIBILITY or RESOLVE (with
-    ``visibility``, the texture the first wrote): one half of the deferred
-    surface, see passes.draw_surface; both halves must be called with the
-    same items, view and settings so that they number the draws alike.
-    ``stage`` LINES (between the two, with ``visibility``) draws the lines
-    of multi-face regions into the bound region-lines target; a RESOLVE
-    given that target (``region_lines``) reads them from it."""
+    style); the variant does not depend on the style. The two halves of
+    the deferred surface (target stages VISIBILITY and RESOLVE, and LINES
+    between them) must be called with the same items, view and settings so
+    that they number the draws alike. ``program`` draws another method
+    through this same pass (the benchmark's, scripts/bench/methods.py)."""
+    target = target or DrawTarget()
     stats = DrawStats()
     if not items:
         return stats
+    show_wire = target.lines != NO_LINES
     settings = styled(settings, None, show_wire)
-    variant = shader_variant(settings, write_view_depth, depth_bias, linear_depth)
-    if hidden_pass:
-        variant = replace(
-            variant,
-            hidden_pass=True,
-            write_view_depth=False,
-            shading=shaders.SHADING_FLAT,
-            material_colors=False,
-            attribute_colors=False,
-        )
-    if write_aovs:
-        variant = replace(variant, write_aovs=True)
-    if stage == RESOLVE:
-        variant = replace(variant, resolve=True, linear_depth=False)
-    elif stage == VISIBILITY:
-        variant = shaders.ShaderVariant(
-            visibility=True, linear_depth=linear_depth, triangle_ids_by_vertex=shaders.triangle_ids_by_vertex()
-        )
-    elif stage == LINES:
-        variant = shaders.ShaderVariant(
-            region_lines_pass=True,
-            thickness_mode=variant.thickness_mode,
-            edge_classes=variant.edge_classes,
-            density_fade=variant.density_fade,
-        )
-    clip_rows = None
-    if clip_planes is not None:
-        variant = replace(variant, clip_planes=True)
-        clip_rows = clip_space_planes(clip_planes, view)
+    variant = shader_variant(settings, target)
+    stage = target.stage
     extras = {}
-    if region_lines is not None:
-        variant = replace(variant, region_lines=True)
-        extras["region_line_image"] = region_lines
-    if display is not None:
-        variant = replace(variant, display_transform=True)
-        extras["display"] = display
-    if visibility is not None:
-        extras["visibility"] = visibility
-    if clip_rows is not None:
+    if target.region_lines is not None:
+        extras["region_line_image"] = target.region_lines
+    if target.display is not None:
+        extras["display"] = target.display
+    if target.visibility is not None:
+        extras["visibility"] = target.visibility
+    if target.clip_planes is not None:
+        clip_rows = clip_space_planes(target.clip_planes, view)
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
     if variant.shading == shaders.SHADING_MATCAP:
         extras["matcap_image"] = matcaps.texture(settings.matcap)
@@ -389,12 +426,12 @@ def draw(
             )
         return block
 
-    gpu.state.depth_test_set("NONE" if stage == RESOLVE else depth_test)
-    gpu.state.depth_mask_set(depth_write and stage != RESOLVE)
+    gpu.state.depth_test_set("NONE" if stage == RESOLVE else target.depth_test)
+    gpu.state.depth_mask_set(target.depth_write and stage != RESOLVE)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
-    groups = list(_groups(items, view, cull, stats, pass_indices=write_aovs))
+    groups = list(_groups(items, view, cull, stats, pass_indices=target.aovs))
     try:
         # Meshes with n-gons need the fragment stage's outline walk; the rest
         # use a variant without it (llvmpipe pays for a loop even when it runs
@@ -409,7 +446,7 @@ def draw(
         setup_ok = getattr(program, "supports_setup_table", False) and _setup_ready()
         # Both deferred stages must split and number the draws alike:
         # instancing does not depend on the stage's variant.
-        instancing = program.supports_instancing and not write_aovs
+        instancing = program.supports_instancing and not target.aovs
         numbering = _DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view)
         draws_of = {}
         for g in groups:
@@ -874,14 +911,3 @@ def _draw_instanced(groups: list[InstancedDraw], variant, ubo, settings, stats: 
         stats.objects_drawn += count
         stats.triangles_drawn += count * mesh.triangle_count
         stats.extra["instanced_draws"] = stats.extra.get("instanced_draws", 0) + 1
-
-
-def draw_hidden_lines(items, view: View, settings, **kwargs) -> DrawStats:
-    """The hidden-line pass (image model §5.4): every face behind the depth
-    already in the bound framebuffer draws its real edges dimmed and dashed,
-    blended with premultiplied "over" (the caller sets the blend mode).
-    Strictly GREATER, so the visible surface itself never passes: the same
-    shader wrote that depth, so there is no z-fight. With one wire colour
-    "over" is commutative (alpha = 1 - prod(1 - a_k)), so draw order does
-    not matter."""
-    return draw(items, view, settings, depth_test="GREATER", depth_write=False, hidden_pass=True, **kwargs)
