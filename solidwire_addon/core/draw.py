@@ -392,17 +392,7 @@ def draw(items, view: View, settings, *, target: DrawTarget | None = None, cull:
     if target.clip_planes is not None:
         clip_rows = clip_space_planes(target.clip_planes, view)
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
-    if variant.shading == shaders.SHADING_MATCAP:
-        extras["matcap_image"] = matcaps.texture(settings.matcap)
-        if extras["matcap_image"] is None:
-            variant = replace(variant, shading=shaders.SHADING_FLAT)
-    if (variant.shading != shaders.SHADING_FLAT or variant.material_colors) and any(
-        item.mesh.corners is None for item in items
-    ):
-        # Meshes gathered without their corner table (a caller that did not
-        # ask for it): draw flat rather than read a missing table.
-        warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
-        variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
+    variant = _available(variant, settings, items, extras)
     # Two per-object mechanisms side by side:
     # an object's style override (wire colour, thickness, fill colour) is a
     # parameter block per distinct style (``ubo(style)``), since thickness
@@ -433,72 +423,123 @@ def draw(items, view: View, settings, *, target: DrawTarget | None = None, cull:
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
     groups = list(_groups(items, view, cull, stats, pass_indices=target.aovs))
     try:
-        # Meshes with n-gons need the fragment stage's outline walk; the rest
-        # use a variant without it (llvmpipe pays for a loop even when it runs
-        # zero times), so tri/quad meshes never pay for n-gons.
-        # Big tri/quad meshes take their edge set-up from the pre-pass.
-        # Only a mesh drawn once in this pass: its table is then written
-        # before its one draw and never rewritten while a draw may still read
-        # it (objects sharing a mesh keep the per-corner set-up). The
-        # deferred resolve sets a triangle up once per pixel it shows, so
-        # there the pre-pass pays only where the draw's pixels outnumber its
-        # triangles (_setup_size).
-        setup_ok = getattr(program, "supports_setup_table", False) and _setup_ready()
-        # Both deferred stages must split and number the draws alike:
-        # instancing does not depend on the stage's variant.
-        instancing = program.supports_instancing and not target.aovs
-        numbering = _DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view)
-        draws_of = {}
-        for g in groups:
-            draws_of[id(g.mesh)] = draws_of.get(id(g.mesh), 0) + len(g.world)
+        call = _DrawCall(
+            ubo=ubo,
+            settings=settings,
+            program=program,
+            flip=flip,
+            stats=stats,
+            extras=extras,
+            bases=bases,
+            # Both deferred stages must split and number the draws alike:
+            # instancing does not depend on the stage's variant.
+            instancing=program.supports_instancing and not target.aovs,
+            numbering=_DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view),
+        )
+        parts = _parts(groups, program, stage, view)
         # One variant per part; parts in a fixed order (both deferred stages
-        # must draw, and so number, alike; the visibility stage itself reads
-        # no table and sets nothing up).
-        parts: dict = {}
-        for g in groups:
-            mesh = g.mesh
-            ngons = program.supports_ngons and mesh.has_ngons
-            # (Part of the key, so that every stage parts the draws alike.)
-            lines_only = ngons and getattr(mesh, "blocks_only_for_region_lines", False)
-            colored = getattr(mesh, "attribute_colors", None) is not None
-            table = (
-                setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g.object_to_clip, view)
-            )
-            in_front = wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max)
-            parts.setdefault((ngons, lines_only, colored, table, in_front), []).append(g)
-        # The visibility and region-lines passes read neither n-gon
-        # outlines nor the set-up table; a draw that reads the region lines
-        # needs no block code for a mesh whose blocks only hold them.
-        plain_stage = variant.visibility or variant.region_lines_pass
-        for key in sorted(parts):
-            ngons, lines_only, colored, table, in_front = key
-            lines_elsewhere = lines_only and variant.region_lines
-            walks = ngons and not plain_stage and not lines_elsewhere
-            part_variant = replace(
-                variant,
-                ngons=walks,
-                setup_table=table and not plain_stage,
-                in_front=in_front and not variant.visibility,
-                attribute_colors=variant.attribute_colors and colored and not plain_stage,
-            )
-            if lines_elsewhere and variant.edge_classes:
-                part_variant = replace(part_variant, edge_classes=False, style_colors=True)
-            _draw_groups(
-                parts[key],
-                part_variant,
-                ubo,
-                settings,
-                program,
-                flip,
-                stats,
-                extras,
-                bases,
-                instancing=instancing,
-                numbering=numbering,
-            )
+        # must draw, and so number, alike).
+        for part in sorted(parts):
+            _draw_groups(parts[part], part.variant(variant), call)
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
+
+
+def _available(variant, settings, items, extras: dict):
+    """``variant`` without what this frame cannot draw: a matcap that did
+    not load, corner tables the items were gathered without."""
+    if variant.shading == shaders.SHADING_MATCAP:
+        extras["matcap_image"] = matcaps.texture(settings.matcap)
+        if extras["matcap_image"] is None:
+            variant = replace(variant, shading=shaders.SHADING_FLAT)
+    if (variant.shading != shaders.SHADING_FLAT or variant.material_colors) and any(
+        item.mesh.corners is None for item in items
+    ):
+        # Meshes gathered without their corner table (a caller that did not
+        # ask for it): draw flat rather than read a missing table.
+        warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
+        variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
+    return variant
+
+
+@dataclass(frozen=True, order=True)
+class _Part:
+    """The draw groups of one draw that share the per-mesh features of
+    their variant. Part of every stage's key alike, so that both deferred
+    stages part (and number) the draws alike."""
+
+    ngons: bool  # the mesh has n-gons or regions: the fragment stage walks blocks
+    lines_only: bool  # ... whose blocks hold only region lines
+    colored: bool  # the mesh has a colour attribute
+    setup_table: bool  # the edge set-up comes from the pre-pass
+    in_front: bool  # every triangle lies in front of the near plane
+
+    def variant(self, variant):
+        """``variant`` for this part. The visibility and region-lines passes
+        read neither n-gon outlines nor the set-up table; a draw that reads
+        the region lines needs no block code for a mesh whose blocks only
+        hold them."""
+        plain_stage = variant.visibility or variant.region_lines_pass
+        lines_elsewhere = self.lines_only and variant.region_lines
+        part_variant = replace(
+            variant,
+            ngons=self.ngons and not plain_stage and not lines_elsewhere,
+            setup_table=self.setup_table and not plain_stage,
+            in_front=self.in_front and not variant.visibility,
+            attribute_colors=variant.attribute_colors and self.colored and not plain_stage,
+        )
+        if lines_elsewhere and variant.edge_classes:
+            part_variant = replace(part_variant, edge_classes=False, style_colors=True)
+        return part_variant
+
+
+def _parts(groups, program, stage, view: View) -> dict:
+    """DrawGroups by _Part.
+
+    Meshes with n-gons need the fragment stage's outline walk; the rest use
+    a variant without it (llvmpipe pays for a loop even when it runs zero
+    times), so tri/quad meshes never pay for n-gons. Big tri/quad meshes
+    take their edge set-up from the pre-pass: only a mesh drawn once in
+    this pass, whose table is then written before its one draw and never
+    rewritten while a draw may still read it (objects sharing a mesh keep
+    the per-corner set-up); see _setup_size for the deferred stages."""
+    setup_ok = getattr(program, "supports_setup_table", False) and _setup_ready()
+    draws_of: dict = {}
+    for g in groups:
+        draws_of[id(g.mesh)] = draws_of.get(id(g.mesh), 0) + len(g.world)
+    parts: dict = {}
+    for g in groups:
+        mesh = g.mesh
+        ngons = program.supports_ngons and mesh.has_ngons
+        table = setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g.object_to_clip, view)
+        part = _Part(
+            ngons=ngons,
+            lines_only=ngons and getattr(mesh, "blocks_only_for_region_lines", False),
+            colored=getattr(mesh, "attribute_colors", None) is not None,
+            setup_table=table,
+            in_front=wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max),
+        )
+        parts.setdefault(part, []).append(g)
+    return parts
+
+
+@dataclass
+class _DrawCall:
+    """What every part of one draw() shares: ``ubo(style)`` the parameter
+    block of a style, the winding flip, the frame's extras (textures and
+    blocks bound once) and colour-table bases, whether many instances of a
+    mesh draw instanced, and the deferred stages' draw numbering."""
+
+    ubo: object
+    settings: object
+    program: object
+    flip: bool
+    stats: DrawStats
+    extras: dict
+    bases: np.ndarray
+    instancing: bool
+    numbering: _DrawNumbers
 
 
 def clip_space_planes(planes, view: View) -> list:
@@ -664,26 +705,11 @@ def release_rectangle() -> None:
     _quad_batches.clear()
 
 
-def _draw_groups(
-    groups,
-    variant,
-    ubo,
-    settings,
-    program,
-    flip: bool,
-    stats: DrawStats,
-    extras=None,
-    bases=None,
-    *,
-    instancing: bool = True,
-    numbering=None,
-) -> None:
+def _draw_groups(groups, variant, call: _DrawCall) -> None:
     """Draw DrawGroups with one shader variant: per object (SingleDraw), or
-    instanced for meshes with many instances (InstancedDraw). ``ubo(style)`` is the
-    parameter block of a style; ``numbering`` makes the draw calls
-    (_DrawNumbers)."""
-    extras = extras or {}
-    numbering = numbering or _DrawNumbers(None, extras)
+    instanced for meshes with many instances (InstancedDraw)."""
+    ubo, settings, program, stats = call.ubo, call.settings, call.program, call.stats
+    extras, bases, numbering = call.extras, call.bases, call.numbering
     resolving = numbering.draws_over_record
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
@@ -698,14 +724,14 @@ def _draw_groups(
     instanced: list[InstancedDraw] = []
     single: list[SingleDraw] = []
     for group in groups:
-        mirrored_all = (np.linalg.det(group.world[:, :3, :3]) < 0.0) != flip
+        mirrored_all = (np.linalg.det(group.world[:, :3, :3]) < 0.0) != call.flip
         info_all = np.zeros((len(group.world), 4))
         if bases is not None and len(bases):
             info_all[:, 0] = bases[group.indices]
         info_all[:, 1] = mirrored_all
         # (The instanced variant has no per-object pass values: with passes
         # every object is drawn on its own.)
-        if instancing and len(group.world) >= INSTANCING_MIN:
+        if call.instancing and len(group.world) >= INSTANCING_MIN:
             sides = (
                 (False, True)
                 if settings.use_backface_culling and 0 < mirrored_all.sum() < len(mirrored_all)
@@ -778,7 +804,7 @@ def _draw_groups(
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
-        _draw_instanced(instanced, variant, ubo, settings, stats, extras, numbering)
+        _draw_instanced(instanced, variant, call)
 
 
 _UNBOUND = object()
@@ -884,16 +910,17 @@ def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_ind
     return block
 
 
-def _draw_instanced(groups: list[InstancedDraw], variant, ubo, settings, stats: DrawStats, extras, numbering) -> None:
+def _draw_instanced(groups: list[InstancedDraw], variant, call: _DrawCall) -> None:
     """One draw_instanced call per (mesh, style, facing) group; every
     instance's matrices in one float texture for the whole frame."""
+    ubo, settings, stats, extras, numbering = call.ubo, call.settings, call.stats, call.extras, call.numbering
     shader = shaders.get(replace(variant, instanced=True, setup_table=False))
     table = table_texture(np.concatenate([_instance_rows(g.object_to_view, g.object_to_clip, g.info) for g in groups]))
     shader.bind()
     bound = None
     shader.uniform_block("params", ubo(bound))
     shader.uniform_sampler("instance_table", table)
-    _bind_extras(shader, variant, extras or {})
+    _bind_extras(shader, variant, extras)
     numbering.bind(shader)
     base = 0
     for group in groups:
