@@ -174,17 +174,13 @@ def gl_context(name: str):
         _context = previous
 
 
-_exit_hook_installed = False
-
-
 def _keep(cache: dict, key, shader):
     """Store a compiled program; the first one installs the exit hook that
-    frees them all while Blender's GPU context still exists."""
-    global _exit_hook_installed
-    cache[key] = shader
-    if not _exit_hook_installed:
+    frees them all while Blender's GPU context still exists (the cache is
+    emptied only by that hook)."""
+    if not cache:
         atexit.register(release_at_exit)
-        _exit_hook_installed = True
+    cache[key] = shader
     return shader
 
 
