@@ -350,12 +350,7 @@ class MeshCache:
             self._tokens[key] = (fast, content)
             self.reused += 1
             return entry, False
-        if (
-            entry is not None
-            and tokens is not None
-            and reposition is not None
-            and tokens[1][0] == content[0]
-        ):
+        if entry is not None and tokens is not None and reposition is not None and tokens[1][0] == content[0]:
             moved = reposition(entry, context)
             if moved is not None:
                 start = time.perf_counter()

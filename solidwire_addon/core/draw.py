@@ -362,7 +362,9 @@ def _instance_rows(object_to_view, object_to_clip, info) -> np.ndarray:
     return rows.reshape(-1, 4)
 
 
-def draw(items, view: View, settings, *, target: DrawTarget | None = None, cull: bool = True, program=EXACT) -> DrawStats:
+def draw(
+    items, view: View, settings, *, target: DrawTarget | None = None, cull: bool = True, program=EXACT
+) -> DrawStats:
     """Draw ``items`` into the bound framebuffer as ``target`` describes
     (by default: depth test LESS_EQUAL and write, the visible wire).
 
