@@ -257,10 +257,7 @@ class StrandsPass(RenderPass):
         )
 
     def over_viewport(self, frame: Frame) -> None:
-        base = frame.base
-        strands_mod.draw_over_viewport(
-            frame.strands, frame.view, self.settings, base.depth_bias, base.display, base.clip_planes
-        )
+        strands_mod.draw_over_viewport(frame.strands, frame.view, self.settings, frame.base)
 
 
 def plan(settings, *, strands: bool = False) -> tuple[RenderPass, ...]:
