@@ -2,12 +2,15 @@
 function-level imports alike), nothing in ``core`` that faces Blender's UI or
 context, no private names used across modules, a shader parameter block
 that is exactly the schema's, one module map in the manual that lists every
-module, one formatter for errors as one line, and one table of render passes.
+module, one formatter for errors as one line, one table of render passes,
+one description of a draw's target from which its shader variant follows,
+passes as units, and no switch kept in a core module.
 """
 
 from __future__ import annotations
 
 import ast
+import dataclasses
 import re
 from pathlib import Path
 
@@ -331,3 +334,168 @@ def test_sampler_slots_are_one_table():
     ]
     assert set(declared) == set(shaders.SAMPLERS), set(declared) ^ set(shaders.SAMPLERS)
     assert all(0 <= slot < 16 for slot, _kind in shaders.SAMPLERS.values())
+
+
+# -- the draw hub -------------------------------------------------------------
+
+
+def _functions(tree: ast.Module) -> dict[str, ast.FunctionDef]:
+    return {node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)}
+
+
+def _calls(node: ast.AST, name: str) -> list[ast.Call]:
+    """Calls of ``name`` or ``<module>.name`` inside ``node``."""
+    found = []
+    for call in ast.walk(node):
+        if isinstance(call, ast.Call):
+            func = call.func
+            if (isinstance(func, ast.Name) and func.id == name) or (
+                isinstance(func, ast.Attribute) and func.attr == name
+            ):
+                found.append(call)
+    return found
+
+
+def test_a_draws_variant_follows_from_its_target_description_alone():
+    """draw.DrawTarget is the one description of where and how a draw lands:
+    draw.shader_variant(settings, target) is the only place in draw.py that
+    makes a shader variant, draw() asks it once, and each field of the
+    description either selects compiled code (the variant changes with it)
+    or is GPU state / an input texture (the variant does not)."""
+    from dataclasses import fields, replace
+
+    import numpy as np
+
+    from solidwire_addon.core import draw
+
+    tree = ast.parse((PACKAGE / "core" / "draw.py").read_text(encoding="utf-8"))
+    functions = _functions(tree)
+    makers = [name for name, node in functions.items() if _calls(node, "ShaderVariant")]
+    assert makers == ["shader_variant"], f"shader variants made outside draw.shader_variant: {makers}"
+    assert len(_calls(functions["draw"], "shader_variant")) == 1
+    # draw() takes the description and a few other arguments, not one
+    # keyword per target feature.
+    arguments = functions["draw"].args
+    assert [a.arg for a in arguments.args + arguments.kwonlyargs] == [
+        "items",
+        "view",
+        "settings",
+        "target",
+        "cull",
+        "program",
+    ]
+
+    settings = DrawSettings()
+    plain = draw.shader_variant(settings, draw.DrawTarget())
+    assert draw.shader_variant(settings) == plain
+    # Field -> (a value that differs from the default, what the variant says then).
+    selects_code = {
+        "depth_bias": (2.0**-18, lambda v: v.depth_bias == 2.0**-18),
+        "linear_depth": (True, lambda v: v.linear_depth),
+        "clip_planes": (np.zeros((6, 4)), lambda v: v.clip_planes),
+        "display": (object(), lambda v: v.display_transform),
+        "stage": (draw.RESOLVE, lambda v: v.resolve),
+        "region_lines": (object(), lambda v: v.region_lines),
+        "view_depth": (True, lambda v: v.write_view_depth),
+        "aovs": (True, lambda v: v.write_aovs),
+        "lines": (draw.HIDDEN_LINES, lambda v: v.hidden_pass),
+    }
+    state_or_input = {"depth_test", "depth_write", "visibility", "triangle_ids_by_vertex"}
+    names = {f.name for f in fields(draw.DrawTarget)}
+    assert names == set(selects_code) | state_or_input, "classify every DrawTarget field here"
+    for name, (value, says) in selects_code.items():
+        variant = draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value}))
+        assert variant != plain and says(variant), name
+    for name in state_or_input - {"triangle_ids_by_vertex"}:
+        value = {"depth_test": "GREATER", "depth_write": False, "visibility": object()}[name]
+        assert draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value})) == plain, name
+    # The visibility stage's numbering is compiled code of that stage only.
+    record = draw.DrawTarget(stage=draw.VISIBILITY, linear_depth=True)
+    numbered = draw.shader_variant(settings, replace(record, triangle_ids_by_vertex=True))
+    assert numbered.triangle_ids_by_vertex and not draw.shader_variant(settings, record).triangle_ids_by_vertex
+    # "No wire" is said once, by the description: the plan leaves the
+    # settings' wire colour alone.
+    from solidwire_addon.core import passes
+
+    hidden = replace(settings, use_hidden_lines=True)
+    (surface,) = [unit for unit in passes.plan(hidden) if isinstance(unit, passes.SurfacePass)]
+    assert surface.settings.wire_color == hidden.wire_color and surface.wire is False
+
+
+def test_every_pass_is_a_unit_that_runs_offscreen_and_over_the_viewport():
+    """The plan is a tuple of pass units (passes.RenderPass), each with its
+    own render and over_viewport steps; the two executors only walk it (no
+    chain of ifs on a pass's kind)."""
+    from solidwire_addon.core import passes
+
+    tree = ast.parse((PACKAGE / "core" / "passes.py").read_text(encoding="utf-8"))
+    functions = _functions(tree)
+    for executor in ("render_passes", "draw_over_viewport"):
+        assert not any(isinstance(node, ast.If) for node in ast.walk(functions[executor])), executor
+    every_option = dataclasses.replace(
+        DrawSettings(), use_hidden_lines=True, use_silhouettes=True, use_fill=True, wire_color=(1, 1, 1, 1)
+    )
+    units = passes.plan(every_option, strands=True)
+    assert all(isinstance(unit, passes.RenderPass) for unit in units)
+    assert [type(unit).__name__ for unit in units] == [
+        "RegionLinesPass",
+        "SurfacePass",
+        "HiddenLinesPass",
+        "WirePass",
+        "OutputsPass",
+        "SilhouettePass",
+        "StrandsPass",
+    ]
+    plain = passes.plan(DrawSettings())
+    assert [type(unit).__name__ for unit in plain] == ["RegionLinesPass", "SurfacePass", "OutputsPass"]
+
+
+def _bool_annotation(node) -> bool:
+    return isinstance(node, ast.AnnAssign) and "bool" in ast.unparse(node.annotation)
+
+
+def test_core_has_no_module_level_switches():
+    """How a frame is drawn comes down from the caller as one frozen
+    options.DrawOptions, never from a switch kept in a core module: no core
+    module binds a name to True/False (or annotates one bool) at module
+    level, no core function rebinds a public module-level name (``global``),
+    and no module of the package assigns to an attribute of a core module."""
+    from dataclasses import fields
+
+    from solidwire_addon.core.options import DrawOptions
+
+    modules = _modules()
+    for name, tree in modules.items():
+        if not name.startswith("solidwire_addon.core"):
+            continue
+        for node in tree.body:
+            value = getattr(node, "value", None)
+            is_bool = isinstance(value, ast.Constant) and isinstance(value.value, bool)
+            assert not (isinstance(node, (ast.Assign, ast.AnnAssign)) and (is_bool or _bool_annotation(node))), (
+                f"{name} keeps a module-level switch: {ast.unparse(node)}"
+            )
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Global):
+                public = [n for n in node.names if not n.startswith("_")]
+                assert not public, f"{name} rebinds module-level {public}"
+    core_modules = {m.rsplit(".", 1)[1] for m in modules if m.startswith("solidwire_addon.core.")}
+    for name, tree in modules.items():
+        aliases = set()
+        in_core = name.startswith("solidwire_addon.core")
+        for node in ast.walk(tree):
+            # ``from ..core import passes`` or, inside core, ``from . import passes``.
+            if isinstance(node, ast.ImportFrom) and (
+                "core" in (node.module or "").split(".") or (node.module is None and in_core)
+            ):
+                aliases |= {a.asname or a.name for a in node.names if a.name in core_modules}
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                for target in targets:
+                    assert not (
+                        isinstance(target, ast.Attribute)
+                        and isinstance(target.value, ast.Name)
+                        and target.value.id in aliases
+                    ), f"{name} sets {ast.unparse(target)} from a distance"
+    assert DrawOptions.__dataclass_params__.frozen
+    assert all(f.default is not dataclasses.MISSING for f in fields(DrawOptions)), "every option has a default"

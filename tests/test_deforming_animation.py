@@ -15,7 +15,8 @@ import pytest
 
 import solidwire_addon
 from solidwire_addon.blender import runtime
-from solidwire_addon.core import cache, draw, extract, passes, shaders
+from solidwire_addon.core import cache, draw, extract, shaders
+from solidwire_addon.core.options import DrawOptions
 from tests.support import accuracy, reference, scenes
 
 FRAMES = (1, 2, 3, 4)
@@ -105,7 +106,7 @@ def test_deformation_uploads_positions_and_normals_only(build, setup_min, monkey
     if setup_min == 1 and not shaders.setup_available():
         pytest.skip("no compute shaders here")
     monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
-    monkeypatch.setattr(passes, "use_deferred_surface", setup_min != 1)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=setup_min != 1))
     setup_calls = []
     real_setup = draw._run_setup
     monkeypatch.setattr(draw, "_run_setup", lambda *args: (setup_calls.append(1), real_setup(*args)))
@@ -144,7 +145,7 @@ def test_deferred_deformation_keeps_the_index_buffer(by_vertex, monkeypatch, out
     numbered by vertex, which corners are copied): those depend on the
     triangles alone. Each frame still equals a fresh extraction's."""
     monkeypatch.setattr(draw, "DEFERRED_MIN_DENSITY", 0.0)
-    monkeypatch.setattr(shaders, "TRIANGLE_IDS_BY_VERTEX", by_vertex)
+    monkeypatch.setattr(runtime, "options", DrawOptions(triangle_ids_by_vertex=by_vertex))
     index_buffers = []
     real_index_buffer = cache.gpu.types.GPUIndexBuf
 

@@ -194,6 +194,7 @@ def gather(
     materials: bool = False,
     edge_lengths: bool = False,
     tessellation: bool = False,
+    reposition: bool = True,
 ):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
@@ -225,7 +226,9 @@ def gather(
     GPU mesh its typical edge length (``mesh.edge_length``, density.py).
     ``tessellation`` (Tessellation): text, curves, surfaces and metaballs
     draw every edge of their tessellation instead of their outlines
-    (outlines.py)."""
+    (outlines.py). ``reposition`` (options.DrawOptions.reposition_meshes):
+    a mesh whose shape alone changed uploads its new positions only;
+    False extracts it again in full."""
     if trust_updates is None:
         trust_updates = depsgraph.mode == "VIEWPORT"
     frame = _FrameGather(
@@ -237,6 +240,7 @@ def gather(
         edges=edges,
         outlines=not tessellation,
         attribute_colors=attribute_colors,
+        reposition=reposition,
     )
     items: list[DrawItem] = []
     for instance in depsgraph.object_instances:
@@ -311,8 +315,10 @@ class _FrameGather:
         edges: edge_select.Selection,
         outlines: bool = True,
         attribute_colors: bool = False,
+        reposition: bool = True,
     ):
         self.cache = cache
+        self.reposition = reposition
         self.mode = depsgraph.mode
         self.trust = (depsgraph.as_pointer(), runtime.epoch) if trust_updates else None
         self.versions = runtime.geometry_version
@@ -403,6 +409,7 @@ class _FrameGather:
                 self.mode == "RENDER",
                 outline=cage_key == OUTLINE_KEY,
                 attribute_colors=self.attribute_colors,
+                allow_reposition=self.reposition,
             )
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
             warn_once(
@@ -535,10 +542,12 @@ def _mesh_for(
     render: bool = False,
     outline: bool = False,
     attribute_colors: bool = False,
+    allow_reposition: bool = True,
 ):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated
     mesh. ``outline``: the drawn mask is outlines.py's (``edges.use_cage``
-    says a mask is passed), not the cage's."""
+    says a mask is passed), not the cage's; ``allow_reposition`` False
+    extracts a mesh whose shape changed in full."""
     obj_orig = obj.original
     fast = None
     if trust is not None:
@@ -636,7 +645,7 @@ def _mesh_for(
             fast,
             lambda: fingerprint(get_source(), corners, edges.classes, attribute_colors),
             make_arrays,
-            None if edges.follows_positions else reposition,
+            None if edges.follows_positions or not allow_reposition else reposition,
         )
     finally:
         if in_edit_mode and source:
