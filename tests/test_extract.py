@@ -9,6 +9,7 @@ import bpy
 import numpy as np
 import pytest
 
+from solidwire_addon.blender import mesh_reading
 from solidwire_addon.core import extract
 from tests.support import scenes
 
@@ -75,7 +76,7 @@ def test_quad_split_matches_loop_triangles(seed):
     obj = scenes.from_pydata(scene, "Quads", verts, faces)
     mesh = evaluated_mesh(obj)
 
-    data = extract.read_mesh_fast(mesh)
+    data = mesh_reading.read_mesh_fast(mesh)
     flip, _undecided = extract.quad_flip(data["positions"], data["corner_vert"].reshape(-1, 4))
     blender = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
     mesh.loop_triangles.foreach_get("loops", blender)
@@ -86,7 +87,7 @@ def test_quad_split_matches_loop_triangles(seed):
     # quads included: for them extraction asks Blender anyway).
     np.testing.assert_array_equal(flip, blender_flip)
 
-    assert_same_arrays(extract.extract_mesh(mesh), extract.extract_mesh_naive(mesh))
+    assert_same_arrays(mesh_reading.extract_mesh(mesh), mesh_reading.extract_mesh_naive(mesh))
 
 
 def test_mixed_tris_quads_ngons_match_reference():
@@ -97,9 +98,9 @@ def test_mixed_tris_quads_ngons_match_reference():
     faces = [tuple(rng.choice(300, size=k, replace=False)) for k in sizes]
     obj = scenes.from_pydata(scene, "Mixed", verts, faces)
     mesh = evaluated_mesh(obj)
-    fast = extract.extract_mesh(mesh)
+    fast = mesh_reading.extract_mesh(mesh)
     assert len(fast.ngon_corners) > 0
-    assert_same_arrays(fast, extract.extract_mesh_naive(mesh))
+    assert_same_arrays(fast, mesh_reading.extract_mesh_naive(mesh))
 
 
 @pytest.mark.parametrize("subdivisions", [0, 2])
@@ -107,7 +108,7 @@ def test_subdivided_monkey_matches_reference(subdivisions):
     scene = scenes.empty_scene()
     obj = scenes.monkey(scene, subdivisions=subdivisions)
     mesh = evaluated_mesh(obj)
-    assert_same_arrays(extract.extract_mesh(mesh), extract.extract_mesh_naive(mesh))
+    assert_same_arrays(mesh_reading.extract_mesh(mesh), mesh_reading.extract_mesh_naive(mesh))
 
 
 def test_nonfinite_vertices_match_reference():
@@ -120,10 +121,10 @@ def test_nonfinite_vertices_match_reference():
     obj.data.vertices.foreach_set("co", positions)
     obj.data.update()
     mesh = evaluated_mesh(obj)
-    fast = extract.extract_mesh(mesh)
+    fast = mesh_reading.extract_mesh(mesh)
     assert fast.dropped_triangles > 0
     assert np.isfinite(fast.positions).all()
-    assert_same_arrays(fast, extract.extract_mesh_naive(mesh))
+    assert_same_arrays(fast, mesh_reading.extract_mesh_naive(mesh))
 
 
 def test_build_arrays_fast_without_blender():

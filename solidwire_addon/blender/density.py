@@ -33,8 +33,8 @@ import math
 
 import numpy as np
 
-from ..core import extract
 from ..core.view import Style, View
+from .mesh_reading import read_positions
 
 # Edges sampled per mesh for the median (evenly spread; enough for a median).
 SAMPLE_EDGES = 20000
@@ -48,7 +48,7 @@ def typical_edge_length(mesh) -> float:
     count = len(mesh.edges)
     if count == 0:
         return 0.0
-    positions = extract.read_positions(mesh).astype(np.float64)
+    positions = read_positions(mesh).astype(np.float64)
     ends = np.empty(count * 2, dtype=np.int32)
     mesh.edges.foreach_get("vertices", ends)
     ends = ends.reshape(count, 2)[:: max(count // SAMPLE_EDGES, 1)]

@@ -112,7 +112,7 @@ class PreparedFrame:
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
             edge_lengths=density.needs_lengths(self.settings),
             tessellation=bool(self.settings.show_tessellation),
-            **passes.gather_options(self.settings),
+            **gather.gather_options(self.settings),
         )
         self.messages += object_settings.messages
         # Measured on the whole frame's view, so every tile fades alike.

@@ -212,7 +212,7 @@ def draw_scene_overlay(
         object_settings=object_settings,
         edge_lengths=density.needs_lengths(settings),
         tessellation=bool(settings.show_tessellation),
-        **passes.gather_options(settings),
+        **gather.gather_options(settings),
     )
     setting_repair.report_later(object_settings.messages)
     drawn = overlay_state.draw_settings(plan, settings)

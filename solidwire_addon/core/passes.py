@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import gpu
 import numpy as np
 
-from . import colors, compositing, edge_select, shaders, silhouettes
+from . import compositing, shaders, silhouettes
 from . import draw as draw_mod
 from . import strands as strands_mod
 from .log import warn_once
@@ -71,20 +71,6 @@ def plan(settings) -> tuple[Pass, ...]:
     if settings.use_silhouettes:
         passes.append(Pass(SILHOUETTES, settings))
     return tuple(passes)
-
-
-def gather_options(settings) -> dict:
-    """What the draw items of a frame with ``settings`` must carry (keyword
-    arguments of blender/gather.gather): corner tables for a shaded fill or
-    material colours, colour-source inputs for per-object colours."""
-    return {
-        "corners": draw_mod.needs_corners(settings),
-        "colors": colors.needs_item_colors(settings),
-        "attribute_colors": colors.needs_attribute_colors(settings),
-        "edges": edge_select.Selection(
-            float(settings.edge_angle), draw_mod.edge_classes_of(settings), bool(settings.use_cage_edges)
-        ),
-    }
 
 
 def render(items, view: View, settings, *, cull: bool = True):
