@@ -108,6 +108,30 @@ def test_core_never_imports_the_blender_side():
             assert not upward, f"{module} imports {upward}"
 
 
+# The add-on's front ends and the only modules that may import them besides
+# the package's __init__ (which registers them): a front end is where a
+# dependency ends, so that no module pulls in the UI, the operators, the
+# overlay, the render engine or the command line for a helper of theirs.
+FRONT_END_IMPORTERS = {
+    "blender.ui": set(),
+    "blender.ops": {"blender.ui"},  # the panels show the operators
+    "blender.ops_composite": set(),
+    "blender.overlay": {"blender.ops"},  # the toggle operator shows and hides it
+    "blender.engine": set(),
+    "blender.cli": set(),
+}
+
+
+def test_front_ends_are_imported_only_by_what_presents_them():
+    graph = import_graph()
+    for front_end, allowed in FRONT_END_IMPORTERS.items():
+        module = f"solidwire_addon.{front_end}"
+        assert module in graph, module
+        importers = {name.removeprefix("solidwire_addon.") for name, imports in graph.items() if module in imports}
+        extra = importers - allowed - {"solidwire_addon"}
+        assert not extra, f"{sorted(extra)} import {front_end}"
+
+
 # Blender's data API, which core never touches: it takes the arrays that
 # blender/mesh_reading.py (and the rest of blender/) read instead. Names of
 # Blender mesh data and its bulk reads, then of objects, depsgraphs and
