@@ -1,8 +1,10 @@
 """The package's layering, read from its source: no import cycles (module- or
 function-level imports alike), nothing in ``core`` that imports Blender's
-modules or reads its data, no private names used across modules, a shader parameter block
-that is exactly the schema's, one module map in the manual that lists every
-module, one formatter for errors as one line, and one table of render passes.
+modules or reads Blender's data, front ends imported only by what presents
+them, core's GPU-free modules and tests/pure/ without Blender, no private
+names used across modules, a shader parameter block that is exactly the
+schema's, one module map in the manual that lists every module, one
+formatter for errors as one line, and one table of render passes.
 """
 
 from __future__ import annotations
@@ -301,6 +303,24 @@ for name in {pure!r}:
 """
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False)
     assert result.returncode == 0, result.stderr
+
+
+def test_the_pure_tests_run_without_blender():
+    """tests/pure/ (extraction, overlay rules on plain arrays) passes in a
+    Python where Blender's modules cannot be imported: neither the tests nor
+    the core modules they use, nor the package's __init__, start Blender."""
+    script = f"""
+import sys
+for blocked in ("bpy", "bmesh", "bpy_extras", "mathutils", "gpu"):
+    sys.modules[blocked] = None  # import raises ImportError
+import pytest
+sys.exit(pytest.main([{str(ROOT / "tests" / "pure")!r}, "-q", "-p", "no:cacheprovider", "-p", "no:randomly"]))
+"""
+    result = subprocess.run(
+        [sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, timeout=300, check=False
+    )
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert " passed" in result.stdout
 
 
 def test_no_private_name_is_used_across_modules():
