@@ -1,16 +1,18 @@
-"""Extraction: an evaluated Blender mesh -> GPU-ready numpy arrays.
+"""Extraction: a mesh's arrays -> GPU-ready numpy arrays.
 
-Only bulk reads (``foreach_get`` on attribute arrays) and vectorised numpy:
-no per-element Python loops. The triangles are exactly Blender's own
-(``loop_triangles``), so the faces we draw are the faces Blender draws; the
-fast path (:func:`extract_mesh`) builds the triangles of tris and quads
-itself with Blender's own quad split rule (reading ``loop_triangles`` through
-RNA costs ~0.1 s per million triangles, most of our budget) and asks Blender
-only for n-gons and for quads whose split is numerically undecided. For each triangle we record which of
-its three edges are polygon boundary edges ("real") and which are diagonals
-added by triangulation, and for a quad the id of its 4th corner so a fragment
-can measure the distance to all four quad edges (clean corners next to a
-hidden diagonal).
+Takes plain arrays (vertex positions, the vertex of each face corner, face
+offsets; blender/mesh_reading.py reads them from an evaluated mesh) and
+works in vectorised numpy: no per-element Python loops. The triangles are
+exactly Blender's own (``loop_triangles``), so the faces we draw are the
+faces Blender draws; the fast path (:func:`build_arrays_fast`) builds the
+triangles of tris and quads itself with Blender's own quad split rule and
+asks its ``blender_tris`` callback only for n-gons and for quads whose split
+is numerically undecided; :func:`build_arrays` takes Blender's triangles for
+every face (the reference path). For each triangle we record which of its
+three edges are polygon boundary edges ("real") and which are diagonals
+added by triangulation, and for a quad the id of its 4th corner so a
+fragment can measure the distance to all four quad edges (clean corners
+next to a hidden diagonal).
 
 Corner order is rotated (never reflected, so winding and back-face culling are
 unchanged) so that a quad triangle's diagonal is always edge 2 (p2 -> p0) and
