@@ -306,9 +306,10 @@ for name in {pure!r}:
 
 
 def test_the_pure_tests_run_without_blender():
-    """tests/pure/ (extraction, overlay rules on plain arrays) passes in a
-    Python where Blender's modules cannot be imported: neither the tests nor
-    the core modules they use, nor the package's __init__, start Blender."""
+    """tests/pure/ (extraction, edge selection and the overlay's rules on
+    plain arrays) passes in a Python where Blender's modules cannot be
+    imported: neither the tests nor the core modules they use, nor the
+    package's __init__, start Blender."""
     script = f"""
 import sys
 for blocked in ("bpy", "bmesh", "bpy_extras", "mathutils", "gpu"):
