@@ -79,9 +79,10 @@ def addon():
     solidwire_addon.unregister()
 
 
-@pytest.fixture(autouse=True)
+@pytest.fixture(scope="module", autouse=True)
 def _addon_registered(request):
-    """Every test outside tests/pure/ runs with the add-on registered."""
+    """Every test file outside tests/pure/ runs with the add-on registered
+    (module-scoped and autouse: before any fixture of the file's own)."""
     if needs_blender(request.path):
         request.getfixturevalue("addon")
 
