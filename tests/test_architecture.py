@@ -178,9 +178,8 @@ BLENDER_DATA_NAMES = frozenset(
 )
 # Blender's Python modules besides ``gpu`` (which core draws with).
 BLENDER_MODULES = frozenset({"bpy", "bmesh", "bpy_extras", "mathutils"})
-# Ways to reach an attribute or a module by its name as a string.
-BY_NAME = frozenset({"getattr", "hasattr", "setattr", "delattr", "attrgetter", "methodcaller"})
-IMPORT_BY_NAME = frozenset({"__import__", "import_module", "find_spec"})
+# Ways to reach an attribute by its name as a string.
+BY_NAME = frozenset({"getattr", "hasattr", "setattr", "delattr", "attrgetter", "methodcaller", "__getattribute__"})
 
 
 def _called_name(call: ast.Call) -> str:
@@ -188,11 +187,23 @@ def _called_name(call: ast.Call) -> str:
     return func.id if isinstance(func, ast.Name) else func.attr if isinstance(func, ast.Attribute) else ""
 
 
+def _docstrings(tree: ast.Module) -> set[int]:
+    kinds = (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)
+    return {
+        id(node.body[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, kinds) and node.body and isinstance(node.body[0], ast.Expr)
+    }
+
+
 def blender_data_access(tree: ast.Module) -> list[str]:
     """Where ``tree`` reaches into Blender: an import of one of Blender's
-    modules (statement or by name), an attribute of Blender's data API
-    (``mesh.polygons``, ``attribute.data.foreach_get(...)``), or such an
-    attribute asked for by name (``getattr(mesh, "polygons")``)."""
+    modules, or its name as a string anywhere but in a docstring
+    (``__import__("bpy")``, ``sys.modules["bpy"]``); an attribute of
+    Blender's data API (``mesh.polygons``, ``attribute.data.foreach_get``);
+    or such an attribute asked for by name (``getattr(mesh, "polygons")``,
+    ``attrgetter("data.polygons")``)."""
+    docstrings = _docstrings(tree)
     found = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
@@ -207,11 +218,13 @@ def blender_data_access(tree: ast.Module) -> list[str]:
             found.append(f"line {node.lineno}: from {node.module} import")
         elif isinstance(node, ast.Attribute) and node.attr in BLENDER_DATA_NAMES:
             found.append(f"line {node.lineno}: .{node.attr}")
-        elif isinstance(node, ast.Call) and _called_name(node) in BY_NAME | IMPORT_BY_NAME:
-            by_name = _called_name(node) in BY_NAME
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings:
+            if node.value.split(".")[0] in BLENDER_MODULES:
+                found.append(f"line {node.lineno}: {node.value!r}")
+        elif isinstance(node, ast.Call) and _called_name(node) in BY_NAME:
             for arg in node.args:
                 value = arg.value if isinstance(arg, ast.Constant) and isinstance(arg.value, str) else ""
-                if (value in BLENDER_DATA_NAMES) if by_name else (value.split(".")[0] in BLENDER_MODULES):
+                if any(part in BLENDER_DATA_NAMES for part in value.split(".")):
                     found.append(f"line {node.lineno}: {_called_name(node)}({value!r})")
     return found
 
@@ -237,6 +250,7 @@ def test_core_reads_no_blender_data():
         "from mathutils import Matrix",
         "bpy = __import__('bpy')",
         "importlib.import_module('bpy.utils')",
+        "bpy = sys.modules['bpy']",
         "n = len(mesh.polygons)",
         "mesh.attributes.get('position')",
         "attribute.data.foreach_get('value', out)",
@@ -246,6 +260,8 @@ def test_core_reads_no_blender_data():
         "obj.matrix_world",
         "faces = getattr(mesh, 'polygons')",
         "read = operator.attrgetter('loop_triangles')",
+        "read = operator.attrgetter('data.polygons')",
+        "mesh.__getattribute__('polygons')",
         "hasattr(mesh, 'foreach_get')",
     ],
 )
@@ -258,6 +274,7 @@ def test_plain_array_code_is_not_taken_for_blender_data():
 import numpy as np
 from .extract import MeshArrays
 def f(arrays, corner_vert, face_offsets, settings, name):
+    \"\"\"bpy.types.Mesh is read on the Blender side; this takes its arrays.\"\"\"
     sizes = np.diff(face_offsets)
     getattr(settings, f"use_{name}_edges")
     return arrays.triangles[:, :3], arrays.triangle_polygons, arrays.vertex_count, {"edges": sizes}
