@@ -64,7 +64,7 @@ import bpy
 import numpy as np
 
 import solidwire_addon
-from solidwire_addon.blender import runtime
+from solidwire_addon.blender import mesh_reading, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.core import draw, extract
 from solidwire_addon.core.options import DrawOptions
@@ -130,11 +130,11 @@ def bench_extraction(level: int, repeat: int) -> dict:
             times.append(time.perf_counter() - start)
         return min(times) * 1000.0
 
-    fast = best(lambda: extract.extract_mesh(mesh))
-    naive = best(lambda: extract.extract_mesh_naive(mesh))
-    raw = extract.read_mesh(mesh)
+    fast = best(lambda: mesh_reading.extract_mesh(mesh))
+    naive = best(lambda: mesh_reading.extract_mesh_naive(mesh))
+    raw = mesh_reading.read_mesh(mesh)
     core = best(lambda: extract.build_arrays(**raw))
-    fast_core_input = extract.read_mesh_fast(mesh)
+    fast_core_input = mesh_reading.read_mesh_fast(mesh)
     fast_core = best(lambda: extract.build_arrays_fast(**fast_core_input))
     _wall, stats = render_once(scene)
     per_m = 1.0e6 / tris

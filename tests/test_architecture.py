@@ -1,9 +1,11 @@
 """The package's layering, read from its source: no import cycles (module- or
-function-level imports alike), nothing in ``core`` that faces Blender's UI or
-context, no private names used across modules, a shader parameter block
-that is exactly the schema's, one module map in the manual that lists every
-module, one formatter for errors as one line, one table of render passes,
-one description of a draw's target from which its shader variant follows,
+function-level imports alike), nothing in ``core`` that imports Blender's
+modules or reads Blender's data, front ends imported only by what presents
+them, core's GPU-free modules and tests/pure/ without Blender, no private
+names used across modules, a shader parameter block that is exactly the
+schema's, one module map in the manual that lists every module, one
+formatter for errors as one line, one table of render passes, one
+description of a draw's target from which its shader variant follows,
 passes as units, and no switch kept in a core module.
 """
 
@@ -12,6 +14,8 @@ from __future__ import annotations
 import ast
 import dataclasses
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -109,17 +113,235 @@ def test_core_never_imports_the_blender_side():
             assert not upward, f"{module} imports {upward}"
 
 
-def test_core_reads_no_blender_ui_or_context():
-    """core may draw with ``gpu`` but never imports ``bpy`` (so no
-    bpy.types, bpy.context or bpy.ops)."""
+# The add-on's front ends and the only modules that may import them besides
+# the package's __init__ (which registers them): a front end is where a
+# dependency ends, so that no module pulls in the UI, the operators, the
+# overlay, the render engine or the command line for a helper of theirs.
+FRONT_END_IMPORTERS = {
+    "blender.ui": set(),
+    "blender.ops": {"blender.ui"},  # the panels show the operators
+    "blender.ops_composite": set(),
+    "blender.overlay": {"blender.ops"},  # the toggle operator shows and hides it
+    "blender.engine": set(),
+    "blender.cli": set(),
+}
+
+
+def test_front_ends_are_imported_only_by_what_presents_them():
+    graph = import_graph()
+    for front_end, allowed in FRONT_END_IMPORTERS.items():
+        module = f"solidwire_addon.{front_end}"
+        assert module in graph, module
+        importers = {name.removeprefix("solidwire_addon.") for name, imports in graph.items() if module in imports}
+        extra = importers - allowed - {"solidwire_addon"}
+        assert not extra, f"{sorted(extra)} import {front_end}"
+
+
+# Blender's data API, which core never touches: it takes the arrays that
+# blender/mesh_reading.py (and the rest of blender/) read instead. Names of
+# Blender mesh data and its bulk reads, then of objects, depsgraphs and
+# data-blocks; none of them names anything of core's own.
+BLENDER_DATA_NAMES = frozenset(
+    {
+        "vertices",
+        "edges",
+        "loops",
+        "polygons",
+        "loop_triangles",
+        "loop_triangle_polygons",
+        "polygon_normals",
+        "vertex_normals",
+        "corner_normals",
+        "normals_domain",
+        "attributes",
+        "color_attributes",
+        "uv_layers",
+        "shape_keys",
+        "calc_loop_triangles",
+        "foreach_get",
+        "foreach_set",
+        # ``data``: an object's mesh (``obj.data``), an attribute's values
+        # (``attribute.data``).
+        "data",
+        "evaluated_get",
+        "evaluated_depsgraph_get",
+        "object_instances",
+        "original",
+        "to_mesh",
+        "to_mesh_clear",
+        "matrix_world",
+        "material_slots",
+        "modifiers",
+        "session_uid",
+        "as_pointer",
+        "bound_box",
+        "bl_rna",
+        "rna_type",
+    }
+)
+# Blender's Python modules besides ``gpu`` (which core draws with).
+BLENDER_MODULES = frozenset({"bpy", "bmesh", "bpy_extras", "mathutils"})
+# Ways to reach an attribute by its name as a string.
+BY_NAME = frozenset({"getattr", "hasattr", "setattr", "delattr", "attrgetter", "methodcaller", "__getattribute__"})
+
+
+def _called_name(call: ast.Call) -> str:
+    func = call.func
+    return func.id if isinstance(func, ast.Name) else func.attr if isinstance(func, ast.Attribute) else ""
+
+
+def _docstrings(tree: ast.Module) -> set[int]:
+    kinds = (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)
+    return {
+        id(node.body[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, kinds) and node.body and isinstance(node.body[0], ast.Expr)
+    }
+
+
+def blender_data_access(tree: ast.Module) -> list[str]:
+    """Where ``tree`` reaches into Blender: an import of one of Blender's
+    modules, or its name as a string anywhere but in a docstring
+    (``__import__("bpy")``, ``sys.modules["bpy"]``); an attribute of
+    Blender's data API (``mesh.polygons``, ``attribute.data.foreach_get``);
+    or such an attribute asked for by name (``getattr(mesh, "polygons")``,
+    ``attrgetter("data.polygons")``)."""
+    docstrings = _docstrings(tree)
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [
+                f"line {node.lineno}: import {a.name}" for a in node.names if a.name.split(".")[0] in BLENDER_MODULES
+            ]
+        elif (
+            isinstance(node, ast.ImportFrom)
+            and node.level == 0
+            and (node.module or "").split(".")[0] in BLENDER_MODULES
+        ):
+            found.append(f"line {node.lineno}: from {node.module} import")
+        elif isinstance(node, ast.Attribute) and node.attr in BLENDER_DATA_NAMES:
+            found.append(f"line {node.lineno}: .{node.attr}")
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings:
+            if node.value.split(".")[0] in BLENDER_MODULES:
+                found.append(f"line {node.lineno}: {node.value!r}")
+        elif isinstance(node, ast.Call) and _called_name(node) in BY_NAME:
+            for arg in node.args:
+                value = arg.value if isinstance(arg, ast.Constant) and isinstance(arg.value, str) else ""
+                if any(part in BLENDER_DATA_NAMES for part in value.split(".")):
+                    found.append(f"line {node.lineno}: {_called_name(node)}({value!r})")
+    return found
+
+
+def test_core_reads_no_blender_data():
+    """core takes numpy arrays and plain dataclasses and draws with ``gpu``:
+    no module of it imports ``bpy`` (so no bpy.types, bpy.context or bpy.ops)
+    or reads a Blender mesh, object or depsgraph (blender/mesh_reading.py
+    does)."""
     for name, tree in _modules().items():
-        if not name.startswith("solidwire_addon.core"):
-            continue
-        for node in ast.walk(tree):
-            if isinstance(node, ast.Import):
-                assert not any(a.name.split(".")[0] == "bpy" for a in node.names), f"{name} imports bpy"
-            elif isinstance(node, ast.ImportFrom) and node.level == 0:
-                assert (node.module or "").split(".")[0] != "bpy", f"{name} imports from bpy"
+        if name.startswith("solidwire_addon.core"):
+            found = blender_data_access(tree)
+            assert not found, f"{name} reads Blender data: {found}"
+
+
+@pytest.mark.parametrize(
+    "source",
+    [
+        "import bpy",
+        "import bpy.types as t",
+        "from bpy.types import Mesh",
+        "import bmesh",
+        "from mathutils import Matrix",
+        "bpy = __import__('bpy')",
+        "importlib.import_module('bpy.utils')",
+        "bpy = sys.modules['bpy']",
+        "n = len(mesh.polygons)",
+        "mesh.attributes.get('position')",
+        "attribute.data.foreach_get('value', out)",
+        "tris = mesh.loop_triangles",
+        "mesh.polygon_normals",
+        "obj.evaluated_get(depsgraph).data",
+        "obj.matrix_world",
+        "faces = getattr(mesh, 'polygons')",
+        "read = operator.attrgetter('loop_triangles')",
+        "read = operator.attrgetter('data.polygons')",
+        "mesh.__getattribute__('polygons')",
+        "hasattr(mesh, 'foreach_get')",
+    ],
+)
+def test_blender_data_access_is_found(source):
+    assert blender_data_access(ast.parse(source)), source
+
+
+def test_plain_array_code_is_not_taken_for_blender_data():
+    source = """
+import numpy as np
+from .extract import MeshArrays
+def f(arrays, corner_vert, face_offsets, settings, name):
+    \"\"\"bpy.types.Mesh is read on the Blender side; this takes its arrays.\"\"\"
+    sizes = np.diff(face_offsets)
+    getattr(settings, f"use_{name}_edges")
+    return arrays.triangles[:, :3], arrays.triangle_polygons, arrays.vertex_count, {"edges": sizes}
+"""
+    assert blender_data_access(ast.parse(source)) == []
+
+
+def _needs_gpu(graph) -> set[str]:
+    """Modules that import ``gpu``, directly or through another module."""
+    direct = {
+        name
+        for name, tree in _modules().items()
+        for node in ast.walk(tree)
+        if (isinstance(node, ast.Import) and any(a.name.split(".")[0] == "gpu" for a in node.names))
+        or (isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").split(".")[0] == "gpu")
+    }
+    needs = set(direct)
+    while True:
+        more = {name for name, imports in graph.items() if imports & needs} - needs
+        if not more:
+            return needs
+        needs |= more
+
+
+def test_core_without_gpu_work_imports_where_there_is_no_blender():
+    """Every core module that does no GPU work imports in a Python without
+    Blender (bpy, bmesh, mathutils and gpu made unimportable; the package's
+    own __init__, which registers the add-on with Blender, left out)."""
+    graph = import_graph()
+    pure = sorted(name for name in graph if name.startswith("solidwire_addon.core.") and name not in _needs_gpu(graph))
+    assert {"solidwire_addon.core.extract", "solidwire_addon.core.edge_select", "solidwire_addon.core.schema"} <= set(
+        pure
+    )
+    script = f"""
+import importlib, sys, types
+for blocked in ("bpy", "bmesh", "bpy_extras", "mathutils", "gpu"):
+    sys.modules[blocked] = None  # import raises ImportError
+package = types.ModuleType("solidwire_addon")
+package.__path__ = [{str(PACKAGE)!r}]
+sys.modules["solidwire_addon"] = package
+for name in {pure!r}:
+    importlib.import_module(name)
+"""
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False)
+    assert result.returncode == 0, result.stderr
+
+
+def test_the_pure_tests_run_without_blender():
+    """tests/pure/ (extraction, edge selection and the overlay's rules on
+    plain arrays) passes in a Python where Blender's modules cannot be
+    imported: neither the tests nor the core modules they use, nor the
+    package's __init__, start Blender."""
+    script = f"""
+import sys
+for blocked in ("bpy", "bmesh", "bpy_extras", "mathutils", "gpu"):
+    sys.modules[blocked] = None  # import raises ImportError
+import pytest
+sys.exit(pytest.main([{str(ROOT / "tests" / "pure")!r}, "-q", "-p", "no:cacheprovider", "-p", "no:randomly"]))
+"""
+    result = subprocess.run(
+        [sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, timeout=300, check=False
+    )
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert " passed" in result.stdout
 
 
 def test_no_private_name_is_used_across_modules():

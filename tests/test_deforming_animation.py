@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import solidwire_addon
-from solidwire_addon.blender import runtime
+from solidwire_addon.blender import mesh_reading, runtime
 from solidwire_addon.core import cache, draw, extract, shaders
 from solidwire_addon.core.options import DrawOptions
 from tests.support import accuracy, reference, scenes
@@ -66,8 +66,8 @@ def armature_tube(scene, collapse: bool = False):
         a, b = poly.vertices[0], poly.vertices[1]
         mesh.vertices[b].co = mesh.vertices[a].co
         mesh.update()
-        positions = extract.read_positions(mesh)
-        quads = extract.read_corner_verts(mesh).reshape(-1, 4)
+        positions = mesh_reading.read_positions(mesh)
+        quads = mesh_reading.read_corner_verts(mesh).reshape(-1, 4)
         assert extract.quad_flip(positions, quads)[1].any()
     scenes.add_bend_rig(scene, tube, (FRAMES[0], FRAMES[-1]), angle_deg=70.0)
     scenes.add_camera(scene, location=(8.0, -3.0, 1.0), target=(0.0, 0.0, 0.5))
@@ -229,9 +229,9 @@ def test_normals_that_follow_the_positions_are_not_checksummed(monkeypatch, outp
     shaded anew, and a change of where the normals live (flat to smooth,
     then a sharp edge) still re-extracts."""
     reads = []
-    real_read_normals = extract.read_normals
+    real_read_normals = mesh_reading.read_normals
     monkeypatch.setattr(
-        extract, "read_normals", lambda mesh, domain: (reads.append(domain), real_read_normals(mesh, domain))[1]
+        mesh_reading, "read_normals", lambda mesh, domain: (reads.append(domain), real_read_normals(mesh, domain))[1]
     )
     scene = default_look_scene()
     monkey = scenes.monkey(scene, "Flat", subdivisions=1, rotation=(0.2, 0.0, 0.5))
@@ -246,7 +246,7 @@ def test_normals_that_follow_the_positions_are_not_checksummed(monkeypatch, outp
     _image, stats = render(scene, output_dir / "derived_again.png")
     assert (stats["meshes_extracted"], stats["meshes_repositioned"], reads) == (0, 0, [])
 
-    positions = extract.read_positions(mesh)
+    positions = mesh_reading.read_positions(mesh)
     positions[:, 2] *= 1.3
     mesh.vertices.foreach_set("co", positions.reshape(-1))
     mesh.update()

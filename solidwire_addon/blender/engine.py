@@ -115,7 +115,7 @@ class PreparedFrame:
             edge_lengths=density.needs_lengths(self.settings),
             tessellation=bool(self.settings.show_tessellation),
             reposition=self.options.reposition_meshes,
-            **passes.gather_options(self.settings),
+            **gather.gather_options(self.settings),
         )
         self.messages += object_settings.messages
         # Measured on the whole frame's view, so every tile fades alike.

@@ -24,13 +24,14 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..core import draw as draw_mod
 from ..core import edge_select, extract
 from ..core.cache import MeshCache
-from ..core.colors import ItemSource
+from ..core.colors import ItemSource, needs_attribute_colors, needs_item_colors
 from ..core.log import one_line, warn_once
 from ..core.schema import OBJECT, OVERRIDE_FIELDS
 from ..core.view import DrawItem, Style, outside_frustum_many
-from . import cage, density, outlines, runtime, setting_repair
+from . import cage, density, mesh_reading, outlines, runtime, setting_repair
 
 # Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
 SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
@@ -127,8 +128,8 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute
     The fingerprint is ``(topology, shape)`` (see MeshCache.get_validated):
     a deformation changes the shape part alone, and then positions and
     corner normals may be uploaded again without a full extraction."""
-    positions = extract.read_positions(mesh)
-    corner_vert = extract.read_corner_verts(mesh)
+    positions = mesh_reading.read_positions(mesh)
+    corner_vert = mesh_reading.read_corner_verts(mesh)
     topology = (
         len(positions),
         len(mesh.edges),
@@ -139,14 +140,14 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute
     )
     shape = (_crc(positions),)
     if attribute_colors:
-        topology += extract.attribute_colors_checksum(mesh)
+        topology += mesh_reading.attribute_colors_checksum(mesh)
     corner_inputs = None
     if corners:
-        materials, domain = extract.read_corner_domain(mesh)
+        materials, domain = mesh_reading.read_corner_domain(mesh)
         topology += (_crc(materials), domain)
         normals = None
         if not extract.normals_follow_geometry(domain):
-            normals = extract.read_normals(mesh, domain)
+            normals = mesh_reading.read_normals(mesh, domain)
             shape += (_crc(normals),)
         corner_inputs = (normals, materials, domain)
     return (topology, shape), (positions, corner_vert, corner_inputs)
@@ -159,7 +160,7 @@ def _crc(array: np.ndarray) -> int:
 def _edge_class_checksums(mesh, edge_classes: tuple) -> tuple:
     if not edge_classes:
         return ()
-    bits = edge_select.read_edge_classes(mesh, edge_classes)
+    bits = mesh_reading.read_edge_classes(mesh, edge_classes)
     return (0,) if bits is None else (_crc(bits),)
 
 
@@ -176,6 +177,21 @@ def item_source(obj) -> ItemSource:
 # The default edge selection (every option off); Selection is frozen, so one
 # instance serves every call.
 NO_SELECTION = edge_select.Selection()
+
+
+def gather_options(settings) -> dict:
+    """What the draw items of a frame with ``settings`` must carry (keyword
+    arguments of :func:`gather`): corner tables for a shaded fill or
+    material colours, colour-source inputs for per-object colours, the
+    active colour attribute, and the edge selection."""
+    return {
+        "corners": draw_mod.needs_corners(settings),
+        "colors": needs_item_colors(settings),
+        "attribute_colors": needs_attribute_colors(settings),
+        "edges": edge_select.Selection(
+            float(settings.edge_angle), draw_mod.edge_classes_of(settings), bool(settings.use_cage_edges)
+        ),
+    }
 
 
 def gather(
@@ -479,7 +495,7 @@ def _materials_of(obj, data, pointer, face_slots) -> tuple | None:
     try:
         slots = face_slots.get(pointer)
         if slots is None:
-            slots = face_slots[pointer] = extract.read_material_indices(data)
+            slots = face_slots[pointer] = mesh_reading.read_material_indices(data)
         passes = tuple(float(s.material.pass_index) if s.material is not None else 0.0 for s in obj.material_slots)
     except (AttributeError, RuntimeError, ValueError) as exc:
         warn_once(("materials", obj.name), f"SolidWire: no material indices for '{obj.name}': {exc}")
@@ -569,30 +585,31 @@ def _mesh_for(
         positions, corner_vert, corner_inputs = context
         try:
             source_mesh = get_source()
-            arrays = extract.extract_mesh(
+            arrays = mesh_reading.extract_mesh(
                 source_mesh, positions=positions, corner_vert=corner_vert, corners=corner_inputs if corners else None
             )
             if edges.active:
-                face_offsets = extract.read_face_offsets(source_mesh)
+                face_offsets = mesh_reading.read_face_offsets(source_mesh)
                 cage_edges = None
                 if outline:
                     cage_edges = outlines.outline_mask(source_mesh, face_offsets)
                 elif edges.use_cage:
                     cage_edges = cage.cage_edges(obj.original, source_mesh, render=render)
-                edge_select.apply_to_mesh(
+                mesh_reading.apply_edge_selection(
                     arrays,
                     source_mesh,
-                    corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
+                    corner_vert if corner_vert is not None else mesh_reading.read_corner_verts(source_mesh),
                     face_offsets,
                     edges,
                     cage_edges,
                 )
-            if attribute_colors:
+            read_colors = mesh_reading.read_attribute_colors(source_mesh) if attribute_colors else None
+            if read_colors is not None:
                 extract.attach_attribute_colors(
                     arrays,
-                    source_mesh,
-                    corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
-                    extract.read_face_offsets(source_mesh),
+                    *read_colors,
+                    corner_vert if corner_vert is not None else mesh_reading.read_corner_verts(source_mesh),
+                    mesh_reading.read_face_offsets(source_mesh),
                 )
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
@@ -618,8 +635,8 @@ def _mesh_for(
             entry,
             positions,
             corner_vert,
-            extract.read_face_offsets(source_mesh),
-            extract.blender_triangles(source_mesh),
+            mesh_reading.read_face_offsets(source_mesh),
+            mesh_reading.blender_triangles(source_mesh),
         )
         if moved is None or not corners:
             return moved
@@ -627,7 +644,7 @@ def _mesh_for(
         if domain == extract.NORMALS_BY_CORNER and entry.corner_rows is None:
             return None
         if normals is None:  # not read by the fingerprint (they follow the positions)
-            normals = extract.read_normals(source_mesh, domain)
+            normals = mesh_reading.read_normals(source_mesh, domain)
         # The normals follow the deformation; which corner each triangle
         # corner is does not (same faces, same triangles; the domain is part
         # of the fingerprint's topology).

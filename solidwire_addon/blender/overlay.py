@@ -214,7 +214,7 @@ def draw_scene_overlay(
         edge_lengths=density.needs_lengths(settings),
         tessellation=bool(settings.show_tessellation),
         reposition=options.reposition_meshes,
-        **passes.gather_options(settings),
+        **gather.gather_options(settings),
     )
     setting_repair.report_later(object_settings.messages)
     drawn = overlay_state.draw_settings(plan, settings)

@@ -47,7 +47,6 @@ from .extract import (
     NGON_SHIFT,
     REGION_LINES,
     MeshArrays,
-    read_face_normals,
 )
 
 # Edge classes, in style order: style k + 1 is class k (style 0 is the
@@ -480,78 +479,6 @@ def flat_edges(
     return flat
 
 
-# Blender's edge data per class: (attribute names to try, kind). Seams are
-# "uv_seam" from Blender 5.0 on and ".uv_seam" before; a crease counts when
-# it is above zero.
-_CLASS_ATTRIBUTES = {
-    "sharp": ("sharp_edge",),
-    "crease": ("crease_edge",),
-    "seam": ("uv_seam", ".uv_seam"),
-    "freestyle": ("freestyle_edge",),
-}
-
-
-def read_edge_classes(mesh, enabled) -> np.ndarray | None:
-    """(E,) class bits of ``mesh``'s edges for the enabled classes (other
-    than boundary, which is topology), read from Blender's edge attributes;
-    None when no enabled class has data."""
-    count = len(mesh.edges)
-    bits = None
-    for name in enabled:
-        if name == "freestyle" and mesh.attributes.get("freestyle_edge") is None:
-            # Blender 4.x keeps Freestyle marks outside the attributes.
-            values = np.zeros(count, bool)
-            try:
-                if count:
-                    mesh.edges.foreach_get("use_freestyle_mark", values)
-            except (AttributeError, TypeError, RuntimeError):
-                continue
-            if values.any():
-                bits = np.zeros(count, np.int64) if bits is None else bits
-                bits[values] |= CLASS_BIT[name]
-            continue
-        for attribute_name in _CLASS_ATTRIBUTES.get(name, ()):
-            attribute = mesh.attributes.get(attribute_name)
-            if attribute is None or attribute.domain != "EDGE":
-                continue
-            values = np.zeros(count, dtype=np.float32 if attribute.data_type == "FLOAT" else bool)
-            if count:
-                attribute.data.foreach_get("value", values)
-            if bits is None:
-                bits = np.zeros(count, np.int64)
-            bits[values > 0] |= CLASS_BIT[name]
-            break
-    return bits
-
-
-def read_edge_topology(mesh) -> tuple[np.ndarray, np.ndarray]:
-    """((E, 2) edge vertex ids, (L,) the edge of each face corner): raw
-    attribute reads where Blender has them (a memcpy, ~50x faster than the
-    per-element ``edges.vertices`` / ``loops.edge_index``)."""
-    edge_count, corner_count = len(mesh.edges), len(mesh.loops)
-    verts = _read_raw(mesh, ".edge_verts", edge_count, 2)
-    if verts is None:
-        verts = np.empty(edge_count * 2, np.int32)
-        if edge_count:
-            mesh.edges.foreach_get("vertices", verts)
-    corner_edge = _read_raw(mesh, ".corner_edge", corner_count, 1)
-    if corner_edge is None:
-        corner_edge = np.empty(corner_count, np.int32)
-        if corner_count:
-            mesh.loops.foreach_get("edge_index", corner_edge)
-    return verts.reshape(-1, 2), corner_edge
-
-
-def _read_raw(mesh, name: str, count: int, width: int):
-    attribute = mesh.attributes.get(name)
-    if attribute is None or len(attribute.data) != count:
-        return None
-    out = np.empty(count * width, np.int32)
-    if count:
-        attribute.data.foreach_get("value", out)
-    return out
-
-
 @dataclass(frozen=True)
 class Selection:
     """What decides the drawn edges and their styles for one mesh (hashable:
@@ -572,36 +499,3 @@ class Selection:
         cage edges depend on the topology alone, so the selection of a
         deforming mesh stays as extracted."""
         return self.edge_angle > 0.0
-
-
-def apply_to_mesh(
-    arrays: MeshArrays,
-    mesh,
-    corner_vert: np.ndarray,
-    face_offsets: np.ndarray,
-    selection: Selection,
-    cage: tuple | None = None,
-) -> SelectionStats:
-    """Read ``mesh``'s edges and apply ``selection`` to ``arrays``. ``cage``:
-    (drawn mask, chain ids[, chain ends]) of the evaluated edges from the
-    cage detection, or None (no subdivision, or cage edges off)."""
-    verts, corner_edge = read_edge_topology(mesh)
-    drawn = chain = chain_ends = None
-    if cage is not None:
-        drawn, chain = np.asarray(cage[0], bool).copy(), cage[1]
-        chain_ends = cage[2] if len(cage) > 2 else None
-    if selection.edge_angle > 0.0:
-        flat = flat_edges(corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle)
-        drawn = ~flat if drawn is None else drawn & ~flat
-    others = tuple(c for c in selection.classes if c != "boundary")
-    inputs = EdgeInputs(
-        verts,
-        drawn,
-        read_edge_classes(mesh, others) if others else None,
-        "boundary" in selection.classes,
-        chain,
-        chain_ends,
-    )
-    if not inputs.selects_anything:
-        return SelectionStats()
-    return select_edges(arrays, corner_vert, face_offsets, corner_edge, inputs)

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field, replace
 import gpu
 import numpy as np
 
-from . import colors, compositing, edge_select, shaders, silhouettes
+from . import compositing, shaders, silhouettes
 from . import draw as draw_mod
 from . import strands as strands_mod
 from .draw import DrawTarget
@@ -300,20 +300,6 @@ def _blended(frame: Frame, draw_pass) -> None:
         finally:
             gpu.state.blend_set("NONE")
             gpu.state.depth_test_set("NONE")
-
-
-def gather_options(settings) -> dict:
-    """What the draw items of a frame with ``settings`` must carry (keyword
-    arguments of blender/gather.gather): corner tables for a shaded fill or
-    material colours, colour-source inputs for per-object colours."""
-    return {
-        "corners": draw_mod.needs_corners(settings),
-        "colors": colors.needs_item_colors(settings),
-        "attribute_colors": colors.needs_attribute_colors(settings),
-        "edges": edge_select.Selection(
-            float(settings.edge_angle), draw_mod.edge_classes_of(settings), bool(settings.use_cage_edges)
-        ),
-    }
 
 
 def render(items, view: View, settings, *, cull: bool = True, options: DrawOptions = DEFAULT_OPTIONS):
