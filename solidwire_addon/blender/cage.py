@@ -293,7 +293,7 @@ def _cage_layout(obj, mesh, *, render: bool):
     cage_children = len(cage) * per_edge
     if cage_children >= sub_edges_num:
         return None  # a mesh without faces: every edge comes from a cage edge
-    if steps and not np.array_equal(_carry_edges(steps, sub_edges), edges):
+    if steps and not _copies_match(steps, edges, sub_edges_num):
         return None  # not the layout of these copies (a merge, a weld)
     return cage_children, per_edge, cage, steps
 
@@ -385,22 +385,40 @@ def _cap_layout(cap_object):
     return cap_edges, len(data.vertices), np.ones(len(cap_edges), bool), len(data.polygons)
 
 
-def _carry(steps, mask, chain, ends, edges):
-    """Follow the subdivided mesh's (drawn mask, chain id, chain ends,
-    edges) through the copies of ``steps`` (_carried_copies): each copy
-    keeps its edges' marks, its chains (new ids) and its ends (shifted
-    with its vertices); a cap's edges are their own chains."""
+def _copies_match(steps, edges, size: int) -> bool:
+    """Whether ``edges`` (the evaluated mesh's) are exactly what the copies
+    of ``steps`` make of their first ``size`` edges: each copy its input's
+    edges with the vertex numbers shifted, each cap its own edges after
+    them. Every step's result is the start of the final array (a later
+    copy keeps its input first), so each is checked in place."""
+    for copies, verts_in, caps in steps:
+        block = edges[: copies * size].reshape(copies, size, 2)
+        shift = (np.arange(1, copies, dtype=np.int64) * verts_in)[:, None, None]
+        if not np.array_equal(block[1:] - block[:1].astype(np.int64), np.broadcast_to(shift, block[1:].shape)):
+            return False
+        end, first_vertex = copies * size, copies * verts_in
+        for cap_edges, cap_verts, _cap_mask in caps:
+            if not np.array_equal(edges[end : end + len(cap_edges)], cap_edges + first_vertex):
+                return False
+            end += len(cap_edges)
+            first_vertex += cap_verts
+        size = end
+    return size == len(edges)
+
+
+def _carry(steps, mask, chain, ends):
+    """Follow the subdivided mesh's (drawn mask, chain id, chain ends)
+    through the copies of ``steps`` (_carried_copies): each copy keeps its
+    edges' marks, its chains (new ids) and its ends (shifted with its
+    vertices); a cap's edges are their own chains."""
     for copies, verts_in, caps in steps:
         size = len(mask)
-        shift = np.repeat(np.arange(copies, dtype=np.int64) * verts_in, size)[:, None]
-        edges = np.tile(edges, (copies, 1)) + shift
-        ends = np.tile(ends, (copies, 1)) + shift
-        ids = np.tile(chain, copies)
-        chain = np.where(ids >= 0, ids + np.repeat(np.arange(copies, dtype=np.int64) * size, size), -1)
+        ends = (np.broadcast_to(ends, (copies, size, 2)) + (np.arange(copies) * verts_in)[:, None, None]).reshape(-1, 2)
+        ids = np.broadcast_to(chain, (copies, size))
+        chain = np.where(ids >= 0, ids + (np.arange(copies) * size)[:, None], -1).reshape(-1)
         mask = np.tile(mask, copies)
         first_vertex = copies * verts_in
-        for cap_edges, cap_verts, cap_mask, *_ in caps:
-            edges = np.concatenate([edges, cap_edges + first_vertex])
+        for cap_edges, cap_verts, cap_mask in caps:
             ends = np.concatenate([ends, cap_edges + first_vertex])
             mask = np.concatenate([mask, cap_mask])
             chain = np.concatenate([chain, np.full(len(cap_edges), -1, np.int64)])
@@ -408,14 +426,7 @@ def _carry(steps, mask, chain, ends, edges):
     # Every edge that is no piece of a longer one: a chain of its own.
     alone = chain < 0
     chain[alone] = -1 - np.flatnonzero(alone)
-    return mask, chain, ends, edges
-
-
-def _carry_edges(steps, edges):
-    """The edge array that the copies of ``steps`` make of ``edges``."""
-    edges = np.asarray(edges, np.int64)
-    none = np.zeros(len(edges), bool)
-    return _carry(steps, none, np.full(len(edges), -1, np.int64), edges, edges)[3]
+    return mask, chain, ends
 
 
 def cage_edge_mask(obj, mesh, *, render: bool):
@@ -451,8 +462,7 @@ def cage_edges(obj, mesh, *, render: bool, layout=None):
     chain = np.where(mask, index // per_edge, -1 - index)
     if not steps:
         return mask, chain, ends
-    mask, chain, ends, _edges = _carry(steps, mask, chain, ends, edges[:size])
-    return mask, chain, ends
+    return _carry(steps, mask, chain, ends)
 
 
 def _subdivided_edge_count(steps, edges_num: int) -> int:
