@@ -21,8 +21,10 @@ E' = n*E + n/2*(n-1)*C) and the chain layout above is then checked on the
 edge array itself, exactly: a count that fits by chance, a level lowered by
 Simplify, a modifier after the subdivision that changed the topology or an
 evaluated mesh that is the coarse one (the subdivision did nothing) never
-passes for a subdivided one. Stacked subdivision modifiers are peeled one by
-one (the children of a child are children of the coarse edge).
+passes for a subdivided one. Only the last subdivision modifier counts (see
+_stack), and the copies a Mirror or an Array after it makes are undone in
+the index layout first (_carried_copies), then checked on the whole edge
+array (_copies_match), as Blender's overlay keeps the cage through them.
 
 What the evaluated mesh is (read in Blender 5.0's source):
 
@@ -46,9 +48,10 @@ import numpy as np
 SUBDIVISION_TYPES = frozenset({"SUBSURF", "MULTIRES"})
 
 # Modifiers that keep the topology (vertex/edge/face counts and order): they
-# move vertices or write data layers only. One of these after a subdivision
-# keeps its edge order; any other enabled modifier after it makes the answer
-# unknowable (None). (bpy 5.0 names; unknown names are simply not listed.)
+# move vertices or write data layers only, and Blender copies the mesh with
+# its Optimal Display marks. One of these after a subdivision keeps its edge
+# order; see CAGE_CARRYING_TYPES for the others that keep the cage. (bpy 5.0
+# names; unknown names are simply not listed.)
 TOPOLOGY_KEEPING_TYPES = frozenset(
     {
         # Deform
