@@ -679,10 +679,12 @@ def _blender_draws(obj, mesh, clear_px: float = 4.0):
         view = HeadlessViewport(*OVERLAY_SIZE)
     except ViewportUnavailable as exc:
         pytest.skip(f"Blender's viewport cannot be drawn headless here: {exc}")
+    shading = view.space.shading
+    saved = shading.type, shading.show_xray
     try:
         view.look_through(scene)
-        view.space.shading.type = "SOLID"
-        view.space.shading.show_xray = True  # every edge, front or back
+        shading.type = "SOLID"
+        shading.show_xray = True  # every edge, front or back
         try:
             set_overlays(view.space, wireframe=True)
             view.draw_blender()
@@ -694,6 +696,7 @@ def _blender_draws(obj, mesh, clear_px: float = 4.0):
             pytest.skip(f"Blender's viewport cannot be drawn headless here: {exc}")
         to_clip = np.asarray(view.view.projection) @ np.asarray(view.view.view_matrix) @ np.array(obj.matrix_world)
     finally:
+        shading.type, shading.show_xray = saved
         view.free()
     wire = (with_wire != without).any(axis=-1)
     positions, edges = _positions(mesh), _edges(mesh)

@@ -11,11 +11,13 @@ from __future__ import annotations
 import math
 
 import bmesh
+import bpy
 import numpy as np
 import pytest
 
 import solidwire_addon
-from solidwire_addon.blender import runtime
+from solidwire_addon.blender import overlay, runtime
+from solidwire_addon.blender.views import camera_view
 from solidwire_addon.core import edge_select, extract
 from tests.support import accuracy, reference, scenes
 
@@ -182,3 +184,32 @@ def test_repositioned_edit_matches_the_reference(output_dir):
         assert stats["meshes_repositioned"] == 1
     report = accuracy.measure(scene, "angle_edits_reference", output_dir)
     accuracy.assert_accurate(report)
+
+
+def test_the_overlay_repositions_an_edit_and_draws_what_a_fresh_frame_draws():
+    """In the viewport overlay (depsgraph update counters, not the content
+    fingerprint): a light edit uploads positions only and draws exactly what
+    a frame from a fresh extraction draws."""
+    from tests.test_overlay import FakeViewport
+
+    scene, obj = _scene()
+    size = (200, 150)
+    keep = overlay.viewport_object_filter(bpy.context.view_layer)
+
+    def redraw():
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        view = camera_view(scene, depsgraph, size)
+        viewport = FakeViewport(*size)
+        stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), object_filter=keep)
+        return stats, viewport.rgba()
+
+    redraw()
+    before = _flat_now(obj.data)
+    _move(obj.data, [42], np.array([[2e-4, 0.0, 0.0]]))
+    assert np.array_equal(_flat_now(obj.data), before)
+    stats, edited = redraw()
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (0, 1)
+    runtime.mesh_cache.clear()
+    stats, fresh = redraw()
+    assert stats["meshes_extracted"] == 1
+    assert np.array_equal(edited, fresh)

@@ -614,8 +614,10 @@ def _mesh_for(
     def reposition(entry, context):
         positions, corner_vert, corner_inputs = context
         source_mesh = get_source()
-        if edges.follows_positions and not _edge_angle_holds(entry, source_mesh):
-            return None  # an edge crossed the angle: other drawn edges and regions
+        if edges.follows_positions and (outline or not _edge_angle_holds(entry, source_mesh)):
+            # An edge crossed the angle: other drawn edges and regions. (An
+            # outline's own mask follows the positions too; it is not kept.)
+            return None
         moved = extract.reposition(
             entry,
             positions,

@@ -502,7 +502,8 @@ class EdgeAngleState:
 
     def __init__(self, corner_edge, face_offsets, face_normals, edge_count: int, angle: float):
         self.angle = float(angle)
-        self.edges, self.first, self.second = _face_pairs(corner_edge, face_offsets, edge_count)
+        pairs = _face_pairs(corner_edge, face_offsets, edge_count)
+        self.edges, self.first, self.second = (ids.astype(np.int32) for ids in pairs)  # kept per mesh: half the memory
         self.normals = np.array(face_normals, np.float32)
         self.flat = np.zeros(edge_count, bool)
         if self.angle > 0.0 and edge_count:
