@@ -726,6 +726,15 @@ def _after_subdivision(obj, case):
         _mirror(obj)
     elif case == "mirror merging":
         _mirror(obj, merge=True)
+    elif case == "mirror merging nothing":
+        _mirror(obj, merge=True).merge_threshold = 1e-4
+        for vertex in obj.data.vertices:
+            vertex.co.x += 0.3
+        obj.data.update()
+    elif case == "array with caps":
+        array = _array(obj, 2)
+        cap = scenes.cube(bpy.context.scene, "Cap", size=0.6, location=(40.0, 0.0, 0.0))
+        array.start_cap = array.end_cap = cap
     elif case == "array":
         _array(obj, 2)
     elif case == "array merge":
@@ -746,6 +755,8 @@ def _after_subdivision(obj, case):
         ("stacked", True),
         ("mirror", True),
         ("mirror merging", False),
+        ("mirror merging nothing", True),
+        ("array with caps", True),
         ("array", True),
         ("array merge", False),
         ("mirror and array", True),
