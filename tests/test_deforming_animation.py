@@ -2,8 +2,8 @@
 a frame that only moves vertices (shape keys, an armature) uploads positions
 and corner normals again without a full extraction, and draws what a fresh
 extraction of that frame draws; whatever changes the faces, the triangles,
-the edge marks or an edge selection that follows the positions (edge angle)
-still goes through a full extraction."""
+the edge marks, or moves an edge across the edge angle still goes through a
+full extraction (tests/test_edge_angle_edits.py: moves that do not)."""
 
 from __future__ import annotations
 
@@ -199,8 +199,8 @@ def test_topology_change_mid_animation_reextracts(output_dir):
 
 def test_edge_marks_and_edge_angle_reextract(output_dir):
     """A sharp mark changes which edges carry a class without moving a
-    vertex; with an edge angle a deformation changes which edges are drawn.
-    Both need the full extraction."""
+    vertex; with an edge angle this deformation moves edges across it,
+    which changes which edges are drawn. Both need the full extraction."""
     scene = default_look_scene()
     scene.solidwire.use_sharp_edges = True
     obj = shape_key_monkey(scene)

@@ -490,6 +490,15 @@ class _FrameGather:
             self.cache.culled += culled  # never extracted: every instance outside the view
 
 
+def _edge_angle_holds(entry, mesh) -> bool:
+    """Whether a move of ``mesh``'s vertices (same faces) leaves every edge
+    on its side of the edge angle, checked against what the extraction kept
+    (edge_select.EdgeAngleState): only edges next to a face that turned are
+    measured again. Then the drawn edges and regions stay as they are."""
+    state = getattr(entry, "edge_angle_state", None)
+    return state is not None and state.still_flat(mesh_reading.read_face_normals(mesh))
+
+
 def _materials_of(obj, data, pointer, face_slots) -> tuple | None:
     """(material slot per face, pass_index per slot) of an evaluated object."""
     try:
@@ -631,6 +640,10 @@ def _mesh_for(
     def reposition(entry, context):
         positions, corner_vert, corner_inputs = context
         source_mesh = get_source()
+        if edges.follows_positions and (outline or not _edge_angle_holds(entry, source_mesh)):
+            # An edge crossed the angle: other drawn edges and regions. (An
+            # outline's own mask follows the positions too; it is not kept.)
+            return None
         moved = extract.reposition(
             entry,
             positions,
@@ -654,15 +667,15 @@ def _mesh_for(
         )
 
     try:
-        # A deformation re-uploads positions (and corner normals) only, unless
-        # the edge selection follows the positions (edge angle): then which
-        # edges are drawn may change, and the mesh is extracted again.
+        # A deformation re-uploads positions (and corner normals) only; with
+        # the edge angle, only while every edge stays on its side of the
+        # angle (else which edges are drawn changes: extracted again).
         mesh, _extracted = cache.get_validated(
             key,
             fast,
             lambda: fingerprint(get_source(), corners, edges.classes, attribute_colors),
             make_arrays,
-            None if edges.follows_positions or not allow_reposition else reposition,
+            reposition if allow_reposition else None,
         )
     finally:
         if in_edit_mode and source:

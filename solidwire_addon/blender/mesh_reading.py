@@ -337,10 +337,11 @@ def apply_edge_selection(
         drawn, chain = np.asarray(cage[0], bool).copy(), cage[1]
         chain_ends = cage[2] if len(cage) > 2 else None
     if selection.edge_angle > 0.0:
-        flat = edge_select.flat_edges(
+        state = edge_select.EdgeAngleState(
             corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle
         )
-        drawn = ~flat if drawn is None else drawn & ~flat
+        arrays.edge_angle_state = state  # a move of vertices is checked against it
+        drawn = ~state.flat if drawn is None else drawn & ~state.flat
     others = tuple(c for c in selection.classes if c != "boundary")
     inputs = EdgeInputs(
         verts,

@@ -466,17 +466,66 @@ def flat_edges(
     flat = np.zeros(edge_count, bool)
     if not angle > 0.0 or edge_count == 0:
         return flat
+    edges, f1, f2 = _face_pairs(corner_edge, face_offsets, edge_count)
+    flat[edges] = _pairs_flat(face_normals, f1, f2, angle)
+    return flat
+
+
+def _face_pairs(corner_edge: np.ndarray, face_offsets: np.ndarray, edge_count: int):
+    """(edge ids, first face, second face) of every edge with exactly two
+    face corners, in the order of their corners."""
     corner_edge = np.asarray(corner_edge, np.int64)
     corner_face = _face_of_corner(np.diff(np.asarray(face_offsets, np.int64)))
     uses = np.bincount(corner_edge, minlength=edge_count)
     corners = np.flatnonzero(uses[corner_edge] == 2)
     corners = corners[np.argsort(corner_edge[corners], kind="stable")]
     first, second = corners[0::2], corners[1::2]
-    f1, f2 = corner_face[first], corner_face[second]
+    return corner_edge[first], corner_face[first], corner_face[second]
+
+
+def _pairs_flat(face_normals: np.ndarray, f1: np.ndarray, f2: np.ndarray, angle: float) -> np.ndarray:
+    """Whether the faces of each pair are distinct and their normals differ
+    by less than ``angle`` radians."""
     n1, n2 = face_normals[f1].astype(np.float64), face_normals[f2].astype(np.float64)
     cosine = np.einsum("ij,ij->i", n1, n2) / np.maximum(np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1), 1e-300)
-    flat[corner_edge[first]] = (np.arccos(np.clip(cosine, -1.0, 1.0)) < angle) & (f1 != f2)
-    return flat
+    return (np.arccos(np.clip(cosine, -1.0, 1.0)) < angle) & (f1 != f2)
+
+
+class EdgeAngleState:
+    """What one extraction's edge angle test keeps so that a move of
+    vertices (same faces) is checked incrementally: the two faces of each
+    tested edge, the face normals it saw and the flat edges it found.
+    :meth:`still_flat` recomputes only the edges next to a face whose
+    normal changed, with the same arithmetic as :func:`flat_edges`, so its
+    answer is the full test's."""
+
+    def __init__(self, corner_edge, face_offsets, face_normals, edge_count: int, angle: float):
+        self.angle = float(angle)
+        pairs = _face_pairs(corner_edge, face_offsets, edge_count)
+        self.tested, self.first, self.second = (ids.astype(np.int32) for ids in pairs)  # kept per mesh: half the memory
+        self.normals = np.array(face_normals, np.float32)
+        self.flat = np.zeros(edge_count, bool)
+        if self.angle > 0.0 and edge_count:
+            self.flat[self.tested] = _pairs_flat(self.normals, self.first, self.second, self.angle)
+
+    def still_flat(self, face_normals) -> bool:
+        """Whether the same edges are flat under ``face_normals`` (the same
+        faces after a move). True: the new normals are kept for the next
+        move. False: some edge crossed the angle (its regions change)."""
+        face_normals = np.asarray(face_normals, np.float32)
+        if face_normals.shape != self.normals.shape:
+            return False
+        changed = face_normals != self.normals
+        turned = changed[:, 0] | changed[:, 1] | changed[:, 2]
+        if not turned.any():
+            return True
+        rows = np.flatnonzero(turned[self.first] | turned[self.second])
+        if len(rows):
+            flat = _pairs_flat(face_normals, self.first[rows], self.second[rows], self.angle)
+            if not np.array_equal(flat, self.flat[self.tested[rows]]):
+                return False
+        self.normals = face_normals.copy()
+        return True
 
 
 @dataclass(frozen=True)
@@ -495,7 +544,8 @@ class Selection:
     @property
     def follows_positions(self) -> bool:
         """Whether moving vertices can change which edges are drawn: the
-        edge angle compares face normals. Classes (marks, boundary) and
-        cage edges depend on the topology alone, so the selection of a
-        deforming mesh stays as extracted."""
+        edge angle compares face normals (a move is checked against the
+        extraction's EdgeAngleState). Classes (marks, boundary) and cage
+        edges depend on the topology alone, so the selection of a deforming
+        mesh stays as extracted."""
         return self.edge_angle > 0.0

@@ -105,6 +105,9 @@ class MeshArrays:
     quad_flip: np.ndarray | None = None
     face_offsets_crc: int | None = None
     source_positions: np.ndarray | None = None  # (V, 3) float32 as read, to find moved vertices
+    # The edge angle test's state (edge_select.EdgeAngleState) when it chose
+    # the drawn edges: a move of vertices is checked against it.
+    edge_angle_state: object | None = None
 
     @property
     def mesh_bounds(self) -> tuple:
