@@ -19,7 +19,7 @@ BLENDER_TAGS = $(VENV_PYTHON) -c "import importlib.util, os; \
 	print(os.path.join(importlib.util.find_spec('bpy').submodule_search_locations[0], \
 	'5.0', 'scripts', 'modules', '_bpy_internal', 'extensions', 'tags.py'))"
 
-.PHONY: demo test docs lint test-newest venv venv-newest zip check-system clean bench bench-scale bench-engines bench-viewport bench-regions fetch-meshes test-slow soak fuzz compat
+.PHONY: demo test docs lint test-newest venv venv-newest zip check-system clean bench bench-scale bench-engines bench-viewport bench-regions fetch-meshes test-slow soak fuzz compat galleries
 
 venv: $(VENV_STAMP)
 
@@ -115,6 +115,14 @@ bench-viewport: $(VENV_STAMP) check-system
 # and edge classes against a plain frame (docs/dev/benchmarks.md).
 bench-regions: $(VENV_STAMP) check-system
 	$(VENV_PYTHON) -m scripts.bench_regions $(BENCH_ARGS)
+
+# The manual's pictures (docs/*.png), labelled (Pillow, from
+# requirements-bench.txt). The wire-over pictures render Cycles and need the
+# fetched meshes: `python -m scripts.wire_over_gallery` on its own.
+GALLERIES := preset_gallery line_styles_gallery look_gallery edges_gallery outlines_gallery object_types_gallery hair_points_gallery
+galleries: $(VENV_STAMP) check-system
+	$(VENV_PYTHON) -m pip install --disable-pip-version-check -q -r requirements-bench.txt
+	set -e; for g in $(GALLERIES); do $(VENV_PYTHON) -m scripts.$$g; done
 
 # Opt-in robustness runs (not part of `make test` / CI; pytest markers, see
 # pytest.ini); see docs/dev/robustness.md.

@@ -29,7 +29,9 @@ import numpy as np
 
 import solidwire_addon
 from scripts import frame_stages
-from solidwire_addon.core import passes, schema
+from solidwire_addon.blender import runtime
+from solidwire_addon.core import schema
+from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 
 # The world colour of Blender's startup file.
@@ -66,8 +68,10 @@ def applied_mesh_scene(width: int, height: int, subdivisions: int):
 
 
 def configure(scene, engine: str) -> None:
+    """Set ``scene`` up for ``engine``; the SolidWire rows draw with the
+    options the render engine reads (runtime.options)."""
     render = scene.render
-    passes.use_deferred_surface = engine != "SOLIDWIRE_DIRECT"
+    runtime.options = DrawOptions(deferred_surface=engine != "SOLIDWIRE_DIRECT")
     if engine.startswith("SOLIDWIRE"):
         render.engine = "SOLIDWIRE"
         return

@@ -64,9 +64,10 @@ import bpy
 import numpy as np
 
 import solidwire_addon
-from solidwire_addon.blender import runtime
+from solidwire_addon.blender import mesh_reading, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.core import draw, extract
+from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 
 
@@ -129,11 +130,11 @@ def bench_extraction(level: int, repeat: int) -> dict:
             times.append(time.perf_counter() - start)
         return min(times) * 1000.0
 
-    fast = best(lambda: extract.extract_mesh(mesh))
-    naive = best(lambda: extract.extract_mesh_naive(mesh))
-    raw = extract.read_mesh(mesh)
+    fast = best(lambda: mesh_reading.extract_mesh(mesh))
+    naive = best(lambda: mesh_reading.extract_mesh_naive(mesh))
+    raw = mesh_reading.read_mesh(mesh)
     core = best(lambda: extract.build_arrays(**raw))
-    fast_core_input = extract.read_mesh_fast(mesh)
+    fast_core_input = mesh_reading.read_mesh_fast(mesh)
     fast_core = best(lambda: extract.build_arrays_fast(**fast_core_input))
     _wall, stats = render_once(scene)
     per_m = 1.0e6 / tris
@@ -172,10 +173,9 @@ def bench_many_objects(count: int, frame_count: int) -> dict:
     scene = many_objects_scene(count)
     out = {}
     for reuse in (True, False):
-        runtime.reuse_enabled = reuse
         runtime.mesh_cache.clear()
-        out["reuse" if reuse else "no_reuse"] = frames(scene, frame_count)
-    runtime.reuse_enabled = True
+        with runtime.drawing_with(DrawOptions(reuse_meshes=reuse)):
+            out["reuse" if reuse else "no_reuse"] = frames(scene, frame_count)
     return out
 
 
@@ -287,11 +287,11 @@ def bench_animation(static: int, frame_end: int) -> dict:
         bpy.app.handlers.render_post.append(record)
         try:
             for reuse in (True, False):
-                runtime.reuse_enabled = reuse
                 runtime.mesh_cache.clear()
                 per_frame.clear()
                 start = time.perf_counter()
-                bpy.ops.render.render(animation=True, scene=scene.name)
+                with runtime.drawing_with(DrawOptions(reuse_meshes=reuse)):
+                    bpy.ops.render.render(animation=True, scene=scene.name)
                 wall = (time.perf_counter() - start) * 1000.0
                 later = per_frame[1:] or per_frame
                 out["reuse" if reuse else "no_reuse"] = {
@@ -303,7 +303,6 @@ def bench_animation(static: int, frame_end: int) -> dict:
                 }
         finally:
             bpy.app.handlers.render_post.remove(record)
-            runtime.reuse_enabled = True
     return out
 
 
@@ -485,14 +484,13 @@ def bench_interactive(level: int, objects: int, edits: int) -> dict:
     bm = bmesh.from_edit_mesh(obj.data)
     bm.verts.ensure_lookup_table()
     for name, allow in (("big_edit_vertex", True), ("big_edit_vertex_full", False)):
-        runtime.mesh_cache.allow_reposition = allow
         samples = []
-        for i in range(edits):
-            bm.verts[i].co.z += 0.01
-            bmesh.update_edit_mesh(obj.data)
-            samples.append(viewport.redraw(scene, plan))
+        with runtime.drawing_with(DrawOptions(reposition_meshes=allow)):
+            for i in range(edits):
+                bm.verts[i].co.z += 0.01
+                bmesh.update_edit_mesh(obj.data)
+                samples.append(viewport.redraw(scene, plan))
         out[name] = _median_stats(samples)
-    runtime.mesh_cache.allow_reposition = True
     bpy.ops.object.mode_set(mode="OBJECT")
 
     scene = many_objects_scene(objects)
@@ -506,14 +504,13 @@ def bench_interactive(level: int, objects: int, edits: int) -> dict:
         samples.append(viewport.redraw(scene, plan))
     out["objects_move_one"] = _median_stats(samples)
     for name, allow in (("objects_edit_one", True), ("objects_edit_one_full", False)):
-        runtime.mesh_cache.allow_reposition = allow
         samples = []
-        for i in range(edits):
-            moved.data.vertices[i].co.z += 0.01
-            moved.data.update()
-            samples.append(viewport.redraw(scene, plan))
+        with runtime.drawing_with(DrawOptions(reposition_meshes=allow)):
+            for i in range(edits):
+                moved.data.vertices[i].co.z += 0.01
+                moved.data.update()
+                samples.append(viewport.redraw(scene, plan))
         out[name] = _median_stats(samples)
-    runtime.mesh_cache.allow_reposition = True
     out["big_triangles"] = out["big_steady"]["triangles_drawn"]
     return out
 

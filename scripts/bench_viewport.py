@@ -230,7 +230,7 @@ def table(results) -> list[str]:
 
 # -- where SolidWire's overlay frame goes -------------------------------------------
 
-# The overlay's draw calls by their stage (draw_mod.draw's ``stage``); a
+# The overlay's draw calls by their target's stage (draw_mod.DrawTarget); a
 # call without one is the surface pass, or the depth pre-pass before it
 # where Blender's depth does not hold the surfaces.
 STAGE_NAMES = {"visibility": "region-lines record", "lines": "region lines", None: "surface pass"}
@@ -254,7 +254,8 @@ class OverlayProbe:
             result = probe._original(*args, **kwargs)
             recorded = time.perf_counter()
             gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "UBYTE")
-            name = STAGE_NAMES.get(kwargs.get("stage"), str(kwargs.get("stage")))
+            stage = (kwargs.get("target") or draw_mod.DrawTarget()).stage
+            name = STAGE_NAMES.get(stage, str(stage))
             probe.calls.append((name, (recorded - start) * 1000.0, (time.perf_counter() - recorded) * 1000.0))
             return result
 

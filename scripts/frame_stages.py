@@ -72,14 +72,14 @@ def _sync() -> None:
 
 
 def _draw_stage(kwargs) -> str:
-    stage = kwargs.get("stage")
-    if stage == draw_mod.VISIBILITY:
+    target = kwargs.get("target") or draw_mod.DrawTarget()
+    if target.stage == draw_mod.VISIBILITY:
         return VISIBILITY
-    if stage == draw_mod.RESOLVE:
+    if target.stage == draw_mod.RESOLVE:
         return RESOLVE
-    if kwargs.get("hidden_pass"):
+    if target.lines == draw_mod.HIDDEN_LINES:
         return HIDDEN
-    if kwargs.get("depth_write") is False:
+    if not target.depth_write:
         return WIRE
     return DIRECT
 

@@ -21,7 +21,7 @@ import bpy
 import solidwire_addon
 from solidwire_addon.blender import engine, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
-from solidwire_addon.core import passes
+from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 
 SIZE = (1920, 1080)
@@ -93,13 +93,10 @@ def first_frame_ms(scene, settings: dict) -> float:
 
 def warm_ms(scene, settings: dict, deferred: bool = True) -> float:
     apply(scene, settings)
-    passes.use_deferred_surface = deferred
     depsgraph = bpy.context.evaluated_depsgraph_get()
     start = time.perf_counter()
-    engine.render_scene(depsgraph, SIZE)
-    elapsed = (time.perf_counter() - start) * 1000.0
-    passes.use_deferred_surface = True
-    return elapsed
+    engine.render_scene(depsgraph, SIZE, options=DrawOptions(deferred_surface=deferred))
+    return (time.perf_counter() - start) * 1000.0
 
 
 def main(argv=None) -> int:

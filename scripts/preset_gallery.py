@@ -114,7 +114,8 @@ def write(sheet: np.ndarray, cells, path: Path, columns: int = COLUMNS, cell=CEL
         # preset sheet, Blender's Solid shading with no overlay, passed for a
         # preset that draws no wire), so say so and name the tiles.
         print(
-            f"warning: Pillow is not installed, so {path.name} has empty label strips; its tiles, "
+            f"warning: Pillow is not installed (`make galleries` installs it), so {path.name} has empty "
+            f"label strips; its tiles, "
             f"left to right, top to bottom: {'; '.join(label for label, _linear in cells)}",
             file=sys.stderr,
         )

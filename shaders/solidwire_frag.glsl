@@ -96,41 +96,78 @@ void offer_faded(int style, float d_sq, vec3 line, vec2 span, vec2 p, float wire
     faded[k] = max(faded[k], faded_line(k, d_sq, line, span, p, wire_half, chain));
   }
 }
+/* (Used where `p`, `half_thickness` and the NearLines `found` are in scope.) */
 #  define OFFER(style, d_sq, line, span, chain) \
-    offer_faded(style, d_sq, line, span, p, half_thickness, chain, faded, faded_diagonal)
+    offer_faded(style, d_sq, line, span, p, half_thickness, chain, found.faded, found.faded_diagonal)
 #else
 #  define OFFER(style, d_sq, line, span, chain)
 #endif
 
-/* The resolve pass (resolve_frag.glsl) calls this for the one pixel it
- * resolves, after setting every input as a plain global. */
-#ifdef RESOLVE_PASS
-void solidwire_fragment()
-#else
-void main()
+/* The lines near this fragment so far. Per style (image model §3.6: style
+ * 0 is the wire, styles 1.. the edge classes) the nearest line with its
+ * line and span (for patterns); the nearest diagonal likewise; and with
+ * USE_LINE_MAXIMUM each style's strongest faded line (faded_line above,
+ * through OFFER). */
+struct NearLines {
+  float d_style[STYLE_COUNT];
+  vec3 line_style[STYLE_COUNT];
+  vec2 span_style[STYLE_COUNT];
+  float d_diag;
+  vec3 diag_line;
+  vec2 diag_span;
+#ifdef USE_LINE_MAXIMUM
+  float faded[STYLE_COUNT];
+  float faded_diagonal;
 #endif
+};
+
+NearLines no_lines()
+{
+  NearLines found;
+  for (int k = 0; k < STYLE_COUNT; k++) {
+    found.d_style[k] = NO_EDGE * NO_EDGE;
+    found.line_style[k] = vec3(0.0, 0.0, NO_EDGE);
+    found.span_style[k] = vec2(0.0);
+  }
+  found.d_diag = NO_EDGE * NO_EDGE;
+  found.diag_line = vec3(0.0, 0.0, NO_EDGE);
+  found.diag_span = vec2(0.0);
+#ifdef USE_LINE_MAXIMUM
+  for (int k = 0; k < STYLE_COUNT; k++) {
+    found.faded[k] = 0.0;
+  }
+  found.faded_diagonal = 0.0;
+#endif
+  return found;
+}
+
+/* The render's own float depth buffer holds view depth / clip end: a float
+ * keeps the same relative precision (2^-24) at every depth, so which of two
+ * surfaces is nearer never depends on the clip range (docs/image_model.md
+ * §2). The GL mapping 0.5 * z/w + 0.5 crowds every far depth into the last
+ * few float steps below 1. */
+void write_linear_depth()
 {
 #ifdef LINEAR_DEPTH
-  /* The render's own float depth buffer holds view depth / clip end: a float
-   * keeps the same relative precision (2^-24) at every depth, so which of two
-   * surfaces is nearer never depends on the clip range (docs/image_model.md
-   * §2). The GL mapping 0.5 * z/w + 0.5 crowds every far depth into the last
-   * few float steps below 1. */
   gl_FragDepth = view_depth * params.inv_clip_end;
 #endif
+}
+
+/* Outside the viewport's clipping region nothing of this face exists
+ * (docs/image_model.md §5.6). */
+bool outside_clip_region()
+{
 #ifdef USE_CLIP_PLANES
-  /* Outside the viewport's clipping region: nothing of this face exists
-   * here (docs/image_model.md §5.6). */
-  if (min(min(min(clip_distance_a.x, clip_distance_a.y), min(clip_distance_a.z, clip_distance_a.w)),
-          min(clip_distance_b.x, clip_distance_b.y)) < 0.0)
-  {
-    discard;
-  }
+  return min(min(min(clip_distance_a.x, clip_distance_a.y), min(clip_distance_a.z, clip_distance_a.w)),
+             min(clip_distance_b.x, clip_distance_b.y)) < 0.0;
+#else
+  return false;
 #endif
-  /* Window position relative to the viewport centre (edge_geometry.glsl). */
-  vec2 p = gl_FragCoord.xy - viewport_centre();
-  /* Squared distances to the five candidate edges. */
-  float d0, d1, d2, d3, d4;
+}
+
+/* Squared distances from window point p to the five candidate edges. */
+void own_edge_distances(vec2 p, out float d0, out float d1, out float d2, out float d3, out float d4)
+{
 #ifdef USE_DENSITY_FADE
   /* The argument below needs every line at full strength: with lines of
    * different fade a diagonal's line distance could show where its
@@ -165,28 +202,18 @@ void main()
     d3 = edge_distance_sq(edge_line3, edge_span3, p);
     d4 = edge_distance_sq(edge_line4, edge_span4, p);
   }
+}
 
-  /* Which of the triangle's own edges are lines (drawn polygon edges) and
-   * which are diagonals (added by triangulation). A triangle that walks its
-   * region's segments takes every line from that block instead; its own
-   * edges then only give diagonals. Polygon edges that are not drawn are
-   * neither. A quad's edges p2-p3, p3-p0 are NO_EDGE unless it has them. */
-  float half_thickness = half_thickness_at(view_depth, SW_INV_CLIP_W);
-#ifdef USE_LINE_MAXIMUM
-  float faded[STYLE_COUNT];
-  for (int k = 0; k < STYLE_COUNT; k++) {
-    faded[k] = 0.0;
-  }
-  float faded_diagonal = 0.0;
-#endif
-  bool listed = (triangle_flags & IN_REGION) != 0;
-#ifdef REGION_LINE_IMAGE
-  /* The region-lines pass measured this triangle's lines (image model
-   * §2.6): the strongest line at this pixel and its style. */
-  bool lines_from_image = (triangle_flags & REGION_LINES) != 0;
-#else
-  const bool lines_from_image = false;
-#endif
+/* The triangle's own edges: which are lines (drawn polygon edges) and
+ * which diagonals (added by triangulation). A triangle that walks its
+ * region's segments (`listed`) takes every line from that block instead;
+ * its own edges then only give diagonals. Polygon edges that are not drawn
+ * are neither. A quad's edges p2-p3, p3-p0 are NO_EDGE unless it has them. */
+NearLines own_edge_lines(vec2 p, float half_thickness, bool listed)
+{
+  float d0, d1, d2, d3, d4;
+  own_edge_distances(p, d0, d1, d2, d3, d4);
+  NearLines found = no_lines();
   bool real0 = (triangle_flags & EDGE0_REAL) != 0;
   bool real1 = (triangle_flags & EDGE1_REAL) != 0;
   bool real2 = (triangle_flags & EDGE2_REAL) != 0;
@@ -194,21 +221,9 @@ void main()
   bool diag1 = !real1 && (triangle_flags & (EDGE0_HIDDEN << 1)) == 0;
   bool diag2 = !real2 && (triangle_flags & (EDGE0_HIDDEN << 2)) == 0;
 
-  /* The nearest line of each style (image model §3.6: style 0 is the wire,
-   * styles 1.. the edge classes), with its line and span (for patterns).
-   * With the density fade, OFFER also keeps each style's strongest faded
-   * line (faded_line above). */
-  float d_style[STYLE_COUNT];
-  vec3 line_style[STYLE_COUNT];
-  vec2 span_style[STYLE_COUNT];
-  for (int k = 0; k < STYLE_COUNT; k++) {
-    d_style[k] = NO_EDGE * NO_EDGE;
-    line_style[k] = vec3(0.0, 0.0, NO_EDGE);
-    span_style[k] = vec2(0.0);
-  }
-  keep_nearest(real0 && !listed, d0, edge_line0, edge_span0, d_style[0], line_style[0], span_style[0]);
-  keep_nearest(real1 && !listed, d1, edge_line1, edge_span1, d_style[0], line_style[0], span_style[0]);
-  keep_nearest(real2 && !listed, d2, edge_line2, edge_span2, d_style[0], line_style[0], span_style[0]);
+  keep_nearest(real0 && !listed, d0, edge_line0, edge_span0, found.d_style[0], found.line_style[0], found.span_style[0]);
+  keep_nearest(real1 && !listed, d1, edge_line1, edge_span1, found.d_style[0], found.line_style[0], found.span_style[0]);
+  keep_nearest(real2 && !listed, d2, edge_line2, edge_span2, found.d_style[0], found.line_style[0], found.span_style[0]);
 #ifdef USE_LINE_MAXIMUM
   if (!listed) {
     if (real0) OFFER(0, d0, edge_line0, edge_span0, edge_span0.y - edge_span0.x);
@@ -218,143 +233,183 @@ void main()
 #endif
   bool real3 = (triangle_flags & EDGE3_HIDDEN) == 0;
   bool real4 = (triangle_flags & EDGE4_HIDDEN) == 0;
-  keep_nearest(real3, d3, edge_line3, edge_span3, d_style[0], line_style[0], span_style[0]);
-  keep_nearest(real4, d4, edge_line4, edge_span4, d_style[0], line_style[0], span_style[0]);
+  keep_nearest(real3, d3, edge_line3, edge_span3, found.d_style[0], found.line_style[0], found.span_style[0]);
+  keep_nearest(real4, d4, edge_line4, edge_span4, found.d_style[0], found.line_style[0], found.span_style[0]);
 #ifdef USE_LINE_MAXIMUM
   if (real3) OFFER(0, d3, edge_line3, edge_span3, edge_span3.y - edge_span3.x);
   if (real4) OFFER(0, d4, edge_line4, edge_span4, edge_span4.y - edge_span4.x);
 #endif
 
   /* The nearest diagonal, with its line and span for the pattern. */
-  float d_diag = NO_EDGE * NO_EDGE;
-  vec3 diag_line = vec3(0.0, 0.0, NO_EDGE);
-  vec2 diag_span = vec2(0.0);
 #if !defined(HIDDEN_PASS) && DIAGONALS >= 1
-  keep_nearest(diag0, d0, edge_line0, edge_span0, d_diag, diag_line, diag_span);
-  keep_nearest(diag1, d1, edge_line1, edge_span1, d_diag, diag_line, diag_span);
-  keep_nearest(diag2, d2, edge_line2, edge_span2, d_diag, diag_line, diag_span);
+  keep_nearest(diag0, d0, edge_line0, edge_span0, found.d_diag, found.diag_line, found.diag_span);
+  keep_nearest(diag1, d1, edge_line1, edge_span1, found.d_diag, found.diag_line, found.diag_span);
+  keep_nearest(diag2, d2, edge_line2, edge_span2, found.d_diag, found.diag_line, found.diag_span);
 #  ifdef USE_LINE_MAXIMUM
   if (diag0) OFFER(DIAGONAL_STYLE, d0, edge_line0, edge_span0, edge_span0.y - edge_span0.x);
   if (diag1) OFFER(DIAGONAL_STYLE, d1, edge_line1, edge_span1, edge_span1.y - edge_span1.x);
   if (diag2) OFFER(DIAGONAL_STYLE, d2, edge_line2, edge_span2, edge_span2.y - edge_span2.x);
 #  endif
 #endif
+  return found;
+}
 
-  /* An n-gon's boundary edges may pass near this fragment although they
-   * belong to another of its triangles (thin ears, concave outlines): walk
-   * the whole outline; a region's lines likewise come from all of its drawn
-   * edges. Compiled only into the variant for meshes that have n-gons or
-   * regions: llvmpipe pays for these loops on every fragment even when they
-   * run zero times. */
+/* An n-gon's boundary edges may pass near this fragment although they
+ * belong to another of its triangles (thin ears, concave outlines): walk
+ * the whole outline; a region's lines likewise come from all of its drawn
+ * edges. Compiled only into the variant for meshes that have n-gons or
+ * regions: llvmpipe pays for these loops on every fragment even when they
+ * run zero times. */
+#ifdef USE_NGONS
+/* A segment of a region block: the nearest line of its style so far, or a
+ * diagonal. */
+void keep_block_segment(int style, float d, vec3 line, vec2 span, inout NearLines found)
+{
+  keep_segment(style, d, line, span, found.d_style, found.line_style, found.span_style, found.d_diag,
+               found.diag_line, found.diag_span);
+}
+
+/* The segments within reach of this triangle, set up by the vertex stage
+ * (solidwire_vert.glsl, select_segments). */
+void walk_selected_segments(vec2 p, float half_thickness, inout NearLines found)
+{
+  for (int k = 0; k < SEGMENT_SLOTS; k++) {
+    if (k >= segment_count) {
+      break;
+    }
+    vec4 a, b;
+    switch (k) {
+      case 0: a = segment_line0; b = segment_rest0; break;
+      case 1: a = segment_line1; b = segment_rest1; break;
+      case 2: a = segment_line2; b = segment_rest2; break;
+      case 3: a = segment_line3; b = segment_rest3; break;
+      case 4: a = segment_line4; b = segment_rest4; break;
+      default: a = segment_line5; b = segment_rest5; break;
+    }
+    vec3 line = a.xyz;
+    vec2 span = vec2(a.w, b.x);
+    float d = edge_distance_sq(line, span, p);
+    int style = int(b.y);
+    OFFER(style, d, line, span, b.z);
+    keep_block_segment(style, d, line, span, found);
+  }
+}
+
+/* Every segment of the triangle's region block; with `lines_from_image`
+ * only its diagonals (its lines are in the region-lines image). */
+void walk_region_block(vec2 p, float half_thickness, int block_size, bool lines_from_image, inout NearLines found)
+{
+  for (int k = 0; k < block_size; k++) {
+    int texel = ngon_corner_start + SEGMENT_TEXELS * k;
+    vec4 segment = fetch_texel(ngon_corners, texel);
+    if (lines_from_image && int(segment.z) != DIAGONAL_STYLE) {
+      break; /* the block's diagonals come first; its lines are in the image */
+    }
+    vec3 line;
+    vec2 span;
+    /* Stored lower id first: patterns run from the lower-id end. */
+    edge_setup(vertex_clip(segment.x), vertex_clip(segment.y), line, span);
+    float d = edge_distance_sq(line, span, p);
+    int style = int(segment.z);
+#  ifdef USE_DENSITY_FADE
+    OFFER(style, d, line, span, chain_length(texel + 1, span));
+#  else
+    OFFER(style, d, line, span, 0.0);
+#  endif
+    keep_block_segment(style, d, line, span, found);
+  }
+}
+
+/* The whole outline of the triangle's n-gon and every one of its
+ * diagonals, not only this triangle's own. */
+void walk_ngon_outline(vec2 p, float half_thickness, int corners, inout NearLines found)
+{
+  for (int k = 0; k < corners; k++) {
+    vec4 slot_a = fetch_texel(ngon_corners, ngon_corner_start + k);
+    if (slot_a.y > 0.5) {
+      continue; /* an outline edge that is not drawn */
+    }
+    float id_a = slot_a.x;
+    float id_b = fetch_texel(ngon_corners, ngon_corner_start + (k + 1) % corners).x;
+    vec3 line;
+    vec2 span;
+    edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
+    float d = edge_distance_sq(line, span, p);
+    keep_nearest(true, d, line, span, found.d_style[0], found.line_style[0], found.span_style[0]);
+    OFFER(0, d, line, span, span.y - span.x);
+  }
+#  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
+  for (int k = 0; k < corners - 3; k++) {
+    int slot = ngon_corner_start + corners + 2 * k;
+    float id_a = fetch_texel(ngon_corners, slot).x;
+    float id_b = fetch_texel(ngon_corners, slot + 1).x;
+    vec3 line;
+    vec2 span;
+    edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
+    float d = edge_distance_sq(line, span, p);
+    keep_nearest(true, d, line, span, found.d_diag, found.diag_line, found.diag_span);
+    OFFER(DIAGONAL_STYLE, d, line, span, span.y - span.x);
+  }
+#  endif
+}
+#endif
+
+/* Lines beyond the triangle's own edges: its region's or its n-gon's. */
+void walk_blocks(vec2 p, float half_thickness, bool listed, bool lines_from_image, inout NearLines found)
+{
 #ifdef USE_NGONS
   int block_size = triangle_flags >> NGON_SHIFT;
   if (listed && segment_count >= 0) {
-    /* The segments within reach of this triangle, set up by the vertex
-     * stage (solidwire_vert.glsl, select_segments). */
-    for (int k = 0; k < SEGMENT_SLOTS; k++) {
-      if (k >= segment_count) {
-        break;
-      }
-      vec4 a, b;
-      switch (k) {
-        case 0: a = segment_line0; b = segment_rest0; break;
-        case 1: a = segment_line1; b = segment_rest1; break;
-        case 2: a = segment_line2; b = segment_rest2; break;
-        case 3: a = segment_line3; b = segment_rest3; break;
-        case 4: a = segment_line4; b = segment_rest4; break;
-        default: a = segment_line5; b = segment_rest5; break;
-      }
-      vec3 line = a.xyz;
-      vec2 span = vec2(a.w, b.x);
-      float d = edge_distance_sq(line, span, p);
-      int style = int(b.y);
-      OFFER(style, d, line, span, b.z);
-      keep_segment(style, d, line, span, d_style, line_style, span_style, d_diag, diag_line, diag_span);
-    }
+    walk_selected_segments(p, half_thickness, found);
   }
   else if (listed) {
-    for (int k = 0; k < block_size; k++) {
-      int texel = ngon_corner_start + SEGMENT_TEXELS * k;
-      vec4 segment = fetch_texel(ngon_corners, texel);
-      if (lines_from_image && int(segment.z) != DIAGONAL_STYLE) {
-        break; /* the block's diagonals come first; its lines are in the image */
-      }
-      vec3 line;
-      vec2 span;
-      /* Stored lower id first: patterns run from the lower-id end. */
-      edge_setup(vertex_clip(segment.x), vertex_clip(segment.y), line, span);
-      float d = edge_distance_sq(line, span, p);
-      int style = int(segment.z);
-#  ifdef USE_DENSITY_FADE
-      OFFER(style, d, line, span, chain_length(texel + 1, span));
-#  else
-      OFFER(style, d, line, span, 0.0);
-#  endif
-      keep_segment(style, d, line, span, d_style, line_style, span_style, d_diag, diag_line, diag_span);
-    }
+    walk_region_block(p, half_thickness, block_size, lines_from_image, found);
   }
   else {
-    int corners = block_size;
-    for (int k = 0; k < corners; k++) {
-      vec4 slot_a = fetch_texel(ngon_corners, ngon_corner_start + k);
-      if (slot_a.y > 0.5) {
-        continue; /* an outline edge that is not drawn */
-      }
-      float id_a = slot_a.x;
-      float id_b = fetch_texel(ngon_corners, ngon_corner_start + (k + 1) % corners).x;
-      vec3 line;
-      vec2 span;
-      edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
-      float d = edge_distance_sq(line, span, p);
-      keep_nearest(true, d, line, span, d_style[0], line_style[0], span_style[0]);
-      OFFER(0, d, line, span, span.y - span.x);
-    }
-#  if !defined(HIDDEN_PASS) && DIAGONALS >= 1
-    /* Every diagonal of an n-gon, not only this triangle's own. */
-    for (int k = 0; k < corners - 3; k++) {
-      int slot = ngon_corner_start + corners + 2 * k;
-      float id_a = fetch_texel(ngon_corners, slot).x;
-      float id_b = fetch_texel(ngon_corners, slot + 1).x;
-      vec3 line;
-      vec2 span;
-      edge_setup_from_lower(vertex_clip(id_a), vertex_clip(id_b), id_a, id_b, line, span);
-      float d = edge_distance_sq(line, span, p);
-      keep_nearest(true, d, line, span, d_diag, diag_line, diag_span);
-      OFFER(DIAGONAL_STYLE, d, line, span, span.y - span.x);
-    }
-#  endif
+    walk_ngon_outline(p, half_thickness, block_size, found);
   }
 #endif
+}
 
-  /* Only a triangle that walks a block has lines of other styles. */
-  int styles = listed ? STYLE_COUNT : 1;
-  /* The nearest line of any style: the Edge Distance pass and hidden lines. */
-  float d_real = d_style[0];
-  vec3 real_line = line_style[0];
-  vec2 real_span = span_style[0];
+/* The nearest line of any style (the Edge Distance pass and hidden lines),
+ * its distance returned, its line and span in `line` and `span`. Only a
+ * triangle that walks a block has lines of other styles. */
+float nearest_line(NearLines found, int styles, out vec3 line, out vec2 span)
+{
+  float d_real = found.d_style[0];
+  line = found.line_style[0];
+  span = found.span_style[0];
   for (int k = 1; k < styles; k++) {
-    keep_nearest(true, d_style[k], line_style[k], span_style[k], d_real, real_line, real_span);
+    keep_nearest(true, found.d_style[k], found.line_style[k], found.span_style[k], d_real, line, span);
   }
-  d_real = sqrt(d_real);
+  return sqrt(d_real);
+}
 
 #ifdef HIDDEN_PASS
-  /* Hidden-line style (docs/image_model.md §5.4): this face is behind the visible surface;
-   * its lines are drawn dimmed and dashed along the nearest one, from
-   * that edge's lower-id end. No diagonals, no styles, no fill. */
+/* Hidden-line style (docs/image_model.md §5.4): this face is behind the
+ * visible surface; its lines are drawn dimmed and dashed along the nearest
+ * one, from that edge's lower-id end. No diagonals, no styles, no fill. */
+float hidden_intensity(vec2 p, float half_thickness, float d_real, vec3 real_line, vec2 real_span)
+{
   float intensity = line_profile(d_real, half_thickness);
   float along_real = dot(vec2(-real_line.y, real_line.x), p);
   intensity *= params.hidden_alpha * pattern_mask(abs(along_real - real_span.x), params.hidden_period, params.hidden_duty);
-  int winner = 0;
+  return intensity;
+}
 #else
-  /* Each style's intensity at its nearest line; the pixel takes the style
-   * whose intensity is largest (image model §3.6). */
+/* Each style's intensity at its nearest line; the pixel takes the style
+ * whose intensity is largest (image model §3.6), `winner`, against the
+ * region-lines image and the nearest diagonal too. */
+float visible_intensity(vec2 p, float half_thickness, NearLines found, int styles, bool lines_from_image,
+                        out int winner)
+{
   float intensity = 0.0;
-  int winner = 0;
+  winner = 0;
   for (int k = 0; k < styles; k++) {
 #  ifdef USE_LINE_MAXIMUM
-    float value = faded[k];
+    float value = found.faded[k];
 #  else
-    float value = line_profile(sqrt(d_style[k]), style_half_thickness(k, half_thickness));
+    float value = line_profile(sqrt(found.d_style[k]), style_half_thickness(k, half_thickness));
 #  endif
     if (value > intensity) {
       intensity = value;
@@ -371,28 +426,30 @@ void main()
   }
 #  endif
 #  if DIAGONALS >= 1
-  d_diag = sqrt(d_diag);
+  float d_diag = sqrt(found.d_diag);
   float diag_intensity = line_profile(d_diag, half_thickness);
 #    if DIAGONALS == 2
   /* Position along the nearest diagonal from its lower-id end (stable for a
    * still camera whatever the settings). */
-  float along = dot(vec2(-diag_line.y, diag_line.x), p);
-  diag_intensity *= pattern_mask(abs(along - diag_span.x), params.pattern_period, params.pattern_duty);
+  float along = dot(vec2(-found.diag_line.y, found.diag_line.x), p);
+  diag_intensity *= pattern_mask(abs(along - found.diag_span.x), params.pattern_period, params.pattern_duty);
 #    endif
 #    ifdef USE_DENSITY_FADE
-  diag_intensity = faded_diagonal;
+  diag_intensity = found.faded_diagonal;
 #    endif
   if (diag_intensity > intensity) {
     intensity = diag_intensity;
     winner = 0;
   }
 #  endif
+  return intensity;
+}
 #endif
 
-#ifdef USE_FADE
-  intensity *= depth_fade(view_depth);
-#endif
-
+/* The fragment's colour: the winning style's colour at `intensity` over
+ * the fill, or premultiplied wire alone. */
+vec4 fragment_colour(float intensity, int winner)
+{
   float wire_weight = intensity * params.wire_color.a;
 #ifdef ITEM_COLORS
   vec3 wire_rgb = item_wire; /* colour sources (fill_shading.glsl) */
@@ -415,11 +472,18 @@ void main()
 #  ifdef ATTRIBUTE_COLORS
   fill_rgb = attribute_fill; /* interpolated over the triangle */
 #  endif
-  frag_color = vec4(mix(shaded_fill(fill_rgb), wire_rgb, wire_weight), 1.0);
+  return vec4(mix(shaded_fill(fill_rgb), wire_rgb, wire_weight), 1.0);
 #else
   /* Premultiplied: what the render pass expects and what blending needs. */
-  frag_color = vec4(wire_rgb * wire_weight, wire_weight);
+  return vec4(wire_rgb * wire_weight, wire_weight);
 #endif
+}
+
+/* Every output of the variant: the colour (through the display transform
+ * over the viewport), the view depth, the render passes' values. */
+void write_outputs(vec4 colour, float d_real, float intensity)
+{
+  frag_color = colour;
 #if defined(WRITE_VIEW_DEPTH) && !defined(HIDDEN_PASS)
   frag_view_depth = view_depth;
 #endif
@@ -430,4 +494,44 @@ void main()
 #ifdef DISPLAY_TRANSFORM
   frag_color = display_transform(frag_color);
 #endif
+}
+
+/* The resolve pass (resolve_frag.glsl) calls this for the one pixel it
+ * resolves, after setting every input as a plain global. */
+#ifdef RESOLVE_PASS
+void solidwire_fragment()
+#else
+void main()
+#endif
+{
+  write_linear_depth();
+  if (outside_clip_region()) {
+    discard;
+  }
+  /* Window position relative to the viewport centre (edge_geometry.glsl). */
+  vec2 p = gl_FragCoord.xy - viewport_centre();
+  float half_thickness = half_thickness_at(view_depth, SW_INV_CLIP_W);
+  bool listed = (triangle_flags & IN_REGION) != 0;
+#ifdef REGION_LINE_IMAGE
+  /* The region-lines pass measured this triangle's lines (image model
+   * §2.6): the strongest line at this pixel and its style. */
+  bool lines_from_image = (triangle_flags & REGION_LINES) != 0;
+#else
+  const bool lines_from_image = false;
+#endif
+  NearLines found = own_edge_lines(p, half_thickness, listed);
+  walk_blocks(p, half_thickness, listed, lines_from_image, found);
+  vec3 real_line;
+  vec2 real_span;
+  float d_real = nearest_line(found, listed ? STYLE_COUNT : 1, real_line, real_span);
+  int winner = 0;
+#ifdef HIDDEN_PASS
+  float intensity = hidden_intensity(p, half_thickness, d_real, real_line, real_span);
+#else
+  float intensity = visible_intensity(p, half_thickness, found, listed ? STYLE_COUNT : 1, lines_from_image, winner);
+#endif
+#ifdef USE_FADE
+  intensity *= depth_fade(view_depth);
+#endif
+  write_outputs(fragment_colour(intensity, winner), d_real, intensity);
 }

@@ -153,25 +153,29 @@ vec4 corner_shading(int triangle, int corner, float vertex_id)
 }
 #endif
 
-/* The per-corner work. The resolve pass (resolve_frag.glsl) runs it too,
- * for the provoking corner of the triangle a pixel shows, with
- * SW_VERTEX_ID standing for gl_VertexID and every output a plain global. */
-#ifdef RESOLVE_PASS
-void solidwire_corner()
-#else
-void main()
-#endif
+/* Whether the fragment stage may take line distances for segment
+ * distances (SIMPLE_TRIANGLE): a triangle wholly in front of the camera,
+ * convex (a quad) or a whole face, whose edges are all drawn. An edge that
+ * is not drawn makes a line distance no longer a segment distance for
+ * every sample; a triangle walking its region's block takes its lines from
+ * there. */
+bool simple_triangle(bool in_front, bool is_quad, bool is_ngon, bool convex)
 {
-  int triangle = SW_VERTEX_ID / 3;
-  int corner = SW_VERTEX_ID - triangle * 3;
-  vec4 ids = fetch_texel(triangle_vertices, triangle);
-  bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
-  bool is_ngon = (edge_flags & IS_NGON) != 0;
-  bool simple = false;
+  if (!in_front) {
+    return false;
+  }
+  bool simple = is_quad ? convex : !is_ngon;
+  int drawn_mask = is_quad ? (EDGE0_REAL | EDGE1_REAL) : (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
+  return simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0
+         && (edge_flags & IN_REGION) == 0;
+}
+
 #ifdef SETUP_TABLE
-  /* A big mesh: the set-up pre-pass (setup_comp.glsl) has set up this
-   * triangle's edges once; each corner only reads them and adds what
-   * depends on the edge flags. */
+/* A big mesh: the set-up pre-pass (setup_comp.glsl) has set up this
+ * triangle's edges once; each corner only reads them and adds what depends
+ * on the edge flags. Returns whether the triangle is simple. */
+bool read_setup_table(int triangle, vec4 ids, bool is_quad, bool is_ngon)
+{
   int row = triangle / SETUP_ROW_TRIANGLES; /* a constant divisor: see setup_texel() in setup_comp.glsl */
   ivec2 at = ivec2((triangle - row * SETUP_ROW_TRIANGLES) * SETUP_TEXELS, row);
   vec4 s0 = texelFetch(setup_table, at, 0);
@@ -195,25 +199,26 @@ void main()
     edge_line4 = s5.yzw;
     edge_span4 = s6.xy;
   }
-  if (in_front) {
-    /* The same test as the per-corner set-up below. */
-    simple = is_quad ? (geometry & 2) != 0 : !is_ngon;
-    int drawn_mask = is_quad ? (EDGE0_REAL | EDGE1_REAL) : (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
-    simple = simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0
-             && (edge_flags & IN_REGION) == 0;
-  }
-  ngon_corner_start = int(ids.w);
 #  ifdef RESOLVE_PASS
   sw_triangle_ids = ids;
   sw_corner_clip0 = vertex_clip(ids.x);
   sw_corner_clip1 = vertex_clip(ids.y);
   sw_corner_clip2 = vertex_clip(ids.z);
 #  endif
+  /* The same test as the per-corner set-up. */
+  return simple_triangle(in_front, is_quad, is_ngon, (geometry & 2) != 0);
+}
 #else
-
-  vec4 c0 = vertex_clip(ids.x);
-  vec4 c1 = vertex_clip(ids.y);
-  vec4 c2 = vertex_clip(ids.z);
+/* The triangle's edges set up at this corner from its clip-space corners
+ * c0..c2 (and c3, a quad's 4th); t0..t2 are its window corners relative to
+ * the viewport centre (region segments). Returns whether the triangle is
+ * simple; `in_front` says whether it lies wholly in front of the camera. */
+bool set_up_edges(vec4 ids, bool is_quad, bool is_ngon, out vec4 c0, out vec4 c1, out vec4 c2, out vec2 t0,
+                  out vec2 t1, out vec2 t2, out bool in_front)
+{
+  c0 = vertex_clip(ids.x);
+  c1 = vertex_clip(ids.y);
+  c2 = vertex_clip(ids.z);
 
   /* For a quad the 4th id is its 4th corner; for an n-gon triangle (or one
    * that walks its region's segments) it is where its block starts in
@@ -226,9 +231,8 @@ void main()
   sw_corner_clip1 = c1;
   sw_corner_clip2 = c2;
 #  endif
-  ngon_corner_start = int(ids.w);
   vec2 w0, w1, w2;
-  bool in_front, convex;
+  bool convex;
 #  ifdef NO_EDGE_SETUP
   /* Every triangle of this draw takes its lines from the region-lines pass
    * and draws no diagonal (ShaderVariant.no_edge_setup): no edge of its
@@ -242,32 +246,26 @@ void main()
   triangle_edges(c0, c1, c2, c3, ids, is_quad, edge_line0, edge_span0, edge_line1, edge_span1, edge_line2,
                  edge_span2, edge_line3, edge_span3, edge_line4, edge_span4, w0, w1, w2, in_front, convex);
 #  endif
-  /* Window corners relative to the viewport centre (region segments). */
-  vec2 t0 = w0 - viewport_centre(), t1 = w1 - viewport_centre(), t2 = w2 - viewport_centre();
-  if (in_front) {
-    simple = is_quad ? convex : !is_ngon;
-    /* An edge that is not drawn makes a line distance no longer a segment
-     * distance for every sample; a triangle walking its region's block
-     * takes its lines from there. */
-    int drawn_mask = is_quad ? (EDGE0_REAL | EDGE1_REAL) : (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
-    simple = simple && (edge_flags & drawn_mask) == drawn_mask && (edge_flags & (EDGE3_HIDDEN | EDGE4_HIDDEN)) == 0
-             && (edge_flags & IN_REGION) == 0;
-  }
+  t0 = w0 - viewport_centre();
+  t1 = w1 - viewport_centre();
+  t2 = w2 - viewport_centre();
+  return simple_triangle(in_front, is_quad, is_ngon, convex);
+}
 #endif
-  if (!is_quad) {
-    edge_line3 = edge_line4 = vec3(0.0, 0.0, NO_EDGE);
-    edge_span3 = edge_span4 = vec2(0.0);
-  }
-  triangle_flags = edge_flags | (simple ? SIMPLE_TRIANGLE : 0);
+
 #ifdef USE_NGONS
+/* The segments of the triangle's region block within reach of it, handed to
+ * the fragment stage (segment_count -1: it walks the whole block). Flat
+ * outputs come from the provoking corner only: the last one under OpenGL
+ * (Blender keeps GL's default), so there the other two skip the selection;
+ * other backends may provoke from the first, so both ends select
+ * (PROVOKING_CORNERS, core/shaders.py). */
+void select_block_segments(int corner, bool in_front, vec2 t0, vec2 t1, vec2 t2, vec3 clip_w)
+{
   segment_count = 0;
   for (int k = 0; k < SEGMENT_SLOTS; k++) {
     store_segment(k, vec3(0.0, 0.0, NO_EDGE), vec2(0.0), 0.0, 0.0);
   }
-  /* Flat outputs come from the provoking corner only: the last one under
-   * OpenGL (Blender keeps GL's default), so there the other two skip the
-   * selection; other backends may provoke from the first, so both ends
-   * select (PROVOKING_CORNERS, core/shaders.py). */
   bool provoking = (corner == 2) || (PROVOKING_CORNERS == 2 && corner == 0);
 #  ifdef REGION_LINE_IMAGE
   /* Lines from the region-lines pass: only the block's diagonals are walked. */
@@ -280,14 +278,18 @@ void main()
   }
   else if ((edge_flags & IN_REGION) != 0 && provoking) {
     /* Behind the near plane a corner has no window position: walk. */
-    segment_count = in_front ? select_segments(t0, t1, t2, line_reach(c0.w, c1.w, c2.w)) : -1;
+    segment_count = in_front ? select_segments(t0, t1, t2, line_reach(clip_w.x, clip_w.y, clip_w.z)) : -1;
   }
+}
 #endif
 
 #ifdef WRITE_AOVS
-  /* Normal pass: the triangle's world-space normal (loop order, through the
-   * normal matrix); the fragment stage turns it towards the camera. The
-   * matrix's sign folds in mirroring, so gl_FrontFacing picks the side. */
+/* Normal pass: the triangle's world-space normal (loop order, through the
+ * normal matrix); the fragment stage turns it towards the camera. The
+ * matrix's sign folds in mirroring, so gl_FrontFacing picks the side. And
+ * IndexMA: the pass_index of this triangle's material (draw.py). */
+void render_pass_outputs(int triangle, vec4 ids)
+{
   vec3 p0 = fetch_texel(vertex_positions, int(ids.x)).xyz;
   vec3 p1 = fetch_texel(vertex_positions, int(ids.y)).xyz;
   vec3 p2 = fetch_texel(vertex_positions, int(ids.z)).xyz;
@@ -296,28 +298,23 @@ void main()
   vec3 n = object_to_world_normal * cross(p1 - p0, p2 - p0);
   float n_length = length(n);
   face_normal = n_length > 0.0 ? n / n_length : vec3(0.0);
-  /* IndexMA: the pass_index of this triangle's material (draw.py). */
   material_pass_index = fetch_texel(triangle_material, triangle).x;
+}
 #endif
-#ifdef SETUP_TABLE
-  vec3 local = fetch_texel(vertex_positions,
-                           int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
-  vec4 position = object_to_clip * vec4(local, 1.0); /* as vertex_clip() */
-#else
-  vec4 position = (corner == 0) ? c0 : ((corner == 1) ? c1 : c2);
-  vec3 local = fetch_texel(vertex_positions,
-                           int((corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z))).xyz;
-#endif
-  view_depth = -dot(object_to_view_z, vec4(local, 1.0));
+
+/* The fill's inputs at this corner: the shading normal, the colour
+ * attribute and the object's colours from the frame's colour table
+ * (core/colors.py), the fill per face material. */
+void fill_outputs(int triangle, int corner, float vertex_id)
+{
 #ifdef USE_CORNERS
-  vec4 corner_data = corner_shading(triangle, corner, (corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z));
+  vec4 corner_data = corner_shading(triangle, corner, vertex_id);
   shading_normal = corner_data.xyz;
 #endif
 #ifdef ATTRIBUTE_COLORS
-  attribute_fill = attribute_row(triangle, corner, (corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z)).rgb;
+  attribute_fill = attribute_row(triangle, corner, vertex_id).rgb;
 #endif
 #ifdef ITEM_COLORS
-  /* The object's block of the frame's colour table (core/colors.py). */
   int item_base = int(item_info.x);
   vec4 item_head = fetch_texel(item_colors, item_base);
   item_wire = item_head.rgb;
@@ -329,29 +326,84 @@ void main()
   }
 #  endif
 #endif
+}
+
 #ifdef USE_CLIP_PLANES
-  /* Viewport clipping region: signed distances to the clip-space planes
-   * (draw.py, clip_space_planes), linear in clip space so the interpolated
-   * value is exact; the fragment stage discards where one is negative.
-   * Taken before the depth bias, which moves only z. */
+/* Viewport clipping region: signed distances to the clip-space planes
+ * (draw.py, clip_space_planes), linear in clip space so the interpolated
+ * value is exact; the fragment stage discards where one is negative.
+ * Taken before the depth bias, which moves only z. */
+void clip_distances(vec4 position)
+{
   clip_distance_a = vec4(dot(clip_params.planes[0], position),
                          dot(clip_params.planes[1], position),
                          dot(clip_params.planes[2], position),
                          dot(clip_params.planes[3], position));
   clip_distance_b = vec2(dot(clip_params.planes[4], position), dot(clip_params.planes[5], position));
+}
 #endif
+
+/* Viewport overlay only: Blender's own Solid shading has already written
+ * (nearly) the same depth for the same surface, but from its own float32
+ * matrices and positions, so ours differs by a few ULPs either way and a
+ * LESS_EQUAL test would stipple. Moving every vertex a constant DEPTH_BIAS
+ * towards the camera in NDC (z - b*w, i.e. z/w - b after the divide) makes
+ * our surface win that tie; NDC bias is the right unit because float32
+ * rounding of z/w is relative to |z/w| <= 1. Window x/y and the edge
+ * distances are untouched (only z changes). */
+vec4 biased(vec4 position)
+{
 #ifdef DEPTH_BIAS
-  /* Viewport overlay only: Blender's own Solid shading has already written
-   * (nearly) the same depth for the same surface, but from its own float32
-   * matrices and positions, so ours differs by a few ULPs either way and a
-   * LESS_EQUAL test would stipple. Moving every vertex a constant DEPTH_BIAS
-   * towards the camera in NDC (z - b*w, i.e. z/w - b after the divide) makes
-   * our surface win that tie; NDC bias is the right unit because float32
-   * rounding of z/w is relative to |z/w| <= 1. Window x/y and the edge
-   * distances are untouched (only z changes). */
   position.z -= DEPTH_BIAS * position.w;
 #endif
+  return position;
+}
+
+/* The per-corner work. The resolve pass (resolve_frag.glsl) runs it too,
+ * for the provoking corner of the triangle a pixel shows, with
+ * SW_VERTEX_ID standing for gl_VertexID and every output a plain global. */
+#ifdef RESOLVE_PASS
+void solidwire_corner()
+#else
+void main()
+#endif
+{
+  int triangle = SW_VERTEX_ID / 3;
+  int corner = SW_VERTEX_ID - triangle * 3;
+  vec4 ids = fetch_texel(triangle_vertices, triangle);
+  float vertex_id = (corner == 0) ? ids.x : ((corner == 1) ? ids.y : ids.z);
+  bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
+  bool is_ngon = (edge_flags & IS_NGON) != 0;
+  ngon_corner_start = int(ids.w);
+#ifdef SETUP_TABLE
+  bool simple = read_setup_table(triangle, ids, is_quad, is_ngon);
+  vec3 local = fetch_texel(vertex_positions, int(vertex_id)).xyz;
+  vec4 position = object_to_clip * vec4(local, 1.0); /* as vertex_clip() */
+#else
+  vec4 c0, c1, c2;
+  vec2 t0, t1, t2;
+  bool in_front;
+  bool simple = set_up_edges(ids, is_quad, is_ngon, c0, c1, c2, t0, t1, t2, in_front);
+  vec4 position = (corner == 0) ? c0 : ((corner == 1) ? c1 : c2);
+  vec3 local = fetch_texel(vertex_positions, int(vertex_id)).xyz;
+#endif
+  if (!is_quad) {
+    edge_line3 = edge_line4 = vec3(0.0, 0.0, NO_EDGE);
+    edge_span3 = edge_span4 = vec2(0.0);
+  }
+  triangle_flags = edge_flags | (simple ? SIMPLE_TRIANGLE : 0);
+#ifdef USE_NGONS
+  select_block_segments(corner, in_front, t0, t1, t2, vec3(c0.w, c1.w, c2.w));
+#endif
+#ifdef WRITE_AOVS
+  render_pass_outputs(triangle, ids);
+#endif
+  view_depth = -dot(object_to_view_z, vec4(local, 1.0));
+  fill_outputs(triangle, corner, vertex_id);
+#ifdef USE_CLIP_PLANES
+  clip_distances(position);
+#endif
 #ifndef RESOLVE_PASS
-  gl_Position = position;
+  gl_Position = biased(position);
 #endif
 }

@@ -17,23 +17,34 @@
 
 #define PX_PER_UNIT strand_view.x
 
-void main()
-{
-  vec2 p = gl_FragCoord.xy;
-  float intensity, weight, depth, inv_w;
-  bool inside = false;
 #ifdef STRAND_POINTS
+/* A point's disc at p: the outline's intensity, with the depth of the
+ * sphere's front, whether p is inside the disc and (for the clipping
+ * region) the centre in clip space. */
+float disc_sample(vec2 p, out float depth, out bool inside, out vec4 clip_position)
+{
   float rim = length(p - disc.xy) - disc.z;
   inside = rim <= 0.0;
-  inv_w = disc_extra.y;
+  float inv_w = disc_extra.y;
   /* The sphere's nearest point along the view axis: a point resting on a
    * surface is not cut in half by it. */
   depth = disc.w - disc_extra.x;
-  intensity = line_profile(abs(rim), half_thickness_at(disc.w, inv_w));
+  float intensity = line_profile(abs(rim), half_thickness_at(disc.w, inv_w));
 #  ifdef USE_FADE
   intensity *= depth_fade(disc.w);
 #  endif
+#  ifdef USE_CLIP_PLANES
+  clip_position = disc_clip;
+#  else
+  clip_position = vec4(0.0);
+#  endif
+  return intensity;
+}
 #else
+/* A strand segment at p: the intensity at its nearest point q, with the
+ * depth of the tube's front there and q in clip space. */
+float segment_sample(vec2 p, out float depth, out vec4 clip_position)
+{
   vec2 wa = window_point(seg_a), wb = window_point(seg_b);
 #  ifdef STRAND_OVERLAY
   /* This segment's side of each joint (strand_vert.glsl, joint_normal). */
@@ -48,33 +59,37 @@ void main()
   /* Window parameter s -> parameter u along the clip-space segment
    * (perspective-correct). */
   float u = s * seg_a.w / (s * seg_a.w + (1.0 - s) * seg_b.w);
-  inv_w = 1.0 / mix(seg_a.w, seg_b.w, u);
+  float inv_w = 1.0 / mix(seg_a.w, seg_b.w, u);
   float q_depth = mix(seg_depth.x, seg_depth.y, u);
   float radius = mix(seg_radius.x, seg_radius.y, u);
   depth = q_depth - radius;
-  intensity = line_profile(d, max(half_thickness_at(q_depth, inv_w), radius * PX_PER_UNIT * inv_w));
+  float intensity = line_profile(d, max(half_thickness_at(q_depth, inv_w), radius * PX_PER_UNIT * inv_w));
 #  ifdef USE_FADE
   intensity *= depth_fade(q_depth);
 #  endif
+  clip_position = mix(seg_a, seg_b, u);
+  return intensity;
+}
 #endif
+
+/* Outside the viewport's clipping region (docs/image_model.md §5.6): a
+ * point by its centre, a strand at its nearest point q. */
+bool outside_clip_region(vec4 clip_position)
+{
 #ifdef USE_CLIP_PLANES
-  /* Outside the viewport's clipping region (docs/image_model.md §5.6): a
-   * point by its centre, a strand at its nearest point q. */
-#  ifdef STRAND_POINTS
-  vec4 clip_position = disc_clip;
-#  else
-  vec4 clip_position = mix(seg_a, seg_b, u);
-#  endif
   for (int k = 0; k < 6; k++) {
     if (dot(clip_params.planes[k], clip_position) < 0.0) {
-      discard;
+      return true;
     }
   }
 #endif
-  weight = inside ? 1.0 : intensity;
-  if (weight <= 0.0) {
-    discard;
-  }
+  return false;
+}
+
+/* Premultiplied wire colour at `intensity`; a filled point's inside is
+ * the fill (shaded as the sphere it stands for) under it. */
+vec4 strand_colour(vec2 p, float intensity, bool inside)
+{
   float a = intensity * params.wire_color.a;
   vec4 color = vec4(params.wire_color.rgb * a, a);
 #if defined(STRAND_POINTS) && defined(USE_FILL)
@@ -91,10 +106,15 @@ void main()
     color = vec4(params.wire_color.rgb * a + fill * (1.0 - a), 1.0);
   }
 #endif
+  return color;
+}
+
 #ifdef STRAND_OVERLAY
-  /* Viewport: the window depth of `depth`, moved towards the camera by the
-   * overlay's depth bias (as the mesh wire), tested LESS_EQUAL against what
-   * Blender drew; blended "over". */
+/* Viewport: the window depth of `depth`, moved towards the camera by the
+ * overlay's depth bias (as the mesh wire), tested LESS_EQUAL against what
+ * Blender drew; blended "over". */
+void write_overlay(vec4 color, float depth)
+{
   float clip_z = -proj_z.x * depth + proj_z.y;
   float clip_w = -proj_z.z * depth + proj_z.w;
   gl_FragDepth = clamp(0.5 * (clip_z / clip_w) + 0.5 - 0.5 * STRAND_OVERLAY, 0.0, 1.0);
@@ -102,16 +122,47 @@ void main()
 #  ifdef DISPLAY_TRANSFORM
   frag_color = display_transform(frag_color);
 #  endif
+}
 #else
+/* Render: hidden where the surface depth at p is nearer; the depth key
+ * lets the largest weight win, the nearest next: the weight in 1/1024
+ * steps, the depth within a step (float32 keeps ~6e-5 of the clip range
+ * there). */
+void write_render(vec2 p, vec4 color, float depth, float weight)
+{
   float key_depth = depth * params.inv_clip_end;
   float scene = texelFetch(scene_depth, ivec2(p), 0).r;
   if (key_depth > scene) {
     discard; /* a nearer surface (or the far plane) hides it here */
   }
-  /* Largest weight first, nearest next: the weight in 1/1024 steps, the
-   * depth within a step (float32 keeps ~6e-5 of the clip range there). */
   gl_FragDepth = (floor((1.0 - weight) * 1023.0) + clamp(key_depth, 0.0, 0.999)) / 1024.0;
   frag_color = color;
   frag_info = vec4(depth, weight, 0.0, 0.0);
+}
+#endif
+
+void main()
+{
+  vec2 p = gl_FragCoord.xy;
+  float depth;
+  bool inside = false;
+  vec4 clip_position;
+#ifdef STRAND_POINTS
+  float intensity = disc_sample(p, depth, inside, clip_position);
+#else
+  float intensity = segment_sample(p, depth, clip_position);
+#endif
+  if (outside_clip_region(clip_position)) {
+    discard;
+  }
+  float weight = inside ? 1.0 : intensity;
+  if (weight <= 0.0) {
+    discard;
+  }
+  vec4 color = strand_colour(p, intensity, inside);
+#ifdef STRAND_OVERLAY
+  write_overlay(color, depth);
+#else
+  write_render(p, color, depth, weight);
 #endif
 }

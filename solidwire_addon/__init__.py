@@ -2,50 +2,48 @@
 on the filled triangles from the exact window-space distance to each face's
 edges.
 
-Data flows one way: scene -> gather/extract -> GPU cache -> pass plan -> draw
--> targets (render engine, command line, viewport overlay). ``core`` holds the
-plain-data and GPU side, ``blender`` everything that faces Blender; the image
-model is defined in docs/image_model.md. ``register()`` and ``unregister()``
-are safe to call repeatedly and leave nothing behind.
+Data flows one way: scene -> gather / mesh reading -> extract -> GPU cache ->
+pass plan -> draw -> targets (render engine, command line, viewport overlay).
+``core`` holds the plain-data and GPU side, ``blender`` everything that
+faces Blender; the image model is defined in docs/image_model.md.
+``register()`` and ``unregister()`` are safe to call repeatedly and leave
+nothing behind.
 """
 
 from __future__ import annotations
 
 import atexit
 
-import bpy
-
-from .blender import (
-    cli,
-    color_management,
-    engine,
-    matcap_files,
-    ops,
-    ops_composite,
-    overlay,
-    properties,
-    runtime,
-    setting_repair,
-    ui,
-)
-from .core import draw, log, matcaps, strands, targets
-
-_classes = (
-    *properties.classes,
-    *engine.classes,
-    *setting_repair.classes,
-    *ops.classes,
-    *ops_composite.classes,
-    *ui.classes,
-)
+# Importing the package starts nothing: the Blender side is imported by
+# register() (and what follows it), so that core's modules without GPU work
+# (extraction, edge selection, the schema, the overlay's rules) import and
+# are tested in a Python without Blender (tests/pure/).
 _registered = False
+
+
+def _classes() -> tuple:
+    """Every class the add-on registers with Blender, in registration order."""
+    from .blender import engine, ops, ops_composite, properties, setting_repair, ui
+
+    return (
+        *properties.classes,
+        *engine.classes,
+        *setting_repair.classes,
+        *ops.classes,
+        *ops_composite.classes,
+        *ui.classes,
+    )
 
 
 def register() -> None:
     global _registered
     if _registered:
         return
-    for cls in _classes:
+    import bpy
+
+    from .blender import cli, engine, matcap_files, ops, overlay, properties, ui
+
+    for cls in _classes():
         bpy.utils.register_class(cls)
     properties.register_properties()
     engine.register_compat()
@@ -62,6 +60,11 @@ def unregister() -> None:
     global _registered
     if not _registered:
         return
+    import bpy
+
+    from .blender import cli, engine, matcap_files, ops, overlay, properties, ui
+    from .core import log
+
     cli.unregister_command()
     matcap_files.unregister()
     overlay.unregister()
@@ -69,7 +72,7 @@ def unregister() -> None:
     ui.unregister_appends()
     engine.unregister_compat()
     properties.unregister_properties()
-    for cls in reversed(_classes):
+    for cls in reversed(_classes()):
         bpy.utils.unregister_class(cls)
     release_gpu()
     atexit.unregister(_at_exit)
@@ -89,6 +92,9 @@ def release_gpu() -> None:
     """Free the GPU objects the add-on holds (targets, meshes, quad batches,
     display LUTs). Compiled shader programs are the exception: they live
     until interpreter exit (core/shaders.py says why)."""
+    from .blender import color_management, runtime
+    from .core import draw, matcaps, strands, targets
+
     targets.release()
     runtime.release()
     strands.release()
@@ -99,4 +105,6 @@ def release_gpu() -> None:
 
 def stats() -> dict:
     """Statistics of the last drawn frame (see docs/user/command-line.md)."""
+    from .blender import runtime
+
     return runtime.stats()

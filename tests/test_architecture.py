@@ -1,14 +1,21 @@
 """The package's layering, read from its source: no import cycles (module- or
-function-level imports alike), nothing in ``core`` that faces Blender's UI or
-context, no private names used across modules, a shader parameter block
-that is exactly the schema's, one module map in the manual that lists every
-module, one formatter for errors as one line, and one table of render passes.
+function-level imports alike), nothing in ``core`` that imports Blender's
+modules or reads Blender's data, front ends imported only by what presents
+them, core's GPU-free modules and tests/pure/ without Blender, no private
+names used across modules, a shader parameter block that is exactly the
+schema's, one module map in the manual that lists every module, one
+formatter for errors as one line, one table of render passes, one
+description of a draw's target from which its shader variant follows,
+passes as units, and no switch kept in a core module.
 """
 
 from __future__ import annotations
 
 import ast
+import dataclasses
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -106,17 +113,235 @@ def test_core_never_imports_the_blender_side():
             assert not upward, f"{module} imports {upward}"
 
 
-def test_core_reads_no_blender_ui_or_context():
-    """core may draw with ``gpu`` but never imports ``bpy`` (so no
-    bpy.types, bpy.context or bpy.ops)."""
+# The add-on's front ends and the only modules that may import them besides
+# the package's __init__ (which registers them): a front end is where a
+# dependency ends, so that no module pulls in the UI, the operators, the
+# overlay, the render engine or the command line for a helper of theirs.
+FRONT_END_IMPORTERS = {
+    "blender.ui": set(),
+    "blender.ops": {"blender.ui"},  # the panels show the operators
+    "blender.ops_composite": set(),
+    "blender.overlay": {"blender.ops"},  # the toggle operator shows and hides it
+    "blender.engine": set(),
+    "blender.cli": set(),
+}
+
+
+def test_front_ends_are_imported_only_by_what_presents_them():
+    graph = import_graph()
+    for front_end, allowed in FRONT_END_IMPORTERS.items():
+        module = f"solidwire_addon.{front_end}"
+        assert module in graph, module
+        importers = {name.removeprefix("solidwire_addon.") for name, imports in graph.items() if module in imports}
+        extra = importers - allowed - {"solidwire_addon"}
+        assert not extra, f"{sorted(extra)} import {front_end}"
+
+
+# Blender's data API, which core never touches: it takes the arrays that
+# blender/mesh_reading.py (and the rest of blender/) read instead. Names of
+# Blender mesh data and its bulk reads, then of objects, depsgraphs and
+# data-blocks; none of them names anything of core's own.
+BLENDER_DATA_NAMES = frozenset(
+    {
+        "vertices",
+        "edges",
+        "loops",
+        "polygons",
+        "loop_triangles",
+        "loop_triangle_polygons",
+        "polygon_normals",
+        "vertex_normals",
+        "corner_normals",
+        "normals_domain",
+        "attributes",
+        "color_attributes",
+        "uv_layers",
+        "shape_keys",
+        "calc_loop_triangles",
+        "foreach_get",
+        "foreach_set",
+        # ``data``: an object's mesh (``obj.data``), an attribute's values
+        # (``attribute.data``).
+        "data",
+        "evaluated_get",
+        "evaluated_depsgraph_get",
+        "object_instances",
+        "original",
+        "to_mesh",
+        "to_mesh_clear",
+        "matrix_world",
+        "material_slots",
+        "modifiers",
+        "session_uid",
+        "as_pointer",
+        "bound_box",
+        "bl_rna",
+        "rna_type",
+    }
+)
+# Blender's Python modules besides ``gpu`` (which core draws with).
+BLENDER_MODULES = frozenset({"bpy", "bmesh", "bpy_extras", "mathutils"})
+# Ways to reach an attribute by its name as a string.
+BY_NAME = frozenset({"getattr", "hasattr", "setattr", "delattr", "attrgetter", "methodcaller", "__getattribute__"})
+
+
+def _called_name(call: ast.Call) -> str:
+    func = call.func
+    return func.id if isinstance(func, ast.Name) else func.attr if isinstance(func, ast.Attribute) else ""
+
+
+def _docstrings(tree: ast.Module) -> set[int]:
+    kinds = (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)
+    return {
+        id(node.body[0].value)
+        for node in ast.walk(tree)
+        if isinstance(node, kinds) and node.body and isinstance(node.body[0], ast.Expr)
+    }
+
+
+def blender_data_access(tree: ast.Module) -> list[str]:
+    """Where ``tree`` reaches into Blender: an import of one of Blender's
+    modules, or its name as a string anywhere but in a docstring
+    (``__import__("bpy")``, ``sys.modules["bpy"]``); an attribute of
+    Blender's data API (``mesh.polygons``, ``attribute.data.foreach_get``);
+    or such an attribute asked for by name (``getattr(mesh, "polygons")``,
+    ``attrgetter("data.polygons")``)."""
+    docstrings = _docstrings(tree)
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            found += [
+                f"line {node.lineno}: import {a.name}" for a in node.names if a.name.split(".")[0] in BLENDER_MODULES
+            ]
+        elif (
+            isinstance(node, ast.ImportFrom)
+            and node.level == 0
+            and (node.module or "").split(".")[0] in BLENDER_MODULES
+        ):
+            found.append(f"line {node.lineno}: from {node.module} import")
+        elif isinstance(node, ast.Attribute) and node.attr in BLENDER_DATA_NAMES:
+            found.append(f"line {node.lineno}: .{node.attr}")
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings:
+            if node.value.split(".")[0] in BLENDER_MODULES:
+                found.append(f"line {node.lineno}: {node.value!r}")
+        elif isinstance(node, ast.Call) and _called_name(node) in BY_NAME:
+            for arg in node.args:
+                value = arg.value if isinstance(arg, ast.Constant) and isinstance(arg.value, str) else ""
+                if any(part in BLENDER_DATA_NAMES for part in value.split(".")):
+                    found.append(f"line {node.lineno}: {_called_name(node)}({value!r})")
+    return found
+
+
+def test_core_reads_no_blender_data():
+    """core takes numpy arrays and plain dataclasses and draws with ``gpu``:
+    no module of it imports ``bpy`` (so no bpy.types, bpy.context or bpy.ops)
+    or reads a Blender mesh, object or depsgraph (blender/mesh_reading.py
+    does)."""
     for name, tree in _modules().items():
-        if not name.startswith("solidwire_addon.core"):
-            continue
-        for node in ast.walk(tree):
-            if isinstance(node, ast.Import):
-                assert not any(a.name.split(".")[0] == "bpy" for a in node.names), f"{name} imports bpy"
-            elif isinstance(node, ast.ImportFrom) and node.level == 0:
-                assert (node.module or "").split(".")[0] != "bpy", f"{name} imports from bpy"
+        if name.startswith("solidwire_addon.core"):
+            found = blender_data_access(tree)
+            assert not found, f"{name} reads Blender data: {found}"
+
+
+@pytest.mark.parametrize(
+    "source",
+    [
+        "import bpy",
+        "import bpy.types as t",
+        "from bpy.types import Mesh",
+        "import bmesh",
+        "from mathutils import Matrix",
+        "bpy = __import__('bpy')",
+        "importlib.import_module('bpy.utils')",
+        "bpy = sys.modules['bpy']",
+        "n = len(mesh.polygons)",
+        "mesh.attributes.get('position')",
+        "attribute.data.foreach_get('value', out)",
+        "tris = mesh.loop_triangles",
+        "mesh.polygon_normals",
+        "obj.evaluated_get(depsgraph).data",
+        "obj.matrix_world",
+        "faces = getattr(mesh, 'polygons')",
+        "read = operator.attrgetter('loop_triangles')",
+        "read = operator.attrgetter('data.polygons')",
+        "mesh.__getattribute__('polygons')",
+        "hasattr(mesh, 'foreach_get')",
+    ],
+)
+def test_blender_data_access_is_found(source):
+    assert blender_data_access(ast.parse(source)), source
+
+
+def test_plain_array_code_is_not_taken_for_blender_data():
+    source = """
+import numpy as np
+from .extract import MeshArrays
+def f(arrays, corner_vert, face_offsets, settings, name):
+    \"\"\"bpy.types.Mesh is read on the Blender side; this takes its arrays.\"\"\"
+    sizes = np.diff(face_offsets)
+    getattr(settings, f"use_{name}_edges")
+    return arrays.triangles[:, :3], arrays.triangle_polygons, arrays.vertex_count, {"edges": sizes}
+"""
+    assert blender_data_access(ast.parse(source)) == []
+
+
+def _needs_gpu(graph) -> set[str]:
+    """Modules that import ``gpu``, directly or through another module."""
+    direct = {
+        name
+        for name, tree in _modules().items()
+        for node in ast.walk(tree)
+        if (isinstance(node, ast.Import) and any(a.name.split(".")[0] == "gpu" for a in node.names))
+        or (isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").split(".")[0] == "gpu")
+    }
+    needs = set(direct)
+    while True:
+        more = {name for name, imports in graph.items() if imports & needs} - needs
+        if not more:
+            return needs
+        needs |= more
+
+
+def test_core_without_gpu_work_imports_where_there_is_no_blender():
+    """Every core module that does no GPU work imports in a Python without
+    Blender (bpy, bmesh, mathutils and gpu made unimportable; the package's
+    own __init__, which registers the add-on with Blender, left out)."""
+    graph = import_graph()
+    pure = sorted(name for name in graph if name.startswith("solidwire_addon.core.") and name not in _needs_gpu(graph))
+    assert {"solidwire_addon.core.extract", "solidwire_addon.core.edge_select", "solidwire_addon.core.schema"} <= set(
+        pure
+    )
+    script = f"""
+import importlib, sys, types
+for blocked in ("bpy", "bmesh", "bpy_extras", "mathutils", "gpu"):
+    sys.modules[blocked] = None  # import raises ImportError
+package = types.ModuleType("solidwire_addon")
+package.__path__ = [{str(PACKAGE)!r}]
+sys.modules["solidwire_addon"] = package
+for name in {pure!r}:
+    importlib.import_module(name)
+"""
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False)
+    assert result.returncode == 0, result.stderr
+
+
+def test_the_pure_tests_run_without_blender():
+    """tests/pure/ (extraction, edge selection and the overlay's rules on
+    plain arrays) passes in a Python where Blender's modules cannot be
+    imported: neither the tests nor the core modules they use, nor the
+    package's __init__, start Blender."""
+    script = f"""
+import sys
+for blocked in ("bpy", "bmesh", "bpy_extras", "mathutils", "gpu"):
+    sys.modules[blocked] = None  # import raises ImportError
+import pytest
+sys.exit(pytest.main([{str(ROOT / "tests" / "pure")!r}, "-q", "-p", "no:cacheprovider", "-p", "no:randomly"]))
+"""
+    result = subprocess.run(
+        [sys.executable, "-c", script], cwd=ROOT, capture_output=True, text=True, timeout=300, check=False
+    )
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    assert " passed" in result.stdout
 
 
 def test_no_private_name_is_used_across_modules():
@@ -331,3 +556,168 @@ def test_sampler_slots_are_one_table():
     ]
     assert set(declared) == set(shaders.SAMPLERS), set(declared) ^ set(shaders.SAMPLERS)
     assert all(0 <= slot < 16 for slot, _kind in shaders.SAMPLERS.values())
+
+
+# -- the draw hub -------------------------------------------------------------
+
+
+def _functions(tree: ast.Module) -> dict[str, ast.FunctionDef]:
+    return {node.name: node for node in tree.body if isinstance(node, ast.FunctionDef)}
+
+
+def _calls(node: ast.AST, name: str) -> list[ast.Call]:
+    """Calls of ``name`` or ``<module>.name`` inside ``node``."""
+    found = []
+    for call in ast.walk(node):
+        if isinstance(call, ast.Call):
+            func = call.func
+            if (isinstance(func, ast.Name) and func.id == name) or (
+                isinstance(func, ast.Attribute) and func.attr == name
+            ):
+                found.append(call)
+    return found
+
+
+def test_a_draws_variant_follows_from_its_target_description_alone():
+    """draw.DrawTarget is the one description of where and how a draw lands:
+    draw.shader_variant(settings, target) is the only place in draw.py that
+    makes a shader variant, draw() asks it once, and each field of the
+    description either selects compiled code (the variant changes with it)
+    or is GPU state / an input texture (the variant does not)."""
+    from dataclasses import fields, replace
+
+    import numpy as np
+
+    from solidwire_addon.core import draw
+
+    tree = ast.parse((PACKAGE / "core" / "draw.py").read_text(encoding="utf-8"))
+    functions = _functions(tree)
+    makers = [name for name, node in functions.items() if _calls(node, "ShaderVariant")]
+    assert makers == ["shader_variant"], f"shader variants made outside draw.shader_variant: {makers}"
+    assert len(_calls(functions["draw"], "shader_variant")) == 1
+    # draw() takes the description and a few other arguments, not one
+    # keyword per target feature.
+    arguments = functions["draw"].args
+    assert [a.arg for a in arguments.args + arguments.kwonlyargs] == [
+        "items",
+        "view",
+        "settings",
+        "target",
+        "cull",
+        "program",
+    ]
+
+    settings = DrawSettings()
+    plain = draw.shader_variant(settings, draw.DrawTarget())
+    assert draw.shader_variant(settings) == plain
+    # Field -> (a value that differs from the default, what the variant says then).
+    selects_code = {
+        "depth_bias": (2.0**-18, lambda v: v.depth_bias == 2.0**-18),
+        "linear_depth": (True, lambda v: v.linear_depth),
+        "clip_planes": (np.zeros((6, 4)), lambda v: v.clip_planes),
+        "display": (object(), lambda v: v.display_transform),
+        "stage": (draw.RESOLVE, lambda v: v.resolve),
+        "region_lines": (object(), lambda v: v.region_lines),
+        "view_depth": (True, lambda v: v.write_view_depth),
+        "aovs": (True, lambda v: v.write_aovs),
+        "lines": (draw.HIDDEN_LINES, lambda v: v.hidden_pass),
+    }
+    state_or_input = {"depth_test", "depth_write", "visibility", "triangle_ids_by_vertex"}
+    names = {f.name for f in fields(draw.DrawTarget)}
+    assert names == set(selects_code) | state_or_input, "classify every DrawTarget field here"
+    for name, (value, says) in selects_code.items():
+        variant = draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value}))
+        assert variant != plain and says(variant), name
+    for name in state_or_input - {"triangle_ids_by_vertex"}:
+        value = {"depth_test": "GREATER", "depth_write": False, "visibility": object()}[name]
+        assert draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value})) == plain, name
+    # The visibility stage's numbering is compiled code of that stage only.
+    record = draw.DrawTarget(stage=draw.VISIBILITY, linear_depth=True)
+    numbered = draw.shader_variant(settings, replace(record, triangle_ids_by_vertex=True))
+    assert numbered.triangle_ids_by_vertex and not draw.shader_variant(settings, record).triangle_ids_by_vertex
+    # "No wire" is said once, by the description: the plan leaves the
+    # settings' wire colour alone.
+    from solidwire_addon.core import passes
+
+    hidden = replace(settings, use_hidden_lines=True)
+    (surface,) = [unit for unit in passes.plan(hidden) if isinstance(unit, passes.SurfacePass)]
+    assert surface.settings.wire_color == hidden.wire_color and surface.wire is False
+
+
+def test_every_pass_is_a_unit_that_runs_offscreen_and_over_the_viewport():
+    """The plan is a tuple of pass units (passes.RenderPass), each with its
+    own render and over_viewport steps; the two executors only walk it (no
+    chain of ifs on a pass's kind)."""
+    from solidwire_addon.core import passes
+
+    tree = ast.parse((PACKAGE / "core" / "passes.py").read_text(encoding="utf-8"))
+    functions = _functions(tree)
+    for executor in ("render_passes", "draw_over_viewport"):
+        assert not any(isinstance(node, ast.If) for node in ast.walk(functions[executor])), executor
+    every_option = dataclasses.replace(
+        DrawSettings(), use_hidden_lines=True, use_silhouettes=True, use_fill=True, wire_color=(1, 1, 1, 1)
+    )
+    units = passes.plan(every_option, strands=True)
+    assert all(isinstance(unit, passes.RenderPass) for unit in units)
+    assert [type(unit).__name__ for unit in units] == [
+        "RegionLinesPass",
+        "SurfacePass",
+        "HiddenLinesPass",
+        "WirePass",
+        "OutputsPass",
+        "SilhouettePass",
+        "StrandsPass",
+    ]
+    plain = passes.plan(DrawSettings())
+    assert [type(unit).__name__ for unit in plain] == ["RegionLinesPass", "SurfacePass", "OutputsPass"]
+
+
+def _bool_annotation(node) -> bool:
+    return isinstance(node, ast.AnnAssign) and "bool" in ast.unparse(node.annotation)
+
+
+def test_core_has_no_module_level_switches():
+    """How a frame is drawn comes down from the caller as one frozen
+    options.DrawOptions, never from a switch kept in a core module: no core
+    module binds a name to True/False (or annotates one bool) at module
+    level, no core function rebinds a public module-level name (``global``),
+    and no module of the package assigns to an attribute of a core module."""
+    from dataclasses import fields
+
+    from solidwire_addon.core.options import DrawOptions
+
+    modules = _modules()
+    for name, tree in modules.items():
+        if not name.startswith("solidwire_addon.core"):
+            continue
+        for node in tree.body:
+            value = getattr(node, "value", None)
+            is_bool = isinstance(value, ast.Constant) and isinstance(value.value, bool)
+            assert not (isinstance(node, (ast.Assign, ast.AnnAssign)) and (is_bool or _bool_annotation(node))), (
+                f"{name} keeps a module-level switch: {ast.unparse(node)}"
+            )
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Global):
+                public = [n for n in node.names if not n.startswith("_")]
+                assert not public, f"{name} rebinds module-level {public}"
+    core_modules = {m.rsplit(".", 1)[1] for m in modules if m.startswith("solidwire_addon.core.")}
+    for name, tree in modules.items():
+        aliases = set()
+        in_core = name.startswith("solidwire_addon.core")
+        for node in ast.walk(tree):
+            # ``from ..core import passes`` or, inside core, ``from . import passes``.
+            if isinstance(node, ast.ImportFrom) and (
+                "core" in (node.module or "").split(".") or (node.module is None and in_core)
+            ):
+                aliases |= {a.asname or a.name for a in node.names if a.name in core_modules}
+        for node in ast.walk(tree):
+            if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                for target in targets:
+                    assert not (
+                        isinstance(target, ast.Attribute)
+                        and isinstance(target.value, ast.Name)
+                        and target.value.id in aliases
+                    ), f"{name} sets {ast.unparse(target)} from a distance"
+    assert DrawOptions.__dataclass_params__.frozen
+    assert all(f.default is not dataclasses.MISSING for f in fields(DrawOptions)), "every option has a default"

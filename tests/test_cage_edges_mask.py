@@ -173,7 +173,7 @@ def test_a_deform_modifier_after_the_subdivision_keeps_the_mask():
     assert np.array_equal(_mask(obj)[0], before)
 
 
-@pytest.mark.parametrize("kind", ["TRIANGULATE", "WELD", "DECIMATE", "NODES"])
+@pytest.mark.parametrize("kind", ["TRIANGULATE", "SOLIDIFY", "DECIMATE", "NODES"])
 def test_a_topology_changing_modifier_after_the_subdivision_gives_none(kind):
     _scene, obj, _mod = _subdivided_cube(2)
     obj.modifiers.new("After", kind)
@@ -182,42 +182,179 @@ def test_a_topology_changing_modifier_after_the_subdivision_gives_none(kind):
     assert _mask(obj)[0] is not None
 
 
-def test_stacked_subdivisions_compose():
-    _scene, obj, _mod = _subdivided_cube(1, "SIMPLE")
-    second = obj.modifiers.new("Second", "SUBSURF")
-    second.subdivision_type = "SIMPLE"
-    second.levels = 2
-    mask, edges, positions = _mask(obj)
-    _assert_simple_cube_cage(mask, edges, positions, level=3)
-
-
-def test_optimal_display_off_shows_every_edge_of_that_modifier():
-    """Blender's overlay shows a subdivision's new edges when the modifier's
-    Optimal Display is off: the last modifier's setting decides whether
-    any edge is hidden, and an earlier one's whether its own are."""
-    _scene, obj, mod = _subdivided_cube(2, "SIMPLE")
-    mod.show_only_control_edges = False
-    mask, _edges, _positions = _mask(obj)
-    assert mask is None
-    # First modifier shows everything, the second hides its inner edges:
-    # the drawn edges are the children of every edge the first one made.
-    mod.levels = 1
+def test_only_the_last_of_stacked_subdivisions_hides_edges():
+    """Blender's subdivision marks the children of every edge of its input,
+    whatever an earlier subdivision marked (subdiv_mesh.cc): with two
+    stacked modifiers the drawn edges are the children of every edge the
+    first one made, and the first one's Optimal Display changes nothing."""
+    _scene, obj, mod = _subdivided_cube(1, "SIMPLE")
     second = obj.modifiers.new("Second", "SUBSURF")
     second.subdivision_type = "SIMPLE"
     second.levels = 1
-    mask, edges, positions = _mask(obj)
-    first_level_edges = 12 * 2 + 6 * 4  # a cube subdivided once: 48 edges
-    assert mask is not None and int(mask.sum()) == 2 * first_level_edges
-    # Each drawn edge lies on a line of the first level's grid: the two
-    # coordinates it does not run along are 0 or +-1 (never +-0.5).
-    a, b = positions[edges[mask, 0]], positions[edges[mask, 1]]
-    fixed = np.isclose(a, b, atol=1e-5)
-    assert (fixed.sum(axis=1) == 2).all()
-    assert np.isin(np.round(np.abs(a[fixed]), 4), (0.0, 1.0)).all()
-    # Both on: the original cube's 12 edges, cut 4 times each.
+    for first_optimal in (True, False):
+        mod.show_only_control_edges = first_optimal
+        mask, edges, positions = _mask(obj)
+        first_level_edges = 12 * 2 + 6 * 4  # a cube subdivided once: 48 edges
+        assert mask is not None and int(mask.sum()) == 2 * first_level_edges
+        # Each drawn edge lies on a line of the first level's grid: the two
+        # coordinates it does not run along are 0 or +-1 (never +-0.5).
+        a, b = positions[edges[mask, 0]], positions[edges[mask, 1]]
+        fixed = np.isclose(a, b, atol=1e-5)
+        assert (fixed.sum(axis=1) == 2).all()
+        assert np.isin(np.round(np.abs(a[fixed]), 4), (0.0, 1.0)).all()
+    # The last one's Optimal Display off: every edge.
+    second.show_only_control_edges = False
+    assert _mask(obj)[0] is None
+
+
+def test_optimal_display_off_shows_every_edge():
+    _scene, obj, mod = _subdivided_cube(2, "SIMPLE")
+    mod.show_only_control_edges = False
+    assert _mask(obj)[0] is None
     mod.show_only_control_edges = True
     mask, edges, positions = _mask(obj)
     _assert_simple_cube_cage(mask, edges, positions, level=2)
+
+
+# -- modifiers after the subdivision that keep the cage (as Blender's overlay) ----------
+
+
+def _half_cube(scene, name="Half"):
+    """A cube spanning x in [0, 2] without its face at x = 0: the half a
+    Mirror completes (its open border stays on the mirror plane under
+    subdivision, so a merging Mirror merges it)."""
+
+    def build(bm):
+        bmesh.ops.create_cube(bm, size=2.0, matrix=Matrix.Translation((1.0, 0.0, 0.0)))
+        border = [f for f in bm.faces if all(abs(v.co.x) < 1e-6 for v in f.verts)]
+        bmesh.ops.delete(bm, geom=border, context="FACES_ONLY")
+
+    return scenes.mesh_object(scene, name, build)
+
+
+def _subdivide(obj, level=1, kind="SIMPLE"):
+    mod = obj.modifiers.new("Subdivision", "SUBSURF")
+    mod.subdivision_type = kind
+    mod.levels = mod.render_levels = level
+    return mod
+
+
+def _mirror(obj, *, merge=False, axes=(True, False, False)):
+    mod = obj.modifiers.new("Mirror", "MIRROR")
+    mod.use_mirror_merge = merge
+    for axis, on in enumerate(axes):
+        mod.use_axis[axis] = on
+    return mod
+
+
+def _array(obj, count=3, *, merge=False, offset=(1.2, 0.0, 0.0)):
+    mod = obj.modifiers.new("Array", "ARRAY")
+    mod.count = count
+    mod.use_merge_vertices = merge
+    mod.relative_offset_displace = offset
+    return mod
+
+
+def _half_cube_cage_count(level):
+    return 12 * 2**level  # the open half cube keeps all 12 edges: 2^L children each
+
+
+def _assert_copies_of(mask, copies, per_copy_mask):
+    """``mask`` is ``copies`` copies of the subdivided mesh's own mask."""
+    assert mask is not None and len(mask) == copies * len(per_copy_mask)
+    assert np.array_equal(mask.reshape(copies, -1), np.tile(per_copy_mask, (copies, 1)))
+
+
+@pytest.mark.parametrize("merge", [False, True])
+def test_mirror_after_the_subdivision_keeps_the_cage_unless_it_merges(merge):
+    scene = scenes.empty_scene()
+    obj = _half_cube(scene)
+    _subdivide(obj, 2, "CATMULL_CLARK")
+    alone, _edges, _positions = _mask(obj)
+    assert int(alone.sum()) == _half_cube_cage_count(2)
+    mirror = _mirror(obj, merge=merge)
+    mask, edges, positions = _mask(obj)
+    if merge:
+        # The border merged: Blender's merge makes a new mesh without the
+        # Optimal Display marks, and its overlay shows every edge.
+        assert len(edges) < 2 * len(alone) and mask is None
+        # Merge on but nothing near enough to merge: still the cage.
+        mirror.merge_threshold = 1e-6
+        for vertex in obj.data.vertices:
+            vertex.co.x += 0.5
+        obj.data.update()
+        _assert_copies_of(_mask(obj)[0], 2, alone)
+        return
+    _assert_copies_of(mask, 2, alone)
+    # Both halves' cage edges, mirror images of each other.
+    middles = positions[edges[mask]].mean(axis=1)
+    drawn = np.round(middles, 4)
+    mirrored = np.round(middles * (-1.0, 1.0, 1.0), 4)
+    assert {tuple(m) for m in drawn} == {tuple(m) for m in mirrored}
+
+
+def test_mirror_on_several_axes_and_an_array_after_it():
+    scene = scenes.empty_scene()
+    obj = _half_cube(scene)
+    _subdivide(obj, 1)
+    alone = _mask(obj)[0]
+    _mirror(obj, axes=(True, True, False))
+    _assert_copies_of(_mask(obj)[0], 4, alone)
+    _array(obj, 3, offset=(0.0, 0.0, 1.5))
+    mask, _edges, _positions = _mask(obj)
+    _assert_copies_of(mask, 12, alone)
+    assert int(mask.sum()) == 12 * _half_cube_cage_count(1)
+
+
+def test_array_fit_length_and_caps():
+    scene = scenes.empty_scene()
+    obj = _half_cube(scene)
+    _subdivide(obj, 1)
+    alone = _mask(obj)[0]
+    array = _array(obj)
+    array.fit_type = "FIT_LENGTH"
+    array.fit_length = 7.0
+    mask, edges, _positions = _mask(obj)
+    copies = len(edges) // len(alone)
+    assert copies >= 2
+    _assert_copies_of(mask, copies, alone)
+    # Caps without modifiers of their own: every cap edge is drawn, as
+    # Blender gives a cap without Optimal Display marks.
+    cap = scenes.cube(scene, "Cap", size=0.5, location=(30.0, 0.0, 0.0))
+    array.fit_type = "FIXED_COUNT"
+    array.count = 2
+    array.start_cap = array.end_cap = cap
+    mask, edges, _positions = _mask(obj)
+    assert len(edges) == 2 * len(alone) + 2 * 12
+    _assert_copies_of(mask[: 2 * len(alone)], 2, alone)
+    assert mask[2 * len(alone) :].all()
+    # A cap with modifiers of its own is not followed: every edge.
+    cap.modifiers.new("Bevel", "BEVEL")
+    assert _mask(obj)[0] is None
+
+
+def test_array_merge_bisect_and_weld():
+    """Array with Merge on drops Blender's marks even when nothing merges;
+    Bisect too; Weld keeps them only when it welds nothing."""
+    scene = scenes.empty_scene()
+    obj = _half_cube(scene)
+    _subdivide(obj, 1)
+    alone = _mask(obj)[0]
+    array = _array(obj, 2, merge=True, offset=(3.0, 0.0, 0.0))
+    assert _mask(obj)[0] is None
+    array.use_merge_vertices = False
+    assert _mask(obj)[0] is not None
+    obj.modifiers.remove(array)
+    mirror = _mirror(obj)
+    mirror.use_bisect_axis[0] = True
+    assert _mask(obj)[0] is None
+    obj.modifiers.remove(mirror)
+    weld = obj.modifiers.new("Weld", "WELD")
+    weld.merge_threshold = 1e-6
+    assert np.array_equal(_mask(obj)[0], alone)
+    weld.merge_threshold = 1.5  # welds the subdivided vertices together
+    mask, edges, _positions = _mask(obj)
+    assert len(edges) < len(alone) and mask is None
 
 
 def test_simplify_lowering_the_level_is_followed():
@@ -523,3 +660,148 @@ def test_edge_attributes_propagate_to_the_child_edges_of_cage_edges():
             assert set(np.flatnonzero(values).tolist()) == children, (kind, name)
         crease = np.array([d.value for d in evaluated.attributes["crease_edge"].data])
         assert np.allclose(crease[sorted(children)], 0.5)
+
+
+# -- against Blender's own overlay -----------------------------------------------------
+
+OVERLAY_SIZE = (360, 270)
+
+
+def _blender_draws(obj, mesh, clear_px: float = 4.0):
+    """(shown, decidable) per evaluated edge: whether Blender's wireframe
+    overlay (drawn headless, every edge its Optimal Display marks allow:
+    threshold 1) has a line at the edge's middle, and whether that can be
+    told (no other edge passes within ``clear_px`` of it)."""
+    from tests.support.viewport import HeadlessViewport, ViewportUnavailable, set_overlays
+
+    scene = bpy.context.scene
+    try:
+        view = HeadlessViewport(*OVERLAY_SIZE)
+    except ViewportUnavailable as exc:
+        pytest.skip(f"Blender's viewport cannot be drawn headless here: {exc}")
+    shading = view.space.shading
+    saved = shading.type, shading.show_xray
+    try:
+        view.look_through(scene)
+        shading.type = "SOLID"
+        shading.show_xray = True  # every edge, front or back
+        try:
+            set_overlays(view.space, wireframe=True)
+            view.draw_blender()
+            with_wire = view.rgba()
+            set_overlays(view.space, wireframe=False)
+            view.draw_blender()
+            without = view.rgba()
+        except ViewportUnavailable as exc:
+            pytest.skip(f"Blender's viewport cannot be drawn headless here: {exc}")
+        to_clip = np.asarray(view.view.projection) @ np.asarray(view.view.view_matrix) @ np.array(obj.matrix_world)
+    finally:
+        shading.type, shading.show_xray = saved
+        view.free()
+    wire = (with_wire != without).any(axis=-1)
+    positions, edges = _positions(mesh), _edges(mesh)
+    clip = np.c_[positions, np.ones(len(positions))] @ to_clip.T
+    width, height = OVERLAY_SIZE
+    screen = (clip[:, :2] / clip[:, 3:4] + 1.0) * 0.5 * (width, height)
+    a, b = screen[edges[:, 0]], screen[edges[:, 1]]
+    middles = 0.5 * (a + b)
+    shown = np.zeros(len(edges), bool)
+    decidable = np.zeros(len(edges), bool)
+    ab = b - a
+    for i, (x, y) in enumerate(middles):
+        if not (2 <= x < width - 2 and 2 <= y < height - 2):
+            continue
+        t = np.clip(((middles[i] - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-12), 0.0, 1.0)
+        distance = np.linalg.norm(a + t[:, None] * ab - middles[i], axis=1)
+        distance[i] = np.inf
+        decidable[i] = distance.min() > clear_px
+        shown[i] = wire[int(y) - 1 : int(y) + 2, int(x) - 1 : int(x) + 2].any()
+    return shown, decidable
+
+
+def _after_subdivision(obj, case):
+    if case == "stacked":
+        _subdivide(obj, 1)
+    elif case == "mirror":
+        _mirror(obj)
+    elif case == "mirror merging":
+        _mirror(obj, merge=True)
+    elif case == "mirror merging nothing":
+        _mirror(obj, merge=True).merge_threshold = 1e-4
+        for vertex in obj.data.vertices:
+            vertex.co.x += 0.3
+        obj.data.update()
+    elif case == "array with caps":
+        array = _array(obj, 2)
+        cap = scenes.cube(bpy.context.scene, "Cap", size=0.6, location=(40.0, 0.0, 0.0))
+        array.start_cap = array.end_cap = cap
+    elif case == "array":
+        _array(obj, 2)
+    elif case == "array merge":
+        _array(obj, 2, merge=True)
+    elif case == "mirror and array":
+        _mirror(obj)
+        _array(obj, 2, offset=(0.0, 1.3, 0.0))
+    elif case == "weld welding nothing":
+        obj.modifiers.new("Weld", "WELD").merge_threshold = 1e-6
+    elif case == "triangulate":
+        obj.modifiers.new("Triangulate", "TRIANGULATE")
+
+
+@pytest.mark.parametrize(
+    "case, keeps",
+    [
+        ("only the subdivision", True),
+        ("stacked", True),
+        ("mirror", True),
+        ("mirror merging", False),
+        ("mirror merging nothing", True),
+        ("array with caps", True),
+        ("array", True),
+        ("array merge", False),
+        ("mirror and array", True),
+        ("weld welding nothing", True),
+        ("triangulate", False),
+    ],
+)
+def test_the_drawn_edges_are_the_ones_blenders_overlay_shows(case, keeps):
+    """Edge by edge, where Blender's wireframe overlay draws a line (or not)
+    the mask draws the edge (or not), for modifiers after the subdivision
+    that keep the cage in Blender's overlay and ones that do not."""
+    scene = scenes.empty_scene(*OVERLAY_SIZE)
+    scenes.add_camera(scene, location=(5.0, -8.0, 6.0), target=(0.0, 0.0, 0.0))
+    obj = _half_cube(scene)
+    _subdivide(obj, 1, "CATMULL_CLARK")
+    _after_subdivision(obj, case)
+    mask, _edges_array, _positions_array = _mask(obj)
+    assert (mask is not None) == keeps
+    obj_eval, mesh, cleanup = _evaluated(obj)
+    try:
+        shown, decidable = _blender_draws(obj_eval, mesh)
+        ours = np.ones(len(mesh.edges), bool) if mask is None else mask
+    finally:
+        cleanup()
+    assert decidable.sum() >= 12, "enough edges to tell apart"
+    if keeps:
+        assert (~shown & decidable).sum() >= 3, "Blender hides some edges"
+    disagree = np.flatnonzero(decidable & (shown != ours))
+    assert len(disagree) == 0, f"edges {disagree.tolist()} differ from Blender's overlay"
+
+
+def test_cage_key_follows_mirror_and_array_settings():
+    scene = scenes.empty_scene()
+    obj = _half_cube(scene)
+    _subdivide(obj, 1)
+    mirror = _mirror(obj)
+    array = _array(obj, 2)
+    seen = {cage_key(obj, False)}
+    for change in (
+        lambda: setattr(mirror, "use_mirror_merge", True),
+        lambda: mirror.use_bisect_axis.__setitem__(1, True),
+        lambda: setattr(array, "use_merge_vertices", True),
+        lambda: setattr(array, "count", 4),
+    ):
+        change()
+        key = cage_key(obj, False)
+        assert key not in seen
+        seen.add(key)

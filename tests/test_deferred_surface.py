@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 
 import solidwire_addon
-from solidwire_addon.core import draw, passes, shaders
+from solidwire_addon.blender import runtime
+from solidwire_addon.core import draw, shaders
+from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 from tests.test_render_passes import _enable_all
 
@@ -28,7 +30,7 @@ def _stages(monkeypatch):
     real = draw.draw
 
     def spy(*args, **kwargs):
-        calls.append(kwargs.get("stage"))
+        calls.append((kwargs.get("target") or draw.DrawTarget()).stage)
         return real(*args, **kwargs)
 
     monkeypatch.setattr(draw, "draw", spy)
@@ -41,11 +43,11 @@ def _render_both(scene, path, monkeypatch):
     however sparse on screen)."""
     monkeypatch.setattr(draw, "DEFERRED_MIN_DENSITY", 0.0)
     calls = _stages(monkeypatch)
-    monkeypatch.setattr(passes, "use_deferred_surface", False)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
     direct = scenes.render_multilayer_exr(scene, path.with_name(path.stem + "_direct.exr"))
     assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
     calls.clear()
-    monkeypatch.setattr(passes, "use_deferred_surface", True)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=True))
     deferred = scenes.render_multilayer_exr(scene, path.with_name(path.stem + "_deferred.exr"))
     # Every stage compiled (a refused one falls back to the direct image,
     # which would hide it here).
@@ -138,9 +140,9 @@ def test_a_deferred_stage_that_does_not_compile_falls_back_to_the_direct_pass(ou
     with the direct pass, says so once, and does not try again."""
     scene = scenes.empty_scene(120, 90, use_fill=True)
     _mixed_scene(scene)
-    monkeypatch.setattr(passes, "use_deferred_surface", False)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
     expected = scenes.render_multilayer_exr(scene, output_dir / "deferred_fallback_expected.exr")
-    monkeypatch.setattr(passes, "use_deferred_surface", True)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=True))
     real_get = shaders.get
 
     def refuse_resolve(variant):
@@ -163,9 +165,9 @@ def test_deferred_and_direct_meshes_share_one_surface(output_dir, monkeypatch):
     between the two kinds included."""
     scene = scenes.empty_scene(200, 150, use_fill=True, fill_shading="STUDIO")
     _mixed_scene(scene)
-    monkeypatch.setattr(passes, "use_deferred_surface", False)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
     direct = scenes.render_multilayer_exr(scene, output_dir / "deferred_mixed_direct.exr")
-    monkeypatch.setattr(passes, "use_deferred_surface", True)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=True))
     real_split = draw.split_deferred
     halves = []
 
@@ -269,7 +271,7 @@ def test_both_triangle_numberings_give_the_same_frame(look, output_dir, monkeypa
     monkeypatch.setattr(draw, "DEFERRED_MIN_DENSITY", 0.0)
     frames = {}
     for by_vertex in (False, True):
-        monkeypatch.setattr(shaders, "TRIANGLE_IDS_BY_VERTEX", by_vertex)
+        monkeypatch.setattr(runtime, "options", DrawOptions(triangle_ids_by_vertex=by_vertex))
         frames[by_vertex] = scenes.render_multilayer_exr(scene, output_dir / f"numbering_{look}_{by_vertex}.exr")
         assert shaders.deferred_available()
     assert solidwire_addon.stats().get("instanced_draws", 0) > 0

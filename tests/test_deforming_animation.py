@@ -2,8 +2,8 @@
 a frame that only moves vertices (shape keys, an armature) uploads positions
 and corner normals again without a full extraction, and draws what a fresh
 extraction of that frame draws; whatever changes the faces, the triangles,
-the edge marks or an edge selection that follows the positions (edge angle)
-still goes through a full extraction."""
+the edge marks, or moves an edge across the edge angle still goes through a
+full extraction (tests/test_edge_angle_edits.py: moves that do not)."""
 
 from __future__ import annotations
 
@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 
 import solidwire_addon
-from solidwire_addon.blender import runtime
-from solidwire_addon.core import cache, draw, extract, passes, shaders
+from solidwire_addon.blender import mesh_reading, runtime
+from solidwire_addon.core import cache, draw, extract, shaders
+from solidwire_addon.core.options import DrawOptions
 from tests.support import accuracy, reference, scenes
 
 FRAMES = (1, 2, 3, 4)
@@ -65,8 +66,8 @@ def armature_tube(scene, collapse: bool = False):
         a, b = poly.vertices[0], poly.vertices[1]
         mesh.vertices[b].co = mesh.vertices[a].co
         mesh.update()
-        positions = extract.read_positions(mesh)
-        quads = extract.read_corner_verts(mesh).reshape(-1, 4)
+        positions = mesh_reading.read_positions(mesh)
+        quads = mesh_reading.read_corner_verts(mesh).reshape(-1, 4)
         assert extract.quad_flip(positions, quads)[1].any()
     scenes.add_bend_rig(scene, tube, (FRAMES[0], FRAMES[-1]), angle_deg=70.0)
     scenes.add_camera(scene, location=(8.0, -3.0, 1.0), target=(0.0, 0.0, 0.5))
@@ -105,7 +106,7 @@ def test_deformation_uploads_positions_and_normals_only(build, setup_min, monkey
     if setup_min == 1 and not shaders.setup_available():
         pytest.skip("no compute shaders here")
     monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
-    monkeypatch.setattr(passes, "use_deferred_surface", setup_min != 1)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=setup_min != 1))
     setup_calls = []
     real_setup = draw._run_setup
     monkeypatch.setattr(draw, "_run_setup", lambda *args: (setup_calls.append(1), real_setup(*args)))
@@ -144,7 +145,7 @@ def test_deferred_deformation_keeps_the_index_buffer(by_vertex, monkeypatch, out
     numbered by vertex, which corners are copied): those depend on the
     triangles alone. Each frame still equals a fresh extraction's."""
     monkeypatch.setattr(draw, "DEFERRED_MIN_DENSITY", 0.0)
-    monkeypatch.setattr(shaders, "TRIANGLE_IDS_BY_VERTEX", by_vertex)
+    monkeypatch.setattr(runtime, "options", DrawOptions(triangle_ids_by_vertex=by_vertex))
     index_buffers = []
     real_index_buffer = cache.gpu.types.GPUIndexBuf
 
@@ -198,8 +199,8 @@ def test_topology_change_mid_animation_reextracts(output_dir):
 
 def test_edge_marks_and_edge_angle_reextract(output_dir):
     """A sharp mark changes which edges carry a class without moving a
-    vertex; with an edge angle a deformation changes which edges are drawn.
-    Both need the full extraction."""
+    vertex; with an edge angle this deformation moves edges across it,
+    which changes which edges are drawn. Both need the full extraction."""
     scene = default_look_scene()
     scene.solidwire.use_sharp_edges = True
     obj = shape_key_monkey(scene)
@@ -228,9 +229,9 @@ def test_normals_that_follow_the_positions_are_not_checksummed(monkeypatch, outp
     shaded anew, and a change of where the normals live (flat to smooth,
     then a sharp edge) still re-extracts."""
     reads = []
-    real_read_normals = extract.read_normals
+    real_read_normals = mesh_reading.read_normals
     monkeypatch.setattr(
-        extract, "read_normals", lambda mesh, domain: (reads.append(domain), real_read_normals(mesh, domain))[1]
+        mesh_reading, "read_normals", lambda mesh, domain: (reads.append(domain), real_read_normals(mesh, domain))[1]
     )
     scene = default_look_scene()
     monkey = scenes.monkey(scene, "Flat", subdivisions=1, rotation=(0.2, 0.0, 0.5))
@@ -245,7 +246,7 @@ def test_normals_that_follow_the_positions_are_not_checksummed(monkeypatch, outp
     _image, stats = render(scene, output_dir / "derived_again.png")
     assert (stats["meshes_extracted"], stats["meshes_repositioned"], reads) == (0, 0, [])
 
-    positions = extract.read_positions(mesh)
+    positions = mesh_reading.read_positions(mesh)
     positions[:, 2] *= 1.3
     mesh.vertices.foreach_set("co", positions.reshape(-1))
     mesh.update()

@@ -9,28 +9,10 @@ import bpy
 import numpy as np
 import pytest
 
+from solidwire_addon.blender import mesh_reading
 from solidwire_addon.core import extract
 from tests.support import scenes
-
-FIELDS = (
-    "positions",
-    "centre",
-    "triangles",
-    "edge_flags",
-    "triangle_polygons",
-    "bounds_min",
-    "bounds_max",
-    "ngon_corners",
-)
-
-
-def assert_same_arrays(fast: extract.MeshArrays, reference: extract.MeshArrays) -> None:
-    for name in FIELDS:
-        a, b = getattr(fast, name), getattr(reference, name)
-        assert a.shape == b.shape, name
-        assert a.dtype == b.dtype, name
-        np.testing.assert_array_equal(a, b, err_msg=name)
-    assert fast.dropped_triangles == reference.dropped_triangles
+from tests.support.mesh_arrays import assert_same_arrays
 
 
 def evaluated_mesh(obj):
@@ -75,7 +57,7 @@ def test_quad_split_matches_loop_triangles(seed):
     obj = scenes.from_pydata(scene, "Quads", verts, faces)
     mesh = evaluated_mesh(obj)
 
-    data = extract.read_mesh_fast(mesh)
+    data = mesh_reading.read_mesh_fast(mesh)
     flip, _undecided = extract.quad_flip(data["positions"], data["corner_vert"].reshape(-1, 4))
     blender = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
     mesh.loop_triangles.foreach_get("loops", blender)
@@ -86,7 +68,7 @@ def test_quad_split_matches_loop_triangles(seed):
     # quads included: for them extraction asks Blender anyway).
     np.testing.assert_array_equal(flip, blender_flip)
 
-    assert_same_arrays(extract.extract_mesh(mesh), extract.extract_mesh_naive(mesh))
+    assert_same_arrays(mesh_reading.extract_mesh(mesh), mesh_reading.extract_mesh_naive(mesh))
 
 
 def test_mixed_tris_quads_ngons_match_reference():
@@ -97,9 +79,9 @@ def test_mixed_tris_quads_ngons_match_reference():
     faces = [tuple(rng.choice(300, size=k, replace=False)) for k in sizes]
     obj = scenes.from_pydata(scene, "Mixed", verts, faces)
     mesh = evaluated_mesh(obj)
-    fast = extract.extract_mesh(mesh)
+    fast = mesh_reading.extract_mesh(mesh)
     assert len(fast.ngon_corners) > 0
-    assert_same_arrays(fast, extract.extract_mesh_naive(mesh))
+    assert_same_arrays(fast, mesh_reading.extract_mesh_naive(mesh))
 
 
 @pytest.mark.parametrize("subdivisions", [0, 2])
@@ -107,7 +89,7 @@ def test_subdivided_monkey_matches_reference(subdivisions):
     scene = scenes.empty_scene()
     obj = scenes.monkey(scene, subdivisions=subdivisions)
     mesh = evaluated_mesh(obj)
-    assert_same_arrays(extract.extract_mesh(mesh), extract.extract_mesh_naive(mesh))
+    assert_same_arrays(mesh_reading.extract_mesh(mesh), mesh_reading.extract_mesh_naive(mesh))
 
 
 def test_nonfinite_vertices_match_reference():
@@ -120,208 +102,7 @@ def test_nonfinite_vertices_match_reference():
     obj.data.vertices.foreach_set("co", positions)
     obj.data.update()
     mesh = evaluated_mesh(obj)
-    fast = extract.extract_mesh(mesh)
+    fast = mesh_reading.extract_mesh(mesh)
     assert fast.dropped_triangles > 0
     assert np.isfinite(fast.positions).all()
-    assert_same_arrays(fast, extract.extract_mesh_naive(mesh))
-
-
-def test_build_arrays_fast_without_blender():
-    """The pure-numpy core on a hand-made quad + triangle, against
-    build_arrays fed the triangles Blender would make."""
-    positions = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0]], dtype=np.float32)
-    corner_vert = np.array([0, 1, 2, 3, 1, 4, 2], dtype=np.int32)
-    offsets = np.array([0, 4, 7], dtype=np.int32)
-    fast = extract.build_arrays_fast(positions, corner_vert, offsets)
-    reference = extract.build_arrays(
-        positions, corner_vert, offsets[:-1], np.diff(offsets), [[0, 1, 2], [0, 2, 3], [4, 5, 6]], [0, 0, 1]
-    )
-    assert_same_arrays(fast, reference)
-    # Quad diagonal is edge 2 and the 4th corner sits in column 3.
-    np.testing.assert_array_equal(fast.triangles[:2], [[0, 1, 2, 3], [2, 3, 0, 1]])
-    assert list(fast.edge_flags) == [11, 11, 7]
-
-
-def test_flipped_quad_without_blender():
-    # Corners 1 and 3 on the same side of diagonal 0-2 (concave at corner 3):
-    # Blender splits along 1-3.
-    positions = np.array([[0, 0, 0], [2, 0, 0], [1, 1, 0], [0.4, 0.1, 0]], dtype=np.float32)
-    fast = extract.build_arrays_fast(positions, np.arange(4, dtype=np.int32), np.array([0, 4], dtype=np.int32))
-    reference = extract.build_arrays(positions, np.arange(4), [0], [4], [[0, 1, 3], [1, 2, 3]], [0, 0])
-    assert_same_arrays(fast, reference)
-    np.testing.assert_array_equal(fast.triangles, [[3, 0, 1, 2], [1, 2, 3, 0]])
-
-
-def _quad_grid(n: int = 12, seed: int = 1):
-    rng = np.random.default_rng(seed)
-    xs, ys = np.meshgrid(np.arange(n + 1, dtype=np.float32), np.arange(n + 1, dtype=np.float32))
-    positions = np.stack([xs.ravel(), ys.ravel(), rng.uniform(-0.05, 0.05, (n + 1) ** 2)], axis=1).astype(np.float32)
-    faces = [
-        (j * (n + 1) + i, j * (n + 1) + i + 1, (j + 1) * (n + 1) + i + 1, (j + 1) * (n + 1) + i)
-        for j in range(n)
-        for i in range(n)
-    ]
-    corner_vert = np.array(faces, dtype=np.int32).ravel()
-    offsets = np.arange(0, len(corner_vert) + 1, 4, dtype=np.int32)
-    return positions, corner_vert, offsets
-
-
-def test_reposition_is_a_full_extraction_of_the_moved_mesh():
-    """Positions-only re-upload: same triangles, and the same world positions
-    as extracting the moved mesh from scratch (bounds may only grow)."""
-    positions, corner_vert, offsets = _quad_grid()
-    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
-    moved = positions.copy()
-    moved[17] += (0.02, -0.01, 0.3)
-    moved[40, 2] -= 0.2
-    result = extract.reposition(arrays, moved, corner_vert, offsets)
-    assert result is not None
-    local, centre, bounds_min, bounds_max, source = result
-    full = extract.build_arrays_fast(moved, corner_vert, offsets)
-    np.testing.assert_array_equal(full.triangles, arrays.triangles)
-    np.testing.assert_array_equal(full.edge_flags, arrays.edge_flags)
-    np.testing.assert_allclose(local + centre, full.positions + full.centre, atol=1e-5)
-    assert (bounds_min <= full.bounds_min).all() and (bounds_max >= full.bounds_max).all()
-    assert np.shares_memory(source, moved)  # kept as read, no copy
-
-
-def _bend(positions: np.ndarray, angle: float) -> np.ndarray:
-    """Every vertex moved: the grid rolled about the y axis (a deformation)."""
-    radius = float(positions[:, 0].max()) / angle
-    theta = positions[:, 0] / radius
-    r = radius - positions[:, 2]
-    return np.stack([r * np.sin(theta), positions[:, 1] + 0.25, radius - r * np.cos(theta)], axis=1).astype(np.float32)
-
-
-def test_reposition_of_a_deformation_is_a_full_extraction():
-    """Every vertex moved (the path a deforming animation takes): same
-    triangles, the world positions of a fresh extraction; a single quad
-    folded among them still refuses."""
-    positions, corner_vert, offsets = _quad_grid()
-    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
-    bent = _bend(positions, 1.5)
-    assert (bent != positions).any(axis=1).all()
-    result = extract.reposition(arrays, bent, corner_vert, offsets)
-    assert result is not None
-    local, centre, bounds_min, bounds_max, _source = result
-    full = extract.build_arrays_fast(bent, corner_vert, offsets)
-    np.testing.assert_array_equal(full.triangles, arrays.triangles)
-    np.testing.assert_allclose(local + centre, full.positions + full.centre, atol=1e-5)
-    assert (bounds_min <= full.bounds_min).all() and (bounds_max >= full.bounds_max).all()
-    q = arrays.quads[40]
-    bent[q[1]] = 0.9 * bent[q[3]] + 0.1 * bent[q[0]]
-    assert extract.reposition(arrays, bent, corner_vert, offsets) is None
-
-
-def test_reposition_asks_blender_about_a_quad_too_close_to_call():
-    """A degenerate quad (an edge collapsed: two corners on one spot) is
-    undecided in every frame; its split comes from Blender's triangles, as at
-    extraction, instead of sending the whole mesh to a full extraction."""
-    positions, corner_vert, offsets = _quad_grid()
-    q = corner_vert[4 * 30 : 4 * 31]
-    positions[q[2]] = positions[q[1]]
-
-    def blender_tris(flipped):
-        def lookup(tri_indices):  # the first triangle of each asked quad, as Blender splits it
-            face = np.asarray(tri_indices) // 2
-            corners = [0, 1, 3] if flipped else [0, 1, 2]
-            return 4 * face[:, None] + np.array(corners)
-
-        return lookup
-
-    arrays = extract.build_arrays_fast(positions, corner_vert, offsets, blender_tris=blender_tris(False))
-    bent = _bend(positions, 1.5)
-    assert extract.quad_flip(bent, arrays.quads)[1][30]  # still undecided
-    assert extract.reposition(arrays, bent, corner_vert, offsets) is None
-    assert extract.reposition(arrays, bent, corner_vert, offsets, blender_tris(True)) is None  # split changed
-    result = extract.reposition(arrays, bent, corner_vert, offsets, blender_tris(False))
-    assert result is not None
-    local, centre = result[:2]
-    full = extract.build_arrays_fast(bent, corner_vert, offsets, blender_tris=blender_tris(False))
-    np.testing.assert_array_equal(full.triangles, arrays.triangles)
-    np.testing.assert_allclose(local + centre, full.positions + full.centre, atol=1e-5)
-
-
-def test_corner_table_refilled_from_new_normals_equals_a_fresh_one():
-    """The corner lookup kept at extraction refills the table of a moved mesh
-    exactly as a fresh corner_table does (normals per loop, materials per face)."""
-    positions, corner_vert, offsets = _quad_grid(6)
-    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
-    rng = np.random.default_rng(4)
-    materials = rng.integers(0, 3, len(offsets) - 1).astype(np.int32)
-    first = extract.corner_table(
-        arrays, corner_vert, offsets, rng.normal(size=(len(corner_vert), 3)).astype(np.float32), materials
-    )
-    normals = rng.normal(size=(len(corner_vert), 3)).astype(np.float32)
-    refilled = extract.fill_corner_table(arrays.corner_rows, arrays.triangle_polygons, normals, materials)
-    fresh = extract.corner_table(
-        extract.build_arrays_fast(positions, corner_vert, offsets), corner_vert, offsets, normals, materials
-    )
-    np.testing.assert_array_equal(refilled, fresh)
-    assert not np.array_equal(refilled, first)
-    # Each triangle corner carries the normal of its own polygon corner.
-    rows = arrays.corner_rows.reshape(-1, 3)
-    np.testing.assert_array_equal(corner_vert[rows], arrays.triangles[:, :3])
-
-
-@pytest.mark.parametrize("domain", [extract.NORMALS_BY_VERTEX, extract.NORMALS_BY_TRIANGLE, extract.NORMALS_BY_CORNER])
-def test_corner_table_rows_hold_their_normal_and_material(domain):
-    """Every row of the corner table, by each domain, is the normal of its
-    vertex / face / polygon corner and the material of its face (clamped to
-    0..32767), NaN normals passed on as they are; a triangle corner with no
-    polygon corner (-1) gets a zero normal."""
-    rng = np.random.default_rng(7)
-    faces, triangles = 40, 80
-    triangle_polygons = np.repeat(np.arange(faces, dtype=np.int32), 2)
-    materials = rng.integers(-2, 40000, faces).astype(np.int32)
-    if domain == extract.NORMALS_BY_VERTEX:
-        materials[:] = 5
-        count = 30
-    else:
-        count = faces if domain == extract.NORMALS_BY_TRIANGLE else 4 * faces
-    normals = rng.normal(size=(count, 3)).astype(np.float32)
-    normals[3, 1] = np.nan
-    rows = rng.integers(0, count, 3 * triangles).astype(np.int32)
-    rows[[5, 17]] = -1
-    table = extract.fill_corner_table(rows, triangle_polygons, normals, materials, domain)
-    clamped = np.clip(materials, 0, 32767).astype(np.float32)
-    if domain == extract.NORMALS_BY_VERTEX:
-        expected_normals, expected_materials = normals, np.full(count, 5.0, np.float32)
-    elif domain == extract.NORMALS_BY_TRIANGLE:
-        expected_normals, expected_materials = normals[triangle_polygons], clamped[triangle_polygons]
-    else:
-        expected_normals = np.where((rows >= 0)[:, None], normals[np.maximum(rows, 0)], 0.0)
-        expected_materials = np.repeat(clamped[triangle_polygons], 3)
-    assert table.shape == (len(expected_normals), 4) and table.dtype == np.float32
-    np.testing.assert_array_equal(table[:, :3], expected_normals)
-    np.testing.assert_array_equal(table[:, 3], expected_materials)
-    assert np.isnan(table[:, 1]).any()
-
-
-def test_reposition_refuses_what_changes_the_triangles():
-    positions, corner_vert, offsets = _quad_grid()
-    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
-    # Corner 1 of the first quad pulled over the diagonal 0-2, next to corner 3:
-    # the quad now splits along 1-3.
-    q = arrays.quads[0]
-    folded = positions.copy()
-    folded[q[1]] = 0.9 * positions[q[3]] + 0.1 * positions[q[0]]
-    assert extract.reposition(arrays, folded, corner_vert, offsets) is None
-    assert not np.array_equal(extract.build_arrays_fast(folded, corner_vert, offsets).triangles, arrays.triangles)
-    # A non-finite vertex, other face sizes, or n-gons: full extraction.
-    broken = positions.copy()
-    broken[3, 0] = np.nan
-    assert extract.reposition(arrays, broken, corner_vert, offsets) is None
-    regrouped = offsets.copy()
-    regrouped[1] -= 1
-    regrouped[2] += 0
-    assert extract.reposition(arrays, positions, corner_vert, regrouped) is None
-    hexagon = np.array([(np.cos(a), np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]], dtype=np.float32)
-    ngon = extract.build_arrays_fast(
-        hexagon,
-        np.arange(6, dtype=np.int32),
-        np.array([0, 6], dtype=np.int32),
-        blender_tris=lambda rows: np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]])[rows],
-    )
-    assert ngon.quads is None
-    assert extract.reposition(ngon, hexagon * 1.1, np.arange(6, dtype=np.int32), np.array([0, 6])) is None
+    assert_same_arrays(fast, mesh_reading.extract_mesh_naive(mesh))

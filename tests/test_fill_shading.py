@@ -289,10 +289,12 @@ def test_attribute_colours_match_reference(shading, surface, output_dir, monkeyp
     by corner (bytes) and by point (floats); a mesh without one takes Fill
     Color. Drawn directly and deferred (the resolve interpolates with its
     own barycentrics), against the float64 reference."""
-    from solidwire_addon.core import draw, passes
+    from solidwire_addon.blender import runtime
+    from solidwire_addon.core import draw
+    from solidwire_addon.core.options import DrawOptions
 
     if surface == "direct":
-        monkeypatch.setattr(passes, "use_deferred_surface", False)
+        monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
     else:
         monkeypatch.setattr(draw, "DEFERRED_MIN_DENSITY", 0.0)
     scene = _colour_scene(fill_color_source="ATTRIBUTE", fill_color=(0.6, 0.6, 0.6), fill_shading=shading)

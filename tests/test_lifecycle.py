@@ -60,7 +60,7 @@ def leftovers() -> dict:
         if isinstance(engines, set) and "SOLIDWIRE" in engines:
             compat.append(name)
     return {
-        "classes": [c.__name__ for c in solidwire_addon._classes if c.is_registered],
+        "classes": [c.__name__ for c in solidwire_addon._classes() if c.is_registered],
         "bpy.types": [n for n in dir(bpy.types) if "solidwire" in n.lower()],
         "properties": [
             f"{t.__name__}.{p}"

@@ -12,6 +12,7 @@ import bmesh
 import bpy
 import numpy as np
 import pytest
+from mathutils import Matrix
 
 import solidwire_addon
 from solidwire_addon.core import exr
@@ -129,6 +130,44 @@ def test_the_angle_threshold_on_a_large_creased_region(output_dir):
     ref = reference.render_reference(scene)
     every_edge = reference.render_reference(scene, settings=reference.SettingsWith(scene.solidwire, edge_angle=0.0))
     assert ref.intensity.sum() < 0.25 * every_edge.intensity.sum()
+
+
+def _half_cube(bm):
+    """A cube spanning x in [0, 1.6] without its face at x = 0, the half a
+    Mirror completes."""
+    bmesh.ops.create_cube(bm, size=1.6, matrix=Matrix.Translation((0.8, 0.0, 0.0)))
+    border = [f for f in bm.faces if all(abs(v.co.x) < 1e-6 for v in f.verts)]
+    bmesh.ops.delete(bm, geom=border, context="FACES_ONLY")
+
+
+@pytest.mark.parametrize("merge", [False, True])
+def test_cage_edges_through_a_mirror_and_an_array(merge, output_dir):
+    """A Mirror and an Array after the subdivision copy its cage edges to
+    every copy, as Blender's overlay shows them (image model §3.4); a
+    Mirror that merges its halves drops them, and every edge is drawn. The
+    density fade measures each copy's cage edges whole."""
+    scene = scenes.empty_scene(220, 160, use_cage_edges=True, thickness=1.5, use_density_fade=True)
+    scene.solidwire.density_fade_length = 6.0
+    obj = scenes.mesh_object(scene, "Half", _half_cube, rotation=(0.2, 0.1, 0.5))
+    _subdivided(obj, 3)
+    mirror = obj.modifiers.new("Mirror", "MIRROR")
+    mirror.use_mirror_merge = merge
+    array = obj.modifiers.new("Array", "ARRAY")
+    array.count = 2
+    array.use_merge_vertices = False
+    array.relative_offset_displace = (0.0, 1.4, 0.0)
+    scenes.add_camera(scene, location=(3.0, -7.5, 5.0), target=(0.3, 1.1, 0.0))
+    report = accuracy.measure(scene, f"regions_mirror_array_{'merged' if merge else 'copied'}", output_dir)
+    accuracy.assert_accurate(report)
+    every_edge = reference.render_reference(
+        scene, settings=reference.SettingsWith(scene.solidwire, use_cage_edges=False)
+    )
+    ref = reference.render_reference(scene)
+    if merge:
+        assert np.array_equal(ref.intensity, every_edge.intensity)
+    else:
+        _assert_region_lines_drawn()
+        assert ref.intensity.sum() < 0.5 * every_edge.intensity.sum()
 
 
 def _grid_with_ngon(bm):

@@ -140,7 +140,7 @@ def test_passes_are_written_only_when_asked_for(tmp_path, monkeypatch):
     real_draw = draw_mod.draw
 
     def spy(*args, **kwargs):
-        calls.append(kwargs.get("write_aovs", False))
+        calls.append((kwargs.get("target") or draw_mod.DrawTarget()).aovs)
         return real_draw(*args, **kwargs)
 
     monkeypatch.setattr(draw_mod, "draw", spy)

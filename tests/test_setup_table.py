@@ -11,7 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solidwire_addon.core import draw, passes, shaders
+from solidwire_addon.blender import runtime
+from solidwire_addon.core import draw, shaders
+from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 
 
@@ -31,7 +33,7 @@ def _quads_tris_mirrored_shared(scene):
 def _render(scene, path, setup_min, monkeypatch):
     calls = []
     real = draw._run_setup
-    monkeypatch.setattr(passes, "use_deferred_surface", False)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
     monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
     # Per pre-pass run: whether it ran without its clipping code (in_front).
     monkeypatch.setattr(draw, "_run_setup", lambda *args: (calls.append(args[3:4] == (True,)), real(*args)))

@@ -31,7 +31,7 @@ method, supersampling included).
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import gpu
@@ -188,9 +188,9 @@ def downsample_shader(factor: int):
     return shader
 
 
-def _draw(items, view, settings, method: str, **kwargs):
+def _draw(items, view, settings, method: str, target, cull: bool):
     program = draw_mod.EXACT if method in ("exact", "exact_direct") else MethodProgram(method)
-    return draw_mod.draw(items, view, settings, program=program, **kwargs)
+    return draw_mod.draw(items, view, settings, target=target, cull=cull, program=program)
 
 
 def draw_method(
@@ -199,22 +199,15 @@ def draw_method(
     """Draw ``items`` with ``method`` into the bound framebuffer (no
     supersampling here: that is a render-target matter, see Renderer)."""
     base, _factor = base_method(method)
+    target = draw_mod.DrawTarget(view_depth=write_view_depth)
     if base != "offset_lines":
-        return _draw(items, view, settings, base, write_view_depth=write_view_depth, cull=cull)
+        return _draw(items, view, settings, base, target, cull)
     # Pass 1: the filled triangles write depth (and the fill colour, or a
     # transparent film); pass 2: lines, depth-tested against pass 1.
-    stats = _draw(items, view, settings, "fill_only", write_view_depth=write_view_depth, cull=cull)
+    stats = _draw(items, view, settings, "fill_only", target, cull)
     gpu.state.line_width_set(line_width)
     try:
-        _draw(
-            items,
-            view,
-            settings,
-            "offset_lines",
-            write_view_depth=write_view_depth,
-            cull=cull,
-            depth_bias=LINE_DEPTH_OFFSET,
-        )
+        _draw(items, view, settings, "offset_lines", replace(target, depth_bias=LINE_DEPTH_OFFSET), cull)
     finally:
         gpu.state.line_width_set(1.0)
     return stats

@@ -21,8 +21,10 @@ E' = n*E + n/2*(n-1)*C) and the chain layout above is then checked on the
 edge array itself, exactly: a count that fits by chance, a level lowered by
 Simplify, a modifier after the subdivision that changed the topology or an
 evaluated mesh that is the coarse one (the subdivision did nothing) never
-passes for a subdivided one. Stacked subdivision modifiers are peeled one by
-one (the children of a child are children of the coarse edge).
+passes for a subdivided one. Only the last subdivision modifier counts (see
+_stack), and the copies a Mirror or an Array after it makes are undone in
+the index layout first (_carried_copies), then checked on the whole edge
+array (_copies_match), as Blender's overlay keeps the cage through them.
 
 What the evaluated mesh is (read in Blender 5.0's source):
 
@@ -46,9 +48,10 @@ import numpy as np
 SUBDIVISION_TYPES = frozenset({"SUBSURF", "MULTIRES"})
 
 # Modifiers that keep the topology (vertex/edge/face counts and order): they
-# move vertices or write data layers only. One of these after a subdivision
-# keeps its edge order; any other enabled modifier after it makes the answer
-# unknowable (None). (bpy 5.0 names; unknown names are simply not listed.)
+# move vertices or write data layers only, and Blender copies the mesh with
+# its Optimal Display marks. One of these after a subdivision keeps its edge
+# order; see CAGE_CARRYING_TYPES for the others that keep the cage. (bpy 5.0
+# names; unknown names are simply not listed.)
 TOPOLOGY_KEEPING_TYPES = frozenset(
     {
         # Deform
@@ -109,18 +112,47 @@ def _requested_level(md, render: bool, sculpt: bool) -> int:
     return max(0, int(md.render_levels if render else md.levels))
 
 
+# Modifiers after the subdivision that carry Blender's Optimal Display
+# marks (``Mesh.runtime->subsurf_optimal_display_edges``) on to their result
+# in Blender 5.0's source, and so keep the cage in Blender's own overlay:
+#
+# * Mirror (``BKE_mesh_mirror_apply_mirror_on_axis_for_modifier``) copies
+#   the marks to both halves, per mirrored axis; but Bisect (a BMesh round
+#   trip) and a vertex merge that merges anything (``mesh_merge_verts``
+#   makes a new mesh) drop them.
+# * Array (``MOD_array.cc``) copies them to every copy when Merge is off,
+#   and gives a cap the cap mesh's own marks (every edge when it has none);
+#   with Merge on it drops them, whether or not anything merges.
+# * Weld returns its input when nothing is within its distance (the marks
+#   stay); when it welds, it makes a new mesh without them.
+# * The topology-keeping modifiers above copy the mesh (``mesh_copy_data``
+#   keeps the marks).
+#
+# Every other modifier makes a new mesh without the marks: Blender's
+# overlay then shows every edge, and so does SolidWire (None).
+# Tested against Blender's overlay in tests/test_cage_edges_mask.py.
+CAGE_CARRYING_TYPES = frozenset({"MIRROR", "ARRAY", "WELD"})
+
+
 def _stack(obj, render: bool):
-    """(requested (level, Optimal Display) of the subdivision modifiers in
-    stack order, whether only topology-keeping modifiers come before the
-    first one) or None when the answer is unknowable or trivial (no
-    subdivision modifier, a modifier that changes the topology after one,
-    or the last one shows every edge: Optimal Display off)."""
+    """(the level and modifier of the last subdivision modifier, the enabled
+    modifiers after it, whether its input is the object's own mesh), or None
+    when every edge shows: no subdivision modifier enabled (or at level 0),
+    Optimal Display off on the last one, or a modifier after it that drops
+    Blender's Optimal Display marks (see CAGE_CARRYING_TYPES).
+
+    Only the last subdivision decides which edges show: Blender's
+    subdivision marks the children of every edge of its input
+    (``subdiv_mesh.cc``, ``subdiv_copy_edge_data``), whatever an earlier
+    modifier marked, so an earlier subdivision's new edges show too."""
     original = getattr(obj, "original", None) or obj
     mode = getattr(original, "mode", "OBJECT")
     edit = mode == "EDIT"
     sculpt = mode == "SCULPT"
-    levels: list[int] = []
-    plain_before = True
+    last = None  # (level, modifier)
+    after: list = []
+    own_input = False
+    topology_changed = False  # by an enabled modifier so far
     for md in obj.modifiers:
         if not _modifier_enabled(md, render, edit):
             continue
@@ -128,19 +160,26 @@ def _stack(obj, render: bool):
         if kind in SUBDIVISION_TYPES:
             if edit and kind == "MULTIRES":
                 continue  # Multires is not evaluated in Edit Mode
-            # Optimal Display (show_only_control_edges), per modifier as in
-            # Blender's own overlay: off, the modifier's new edges show too.
-            levels.append((_requested_level(md, render, sculpt), bool(getattr(md, "show_only_control_edges", True))))
+            level = _requested_level(md, render, sculpt)
+            if level <= 0:
+                continue  # a subdivision at level 0 returns its input
+            last, after, own_input = (level, md), [], not topology_changed
+            topology_changed = True
         elif kind in TOPOLOGY_KEEPING_TYPES:
             continue
-        elif levels:
-            return None  # topology changed after a subdivision
         else:
-            plain_before = False
-    levels = [entry for entry in levels if entry[0] > 0]
-    if not levels or not levels[-1][1]:
+            topology_changed = True
+            if last is not None:
+                after.append(md)
+    if last is None:
         return None
-    return levels, plain_before
+    # Optimal Display (show_only_control_edges), per modifier as in
+    # Blender's own overlay: off on the last one, every edge shows.
+    if not bool(getattr(last[1], "show_only_control_edges", True)):
+        return None
+    if any(md.type not in CAGE_CARRYING_TYPES for md in after):
+        return None
+    return last[0], after, own_input
 
 
 def _read_edges(mesh) -> np.ndarray:
@@ -210,54 +249,187 @@ def _cage_counts(obj):
 
 
 def _cage_layout(obj, mesh, *, render: bool):
-    """(E,) bool, True for the edges of ``mesh`` (the evaluated mesh of
-    ``obj``, original or evaluated object) that come from an edge of the
-    cage (the mesh before its Subdivision Surface / Multiresolution
-    modifiers); None to draw every edge: no such modifier enabled for this
-    mode (``render``: the render depsgraph's settings), level 0, a mesh the
-    subdivision left coarse, or one whose origin cannot be told (a modifier
-    after the subdivision that changes the topology, an edge layout that is
-    not the subdivision's).
+    """Which edges of ``mesh`` (the evaluated mesh of ``obj``, original or
+    evaluated object) come from an edge of the cage: the input of the last
+    Subdivision Surface / Multiresolution modifier, as Blender's overlay
+    shows it. None to draw every edge: no such modifier enabled for this
+    mode (``render``: the render depsgraph's settings), level 0, Optimal
+    Display off, a mesh the subdivision left coarse, a modifier after it
+    that drops Blender's Optimal Display marks (CAGE_CARRYING_TYPES), or an
+    edge layout that is not the one these modifiers make.
 
-    Returned as (edges that are cage children, children per cage edge,
-    (C, 2) the two end vertices of each cage edge): the mask is the first
-    ones, each cage edge's children consecutive. A subdivision keeps the
-    coarse vertices' numbers, so the ends are vertices of ``mesh`` too."""
+    Returned as (edges of the subdivision's own result that are cage
+    children, children per cage edge, (C, 2) the two end vertices of each
+    cage edge, the copies made after the subdivision (_carried_copies;
+    empty when ``mesh`` is the subdivision's result)): in the subdivision's
+    result the mask is the first edges, each cage edge's children
+    consecutive, and a subdivision keeps the coarse vertices' numbers, so
+    the ends are vertices of ``mesh`` too."""
     stack = _stack(obj, render)
     if stack is None:
         return None
-    levels, plain_before = stack
+    requested, after, own_input = stack
     edges_num = len(mesh.edges)
     if edges_num == 0:
         return None
     edges = _read_edges(mesh)
     verts_num, faces_num = len(mesh.vertices), len(mesh.polygons)
-    total = 1  # child edges per cage edge so far
-    own_mesh = True  # peeled down to the object's own mesh
-    for requested, optimal in reversed(levels):
-        if not optimal:
-            # This modifier shows every edge it makes: the drawn edges are
-            # the children of all of its input's edges.
-            own_mesh = False
+    carried = _carried_copies(after, edges, verts_num, faces_num)
+    if carried is None:
+        return None
+    steps, (sub_edges_num, verts_num, faces_num) = carried
+    sub_edges = edges[:sub_edges_num]  # every copy keeps its input first
+    # Simplify can lower a level (and 0 skips the modifier): the first level
+    # whose layout fits is the one used; none fits -> left coarse.
+    for level in range(min(requested, MAX_LEVEL), 0, -1):
+        peeled = peel(sub_edges, verts_num, faces_num, level)
+        if peeled is not None:
             break
-        # Simplify can lower a level (and 0 skips the modifier): the first
-        # level whose layout fits is the one used; none fits -> skipped.
-        for level in range(min(requested, MAX_LEVEL), 0, -1):
-            peeled = peel(edges, verts_num, faces_num, level)
-            if peeled is not None:
-                edges, verts_num, faces_num = peeled
-                total <<= level
-                break
-    if total == 1:
+    else:
         return None  # left coarse: every edge is a cage edge
-    if plain_before and own_mesh:
+    cage, verts_num, _faces_num = peeled
+    if own_input:
         counts = _cage_counts(obj)
-        if counts is not None and (verts_num, len(edges)) not in counts:
+        if counts is not None and (verts_num, len(cage)) not in counts:
             return None  # not this object's own mesh (or not yet re-evaluated)
-    cage_children = len(edges) * total
-    if cage_children >= edges_num:
+    per_edge = 1 << level
+    cage_children = len(cage) * per_edge
+    if cage_children >= sub_edges_num:
         return None  # a mesh without faces: every edge comes from a cage edge
-    return cage_children, total, edges
+    if steps and not _copies_match(steps, edges, sub_edges_num):
+        return None  # not the layout of these copies (a merge, a weld)
+    return cage_children, per_edge, cage, steps
+
+
+def _carried_copies(after, edges, verts_num: int, faces_num: int):
+    """Undo, in the index layout, the copies that the modifiers ``after``
+    the last subdivision (CAGE_CARRYING_TYPES, stack order) made of the
+    subdivided mesh: ``(steps, (edges, vertices, faces) of the subdivided
+    mesh))`` where each step, in stack order, is ``(copies, vertices of its
+    input, caps)``: ``copies`` copies of its input one after the other (its
+    vertex numbers shifted by the input's vertex count for each), then each
+    cap's ``((E, 2) edges, vertex count, drawn mask)``. None where the
+    marks are dropped or the counts do not fit (the caller checks the
+    edges themselves)."""
+    edges_num = len(edges)
+    steps = []
+    for md in reversed(after):
+        kind = md.type
+        if kind == "MIRROR":
+            # Axes X, Y, Z are mirrored in that order, each doubling the mesh.
+            for axis in (2, 1, 0):
+                if not md.use_axis[axis]:
+                    continue
+                if md.use_bisect_axis[axis]:
+                    return None  # bisected through a BMesh: the marks are gone
+                if edges_num % 2 or verts_num % 2 or faces_num % 2:
+                    return None  # merged vertices (or not a mirror copy at all)
+                edges_num, verts_num, faces_num = edges_num // 2, verts_num // 2, faces_num // 2
+                steps.append((2, verts_num, ()))
+        elif kind == "ARRAY":
+            if md.use_merge_vertices:
+                return None  # Blender drops the marks whenever Merge is on
+            caps = []
+            for cap_object in (md.start_cap, md.end_cap):
+                if cap_object is None:
+                    continue
+                cap = _cap_layout(cap_object)
+                if cap is None:
+                    return None
+                caps.append(cap)
+                edges_num -= len(cap[0])
+                verts_num -= cap[1]
+                faces_num -= cap[3]
+            if min(edges_num, verts_num, faces_num) <= 0:
+                return None
+            count = _array_count(md, edges, edges_num, verts_num, faces_num)
+            if count is None:
+                return None
+            edges_num, verts_num, faces_num = edges_num // count, verts_num // count, faces_num // count
+            steps.append((count, verts_num, tuple((c[0], c[1], c[2]) for c in caps)))
+        # WELD: it kept its input only if nothing was welded, which the
+        # caller's check of the whole layout tells.
+    return steps[::-1], (edges_num, verts_num, faces_num)
+
+
+def _array_count(md, edges, edges_num: int, verts_num: int, faces_num: int):
+    """How many copies an Array modifier made of a mesh now ``edges_num``
+    edges (caps taken off): its Count, or for Fit Length / Fit Curve (a
+    count that follows the geometry) the largest count whose second copy
+    is the first one shifted."""
+    if md.fit_type == "FIXED_COUNT":
+        count = max(1, int(md.count))
+        if edges_num % count or verts_num % count or faces_num % count:
+            return None
+        return count
+    common = int(np.gcd.reduce([edges_num, verts_num, faces_num]))
+    for count in range(common, 1, -1):
+        if common % count:
+            continue
+        size, shift = edges_num // count, verts_num // count
+        if np.array_equal(edges[size : 2 * size], edges[:size] + shift):
+            return count
+    return 1
+
+
+def _cap_layout(cap_object):
+    """((E, 2) edges, vertex count, drawn mask, face count) of an Array
+    cap, or None when it cannot be told: a cap whose evaluated mesh is its
+    own mesh (no enabled modifier) gives every edge, as Blender gives a cap
+    without Optimal Display marks; a cap with modifiers of its own (its
+    marks would come from its own evaluation) is not followed."""
+    original = getattr(cap_object, "original", None) or cap_object
+    data = getattr(original, "data", None)
+    if getattr(original, "type", None) != "MESH" or data is None:
+        return None
+    if any(md.show_viewport or md.show_render for md in original.modifiers):
+        return None
+    cap_edges = _read_edges(data).astype(np.int64)
+    return cap_edges, len(data.vertices), np.ones(len(cap_edges), bool), len(data.polygons)
+
+
+def _copies_match(steps, edges, size: int) -> bool:
+    """Whether ``edges`` (the evaluated mesh's) are exactly what the copies
+    of ``steps`` make of their first ``size`` edges: each copy its input's
+    edges with the vertex numbers shifted, each cap its own edges after
+    them. Every step's result is the start of the final array (a later
+    copy keeps its input first), so each is checked in place."""
+    for copies, verts_in, caps in steps:
+        block = edges[: copies * size].reshape(copies, size, 2)
+        shift = (np.arange(1, copies, dtype=np.int64) * verts_in)[:, None, None]
+        if not np.array_equal(block[1:] - block[:1].astype(np.int64), np.broadcast_to(shift, block[1:].shape)):
+            return False
+        end, first_vertex = copies * size, copies * verts_in
+        for cap_edges, cap_verts, _cap_mask in caps:
+            if not np.array_equal(edges[end : end + len(cap_edges)], cap_edges + first_vertex):
+                return False
+            end += len(cap_edges)
+            first_vertex += cap_verts
+        size = end
+    return size == len(edges)
+
+
+def _carry(steps, mask, chain, ends):
+    """Follow the subdivided mesh's (drawn mask, chain id, chain ends)
+    through the copies of ``steps`` (_carried_copies): each copy keeps its
+    edges' marks, its chains (new ids) and its ends (shifted with its
+    vertices); a cap's edges are their own chains."""
+    for copies, verts_in, caps in steps:
+        size = len(mask)
+        ends = (np.broadcast_to(ends, (copies, size, 2)) + (np.arange(copies) * verts_in)[:, None, None]).reshape(-1, 2)
+        ids = np.broadcast_to(chain, (copies, size))
+        chain = np.where(ids >= 0, ids + (np.arange(copies) * size)[:, None], -1).reshape(-1)
+        mask = np.tile(mask, copies)
+        first_vertex = copies * verts_in
+        for cap_edges, cap_verts, cap_mask in caps:
+            ends = np.concatenate([ends, cap_edges + first_vertex])
+            mask = np.concatenate([mask, cap_mask])
+            chain = np.concatenate([chain, np.full(len(cap_edges), -1, np.int64)])
+            first_vertex += cap_verts
+    # Every edge that is no piece of a longer one: a chain of its own.
+    alone = chain < 0
+    chain[alone] = -1 - np.flatnonzero(alone)
+    return mask, chain, ends
 
 
 def cage_edge_mask(obj, mesh, *, render: bool):
@@ -266,25 +438,41 @@ def cage_edge_mask(obj, mesh, *, render: bool):
     layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
         return None
+    children, _per_edge, _cage, steps = layout
+    if steps:
+        return cage_edges(obj, mesh, render=render, layout=layout)[0]
     mask = np.zeros(len(mesh.edges), dtype=bool)
-    mask[: layout[0]] = True
+    mask[:children] = True
     return mask
 
 
-def cage_edges(obj, mesh, *, render: bool):
+def cage_edges(obj, mesh, *, render: bool, layout=None):
     """(drawn mask, chain id per edge, (E, 2) chain ends per edge) for
     core/edge_select.py, or None: the children of one cage edge share a
     chain id and ends, so the density fade measures the whole cage edge,
     not its pieces (an edge that is no cage child is its own chain)."""
-    layout = _cage_layout(obj, mesh, render=render)
+    if layout is None:
+        layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
         return None
-    children, per_edge, cage = layout
-    index = np.arange(len(mesh.edges), dtype=np.int64)
+    children, per_edge, cage, steps = layout
+    edges = _read_edges(mesh).astype(np.int64)
+    size = len(edges) if not steps else _subdivided_edge_count(steps, len(edges))
+    index = np.arange(size, dtype=np.int64)
     mask = index < children
-    ends = _read_edges(mesh).astype(np.int64)
+    ends = edges[:size].copy()
     ends[:children] = np.repeat(np.asarray(cage, np.int64), per_edge, axis=0)
-    return mask, np.where(mask, index // per_edge, -1 - index), ends
+    chain = np.where(mask, index // per_edge, -1 - index)
+    if not steps:
+        return mask, chain, ends
+    return _carry(steps, mask, chain, ends)
+
+
+def _subdivided_edge_count(steps, edges_num: int) -> int:
+    """Edges of the subdivided mesh that ``steps`` copied into ``edges_num``."""
+    for copies, _verts_in, caps in reversed(steps):
+        edges_num = (edges_num - sum(len(cap[0]) for cap in caps)) // copies
+    return edges_num
 
 
 def subdivides(obj, render: bool) -> bool:
@@ -313,5 +501,33 @@ def cage_key(obj, render: bool):
                 bool(md.use_sculpt_base_mesh),
                 bool(md.show_only_control_edges),
             )
+        elif md.type in CAGE_CARRYING_TYPES:
+            entry += _carrying_key(md)
         parts.append(entry)
     return tuple(parts)
+
+
+def _carrying_key(md) -> tuple:
+    """What of a Mirror or Array modifier decides whether it keeps the cage
+    marks without changing the evaluated topology (a merge that merges
+    nothing, a cap's own modifiers)."""
+    if md.type == "MIRROR":
+        return (
+            tuple(bool(a) for a in md.use_axis),
+            tuple(bool(a) for a in md.use_bisect_axis),
+            bool(md.use_mirror_merge),
+        )
+    if md.type == "ARRAY":
+        caps = []
+        for cap in (md.start_cap, md.end_cap):
+            original = getattr(cap, "original", None) or cap
+            caps.append(
+                None
+                if original is None
+                else (
+                    original.session_uid,
+                    tuple((m.type, bool(m.show_viewport), bool(m.show_render)) for m in original.modifiers),
+                )
+            )
+        return (bool(md.use_merge_vertices), md.fit_type, int(md.count), *caps)
+    return ()

@@ -33,8 +33,8 @@ import math
 
 import numpy as np
 
-from ..core import extract
 from ..core.view import Style, View
+from .mesh_reading import read_edge_verts, read_positions
 
 # Edges sampled per mesh for the median (evenly spread; enough for a median).
 SAMPLE_EDGES = 20000
@@ -48,10 +48,8 @@ def typical_edge_length(mesh) -> float:
     count = len(mesh.edges)
     if count == 0:
         return 0.0
-    positions = extract.read_positions(mesh).astype(np.float64)
-    ends = np.empty(count * 2, dtype=np.int32)
-    mesh.edges.foreach_get("vertices", ends)
-    ends = ends.reshape(count, 2)[:: max(count // SAMPLE_EDGES, 1)]
+    positions = read_positions(mesh).astype(np.float64)
+    ends = read_edge_verts(mesh)[:: max(count // SAMPLE_EDGES, 1)]
     if len(positions) == 0 or ends.max(initial=0) >= len(positions):
         return 0.0
     lengths = np.linalg.norm(positions[ends[:, 0]] - positions[ends[:, 1]], axis=1)

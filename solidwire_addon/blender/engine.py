@@ -86,8 +86,10 @@ class PreparedFrame:
     snapshot and the gathered draw items (extracted and uploaded once).
     ``extra_passes`` (core.schema.EXTRA_PASSES) are drawn with each tile."""
 
-    def __init__(self, depsgraph, size, *, should_stop=None, extra_passes=()):
+    def __init__(self, depsgraph, size, *, should_stop=None, extra_passes=(), options=None):
         ensure_gpu()  # uploads start in gather(), before anything is drawn
+        # Read once per frame: every tile draws with the same options.
+        self.options = runtime.options if options is None else options
         self.scene = depsgraph.scene
         self.view = camera_view(self.scene, depsgraph, size)
         # A stored NaN is drawn as its default and put right in the scene
@@ -97,7 +99,7 @@ class PreparedFrame:
         # Reuse: unchanged meshes are recognised by their content fingerprint
         # (runtime.py says why), so a multi-frame render re-extracts only what
         # changed on each frame.
-        self.frame = runtime.begin_frame(reuse=True)
+        self.frame = runtime.begin_frame(reuse=self.options.reuse_meshes)
         # The view lets gather skip extracting meshes that are wholly off-screen.
         self.extra_passes = tuple(extra_passes)
         object_settings = gather.ObjectSettings(
@@ -112,7 +114,8 @@ class PreparedFrame:
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,
             edge_lengths=density.needs_lengths(self.settings),
             tessellation=bool(self.settings.show_tessellation),
-            **passes.gather_options(self.settings),
+            reposition=self.options.reposition_meshes,
+            **gather.gather_options(self.settings),
         )
         self.messages += object_settings.messages
         # Measured on the whole frame's view, so every tile fades alike.
@@ -144,6 +147,7 @@ class PreparedFrame:
             keep_readback=keep_readback,
             read_depth=read_depth,
             strands=self.strands,
+            options=self.options,
         )
         self.ms_draw += (time.perf_counter() - start) * 1000.0
         if self.draw_stats is None:
@@ -154,16 +158,19 @@ class PreparedFrame:
         runtime.end_frame(self.frame, self.draw_stats or DrawStats(), self.ms_extract, self.ms_draw, self.seen)
 
 
-def render_scene(depsgraph, size=None, *, region=None, should_stop=None, report=None, extra_passes=(), extra_out=None):
+def render_scene(
+    depsgraph, size=None, *, region=None, should_stop=None, report=None, extra_passes=(), extra_out=None, options=None
+):
     """Render ``depsgraph``'s scene from its camera in one piece: (rgba
     premultiplied over the film, view depth), or None when ``should_stop()``
     said so. ``region`` (x0, y0, w, h) in pixels of the full frame draws that
     window only. ``report(text, fraction)`` hears about the stages. The render
     passes named in ``extra_passes`` (core.schema.EXTRA_PASSES) go into the
-    dict ``extra_out``."""
+    dict ``extra_out``. ``options`` (core.options.DrawOptions): how to draw,
+    by default runtime.options."""
     report = report or (lambda _text, _fraction: None)
     report("extracting meshes", 0.0)
-    frame = PreparedFrame(depsgraph, size, should_stop=should_stop, extra_passes=extra_passes)
+    frame = PreparedFrame(depsgraph, size, should_stop=should_stop, extra_passes=extra_passes, options=options)
     for line in frame.messages:
         warn_once(("repaired", line), line)
     if should_stop is not None and should_stop():

@@ -24,13 +24,14 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..core import draw as draw_mod
 from ..core import edge_select, extract
 from ..core.cache import MeshCache
-from ..core.colors import ItemSource
+from ..core.colors import ItemSource, needs_attribute_colors, needs_item_colors
 from ..core.log import one_line, warn_once
 from ..core.schema import OBJECT, OVERRIDE_FIELDS
 from ..core.view import DrawItem, Style, outside_frustum_many
-from . import cage, density, outlines, runtime, setting_repair
+from . import cage, density, mesh_reading, outlines, runtime, setting_repair
 
 # Which per-object switch a target honours (object.solidwire, docs/image_model.md §5.9).
 SHOW_IN_RENDER, SHOW_IN_VIEWPORT = "show_in_render", "show_in_viewport"
@@ -127,8 +128,8 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute
     The fingerprint is ``(topology, shape)`` (see MeshCache.get_validated):
     a deformation changes the shape part alone, and then positions and
     corner normals may be uploaded again without a full extraction."""
-    positions = extract.read_positions(mesh)
-    corner_vert = extract.read_corner_verts(mesh)
+    positions = mesh_reading.read_positions(mesh)
+    corner_vert = mesh_reading.read_corner_verts(mesh)
     topology = (
         len(positions),
         len(mesh.edges),
@@ -139,14 +140,14 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute
     )
     shape = (_crc(positions),)
     if attribute_colors:
-        topology += extract.attribute_colors_checksum(mesh)
+        topology += mesh_reading.attribute_colors_checksum(mesh)
     corner_inputs = None
     if corners:
-        materials, domain = extract.read_corner_domain(mesh)
+        materials, domain = mesh_reading.read_corner_domain(mesh)
         topology += (_crc(materials), domain)
         normals = None
         if not extract.normals_follow_geometry(domain):
-            normals = extract.read_normals(mesh, domain)
+            normals = mesh_reading.read_normals(mesh, domain)
             shape += (_crc(normals),)
         corner_inputs = (normals, materials, domain)
     return (topology, shape), (positions, corner_vert, corner_inputs)
@@ -159,7 +160,7 @@ def _crc(array: np.ndarray) -> int:
 def _edge_class_checksums(mesh, edge_classes: tuple) -> tuple:
     if not edge_classes:
         return ()
-    bits = edge_select.read_edge_classes(mesh, edge_classes)
+    bits = mesh_reading.read_edge_classes(mesh, edge_classes)
     return (0,) if bits is None else (_crc(bits),)
 
 
@@ -178,6 +179,21 @@ def item_source(obj) -> ItemSource:
 NO_SELECTION = edge_select.Selection()
 
 
+def gather_options(settings) -> dict:
+    """What the draw items of a frame with ``settings`` must carry (keyword
+    arguments of :func:`gather`): corner tables for a shaded fill or
+    material colours, colour-source inputs for per-object colours, the
+    active colour attribute, and the edge selection."""
+    return {
+        "corners": draw_mod.needs_corners(settings),
+        "colors": needs_item_colors(settings),
+        "attribute_colors": needs_attribute_colors(settings),
+        "edges": edge_select.Selection(
+            float(settings.edge_angle), draw_mod.edge_classes_of(settings), bool(settings.use_cage_edges)
+        ),
+    }
+
+
 def gather(
     depsgraph,
     cache: MeshCache,
@@ -194,6 +210,7 @@ def gather(
     materials: bool = False,
     edge_lengths: bool = False,
     tessellation: bool = False,
+    reposition: bool = True,
 ):
     """(items, seen keys, ms_extract) for every drawn mesh instance of ``depsgraph``.
 
@@ -225,7 +242,9 @@ def gather(
     GPU mesh its typical edge length (``mesh.edge_length``, density.py).
     ``tessellation`` (Tessellation): text, curves, surfaces and metaballs
     draw every edge of their tessellation instead of their outlines
-    (outlines.py)."""
+    (outlines.py). ``reposition`` (options.DrawOptions.reposition_meshes):
+    a mesh whose shape alone changed uploads its new positions only;
+    False extracts it again in full."""
     if trust_updates is None:
         trust_updates = depsgraph.mode == "VIEWPORT"
     frame = _FrameGather(
@@ -237,6 +256,7 @@ def gather(
         edges=edges,
         outlines=not tessellation,
         attribute_colors=attribute_colors,
+        reposition=reposition,
     )
     items: list[DrawItem] = []
     for instance in depsgraph.object_instances:
@@ -311,8 +331,10 @@ class _FrameGather:
         edges: edge_select.Selection,
         outlines: bool = True,
         attribute_colors: bool = False,
+        reposition: bool = True,
     ):
         self.cache = cache
+        self.reposition = reposition
         self.mode = depsgraph.mode
         self.trust = (depsgraph.as_pointer(), runtime.epoch) if trust_updates else None
         self.versions = runtime.geometry_version
@@ -403,6 +425,7 @@ class _FrameGather:
                 self.mode == "RENDER",
                 outline=cage_key == OUTLINE_KEY,
                 attribute_colors=self.attribute_colors,
+                allow_reposition=self.reposition,
             )
         except Exception as exc:  # noqa: BLE001 - one bad object must not blank the frame
             warn_once(
@@ -467,12 +490,21 @@ class _FrameGather:
             self.cache.culled += culled  # never extracted: every instance outside the view
 
 
+def _edge_angle_holds(entry, mesh) -> bool:
+    """Whether a move of ``mesh``'s vertices (same faces) leaves every edge
+    on its side of the edge angle, checked against what the extraction kept
+    (edge_select.EdgeAngleState): only edges next to a face that turned are
+    measured again. Then the drawn edges and regions stay as they are."""
+    state = getattr(entry, "edge_angle_state", None)
+    return state is not None and state.still_flat(mesh_reading.read_face_normals(mesh))
+
+
 def _materials_of(obj, data, pointer, face_slots) -> tuple | None:
     """(material slot per face, pass_index per slot) of an evaluated object."""
     try:
         slots = face_slots.get(pointer)
         if slots is None:
-            slots = face_slots[pointer] = extract.read_material_indices(data)
+            slots = face_slots[pointer] = mesh_reading.read_material_indices(data)
         passes = tuple(float(s.material.pass_index) if s.material is not None else 0.0 for s in obj.material_slots)
     except (AttributeError, RuntimeError, ValueError) as exc:
         warn_once(("materials", obj.name), f"SolidWire: no material indices for '{obj.name}': {exc}")
@@ -535,10 +567,12 @@ def _mesh_for(
     render: bool = False,
     outline: bool = False,
     attribute_colors: bool = False,
+    allow_reposition: bool = True,
 ):
     """(GPUMesh or None, ms spent validating/extracting) for one evaluated
     mesh. ``outline``: the drawn mask is outlines.py's (``edges.use_cage``
-    says a mask is passed), not the cage's."""
+    says a mask is passed), not the cage's; ``allow_reposition`` False
+    extracts a mesh whose shape changed in full."""
     obj_orig = obj.original
     fast = None
     if trust is not None:
@@ -560,30 +594,31 @@ def _mesh_for(
         positions, corner_vert, corner_inputs = context
         try:
             source_mesh = get_source()
-            arrays = extract.extract_mesh(
+            arrays = mesh_reading.extract_mesh(
                 source_mesh, positions=positions, corner_vert=corner_vert, corners=corner_inputs if corners else None
             )
             if edges.active:
-                face_offsets = extract.read_face_offsets(source_mesh)
+                face_offsets = mesh_reading.read_face_offsets(source_mesh)
                 cage_edges = None
                 if outline:
                     cage_edges = outlines.outline_mask(source_mesh, face_offsets)
                 elif edges.use_cage:
                     cage_edges = cage.cage_edges(obj.original, source_mesh, render=render)
-                edge_select.apply_to_mesh(
+                mesh_reading.apply_edge_selection(
                     arrays,
                     source_mesh,
-                    corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
+                    corner_vert if corner_vert is not None else mesh_reading.read_corner_verts(source_mesh),
                     face_offsets,
                     edges,
                     cage_edges,
                 )
-            if attribute_colors:
+            read_colors = mesh_reading.read_attribute_colors(source_mesh) if attribute_colors else None
+            if read_colors is not None:
                 extract.attach_attribute_colors(
                     arrays,
-                    source_mesh,
-                    corner_vert if corner_vert is not None else extract.read_corner_verts(source_mesh),
-                    extract.read_face_offsets(source_mesh),
+                    *read_colors,
+                    corner_vert if corner_vert is not None else mesh_reading.read_corner_verts(source_mesh),
+                    mesh_reading.read_face_offsets(source_mesh),
                 )
         except extract.ExtractError as exc:
             warn_once(("extract", obj.name), f"SolidWire skips object '{obj.name}': {exc}")
@@ -605,12 +640,16 @@ def _mesh_for(
     def reposition(entry, context):
         positions, corner_vert, corner_inputs = context
         source_mesh = get_source()
+        if edges.follows_positions and (outline or not _edge_angle_holds(entry, source_mesh)):
+            # An edge crossed the angle: other drawn edges and regions. (An
+            # outline's own mask follows the positions too; it is not kept.)
+            return None
         moved = extract.reposition(
             entry,
             positions,
             corner_vert,
-            extract.read_face_offsets(source_mesh),
-            extract.blender_triangles(source_mesh),
+            mesh_reading.read_face_offsets(source_mesh),
+            mesh_reading.blender_triangles(source_mesh),
         )
         if moved is None or not corners:
             return moved
@@ -618,7 +657,7 @@ def _mesh_for(
         if domain == extract.NORMALS_BY_CORNER and entry.corner_rows is None:
             return None
         if normals is None:  # not read by the fingerprint (they follow the positions)
-            normals = extract.read_normals(source_mesh, domain)
+            normals = mesh_reading.read_normals(source_mesh, domain)
         # The normals follow the deformation; which corner each triangle
         # corner is does not (same faces, same triangles; the domain is part
         # of the fingerprint's topology).
@@ -628,15 +667,15 @@ def _mesh_for(
         )
 
     try:
-        # A deformation re-uploads positions (and corner normals) only, unless
-        # the edge selection follows the positions (edge angle): then which
-        # edges are drawn may change, and the mesh is extracted again.
+        # A deformation re-uploads positions (and corner normals) only; with
+        # the edge angle, only while every edge stays on its side of the
+        # angle (else which edges are drawn changes: extracted again).
         mesh, _extracted = cache.get_validated(
             key,
             fast,
             lambda: fingerprint(get_source(), corners, edges.classes, attribute_colors),
             make_arrays,
-            None if edges.follows_positions else reposition,
+            reposition if allow_reposition else None,
         )
     finally:
         if in_edit_mode and source:

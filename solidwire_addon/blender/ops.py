@@ -6,7 +6,6 @@ the overlay handler, reacting to the settings' update callbacks.
 
 from __future__ import annotations
 
-import functools
 from pathlib import Path
 
 import bpy
@@ -16,8 +15,9 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 from ..core.log import one_line
 from . import overlay, presets
 from .fade_range import visible_depth_extent
+from .operator_errors import one_line_errors
 from .overlay import viewport_object_filter
-from .properties import redraw_viewports
+from .runtime import redraw_viewports
 
 # Default key of the overlay toggle in the 3D View: Ctrl+Shift+Alt+W ("W" for
 # wire). Shift+Alt+W is taken in Blender's default keymap (Sculpt: expand face
@@ -54,34 +54,6 @@ def overlay_shown(context) -> bool:
     if viewport is None:
         return bool(props.show_overlay)
     return overlay.viewport_shows(*viewport, props)
-
-
-def one_line_errors(method):
-    """Wrap an operator's ``execute`` / ``invoke``: an unexpected exception is
-    reported as one line (``bpy.ops`` raises RuntimeError with it) and the
-    operator is cancelled, instead of Blender printing a traceback. Expected
-    problems are checked and reported by the operators themselves."""
-
-    def run(self, *args):
-        try:
-            return method(self, *args)
-        except Exception as exc:  # noqa: BLE001 - no traceback from an operator
-            message = one_line(exc)
-            self.report({"ERROR"}, f"SolidWire: {self.bl_label} failed: {type(exc).__name__}: {message}")
-            return {"CANCELLED"}
-
-    # Blender checks the argument count of execute (self, context) and
-    # invoke (self, context, event), so the wrapper keeps it.
-    if method.__code__.co_argcount == 3:
-
-        def guarded(self, context, event):
-            return run(self, context, event)
-    else:
-
-        def guarded(self, context):
-            return run(self, context)
-
-    return functools.wraps(method)(guarded)
 
 
 class SOLIDWIRE_OT_toggle_overlay(bpy.types.Operator):

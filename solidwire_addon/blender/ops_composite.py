@@ -10,7 +10,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, StringProperty
 
 from . import composite
-from .ops import one_line_errors
+from .operator_errors import one_line_errors
 
 ENGINE_ITEMS = (
     ("SCENE", "Scene Engine", "The scene's render engine (when that is not SolidWire)"),

@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core import edge_select, extract
+from ..core import edge_select
+from .mesh_reading import read_edge_topology, read_face_normals, read_face_offsets
 
 # Object types whose evaluated mesh is a tessellation Blender made.
 TESSELLATED_TYPES = frozenset({"FONT", "CURVE", "SURFACE", "META"})
@@ -51,12 +52,10 @@ def is_curve_outline(obj) -> bool:
 
 def outline_mask(mesh, face_offsets: np.ndarray | None = None) -> tuple[np.ndarray, None]:
     """(drawn mask, chain ids = None) of ``mesh``'s edges in the form
-    edge_select.apply_to_mesh takes for its cage input: False for an edge
+    mesh_reading.apply_edge_selection takes for its cage input: False for an edge
     of exactly two faces in one plane."""
     if face_offsets is None:
-        face_offsets = extract.read_face_offsets(mesh)
-    verts, corner_edge = edge_select.read_edge_topology(mesh)
-    flat = edge_select.flat_edges(
-        corner_edge, face_offsets, extract.read_face_normals(mesh), len(verts), COPLANAR_ANGLE
-    )
+        face_offsets = read_face_offsets(mesh)
+    verts, corner_edge = read_edge_topology(mesh)
+    flat = edge_select.flat_edges(corner_edge, face_offsets, read_face_normals(mesh), len(verts), COPLANAR_ANGLE)
     return ~flat, None

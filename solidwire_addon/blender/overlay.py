@@ -203,7 +203,8 @@ def draw_scene_overlay(
         display = color_management.display_lut(depsgraph.scene)
     # Meshes are reused across redraws: the viewport depsgraph reports every
     # edit before it is drawn, and gather() re-extracts only what changed.
-    frame = runtime.begin_frame(reuse=True)
+    options = runtime.options  # read once per redraw and handed down
+    frame = runtime.begin_frame(reuse=options.reuse_meshes)
     object_settings = gather.ObjectSettings(gather.SHOW_IN_VIEWPORT, bpy.data.objects)
     items, seen, ms_extract = gather.gather(
         depsgraph,
@@ -212,7 +213,8 @@ def draw_scene_overlay(
         object_settings=object_settings,
         edge_lengths=density.needs_lengths(settings),
         tessellation=bool(settings.show_tessellation),
-        **passes.gather_options(settings),
+        reposition=options.reposition_meshes,
+        **gather.gather_options(settings),
     )
     setting_repair.report_later(object_settings.messages)
     drawn = overlay_state.draw_settings(plan, settings)
@@ -238,6 +240,7 @@ def draw_scene_overlay(
             clip_planes=plan.clip_planes,
             display=display,
             strands=strand_items,
+            options=options,
         )
     else:
         # Nothing to draw (every object hidden, opted out or not drawable):

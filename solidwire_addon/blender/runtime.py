@@ -24,21 +24,25 @@ A file load (``load_pre``/``load_post``) frees every GPU mesh.
 
 from __future__ import annotations
 
+import contextlib
 import time
 
 import bpy
 from bpy.app.handlers import persistent
 
 from ..core.cache import MeshCache
+from ..core.options import DrawOptions
 
 mesh_cache = MeshCache()
 _last_stats: dict = {}
 
 geometry_version: dict[int, int] = {}  # session_uid -> geometry updates seen
 epoch = 0  # bumped by frame changes, undo/redo and file loads
-# Benchmark switch (scripts/bench_scale.py): False makes every frame start
-# from an empty cache, the behaviour before reuse, to compare against.
-reuse_enabled = True
+# What the entry points Blender calls (the render engine, the overlay's draw
+# handler) draw with: they take no arguments of ours, so they read this once
+# per frame and hand it down (core/options.py). The shipped defaults;
+# benchmarks and tests draw with other options inside ``drawing_with``.
+options = DrawOptions()
 # Set by the command line while Blender's animation render draws its frames:
 # Blender ends an animation render early only when the engine reports an
 # error, so when this returns a reason (a stop was asked for) the engine
@@ -98,13 +102,25 @@ def remove_handlers() -> None:
     _installed.clear()
 
 
+@contextlib.contextmanager
+def drawing_with(draw_options: DrawOptions):
+    """Frames drawn inside (F12, the overlay) use ``draw_options``; the
+    previous options come back on exit."""
+    global options
+    previous, options = options, draw_options
+    try:
+        yield draw_options
+    finally:
+        options = previous
+
+
 def begin_frame(*, reuse: bool = False) -> float:
     """Start counting a frame. Without ``reuse`` the cache starts empty.
 
     With ``reuse`` every mesh is validated (blender/gather.py): unchanged meshes are
     drawn from the cache, changed ones re-extracted."""
     install_handlers()
-    if not (reuse and reuse_enabled):
+    if not reuse:
         mesh_cache.clear()
     mesh_cache.reset_counters()
     return time.perf_counter()

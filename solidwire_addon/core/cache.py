@@ -155,6 +155,7 @@ class GPUMesh:
         self.quad_flip = arrays.quad_flip
         self.face_offsets_crc = arrays.face_offsets_crc
         self.source_positions = arrays.source_positions
+        self.edge_angle_state = arrays.edge_angle_state  # edge_select.EdgeAngleState
         self.mesh_bounds = (arrays.bounds_min, arrays.bounds_max)  # mesh space
 
         self._batch = None  # batch, made on first use
@@ -333,9 +334,6 @@ class MeshCache:
         self.extracted = 0
         self.reused = 0
         self.repositioned = 0  # meshes whose positions alone were uploaded again
-        # Benchmark switch (scripts/bench_scale.py): False re-extracts every
-        # changed mesh in full, the behaviour before positions-only uploads.
-        self.allow_reposition = True
         self.culled = 0  # instances culled before their mesh was ever extracted
         self.ms_upload = 0.0
 
@@ -373,13 +371,7 @@ class MeshCache:
             self._tokens[key] = (fast, content)
             self.reused += 1
             return entry, False
-        if (
-            entry is not None
-            and tokens is not None
-            and reposition is not None
-            and self.allow_reposition
-            and tokens[1][0] == content[0]
-        ):
+        if entry is not None and tokens is not None and reposition is not None and tokens[1][0] == content[0]:
             moved = reposition(entry, context)
             if moved is not None:
                 start = time.perf_counter()

@@ -30,22 +30,87 @@ from .view import (
     window_rect,
 )
 
+# Which lines a draw shows (DrawTarget.lines): the visible wire with the
+# fill, none (the fill and depth only: the surface under hidden lines), or
+# the hidden-line layer (image model §5.4: real edges behind the surface,
+# dimmed and dashed, no fill).
+WIRE_LINES, NO_LINES, HIDDEN_LINES = "wire", "none", "hidden"
 
-def shader_variant(
-    settings, write_view_depth: bool = False, depth_bias: float = 0.0, linear_depth: bool = False
-) -> shaders.ShaderVariant:
-    """The compiled-code features ``settings`` ask for."""
+# The two stages of the deferred surface (docs/image_model.md §2.5; see
+# passes.SurfacePass): VISIBILITY records which triangle of which draw
+# each pixel shows, RESOLVE runs the exact fragment stage once per pixel of
+# that record. ``stage=None`` draws directly (one pass, every fragment).
+VISIBILITY, RESOLVE = "visibility", "resolve"
+# Between the two: the lines of multi-face regions drawn over the
+# visibility record (passes._draw_region_lines, docs/image_model.md §2.6).
+LINES = "lines"
+
+
+@dataclass(frozen=True, eq=False)
+class DrawTarget:
+    """Where one draw lands and how: the one description of a draw's
+    target, from which its shader variant follows (:func:`shader_variant`).
+
+    Depth: the test and whether the draw writes depth, an NDC bias towards
+    the camera (the viewport overlay, passes.OVERLAY_DEPTH_BIAS) and whether
+    the depth written is view depth / clip end (the render's own targets,
+    LINEAR_DEPTH in solidwire_frag.glsl). ``clip_planes`` ((6, 4)
+    world-space planes of a viewport's clipping region): fragments outside
+    them are discarded. ``display`` (a display_transform.DisplayLUT,
+    viewport overlay only): the colour leaves through the scene's colour
+    management (image model §9). ``stage``: None draws directly, VISIBILITY
+    or RESOLVE one half of the deferred surface (RESOLVE reads the record
+    in ``visibility``), LINES the lines of multi-face regions over that
+    record into the bound region-lines target; ``region_lines`` is that
+    target's image, which a surface draw then reads. Outputs: the view
+    depth in a second colour target, the render passes' targets (``aovs``),
+    and which ``lines`` the colour shows (WIRE_LINES, NO_LINES,
+    HIDDEN_LINES). ``triangle_ids_by_vertex``: how the VISIBILITY stage
+    numbers triangles (options.DrawOptions)."""
+
+    depth_test: str = "LESS_EQUAL"
+    depth_write: bool = True
+    depth_bias: float = 0.0
+    linear_depth: bool = False
+    clip_planes: object = None
+    display: object = None
+    stage: str | None = None
+    visibility: object = None
+    region_lines: object = None
+    view_depth: bool = False
+    aovs: bool = False
+    lines: str = WIRE_LINES
+    triangle_ids_by_vertex: bool = False
+
+    def hidden(self) -> DrawTarget:
+        """The hidden-line layer over this target (image model §5.4): every
+        face behind the depth already in the framebuffer draws its real
+        edges dimmed and dashed, blended "over" (the caller sets the blend
+        mode). Strictly GREATER, so the visible surface itself never
+        passes: the same shader wrote that depth, so there is no z-fight.
+        With one wire colour "over" is commutative (alpha = 1 - prod(1 -
+        a_k)), so draw order does not matter. No region-lines image: the
+        layer walks every region itself."""
+        return replace(
+            self, depth_test="GREATER", depth_write=False, lines=HIDDEN_LINES, region_lines=None, view_depth=False
+        )
+
+
+def shader_variant(settings, target: DrawTarget | None = None) -> shaders.ShaderVariant:
+    """The compiled-code features of a draw of ``settings`` into ``target``
+    (per-mesh parts and missing resources refine it in :func:`draw`)."""
+    target = target or DrawTarget()
     diagonals = {
         "HIDDEN": shaders.DIAGONALS_HIDDEN,
         "SOLID": shaders.DIAGONALS_SOLID,
     }.get(settings.diagonal_mode, shaders.DIAGONALS_PATTERN)
-    return shaders.ShaderVariant(
+    variant = shaders.ShaderVariant(
         diagonals=diagonals,
         use_fill=bool(settings.use_fill),
         use_fade=bool(settings.use_fade),
-        write_view_depth=write_view_depth,
-        depth_bias=depth_bias,
-        linear_depth=linear_depth,
+        write_view_depth=target.view_depth,
+        depth_bias=target.depth_bias,
+        linear_depth=target.linear_depth,
         thickness_mode={"WORLD": shaders.THICKNESS_WORLD, "DEPTH": shaders.THICKNESS_DEPTH}.get(
             settings.thickness_mode, shaders.THICKNESS_PIXELS
         ),
@@ -56,6 +121,37 @@ def shader_variant(
         edge_classes=bool(edge_classes_of(settings)),
         density_fade=bool(settings.use_density_fade),
     )
+    if target.lines == HIDDEN_LINES:
+        variant = replace(
+            variant,
+            hidden_pass=True,
+            write_view_depth=False,
+            shading=shaders.SHADING_FLAT,
+            material_colors=False,
+            attribute_colors=False,
+        )
+    if target.aovs:
+        variant = replace(variant, write_aovs=True)
+    if target.stage == RESOLVE:
+        variant = replace(variant, resolve=True, linear_depth=False)
+    elif target.stage == VISIBILITY:
+        variant = shaders.ShaderVariant(
+            visibility=True, linear_depth=target.linear_depth, triangle_ids_by_vertex=target.triangle_ids_by_vertex
+        )
+    elif target.stage == LINES:
+        variant = shaders.ShaderVariant(
+            region_lines_pass=True,
+            thickness_mode=variant.thickness_mode,
+            edge_classes=variant.edge_classes,
+            density_fade=variant.density_fade,
+        )
+    if target.clip_planes is not None:
+        variant = replace(variant, clip_planes=True)
+    if target.region_lines is not None:
+        variant = replace(variant, region_lines=True)
+    if target.display is not None:
+        variant = replace(variant, display_transform=True)
+    return variant
 
 
 def edge_classes_of(settings) -> tuple:
@@ -109,14 +205,6 @@ INSTANCING_MIN = 16
 # corner of the vertex stage; below it the dispatch costs more than it saves.
 SETUP_TABLE_MIN = 50_000
 
-# The two stages of the deferred surface (docs/image_model.md §2.5; see
-# passes.draw_surface): VISIBILITY records which triangle of which draw
-# each pixel shows, RESOLVE runs the exact fragment stage once per pixel of
-# that record. ``stage=None`` draws directly (one pass, every fragment).
-VISIBILITY, RESOLVE = "visibility", "resolve"
-# Between the two: the lines of multi-face regions drawn over the
-# visibility record (passes._draw_region_lines, docs/image_model.md §2.6).
-LINES = "lines"
 # Triangle numbers, instances and draw numbers travel as float32 whole
 # numbers in the visibility record: exact below 2^24.
 DEFERRED_MAX = 1 << 24
@@ -275,97 +363,38 @@ def _instance_rows(object_to_view, object_to_clip, info) -> np.ndarray:
 
 
 def draw(
-    items,
-    view: View,
-    settings,
-    *,
-    write_view_depth: bool = False,
-    cull: bool = True,
-    depth_bias: float = 0.0,
-    depth_test: str = "LESS_EQUAL",
-    depth_write: bool = True,
-    hidden_pass: bool = False,
-    show_wire: bool = True,
-    write_aovs: bool = False,
-    linear_depth: bool = False,
-    clip_planes=None,
-    display=None,
-    program=EXACT,
-    stage=None,
-    visibility=None,
-    region_lines=None,
+    items, view: View, settings, *, target: DrawTarget | None = None, cull: bool = True, program=EXACT
 ) -> DrawStats:
-    """Draw ``items`` into the bound framebuffer with depth test and write.
+    """Draw ``items`` into the bound framebuffer as ``target`` describes
+    (by default: depth test LESS_EQUAL and write, the visible wire).
 
     Every fragment of a face writes depth (nothing is discarded), so a wire is
     only ever seen on the face that is the visible surface there. Items with
     a style override draw with their own parameter block (one per distinct
-    style); the variant does not depend on the style. ``clip_planes``
-    ((6, 4) world-space planes of a viewport's clipping region): fragments
-    outside them are discarded. ``display`` (a display_transform.DisplayLUT,
-    viewport overlay only): the colour leaves through the scene's colour
-    management (image model §9). ``stage`` VISIBILITY or RESOLVE (with
-    ``visibility``, the texture the first wrote): one half of the deferred
-    surface, see passes.draw_surface; both halves must be called with the
-    same items, view and settings so that they number the draws alike.
-    ``stage`` LINES (between the two, with ``visibility``) draws the lines
-    of multi-face regions into the bound region-lines target; a RESOLVE
-    given that target (``region_lines``) reads them from it."""
+    style); the variant does not depend on the style. The two halves of
+    the deferred surface (target stages VISIBILITY and RESOLVE, and LINES
+    between them) must be called with the same items, view and settings so
+    that they number the draws alike. ``program`` draws another method
+    through this same pass (the benchmark's, scripts/bench/methods.py)."""
+    target = target or DrawTarget()
     stats = DrawStats()
     if not items:
         return stats
+    show_wire = target.lines != NO_LINES
     settings = styled(settings, None, show_wire)
-    variant = shader_variant(settings, write_view_depth, depth_bias, linear_depth)
-    if hidden_pass:
-        variant = replace(
-            variant,
-            hidden_pass=True,
-            write_view_depth=False,
-            shading=shaders.SHADING_FLAT,
-            material_colors=False,
-            attribute_colors=False,
-        )
-    if write_aovs:
-        variant = replace(variant, write_aovs=True)
-    if stage == RESOLVE:
-        variant = replace(variant, resolve=True, linear_depth=False)
-    elif stage == VISIBILITY:
-        variant = shaders.ShaderVariant(
-            visibility=True, linear_depth=linear_depth, triangle_ids_by_vertex=shaders.triangle_ids_by_vertex()
-        )
-    elif stage == LINES:
-        variant = shaders.ShaderVariant(
-            region_lines_pass=True,
-            thickness_mode=variant.thickness_mode,
-            edge_classes=variant.edge_classes,
-            density_fade=variant.density_fade,
-        )
-    clip_rows = None
-    if clip_planes is not None:
-        variant = replace(variant, clip_planes=True)
-        clip_rows = clip_space_planes(clip_planes, view)
+    variant = shader_variant(settings, target)
+    stage = target.stage
     extras = {}
-    if region_lines is not None:
-        variant = replace(variant, region_lines=True)
-        extras["region_line_image"] = region_lines
-    if display is not None:
-        variant = replace(variant, display_transform=True)
-        extras["display"] = display
-    if visibility is not None:
-        extras["visibility"] = visibility
-    if clip_rows is not None:
+    if target.region_lines is not None:
+        extras["region_line_image"] = target.region_lines
+    if target.display is not None:
+        extras["display"] = target.display
+    if target.visibility is not None:
+        extras["visibility"] = target.visibility
+    if target.clip_planes is not None:
+        clip_rows = clip_space_planes(target.clip_planes, view)
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
-    if variant.shading == shaders.SHADING_MATCAP:
-        extras["matcap_image"] = matcaps.texture(settings.matcap)
-        if extras["matcap_image"] is None:
-            variant = replace(variant, shading=shaders.SHADING_FLAT)
-    if (variant.shading != shaders.SHADING_FLAT or variant.material_colors) and any(
-        item.mesh.corners is None for item in items
-    ):
-        # Meshes gathered without their corner table (a caller that did not
-        # ask for it): draw flat rather than read a missing table.
-        warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
-        variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
+    variant = _available(variant, settings, items, extras)
     # Two per-object mechanisms side by side:
     # an object's style override (wire colour, thickness, fill colour) is a
     # parameter block per distinct style (``ubo(style)``), since thickness
@@ -389,89 +418,145 @@ def draw(
             )
         return block
 
-    gpu.state.depth_test_set("NONE" if stage == RESOLVE else depth_test)
-    gpu.state.depth_mask_set(depth_write and stage != RESOLVE)
+    gpu.state.depth_test_set("NONE" if stage == RESOLVE else target.depth_test)
+    gpu.state.depth_mask_set(target.depth_write and stage != RESOLVE)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
-    groups = list(_groups(items, view, cull, stats, pass_indices=write_aovs))
+    groups = list(_groups(items, view, cull, stats, pass_indices=target.aovs))
     try:
-        # Meshes with n-gons need the fragment stage's outline walk; the rest
-        # use a variant without it (llvmpipe pays for a loop even when it runs
-        # zero times), so tri/quad meshes never pay for n-gons.
-        # Big tri/quad meshes take their edge set-up from the pre-pass.
-        # Only a mesh drawn once in this pass: its table is then written
-        # before its one draw and never rewritten while a draw may still read
-        # it (objects sharing a mesh keep the per-corner set-up). The
-        # deferred resolve sets a triangle up once per pixel it shows, so
-        # there the pre-pass pays only where the draw's pixels outnumber its
-        # triangles (_setup_size).
-        setup_ok = getattr(program, "supports_setup_table", False) and _setup_ready()
-        # Both deferred stages must split and number the draws alike:
-        # instancing does not depend on the stage's variant.
-        instancing = program.supports_instancing and not write_aovs
-        numbering = _DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view)
-        draws_of = {}
-        for g in groups:
-            draws_of[id(g.mesh)] = draws_of.get(id(g.mesh), 0) + len(g.world)
+        call = _DrawCall(
+            ubo=ubo,
+            settings=settings,
+            program=program,
+            flip=flip,
+            stats=stats,
+            extras=extras,
+            bases=bases,
+            # Both deferred stages must split and number the draws alike:
+            # instancing does not depend on the stage's variant.
+            instancing=program.supports_instancing and not target.aovs,
+            numbering=_DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view),
+        )
+        parts = _parts(groups, program, stage, view)
         # One variant per part; parts in a fixed order (both deferred stages
-        # must draw, and so number, alike; the visibility stage itself reads
-        # no table and sets nothing up).
-        parts: dict = {}
-        for g in groups:
-            mesh = g.mesh
-            ngons = program.supports_ngons and mesh.has_ngons
-            # (Part of the key, so that every stage parts the draws alike.)
-            lines_only = ngons and getattr(mesh, "blocks_only_for_region_lines", False)
-            colored = getattr(mesh, "attribute_colors", None) is not None
-            table = (
-                setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g.object_to_clip, view)
-            )
-            in_front = wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max)
-            runs = getattr(mesh, "region_run_segments", 1)  # the region-lines pass's segments per quad
-            image_only = getattr(mesh, "lines_only_from_region_pass", False)
-            parts.setdefault((ngons, lines_only, colored, table, in_front, runs, image_only), []).append(g)
-        # The visibility and region-lines passes read neither n-gon
-        # outlines nor the set-up table; a draw that reads the region lines
-        # needs no block code for a mesh whose blocks only hold them.
-        plain_stage = variant.visibility or variant.region_lines_pass
-        for key in sorted(parts):
-            ngons, lines_only, colored, table, in_front, runs, image_only = key
-            lines_elsewhere = lines_only and variant.region_lines
-            walks = ngons and not plain_stage and not lines_elsewhere
-            part_variant = replace(
-                variant,
-                ngons=walks,
-                setup_table=table and not plain_stage,
-                in_front=in_front and not variant.visibility,
-                attribute_colors=variant.attribute_colors and colored and not plain_stage,
-                run_segments=runs if variant.region_lines_pass else 1,
-            )
-            if (
-                image_only
-                and variant.resolve
-                and variant.region_lines
-                and variant.diagonals == shaders.DIAGONALS_HIDDEN
-            ):
-                part_variant = replace(part_variant, no_edge_setup=not (part_variant.ngons or part_variant.setup_table))
-            if lines_elsewhere and variant.edge_classes:
-                part_variant = replace(part_variant, edge_classes=False, style_colors=True)
-            _draw_groups(
-                parts[key],
-                part_variant,
-                ubo,
-                settings,
-                program,
-                flip,
-                stats,
-                extras,
-                bases,
-                instancing=instancing,
-                numbering=numbering,
-            )
+        # must draw, and so number, alike).
+        for part in sorted(parts):
+            _draw_groups(parts[part], part.variant(variant), call)
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
+
+
+def _available(variant, settings, items, extras: dict):
+    """``variant`` without what this frame cannot draw: a matcap that did
+    not load, corner tables the items were gathered without."""
+    if variant.shading == shaders.SHADING_MATCAP:
+        extras["matcap_image"] = matcaps.texture(settings.matcap)
+        if extras["matcap_image"] is None:
+            variant = replace(variant, shading=shaders.SHADING_FLAT)
+    if (variant.shading != shaders.SHADING_FLAT or variant.material_colors) and any(
+        item.mesh.corners is None for item in items
+    ):
+        # Meshes gathered without their corner table (a caller that did not
+        # ask for it): draw flat rather than read a missing table.
+        warn_once(("corners",), "SolidWire: meshes were gathered without normals; drawing a flat fill")
+        variant = replace(variant, shading=shaders.SHADING_FLAT, material_colors=False)
+    return variant
+
+
+@dataclass(frozen=True, order=True)
+class _Part:
+    """The draw groups of one draw that share the per-mesh features of
+    their variant. Part of every stage's key alike, so that both deferred
+    stages part (and number) the draws alike."""
+
+    ngons: bool  # the mesh has n-gons or regions: the fragment stage walks blocks
+    lines_only: bool  # ... whose blocks hold only region lines
+    colored: bool  # the mesh has a colour attribute
+    setup_table: bool  # the edge set-up comes from the pre-pass
+    in_front: bool  # every triangle lies in front of the near plane
+    run_segments: int = 1  # the region-lines pass's segments per quad
+    lines_from_image_only: bool = False  # every triangle's lines come from the region-lines pass
+
+    def variant(self, variant):
+        """``variant`` for this part. The visibility and region-lines passes
+        read neither n-gon outlines nor the set-up table; a draw that reads
+        the region lines needs no block code for a mesh whose blocks only
+        hold them."""
+        plain_stage = variant.visibility or variant.region_lines_pass
+        lines_elsewhere = self.lines_only and variant.region_lines
+        part_variant = replace(
+            variant,
+            ngons=self.ngons and not plain_stage and not lines_elsewhere,
+            setup_table=self.setup_table and not plain_stage,
+            in_front=self.in_front and not variant.visibility,
+            attribute_colors=variant.attribute_colors and self.colored and not plain_stage,
+            run_segments=self.run_segments if variant.region_lines_pass else 1,
+        )
+        if (
+            self.lines_from_image_only
+            and variant.resolve
+            and variant.region_lines
+            and variant.diagonals == shaders.DIAGONALS_HIDDEN
+            and not (part_variant.ngons or part_variant.setup_table)
+        ):
+            # Every triangle's lines come from the region-lines image and
+            # no diagonal is drawn: no triangle edge to set up per pixel.
+            part_variant = replace(part_variant, no_edge_setup=True)
+        if lines_elsewhere and variant.edge_classes:
+            part_variant = replace(part_variant, edge_classes=False, style_colors=True)
+        return part_variant
+
+
+def _parts(groups, program, stage, view: View) -> dict:
+    """DrawGroups by _Part.
+
+    Meshes with n-gons need the fragment stage's outline walk; the rest use
+    a variant without it (llvmpipe pays for a loop even when it runs zero
+    times), so tri/quad meshes never pay for n-gons. Big tri/quad meshes
+    take their edge set-up from the pre-pass: only a mesh drawn once in
+    this pass, whose table is then written before its one draw and never
+    rewritten while a draw may still read it (objects sharing a mesh keep
+    the per-corner set-up); see _setup_size for the deferred stages."""
+    setup_ok = getattr(program, "supports_setup_table", False) and _setup_ready()
+    draws_of: dict = {}
+    for g in groups:
+        draws_of[id(g.mesh)] = draws_of.get(id(g.mesh), 0) + len(g.world)
+    parts: dict = {}
+    for g in groups:
+        mesh = g.mesh
+        ngons = program.supports_ngons and mesh.has_ngons
+        table = setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g.object_to_clip, view)
+        part = _Part(
+            ngons=ngons,
+            lines_only=ngons and getattr(mesh, "blocks_only_for_region_lines", False),
+            colored=getattr(mesh, "attribute_colors", None) is not None,
+            setup_table=table,
+            in_front=wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max),
+            run_segments=getattr(mesh, "region_run_segments", 1),
+            lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
+        )
+        parts.setdefault(part, []).append(g)
+    return parts
+
+
+@dataclass
+class _DrawCall:
+    """What every part of one draw() shares: ``ubo(style)`` the parameter
+    block of a style, the winding flip, the frame's extras (textures and
+    blocks bound once) and colour-table bases, whether many instances of a
+    mesh draw instanced, and the deferred stages' draw numbering."""
+
+    ubo: object
+    settings: object
+    program: object
+    flip: bool
+    stats: DrawStats
+    extras: dict
+    bases: np.ndarray
+    instancing: bool
+    numbering: _DrawNumbers
 
 
 def clip_space_planes(planes, view: View) -> list:
@@ -637,26 +722,11 @@ def release_rectangle() -> None:
     _quad_batches.clear()
 
 
-def _draw_groups(
-    groups,
-    variant,
-    ubo,
-    settings,
-    program,
-    flip: bool,
-    stats: DrawStats,
-    extras=None,
-    bases=None,
-    *,
-    instancing: bool = True,
-    numbering=None,
-) -> None:
+def _draw_groups(groups, variant, call: _DrawCall) -> None:
     """Draw DrawGroups with one shader variant: per object (SingleDraw), or
-    instanced for meshes with many instances (InstancedDraw). ``ubo(style)`` is the
-    parameter block of a style; ``numbering`` makes the draw calls
-    (_DrawNumbers)."""
-    extras = extras or {}
-    numbering = numbering or _DrawNumbers(None, extras)
+    instanced for meshes with many instances (InstancedDraw)."""
+    ubo, settings, program, stats = call.ubo, call.settings, call.program, call.stats
+    extras, bases, numbering = call.extras, call.bases, call.numbering
     resolving = numbering.draws_over_record
     shader = program.shader(variant)
     uses_view_depth = shaders.uses_uniform(shader, "object_to_view_z")
@@ -671,14 +741,14 @@ def _draw_groups(
     instanced: list[InstancedDraw] = []
     single: list[SingleDraw] = []
     for group in groups:
-        mirrored_all = (np.linalg.det(group.world[:, :3, :3]) < 0.0) != flip
+        mirrored_all = (np.linalg.det(group.world[:, :3, :3]) < 0.0) != call.flip
         info_all = np.zeros((len(group.world), 4))
         if bases is not None and len(bases):
             info_all[:, 0] = bases[group.indices]
         info_all[:, 1] = mirrored_all
         # (The instanced variant has no per-object pass values: with passes
         # every object is drawn on its own.)
-        if instancing and len(group.world) >= INSTANCING_MIN:
+        if call.instancing and len(group.world) >= INSTANCING_MIN:
             sides = (
                 (False, True)
                 if settings.use_backface_culling and 0 < mirrored_all.sum() < len(mirrored_all)
@@ -751,7 +821,7 @@ def _draw_groups(
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     if instanced:
-        _draw_instanced(instanced, variant, ubo, settings, stats, extras, numbering)
+        _draw_instanced(instanced, variant, call)
 
 
 _UNBOUND = object()
@@ -857,16 +927,17 @@ def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_ind
     return block
 
 
-def _draw_instanced(groups: list[InstancedDraw], variant, ubo, settings, stats: DrawStats, extras, numbering) -> None:
+def _draw_instanced(groups: list[InstancedDraw], variant, call: _DrawCall) -> None:
     """One draw_instanced call per (mesh, style, facing) group; every
     instance's matrices in one float texture for the whole frame."""
+    ubo, settings, stats, extras, numbering = call.ubo, call.settings, call.stats, call.extras, call.numbering
     shader = shaders.get(replace(variant, instanced=True, setup_table=False))
     table = table_texture(np.concatenate([_instance_rows(g.object_to_view, g.object_to_clip, g.info) for g in groups]))
     shader.bind()
     bound = None
     shader.uniform_block("params", ubo(bound))
     shader.uniform_sampler("instance_table", table)
-    _bind_extras(shader, variant, extras or {})
+    _bind_extras(shader, variant, extras)
     numbering.bind(shader)
     base = 0
     for group in groups:
@@ -884,14 +955,3 @@ def _draw_instanced(groups: list[InstancedDraw], variant, ubo, settings, stats: 
         stats.objects_drawn += count
         stats.triangles_drawn += count * mesh.triangle_count
         stats.extra["instanced_draws"] = stats.extra.get("instanced_draws", 0) + 1
-
-
-def draw_hidden_lines(items, view: View, settings, **kwargs) -> DrawStats:
-    """The hidden-line pass (image model §5.4): every face behind the depth
-    already in the bound framebuffer draws its real edges dimmed and dashed,
-    blended with premultiplied "over" (the caller sets the blend mode).
-    Strictly GREATER, so the visible surface itself never passes: the same
-    shader wrote that depth, so there is no z-fight. With one wire colour
-    "over" is commutative (alpha = 1 - prod(1 - a_k)), so draw order does
-    not matter."""
-    return draw(items, view, settings, depth_test="GREATER", depth_write=False, hidden_pass=True, **kwargs)

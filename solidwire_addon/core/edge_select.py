@@ -47,7 +47,6 @@ from .extract import (
     NGON_SHIFT,
     REGION_LINES,
     MeshArrays,
-    read_face_normals,
 )
 
 # Edge classes, in style order: style k + 1 is class k (style 0 is the
@@ -592,89 +591,66 @@ def flat_edges(
     flat = np.zeros(edge_count, bool)
     if not angle > 0.0 or edge_count == 0:
         return flat
+    edges, f1, f2 = _face_pairs(corner_edge, face_offsets, edge_count)
+    flat[edges] = _pairs_flat(face_normals, f1, f2, angle)
+    return flat
+
+
+def _face_pairs(corner_edge: np.ndarray, face_offsets: np.ndarray, edge_count: int):
+    """(edge ids, first face, second face) of every edge with exactly two
+    face corners, in the order of their corners."""
     corner_edge = np.asarray(corner_edge, np.int64)
     corner_face = _face_of_corner(np.diff(np.asarray(face_offsets, np.int64)))
     uses = np.bincount(corner_edge, minlength=edge_count)
     corners = np.flatnonzero(uses[corner_edge] == 2)
     corners = corners[np.argsort(corner_edge[corners], kind="stable")]
     first, second = corners[0::2], corners[1::2]
-    f1, f2 = corner_face[first], corner_face[second]
+    return corner_edge[first], corner_face[first], corner_face[second]
+
+
+def _pairs_flat(face_normals: np.ndarray, f1: np.ndarray, f2: np.ndarray, angle: float) -> np.ndarray:
+    """Whether the faces of each pair are distinct and their normals differ
+    by less than ``angle`` radians."""
     n1, n2 = face_normals[f1].astype(np.float64), face_normals[f2].astype(np.float64)
     cosine = np.einsum("ij,ij->i", n1, n2) / np.maximum(np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1), 1e-300)
-    flat[corner_edge[first]] = (np.arccos(np.clip(cosine, -1.0, 1.0)) < angle) & (f1 != f2)
-    return flat
+    return (np.arccos(np.clip(cosine, -1.0, 1.0)) < angle) & (f1 != f2)
 
 
-# Blender's edge data per class: (attribute names to try, kind). Seams are
-# "uv_seam" from Blender 5.0 on and ".uv_seam" before; a crease counts when
-# it is above zero.
-_CLASS_ATTRIBUTES = {
-    "sharp": ("sharp_edge",),
-    "crease": ("crease_edge",),
-    "seam": ("uv_seam", ".uv_seam"),
-    "freestyle": ("freestyle_edge",),
-}
+class EdgeAngleState:
+    """What one extraction's edge angle test keeps so that a move of
+    vertices (same faces) is checked incrementally: the two faces of each
+    tested edge, the face normals it saw and the flat edges it found.
+    :meth:`still_flat` recomputes only the edges next to a face whose
+    normal changed, with the same arithmetic as :func:`flat_edges`, so its
+    answer is the full test's."""
 
+    def __init__(self, corner_edge, face_offsets, face_normals, edge_count: int, angle: float):
+        self.angle = float(angle)
+        pairs = _face_pairs(corner_edge, face_offsets, edge_count)
+        self.tested, self.first, self.second = (ids.astype(np.int32) for ids in pairs)  # kept per mesh: half the memory
+        self.normals = np.array(face_normals, np.float32)
+        self.flat = np.zeros(edge_count, bool)
+        if self.angle > 0.0 and edge_count:
+            self.flat[self.tested] = _pairs_flat(self.normals, self.first, self.second, self.angle)
 
-def read_edge_classes(mesh, enabled) -> np.ndarray | None:
-    """(E,) class bits of ``mesh``'s edges for the enabled classes (other
-    than boundary, which is topology), read from Blender's edge attributes;
-    None when no enabled class has data."""
-    count = len(mesh.edges)
-    bits = None
-    for name in enabled:
-        if name == "freestyle" and mesh.attributes.get("freestyle_edge") is None:
-            # Blender 4.x keeps Freestyle marks outside the attributes.
-            values = np.zeros(count, bool)
-            try:
-                if count:
-                    mesh.edges.foreach_get("use_freestyle_mark", values)
-            except (AttributeError, TypeError, RuntimeError):
-                continue
-            if values.any():
-                bits = np.zeros(count, np.int64) if bits is None else bits
-                bits[values] |= CLASS_BIT[name]
-            continue
-        for attribute_name in _CLASS_ATTRIBUTES.get(name, ()):
-            attribute = mesh.attributes.get(attribute_name)
-            if attribute is None or attribute.domain != "EDGE":
-                continue
-            values = np.zeros(count, dtype=np.float32 if attribute.data_type == "FLOAT" else bool)
-            if count:
-                attribute.data.foreach_get("value", values)
-            if bits is None:
-                bits = np.zeros(count, np.int64)
-            bits[values > 0] |= CLASS_BIT[name]
-            break
-    return bits
-
-
-def read_edge_topology(mesh) -> tuple[np.ndarray, np.ndarray]:
-    """((E, 2) edge vertex ids, (L,) the edge of each face corner): raw
-    attribute reads where Blender has them (a memcpy, ~50x faster than the
-    per-element ``edges.vertices`` / ``loops.edge_index``)."""
-    edge_count, corner_count = len(mesh.edges), len(mesh.loops)
-    verts = _read_raw(mesh, ".edge_verts", edge_count, 2)
-    if verts is None:
-        verts = np.empty(edge_count * 2, np.int32)
-        if edge_count:
-            mesh.edges.foreach_get("vertices", verts)
-    corner_edge = _read_raw(mesh, ".corner_edge", corner_count, 1)
-    if corner_edge is None:
-        corner_edge = np.empty(corner_count, np.int32)
-        if corner_count:
-            mesh.loops.foreach_get("edge_index", corner_edge)
-    return verts.reshape(-1, 2), corner_edge
-
-
-def _read_raw(mesh, name: str, count: int, width: int):
-    attribute = mesh.attributes.get(name)
-    if attribute is None or len(attribute.data) != count:
-        return None
-    out = np.empty(count * width, np.int32)
-    if count:
-        attribute.data.foreach_get("value", out)
-    return out
+    def still_flat(self, face_normals) -> bool:
+        """Whether the same edges are flat under ``face_normals`` (the same
+        faces after a move). True: the new normals are kept for the next
+        move. False: some edge crossed the angle (its regions change)."""
+        face_normals = np.asarray(face_normals, np.float32)
+        if face_normals.shape != self.normals.shape:
+            return False
+        changed = face_normals != self.normals
+        turned = changed[:, 0] | changed[:, 1] | changed[:, 2]
+        if not turned.any():
+            return True
+        rows = np.flatnonzero(turned[self.first] | turned[self.second])
+        if len(rows):
+            flat = _pairs_flat(face_normals, self.first[rows], self.second[rows], self.angle)
+            if not np.array_equal(flat, self.flat[self.tested[rows]]):
+                return False
+        self.normals = face_normals.copy()
+        return True
 
 
 @dataclass(frozen=True)
@@ -693,40 +669,8 @@ class Selection:
     @property
     def follows_positions(self) -> bool:
         """Whether moving vertices can change which edges are drawn: the
-        edge angle compares face normals. Classes (marks, boundary) and
-        cage edges depend on the topology alone, so the selection of a
-        deforming mesh stays as extracted."""
+        edge angle compares face normals (a move is checked against the
+        extraction's EdgeAngleState). Classes (marks, boundary) and cage
+        edges depend on the topology alone, so the selection of a deforming
+        mesh stays as extracted."""
         return self.edge_angle > 0.0
-
-
-def apply_to_mesh(
-    arrays: MeshArrays,
-    mesh,
-    corner_vert: np.ndarray,
-    face_offsets: np.ndarray,
-    selection: Selection,
-    cage: tuple | None = None,
-) -> SelectionStats:
-    """Read ``mesh``'s edges and apply ``selection`` to ``arrays``. ``cage``:
-    (drawn mask, chain ids[, chain ends]) of the evaluated edges from the
-    cage detection, or None (no subdivision, or cage edges off)."""
-    verts, corner_edge = read_edge_topology(mesh)
-    drawn = chain = chain_ends = None
-    if cage is not None:
-        drawn, chain = np.asarray(cage[0], bool).copy(), cage[1]
-        chain_ends = cage[2] if len(cage) > 2 else None
-    if selection.edge_angle > 0.0:
-        flat = flat_edges(corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle)
-        drawn = ~flat if drawn is None else drawn & ~flat
-    others = tuple(c for c in selection.classes if c != "boundary")
-    inputs = EdgeInputs(
-        verts,
-        drawn,
-        read_edge_classes(mesh, others) if others else None,
-        "boundary" in selection.classes,
-        chain,
-        chain_ends,
-    )
-    if not inputs.selects_anything:
-        return SelectionStats()
-    return select_edges(arrays, corner_vert, face_offsets, corner_edge, inputs)

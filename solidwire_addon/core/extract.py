@@ -1,16 +1,18 @@
-"""Extraction: an evaluated Blender mesh -> GPU-ready numpy arrays.
+"""Extraction: a mesh's arrays -> GPU-ready numpy arrays.
 
-Only bulk reads (``foreach_get`` on attribute arrays) and vectorised numpy:
-no per-element Python loops. The triangles are exactly Blender's own
-(``loop_triangles``), so the faces we draw are the faces Blender draws; the
-fast path (:func:`extract_mesh`) builds the triangles of tris and quads
-itself with Blender's own quad split rule (reading ``loop_triangles`` through
-RNA costs ~0.1 s per million triangles, most of our budget) and asks Blender
-only for n-gons and for quads whose split is numerically undecided. For each triangle we record which of
-its three edges are polygon boundary edges ("real") and which are diagonals
-added by triangulation, and for a quad the id of its 4th corner so a fragment
-can measure the distance to all four quad edges (clean corners next to a
-hidden diagonal).
+Takes plain arrays (vertex positions, the vertex of each face corner, face
+offsets; blender/mesh_reading.py reads them from an evaluated mesh) and
+works in vectorised numpy: no per-element Python loops. The triangles are
+exactly Blender's own (``loop_triangles``), so the faces we draw are the
+faces Blender draws; the fast path (:func:`build_arrays_fast`) builds the
+triangles of tris and quads itself with Blender's own quad split rule and
+asks its ``blender_tris`` callback only for n-gons and for quads whose split
+is numerically undecided; :func:`build_arrays` takes Blender's triangles for
+every face (the reference path). For each triangle we record which of its
+three edges are polygon boundary edges ("real") and which are diagonals
+added by triangulation, and for a quad the id of its 4th corner so a
+fragment can measure the distance to all four quad edges (clean corners
+next to a hidden diagonal).
 
 Corner order is rotated (never reflected, so winding and back-face culling are
 unchanged) so that a quad triangle's diagonal is always edge 2 (p2 -> p0) and
@@ -108,6 +110,9 @@ class MeshArrays:
     quad_flip: np.ndarray | None = None
     face_offsets_crc: int | None = None
     source_positions: np.ndarray | None = None  # (V, 3) float32 as read, to find moved vertices
+    # The edge angle test's state (edge_select.EdgeAngleState) when it chose
+    # the drawn edges: a move of vertices is checked against it.
+    edge_angle_state: object | None = None
 
     @property
     def mesh_bounds(self) -> tuple:
@@ -129,90 +134,6 @@ class MeshArrays:
 
 class ExtractError(ValueError):
     """A mesh that cannot be drawn; the message is one line for the user."""
-
-
-def _read(collection, attr: str, count: int, dtype, width: int = 1) -> np.ndarray:
-    out = np.empty(count * width, dtype=dtype)
-    if count:
-        collection.foreach_get(attr, out)
-    return out if width == 1 else out.reshape(count, width)
-
-
-def _read_attribute(mesh, name: str, prop: str, count: int, dtype, width: int = 1):
-    """A generic attribute array read through ``mesh.attributes`` (a raw
-    memcpy: ~10x faster than ``vertices.co`` / ``loops.vertex_index``, which
-    go through RNA per element). None when the attribute is missing."""
-    attribute = mesh.attributes.get(name)
-    if attribute is None:
-        return None
-    out = np.empty(count * width, dtype=dtype)
-    if count:
-        attribute.data.foreach_get(prop, out)
-    return out if width == 1 else out.reshape(count, width)
-
-
-def read_material_indices(mesh) -> np.ndarray:
-    """(F,) int32 material slot index of each face (0 without the attribute)."""
-    count = len(mesh.polygons)
-    values = _read_attribute(mesh, "material_index", "value", count, np.int32)
-    return np.zeros(count, dtype=np.int32) if values is None else values
-
-
-def read_positions(mesh) -> np.ndarray:
-    """(V, 3) float32 vertex positions."""
-    count = len(mesh.vertices)
-    out = _read_attribute(mesh, "position", "vector", count, np.float32, 3)
-    return out if out is not None else _read(mesh.vertices, "co", count, np.float32, 3)
-
-
-def read_corner_verts(mesh) -> np.ndarray:
-    """(L,) int32 vertex of each face corner (loop)."""
-    count = len(mesh.loops)
-    out = _read_attribute(mesh, ".corner_vert", "value", count, np.int32)
-    return out if out is not None else _read(mesh.loops, "vertex_index", count, np.int32)
-
-
-def read_face_offsets(mesh) -> np.ndarray:
-    """(P + 1,) int32 face offsets: face i owns corners offsets[i]:offsets[i+1].
-
-    Blender stores faces as offsets into the corner arrays, so the sizes come
-    from ``loop_triangle_polygons`` (a raw int array, a face of n corners has
-    n - 2 triangles) with one bincount, ~6x cheaper than reading
-    ``polygons.loop_start``. The RNA read is the fallback if the counts do not
-    add up (they always should)."""
-    face_count = len(mesh.polygons)
-    corner_count = len(mesh.loops)
-    offsets = np.empty(face_count + 1, dtype=np.int32)
-    offsets[0] = 0
-    tri_count = corner_count - 2 * face_count
-    tri_polygons = mesh.loop_triangle_polygons
-    if face_count and len(tri_polygons) == tri_count:
-        tri_faces = _read(tri_polygons, "value", tri_count, np.int32)
-        sizes = np.bincount(tri_faces, minlength=face_count)
-        if len(sizes) == face_count:
-            sizes += 2
-            np.cumsum(sizes, out=offsets[1:])
-            if offsets[-1] == corner_count:
-                return offsets
-    offsets[:-1] = _read(mesh.polygons, "loop_start", face_count, np.int32)
-    offsets[-1] = corner_count
-    return offsets
-
-
-def read_mesh(mesh) -> dict[str, np.ndarray]:
-    """Bulk-read a Blender mesh with Blender's triangles (``loop_triangles``):
-    the input of :func:`build_arrays` (the reference path)."""
-    offsets = read_face_offsets(mesh)
-    loop_tris = mesh.loop_triangles  # computed lazily by Blender and cached on the mesh
-    tri_count = len(loop_tris)
-    return {
-        "positions": read_positions(mesh),
-        "corner_vert": read_corner_verts(mesh),
-        "loop_start": offsets[:-1],
-        "loop_total": np.diff(offsets),
-        "tri_loops": _read(loop_tris, "loops", tri_count, np.int32, 3),
-        "tri_polygons": _read(mesh.loop_triangle_polygons, "value", tri_count, np.int32),
-    }
 
 
 def _check_vertex_count(positions: np.ndarray) -> None:
@@ -462,9 +383,6 @@ def build_arrays(
 # Blender's build) could tip Blender's answer either way, so Blender is asked.
 # Exactly degenerate quads (zero-area halves, dot == 0) land here too.
 QUAD_UNDECIDED = 1.0e-5
-# Above this many triangles to ask Blender about, one bulk read of all of
-# ``loop_triangles`` is cheaper than reading them one by one.
-BLENDER_TRIS_ONE_BY_ONE = 4096
 
 
 def quad_flip(positions: np.ndarray, quads: np.ndarray, columns: np.ndarray | None = None):
@@ -759,73 +677,6 @@ def _ngon_tri_rows(tri_start, sizes, ngon_faces) -> np.ndarray:
     return first + rank
 
 
-def blender_triangles(mesh) -> Callable[[np.ndarray], np.ndarray]:
-    """``tri_indices -> (N, 3) corner ids`` of Blender's own ``loop_triangles``:
-    one by one for a few, one bulk read for many."""
-    cache = {}
-
-    def lookup(tri_indices: np.ndarray) -> np.ndarray:
-        tri_indices = np.asarray(tri_indices)
-        loop_tris = mesh.loop_triangles
-        if "all" in cache or len(tri_indices) > BLENDER_TRIS_ONE_BY_ONE:
-            if "all" not in cache:
-                cache["all"] = _read(loop_tris, "loops", len(loop_tris), np.int32, 3)
-            return cache["all"][tri_indices]
-        out = np.empty((len(tri_indices), 3), dtype=np.int32)
-        for row, index in enumerate(tri_indices.tolist()):  # few: see BLENDER_TRIS_ONE_BY_ONE
-            out[row] = loop_tris[index].loops
-        return out
-
-    return lookup
-
-
-def read_mesh_fast(mesh) -> dict:
-    """Bulk-read a mesh for :func:`build_arrays_fast` (no triangle reads)."""
-    return {
-        "positions": read_positions(mesh),
-        "corner_vert": read_corner_verts(mesh),
-        "face_offsets": read_face_offsets(mesh),
-        "blender_tris": blender_triangles(mesh),
-    }
-
-
-def read_face_normals(mesh) -> np.ndarray:
-    """(P, 3) float32: Blender's face normals (mesh space)."""
-    return _read(mesh.polygon_normals, "vector", len(mesh.polygons), np.float32, 3)
-
-
-def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> MeshArrays:
-    """Evaluated Blender mesh -> :class:`MeshArrays` (fast path).
-
-    ``positions`` / ``corner_vert`` may be passed when the caller has just
-    read them (the GPU cache reads them for its change fingerprint).
-    ``corners``: also build the corner table (shaded fill, material colours);
-    True, or the (normals, materials, domain) of :func:`read_corner_inputs` when the
-    caller has them already (normals None: read here)."""
-    data = (
-        read_mesh_fast(mesh)
-        if positions is None
-        else {
-            "positions": positions,
-            "corner_vert": corner_vert if corner_vert is not None else read_corner_verts(mesh),
-            "face_offsets": read_face_offsets(mesh),
-            "blender_tris": blender_triangles(mesh),
-        }
-    )
-    arrays = build_arrays_fast(**data)
-    if corners:
-        normals, materials, domain = read_corner_inputs(mesh) if corners is True else corners
-        if normals is None:
-            normals = read_normals(mesh, domain)
-        arrays.corners = corner_table(arrays, data["corner_vert"], data["face_offsets"], normals, materials, domain)
-    return arrays
-
-
-def extract_mesh_naive(mesh) -> MeshArrays:
-    """The reference path: Blender's ``loop_triangles`` for every face."""
-    return build_arrays(**read_mesh(mesh))
-
-
 # Where the shading normals of a mesh live, so where its corner table has a
 # row: per vertex (smooth shading without sharp edges or custom normals), per
 # triangle (flat shading: its face's normal) or per triangle corner. The
@@ -834,50 +685,26 @@ def extract_mesh_naive(mesh) -> MeshArrays:
 NORMALS_BY_VERTEX, NORMALS_BY_TRIANGLE, NORMALS_BY_CORNER = 0, 1, 2
 
 
-def read_corner_inputs(mesh) -> tuple[np.ndarray, np.ndarray, int]:
-    """(normals (N, 3) float32, material index per face (P,) int32, domain
-    NORMALS_BY_*): what :func:`corner_table` needs. The normals are Blender's
-    own (smooth, flat, sharp edges and custom normals as the mesh defines
-    them; ``Mesh.normals_domain`` says where they vary), so the fill is
-    shaded as Blender shades it."""
-    materials, domain = read_corner_domain(mesh)
-    return read_normals(mesh, domain), materials, domain
+def normals_domain(blender_domain: str, materials: np.ndarray) -> int:
+    """Where a mesh's corner table has its rows (NORMALS_BY_*), from where
+    Blender's normals vary (``Mesh.normals_domain``: "POINT", "FACE" or
+    "CORNER") and the material index of each face. Per vertex only with a
+    single material (a vertex has no material of its own)."""
+    if blender_domain == "POINT" and (len(materials) == 0 or bool((materials == materials[0]).all())):
+        return NORMALS_BY_VERTEX
+    if blender_domain == "FACE":
+        return NORMALS_BY_TRIANGLE
+    return NORMALS_BY_CORNER
 
 
-def read_attribute_colors(mesh):
-    """(colours (N, 4) float32 scene-linear RGBA, domain "POINT" or
-    "CORNER") of the mesh's active colour attribute, as Workbench's
-    Attribute colour shows it (byte colours are read decoded to linear);
-    None when it has none on those domains."""
-    attributes = getattr(mesh, "color_attributes", None)
-    attribute = None if attributes is None else attributes.active_color
-    if attribute is None or attribute.domain not in ("POINT", "CORNER"):
-        return None
-    count = len(attribute.data)
-    values = np.empty(count * 4, np.float32)
-    if count:
-        attribute.data.foreach_get("color", values)
-    return values.reshape(-1, 4), attribute.domain
-
-
-def attribute_colors_checksum(mesh) -> tuple:
-    """What identifies the active colour attribute's content (for the mesh
-    cache: painting changes it without moving a vertex)."""
-    colors = read_attribute_colors(mesh)
-    if colors is None:
-        return (None,)
-    return (colors[1], zlib.crc32(memoryview(np.ascontiguousarray(colors[0])).cast("B")))
-
-
-def attach_attribute_colors(arrays: MeshArrays, mesh, corner_vert: np.ndarray, face_offsets: np.ndarray) -> None:
-    """Read the active colour attribute of ``mesh`` into ``arrays`` as the
-    rows the vertex stage reads: per vertex, or per corner of each drawn
-    triangle (through :func:`corner_rows`). A colour that is not finite
-    reads as black rather than poisoning the interpolation."""
-    read = read_attribute_colors(mesh)
-    if read is None:
-        return
-    colors, domain = read
+def attach_attribute_colors(
+    arrays: MeshArrays, colors: np.ndarray, domain: str, corner_vert: np.ndarray, face_offsets: np.ndarray
+) -> None:
+    """Put a colour attribute's values (``colors`` (N, 4) scene-linear RGBA
+    on Blender's ``domain`` "POINT" or "CORNER") into ``arrays`` as the rows
+    the vertex stage reads: per vertex, or per corner of each drawn triangle
+    (through :func:`corner_rows`). A colour that is not finite reads as
+    black rather than poisoning the interpolation."""
     colors = np.nan_to_num(colors, nan=0.0, posinf=0.0, neginf=0.0)
     if domain == "POINT":
         if len(colors) != arrays.vertex_count:
@@ -889,30 +716,6 @@ def attach_attribute_colors(arrays: MeshArrays, mesh, corner_vert: np.ndarray, f
     found = (rows >= 0) & (rows < len(colors))
     table[found] = colors[rows[found]]
     arrays.attribute_colors, arrays.attribute_domain = table, NORMALS_BY_CORNER
-
-
-def read_corner_domain(mesh) -> tuple[np.ndarray, int]:
-    """(material index per face (P,) int32, domain NORMALS_BY_*) of
-    :func:`read_corner_inputs`, without the normals. Per vertex only with a
-    single material (a vertex has no material of its own)."""
-    materials = _read_attribute(mesh, "material_index", "value", len(mesh.polygons), np.int32)
-    if materials is None:
-        materials = np.zeros(len(mesh.polygons), dtype=np.int32)
-    domain = getattr(mesh, "normals_domain", "CORNER")  # Blender 4.1+
-    if domain == "POINT" and (len(materials) == 0 or bool((materials == materials[0]).all())):
-        return materials, NORMALS_BY_VERTEX
-    if domain == "FACE":
-        return materials, NORMALS_BY_TRIANGLE
-    return materials, NORMALS_BY_CORNER
-
-
-def read_normals(mesh, domain: int) -> np.ndarray:
-    """Blender's normals of ``mesh`` on ``domain`` (NORMALS_BY_*), (N, 3) float32."""
-    if domain == NORMALS_BY_VERTEX:
-        return _read(mesh.vertex_normals, "vector", len(mesh.vertices), np.float32, 3)
-    if domain == NORMALS_BY_TRIANGLE:
-        return _read(mesh.polygon_normals, "vector", len(mesh.polygons), np.float32, 3)
-    return _read(mesh.corner_normals, "vector", len(mesh.loops), np.float32, 3)
 
 
 def normals_follow_geometry(domain: int) -> bool:

@@ -1,31 +1,46 @@
 """The pass plan: which passes draw a frame, in which order, with which
-settings. One plan serves every target; the two executors below differ only
-in where the passes land.
+settings. Each pass is a unit that owns its settings, its framebuffers and
+the state it leaves for the passes after it (in :class:`Frame`), and runs
+either way, as Blender's overlay engine gives each overlay a class with its
+sync and draw steps:
 
-    surface      every drawn face: depth, the fill colour and (unless hidden
-                 lines are on) the visible wire, in one pass
-    hidden       hidden lines, behind the surface depth, blended "over"
-    wire         the visible wire over the hidden lines (only with hidden lines)
-    silhouettes  the outer half of silhouette edges (image model §5.5)
+    RegionLinesPass   the lines of multi-face regions as an image the surface
+                      and wire passes read (docs/image_model.md §2.6)
+    SurfacePass       every drawn face: depth, the fill colour and (unless
+                      hidden lines are on) the visible wire, in one pass
+    HiddenLinesPass   hidden lines, behind the surface depth, blended "over"
+    WirePass          the visible wire over the hidden lines (only with
+                      hidden lines)
+    OutputsPass       the read-back image and the render passes (offscreen)
+    SilhouettePass    the outer half of silhouette edges (image model §5.5)
+    StrandsPass       hair and point clouds (core/strands.py)
 
-* :func:`render` (render engine, command line, tests): float offscreen
-  targets, read back as premultiplied RGBA plus view depth.
-* :func:`draw_over_viewport` (viewport overlay): straight into a bound
+* :meth:`render` of each unit (render engine, command line, tests): float
+  offscreen targets, read back as premultiplied RGBA plus view depth; the
+  executor is :func:`render_passes`.
+* :meth:`over_viewport` (viewport overlay): straight into a bound
   framebuffer that already holds the scene's colour and depth, through the
-  scene's colour management (a display LUT, docs/image_model.md §9).
+  scene's colour management (a display LUT, docs/image_model.md §9); the
+  executor is :func:`draw_over_viewport`.
+
+How a frame is drawn apart from what it shows (deferred surface or not,
+say) comes in one options.DrawOptions value, handed down from the caller.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import gpu
 import numpy as np
 
-from . import colors, compositing, edge_select, shaders, silhouettes
+from . import compositing, shaders, silhouettes
 from . import draw as draw_mod
 from . import strands as strands_mod
+from .draw import DrawTarget
 from .log import warn_once
+from .options import DEFAULT as DEFAULT_OPTIONS
+from .options import DrawOptions
 
 # Render passes beyond Combined and Depth (docs/image_model.md §6), by the
 # name they have in Blender's render result: the schema's one table.
@@ -38,62 +53,262 @@ from .schema import (
     WIRE_PASS,
 )
 from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, targets_for
-from .view import View
-
-SURFACE, HIDDEN, WIRE, SILHOUETTES = "surface", "hidden", "wire", "silhouettes"
+from .view import DrawStats, View
 
 # Written by the surface pass's extra outputs (the rest has its own pass).
 _SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
 
+# NDC depth bias of the viewport overlay (2^-18: 32 steps of a 24-bit depth
+# buffer, about 4 float32 ULPs of z/w near 1). Enough to win the tie with
+# Blender's own depth of the same surface (a few ULPs off, computed from other
+# float32 matrices); small enough that a surface more than a hair behind
+# another stays hidden. See DEPTH_BIAS in shaders/solidwire_vert.glsl.
+OVERLAY_DEPTH_BIAS = 2.0**-18
 
-@dataclass(frozen=True)
-class Pass:
-    kind: str
-    settings: object  # the DrawSettings this pass draws with
-    show_wire: bool = True  # False: the pass draws no wire, whatever an object's override says
+
+@dataclass
+class Frame:
+    """What the passes of one frame share: their inputs, and what each
+    leaves for the passes after it.
+
+    ``base`` is what every draw of the frame has in common (draw.DrawTarget):
+    offscreen the render's linear depth, over the viewport the depth bias,
+    the clipping region and the display transform. Offscreen, ``targets``
+    are the float targets the passes draw into and ``rgba``, ``depth`` and
+    ``extra`` what OutputsPass read back; over the viewport,
+    ``region_lines`` is the image RegionLinesPass drew."""
+
+    items: list
+    view: View
+    settings: object
+    base: DrawTarget
+    options: DrawOptions = DEFAULT_OPTIONS
+    cull: bool = True
+    strands: tuple = ()
+    stats: DrawStats | None = None
+    # Offscreen
+    targets: object = None
+    extra_passes: frozenset = frozenset()
+    keep_readback: bool = False
+    read_depth: bool = True
+    rgba: np.ndarray | None = None
+    depth: np.ndarray | None = None
+    extra: dict = field(default_factory=dict)
+    # Over the viewport
+    scene_depth: bool = True
+    scene_surfaces: bool = False
+    region_lines: object = None
+    line_stats: DrawStats = field(default_factory=DrawStats)
+
+    @property
+    def aovs(self) -> bool:
+        """The surface pass writes the render passes' outputs."""
+        return bool(self.extra_passes & _SURFACE_AOVS)
 
 
-def plan(settings) -> tuple[Pass, ...]:
+class RenderPass:
+    """One pass of the plan. ``render`` draws it into the frame's offscreen
+    targets, ``over_viewport`` into the bound viewport framebuffer; a pass
+    that has nothing to do in one of the two leaves it as it is."""
+
+    def __init__(self, settings):
+        self.settings = settings  # the DrawSettings this pass draws with
+
+    def render(self, frame: Frame) -> None:
+        pass
+
+    def over_viewport(self, frame: Frame) -> None:
+        pass
+
+
+class RegionLinesPass(RenderPass):
+    """The lines of multi-face regions (docs/image_model.md §2.6). Over the
+    viewport: an image of its own, drawn first, which the surface and wire
+    passes read. Offscreen the surface pass draws them between its two
+    deferred stages, over its own visibility record."""
+
+    def over_viewport(self, frame: Frame) -> None:
+        # (Inside a clipping region the record would keep clipped-away
+        # surfaces: there the regions are walked.)
+        if frame.base.clip_planes is not None or not _has_region_lines(frame.items):
+            return
+        saved_viewport = gpu.state.viewport_get()
+        try:
+            frame.region_lines = _overlay_region_lines(
+                frame.items, frame.view, self.settings, frame.line_stats, frame.options
+            )
+        finally:
+            gpu.state.viewport_set(*saved_viewport)
+
+
+class SurfacePass(RenderPass):
+    """Every drawn face: depth, the fill and, with ``wire``, the visible
+    wire. ``wire`` False (under hidden lines) draws no wire whatever an
+    object's override says."""
+
+    def __init__(self, settings, *, wire: bool = True):
+        super().__init__(settings)
+        self.wire = wire
+
+    def render(self, frame: Frame) -> None:
+        frame.stats = draw_surface(
+            frame.targets,
+            frame.items,
+            frame.view,
+            self.settings,
+            wire=self.wire,
+            aovs=frame.aovs,
+            cull=frame.cull,
+            options=frame.options,
+        )
+
+    def over_viewport(self, frame: Frame) -> None:
+        """Unless the scene's depth holds every item's surface (Solid
+        shading without X-ray: not for an object drawn as wire or in front,
+        item.in_scene_depth), a depth-only pre-pass comes first, so only the
+        nearest of our own surfaces passes the colour passes (no back edges
+        show through where the scene depth is empty). Where it does, the
+        scene's depth already is that surface (our surfaces win the tie by
+        the depth bias) and the pre-pass would only cost a second pass over
+        every triangle. Without scene depth (X-ray: Blender's depth is no
+        surface there) the bound depth is cleared first, so only our own
+        surfaces occlude."""
+        items, view, settings = frame.items, frame.view, frame.settings
+        # The pre-pass gets the clipping planes and the LUT too: with the LUT
+        # its variant, and so its compiled program, is the surface pass's.
+        base = replace(frame.base, region_lines=frame.region_lines)
+        if not frame.scene_depth:
+            gpu.state.depth_mask_set(True)
+            gpu.state.active_framebuffer_get().clear(depth=1.0)
+        if not (frame.scene_depth and frame.scene_surfaces and all(item.in_scene_depth for item in items)):
+            gpu.state.blend_set("NONE")
+            gpu.state.color_mask_set(False, False, False, False)
+            draw_mod.draw(items, view, settings, target=base)
+            gpu.state.color_mask_set(True, True, True, True)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        # Without the wire and the fill the pass would draw nothing the
+        # pre-pass did not.
+        if not self.wire and not self.settings.use_fill:
+            return
+        frame.stats = draw_mod.draw(items, view, self.settings, target=_with_lines(base, self.wire))
+
+
+class HiddenLinesPass(RenderPass):
+    """Hidden lines (image model §5.4), behind the surface depth, blended
+    "over" (draw.DrawTarget.hidden)."""
+
+    def render(self, frame: Frame) -> None:
+        _blended(frame, lambda: _draw(frame, self.settings, frame.base.hidden()))
+
+    def over_viewport(self, frame: Frame) -> None:
+        _draw(frame, self.settings, frame.base.hidden())
+
+
+class WirePass(RenderPass):
+    """The visible wire on its own, over the hidden lines; leaves the
+    surface's depth and view depth alone."""
+
+    def render(self, frame: Frame) -> None:
+        _blended(frame, lambda: _draw(frame, self.settings, replace(frame.base, depth_write=False)))
+
+    def over_viewport(self, frame: Frame) -> None:
+        frame.stats = _draw(frame, self.settings, replace(frame.base, region_lines=frame.region_lines))
+
+
+class OutputsPass(RenderPass):
+    """Offscreen only: the Hidden Wire pass when asked for, then the image
+    and view depth read back, and the surface pass's extra outputs."""
+
+    def render(self, frame: Frame) -> None:
+        targets = frame.targets
+        if HIDDEN_WIRE_PASS in frame.extra_passes:
+            frame.extra[HIDDEN_WIRE_PASS] = _hidden_wire(targets, frame.items, frame.view, self.settings, frame.cull)
+        # The surface passes' outputs need the coverage that the view depth holds.
+        aovs = frame.aovs
+        frame.rgba, frame.depth = targets.read(keep=frame.keep_readback, depth=frame.read_depth or aovs)
+        if aovs:
+            covered = frame.depth < BACKGROUND_DEPTH
+            aov = read_texture(targets.aov, 4)
+            frame.extra[WIRE_PASS] = aov[..., 1:2]
+            frame.extra[EDGE_DISTANCE_PASS] = np.where(covered, aov[..., 0], BACKGROUND_DEPTH)[..., None]
+            frame.extra[OBJECT_INDEX_PASS] = aov[..., 2:3]
+            frame.extra[MATERIAL_INDEX_PASS] = aov[..., 3:4]
+            frame.extra[NORMAL_PASS] = read_texture(targets.normal, 4)[..., :3]
+
+
+class SilhouettePass(RenderPass):
+    """The outer halves of silhouette edges (image model §5.5): offscreen
+    into a target of their own, composited over the read-back image; over
+    the viewport straight into it."""
+
+    def render(self, frame: Frame) -> None:
+        frame.rgba = _composite_silhouettes(frame.rgba, frame.targets, frame.items, frame.view, self.settings)
+
+    def over_viewport(self, frame: Frame) -> None:
+        silhouettes.draw_silhouettes(frame.items, frame.view, self.settings, frame.base)
+
+
+class StrandsPass(RenderPass):
+    """Hair and point clouds (core/strands.py), over everything above."""
+
+    def render(self, frame: Frame) -> None:
+        frame.rgba, frame.depth = strands_mod.composite_render(
+            frame.rgba, frame.depth, frame.targets, frame.view, self.settings, frame.strands
+        )
+
+    def over_viewport(self, frame: Frame) -> None:
+        strands_mod.draw_over_viewport(frame.strands, frame.view, self.settings, frame.base)
+
+
+def plan(settings, *, strands: bool = False) -> tuple[RenderPass, ...]:
     """The passes ``settings`` need, in drawing order (an option that is off
-    adds no pass)."""
+    adds no pass). Over the viewport OutputsPass does nothing; offscreen
+    RegionLinesPass does nothing (the surface pass draws the lines)."""
+    passes: list[RenderPass] = [RegionLinesPass(settings)]
     if settings.use_hidden_lines:
         # Hidden lines sit under the visible wire and over the fill: the
-        # surface pass draws the fill (wire switched off), then hidden lines,
-        # then the wire on its own.
+        # surface pass draws the fill (no wire), then hidden lines, then the
+        # wire on its own.
         wire_only = replace(settings, use_fill=False)
-        passes = [
-            Pass(SURFACE, replace(settings, wire_color=(*settings.wire_color[:3], 0.0)), show_wire=False),
-            Pass(HIDDEN, wire_only),
-            Pass(WIRE, wire_only),
-        ]
+        passes += [SurfacePass(settings, wire=False), HiddenLinesPass(wire_only), WirePass(wire_only)]
     else:
-        passes = [Pass(SURFACE, settings)]
+        passes.append(SurfacePass(settings))
+    passes.append(OutputsPass(settings))
     if settings.use_silhouettes:
-        passes.append(Pass(SILHOUETTES, settings))
+        passes.append(SilhouettePass(settings))
+    if strands:
+        passes.append(StrandsPass(settings))
     return tuple(passes)
 
 
-def gather_options(settings) -> dict:
-    """What the draw items of a frame with ``settings`` must carry (keyword
-    arguments of blender/gather.gather): corner tables for a shaded fill or
-    material colours, colour-source inputs for per-object colours."""
-    return {
-        "corners": draw_mod.needs_corners(settings),
-        "colors": colors.needs_item_colors(settings),
-        "attribute_colors": colors.needs_attribute_colors(settings),
-        "edges": edge_select.Selection(
-            float(settings.edge_angle), draw_mod.edge_classes_of(settings), bool(settings.use_cage_edges)
-        ),
-    }
+def _with_lines(target: DrawTarget, wire: bool) -> DrawTarget:
+    return target if wire else replace(target, lines=draw_mod.NO_LINES)
 
 
-def render(items, view: View, settings, *, cull: bool = True):
+def _draw(frame: Frame, settings, target: DrawTarget):
+    return draw_mod.draw(frame.items, frame.view, settings, target=target, cull=frame.cull)
+
+
+def _blended(frame: Frame, draw_pass) -> None:
+    """A pass blended "over" the offscreen colour: a framebuffer without the
+    view-depth target, which must keep the surface's view depth."""
+    with frame.targets.color_framebuffer().bind():
+        gpu.state.viewport_set(0, 0, frame.view.width, frame.view.height)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        try:
+            draw_pass()
+        finally:
+            gpu.state.blend_set("NONE")
+            gpu.state.depth_test_set("NONE")
+
+
+def render(items, view: View, settings, *, cull: bool = True, options: DrawOptions = DEFAULT_OPTIONS):
     """Draw ``items`` offscreen; return (rgba, view_depth, stats).
 
     ``rgba`` is (H, W, 4) float32, premultiplied, bottom row first, over a
     transparent background; ``view_depth`` is (H, W) with BACKGROUND_DEPTH
     where nothing was drawn. The caller makes sure the GPU is usable."""
-    rgba, depth, stats, _extra = render_passes(items, view, settings, cull=cull)
+    rgba, depth, stats, _extra = render_passes(items, view, settings, cull=cull, options=options)
     return rgba, depth, stats
 
 
@@ -107,6 +322,7 @@ def render_passes(
     keep_readback: bool = False,
     read_depth: bool = True,
     strands=(),
+    options: DrawOptions = DEFAULT_OPTIONS,
 ):
     """:func:`render` plus the render passes named in ``extra_passes`` (of
     schema.EXTRA_PASSES): (rgba, view_depth, stats, {name: (H, W, channels)}).
@@ -117,46 +333,23 @@ def render_passes(
     view_depth are views of buffers the targets keep, valid until the next
     such frame (:meth:`Targets.read`)."""
     extra_passes = frozenset(extra_passes)
-    aovs = bool(extra_passes & _SURFACE_AOVS)
-    width, height = view.width, view.height
-    targets = targets_for(width, height)
-    steps = plan(settings)
-    surface = steps[0]
-    stats = draw_surface(targets, items, view, surface.settings, show_wire=surface.show_wire, aovs=aovs, cull=cull)
-    blended = [step for step in steps[1:] if step.kind in (HIDDEN, WIRE)]
-    if blended:
-        # A framebuffer without the view-depth target: blended passes must
-        # leave the surface's view depth alone.
-        with targets.color_framebuffer().bind():
-            gpu.state.viewport_set(0, 0, width, height)
-            gpu.state.blend_set("ALPHA_PREMULT")
-            try:
-                for step in blended:
-                    if step.kind == HIDDEN:
-                        draw_mod.draw_hidden_lines(items, view, step.settings, cull=cull, linear_depth=True)
-                    else:
-                        draw_mod.draw(items, view, step.settings, depth_write=False, cull=cull, linear_depth=True)
-            finally:
-                gpu.state.blend_set("NONE")
-                gpu.state.depth_test_set("NONE")
-    extra = {}
-    if HIDDEN_WIRE_PASS in extra_passes:
-        extra[HIDDEN_WIRE_PASS] = _hidden_wire(targets, items, view, settings, cull)
-    # The surface passes' outputs need the coverage that the view depth holds.
-    rgba, depth = targets.read(keep=keep_readback, depth=read_depth or aovs)
-    if aovs:
-        covered = depth < BACKGROUND_DEPTH
-        aov = read_texture(targets.aov, 4)
-        extra[WIRE_PASS] = aov[..., 1:2]
-        extra[EDGE_DISTANCE_PASS] = np.where(covered, aov[..., 0], BACKGROUND_DEPTH)[..., None]
-        extra[OBJECT_INDEX_PASS] = aov[..., 2:3]
-        extra[MATERIAL_INDEX_PASS] = aov[..., 3:4]
-        extra[NORMAL_PASS] = read_texture(targets.normal, 4)[..., :3]
-    if any(step.kind == SILHOUETTES for step in steps):
-        rgba = _composite_silhouettes(rgba, targets, items, view, settings)
-    if strands:  # hair and point clouds (core/strands.py), over everything above
-        rgba, depth = strands_mod.composite_render(rgba, depth, targets, view, settings, strands)
-    return rgba, depth, stats, {name: value for name, value in extra.items() if name in extra_passes}
+    frame = Frame(
+        items,
+        view,
+        settings,
+        DrawTarget(linear_depth=True),
+        options=options,
+        cull=cull,
+        strands=tuple(strands),
+        targets=targets_for(view.width, view.height),
+        extra_passes=extra_passes,
+        keep_readback=keep_readback,
+        read_depth=read_depth,
+    )
+    for unit in plan(settings, strands=bool(strands)):
+        unit.render(frame)
+    extra = {name: value for name, value in frame.extra.items() if name in extra_passes}
+    return frame.rgba, frame.depth, frame.stats, extra
 
 
 def _clear(framebuffer, width: int, height: int, depth: bool = True) -> None:
@@ -174,43 +367,48 @@ def _clear(framebuffer, width: int, height: int, depth: bool = True) -> None:
     gpu.state.viewport_set(0, 0, width, height)
 
 
-# Off only to measure the direct surface pass against it (scripts/bench).
-use_deferred_surface = True
-
-
 def draw_surface(
-    targets, items, view: View, settings, *, show_wire: bool = True, aovs: bool = False, cull: bool = True
+    targets,
+    items,
+    view: View,
+    settings,
+    *,
+    wire: bool = True,
+    aovs: bool = False,
+    cull: bool = True,
+    options: DrawOptions = DEFAULT_OPTIONS,
 ):
     """The surface pass into ``targets`` (cleared first): depth, the fill
-    and the visible wire, and the render passes' outputs with ``aovs``.
-    Meshes dense on screen are drawn deferred (docs/image_model.md §2.5,
-    draw.split_deferred), the rest directly, into the same depth buffer; the
-    same image either way. Returns the DrawStats."""
+    and the visible wire (none with ``wire`` False), and the render passes'
+    outputs with ``aovs``. Meshes dense on screen are drawn deferred
+    (docs/image_model.md §2.5, draw.split_deferred) unless ``options`` say
+    otherwise, the rest directly, into the same depth buffer; the same image
+    either way. Returns the DrawStats."""
     width, height = view.width, view.height
-    surface_args = {"cull": cull, "show_wire": show_wire, "write_aovs": aovs, "linear_depth": True}
+    target = DrawTarget(linear_depth=True, aovs=aovs, lines=draw_mod.WIRE_LINES if wire else draw_mod.NO_LINES)
     deferred, direct = ([], list(items))
-    if use_deferred_surface and shaders.deferred_available():
+    if options.deferred_surface and shaders.deferred_available():
         deferred, direct = draw_mod.split_deferred(items, view)
     framebuffer = targets.framebuffer(aovs=aovs)
     with framebuffer.bind():
         _clear(framebuffer, width, height)
         targets.clear_view_depth()
-        stats = draw_mod.draw(direct, view, settings, write_view_depth=True, **surface_args)
+        stats = draw_mod.draw(direct, view, settings, target=replace(target, view_depth=True), cull=cull)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     if deferred:
         try:
-            stats.add(_deferred_surface(targets, deferred, view, settings, aovs, surface_args))
+            stats.add(_deferred_surface(targets, deferred, view, settings, target, cull, options))
         except shaders.DeferredUnavailable as exc:
             shaders.disable_deferred()
             warn_once(
                 ("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly"
             )
-            return draw_surface(targets, items, view, settings, show_wire=show_wire, aovs=aovs, cull=cull)
+            return draw_surface(targets, items, view, settings, wire=wire, aovs=aovs, cull=cull, options=options)
     return stats
 
 
-def _deferred_surface(targets, items, view: View, settings, aovs: bool, surface_args: dict):
+def _deferred_surface(targets, items, view: View, settings, target: DrawTarget, cull: bool, options: DrawOptions):
     """The surface pass of ``items`` in two stages over the depth the direct
     draws left: which triangle each pixel shows (depth test, no shading),
     then the exact fragment stage once per pixel shown. Same depth, same
@@ -218,9 +416,11 @@ def _deferred_surface(targets, items, view: View, settings, aovs: bool, surface_
     instead of at every corner of every triangle."""
     width, height = view.width, view.height
     framebuffer = targets.visibility_framebuffer()
+    by_vertex = _triangle_ids_by_vertex(options)
     with framebuffer.bind():
         _clear(framebuffer, width, height, depth=False)  # keep the direct draws' depth
-        stats = draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY, **surface_args)
+        visibility = replace(target, stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=by_vertex)
+        stats = draw_mod.draw(items, view, settings, target=visibility, cull=cull)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     # The lines of multi-face regions as quads over the record, so that no
@@ -229,42 +429,43 @@ def _deferred_surface(targets, items, view: View, settings, aovs: bool, surface_
     # resolve walks the regions instead; a pass with the wire switched off
     # needs no lines.
     lines = None
-    if not aovs and surface_args["show_wire"] and _has_region_lines(items):
-        lines = _draw_region_lines(targets, items, view, settings, surface_args, stats)
-    with targets.resolve_framebuffer(aovs=aovs).bind():
+    if not target.aovs and target.lines != draw_mod.NO_LINES and _has_region_lines(items):
+        lines = _draw_region_lines(targets, items, view, settings, replace(target, aovs=False), cull, stats)
+    with targets.resolve_framebuffer(aovs=target.aovs).bind():
         gpu.state.viewport_set(0, 0, width, height)
-        draw_mod.draw(
-            items,
-            view,
-            settings,
-            stage=draw_mod.RESOLVE,
-            visibility=targets.visible,
-            write_view_depth=True,
-            region_lines=lines,
-            **surface_args,
+        resolve = replace(
+            target, stage=draw_mod.RESOLVE, visibility=targets.visible, view_depth=True, region_lines=lines
         )
+        draw_mod.draw(items, view, settings, target=resolve, cull=cull)
     return stats
+
+
+def _triangle_ids_by_vertex(options: DrawOptions) -> bool:
+    if options.triangle_ids_by_vertex is not None:
+        return options.triangle_ids_by_vertex
+    return shaders.triangle_ids_by_vertex()
 
 
 def _has_region_lines(items) -> bool:
     return any(item.mesh.region_line_count for item in items)
 
 
-def _draw_region_lines(targets, items, view: View, settings, draw_args: dict, stats):
+def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget, cull: bool, stats):
     """The region-lines pass over ``targets.visible`` (the visibility
     record of ``items``, numbered as draw() numbers them): the strongest
     line per pixel into ``targets.lines``, which it returns."""
     framebuffer = targets.region_lines_framebuffer()
     with framebuffer.bind():
         _clear(framebuffer, view.width, view.height)
-        draw_mod.draw(items, view, settings, stage=draw_mod.LINES, visibility=targets.visible, **draw_args)
+        lines = replace(target, stage=draw_mod.LINES, visibility=targets.visible)
+        draw_mod.draw(items, view, settings, target=lines, cull=cull)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
     return targets.lines
 
 
-def _overlay_region_lines(items, view: View, settings, stats):
+def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptions = DEFAULT_OPTIONS):
     """The viewport overlay's region lines: a visibility record of the
     meshes with multi-face regions at the region's size (own depth:
     Blender's depth buffer cannot be read back here), then the region-lines
@@ -289,10 +490,13 @@ def _overlay_region_lines(items, view: View, settings, stats):
     framebuffer = targets.visibility_framebuffer()
     with framebuffer.bind():
         _clear(framebuffer, view.width, view.height)
-        draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY, linear_depth=True)
+        record = DrawTarget(
+            linear_depth=True, stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=_triangle_ids_by_vertex(options)
+        )
+        draw_mod.draw(items, view, settings, target=record)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
-    lines = _draw_region_lines(targets, items, view, settings, {"linear_depth": True}, stats)
+    lines = _draw_region_lines(targets, items, view, settings, DrawTarget(linear_depth=True), True, stats)
     targets.lines_key = key
     return lines
 
@@ -325,7 +529,8 @@ def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:
         _clear(framebuffer, view.width, view.height, depth=False)  # the surface depth stays
         gpu.state.blend_set("ALPHA_PREMULT")
         try:
-            draw_mod.draw_hidden_lines(items, view, replace(settings, use_fill=False), cull=cull, linear_depth=True)
+            hidden = DrawTarget(linear_depth=True).hidden()
+            draw_mod.draw(items, view, replace(settings, use_fill=False), target=hidden, cull=cull)
         finally:
             gpu.state.blend_set("NONE")
             gpu.state.depth_test_set("NONE")
@@ -339,19 +544,11 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
     framebuffer = targets.silhouette_framebuffer()
     with framebuffer.bind():
         _clear(framebuffer, view.width, view.height)
-        silhouettes.draw_silhouettes(items, view, settings, targets.depth, linear_depth=True)
+        silhouettes.draw_silhouettes(items, view, settings, DrawTarget(linear_depth=True), targets.depth)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     compositing.color_over(rgba, settings.wire_color, read_texture(targets.outer, 1)[..., 0])
     return rgba
-
-
-# NDC depth bias of the viewport overlay (2^-18: 32 steps of a 24-bit depth
-# buffer, about 4 float32 ULPs of z/w near 1). Enough to win the tie with
-# Blender's own depth of the same surface (a few ULPs off, computed from other
-# float32 matrices); small enough that a surface more than a hair behind
-# another stays hidden. See DEPTH_BIAS in shaders/solidwire_vert.glsl.
-OVERLAY_DEPTH_BIAS = 2.0**-18
 
 
 def draw_over_viewport(
@@ -365,6 +562,7 @@ def draw_over_viewport(
     clip_planes=None,
     display=None,
     strands=(),
+    options: DrawOptions = DEFAULT_OPTIONS,
 ):
     """Draw ``items`` over a bound framebuffer that already holds the scene's
     colour and depth (a 3D viewport after its own drawing). Returns the
@@ -391,53 +589,25 @@ def draw_over_viewport(
     saved_blend = gpu.state.blend_get()
     saved_depth_test = gpu.state.depth_test_get()
     saved_depth_mask = gpu.state.depth_mask_get()
-    stats = None
-    # Every pass gets the clipping planes and the LUT (the depth pre-pass
-    # too: with the LUT its variant, and so its compiled program, is the
-    # surface pass's).
-    options = {"display": display} if clip_planes is None else {"clip_planes": clip_planes, "display": display}
-    line_stats = draw_mod.DrawStats()
-    if clip_planes is None and _has_region_lines(items):
-        # (Inside a clipping region the record would keep clipped-away
-        # surfaces: there the regions are walked.)
-        saved_viewport = gpu.state.viewport_get()
-        try:
-            options["region_lines"] = _overlay_region_lines(items, view, settings, line_stats)
-        finally:
-            gpu.state.viewport_set(*saved_viewport)
+    # Every pass gets the clipping planes and the LUT.
+    frame = Frame(
+        items,
+        view,
+        settings,
+        DrawTarget(depth_bias=depth_bias, clip_planes=clip_planes, display=display),
+        options=options,
+        strands=tuple(strands),
+        scene_depth=scene_depth,
+        scene_surfaces=scene_surfaces,
+    )
     try:
-        if not scene_depth:
-            gpu.state.depth_mask_set(True)
-            gpu.state.active_framebuffer_get().clear(depth=1.0)
-        if not (scene_depth and scene_surfaces and all(item.in_scene_depth for item in items)):
-            gpu.state.blend_set("NONE")
-            gpu.state.color_mask_set(False, False, False, False)
-            draw_mod.draw(items, view, settings, depth_bias=depth_bias, **options)
-            gpu.state.color_mask_set(True, True, True, True)
-        gpu.state.blend_set("ALPHA_PREMULT")
-        for step in plan(settings):
-            if step.kind == SURFACE:
-                # With hidden lines the surface pass only carries the fill.
-                if settings.use_hidden_lines and not settings.use_fill:
-                    continue
-                surface_stats = draw_mod.draw(
-                    items, view, step.settings, depth_bias=depth_bias, show_wire=step.show_wire, **options
-                )
-                stats = stats or surface_stats
-            elif step.kind == HIDDEN:
-                walk = {name: value for name, value in options.items() if name != "region_lines"}
-                draw_mod.draw_hidden_lines(items, view, step.settings, depth_bias=depth_bias, **walk)
-            elif step.kind == WIRE:
-                stats = draw_mod.draw(items, view, step.settings, depth_bias=depth_bias, **options)
-            elif step.kind == SILHOUETTES:
-                silhouettes.draw_silhouettes(items, view, step.settings, overlay_bias=depth_bias, display=display)
-        if strands:  # hair and point clouds (core/strands.py)
-            strands_mod.draw_over_viewport(strands, view, settings, depth_bias, display, clip_planes)
+        for unit in plan(settings, strands=bool(strands)):
+            unit.over_viewport(frame)
     finally:
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set(saved_blend)
         gpu.state.depth_test_set(saved_depth_test)
         gpu.state.depth_mask_set(saved_depth_mask)
-    stats = stats if stats is not None else draw_mod.DrawStats()
-    stats.extra.update(line_stats.extra)
+    stats = frame.stats if frame.stats is not None else DrawStats()
+    stats.extra.update(frame.line_stats.extra)
     return stats

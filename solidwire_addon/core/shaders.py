@@ -181,17 +181,13 @@ def gl_context(name: str):
         _context = previous
 
 
-_exit_hook_installed = False
-
-
 def _keep(cache: dict, key, shader):
     """Store a compiled program; the first one installs the exit hook that
-    frees them all while Blender's GPU context still exists."""
-    global _exit_hook_installed
-    cache[key] = shader
-    if not _exit_hook_installed:
+    frees them all while Blender's GPU context still exists (the cache is
+    emptied only by that hook)."""
+    if not cache:
         atexit.register(release_at_exit)
-        _exit_hook_installed = True
+    cache[key] = shader
     return shader
 
 
@@ -502,10 +498,6 @@ def _region_lines_create_info(variant: ShaderVariant):
     return info
 
 
-# None: triangle_ids_by_vertex() decides; True / False force it (tests).
-TRIANGLE_IDS_BY_VERTEX: bool | None = None
-
-
 def triangle_ids_by_vertex() -> bool:
     """Whether the visibility pass numbers triangles by their provoking
     vertex rather than with gl_PrimitiveID: on a software rasteriser under
@@ -513,9 +505,8 @@ def triangle_ids_by_vertex() -> bool:
     bookkeeping (~35 ms of a 1M-triangle 1280 x 720 frame of ~210 ms on 2
     cores), while a GPU hands it out for free and the copied corners would
     only cost memory. OpenGL's provoking vertex is the last corner, which
-    Blender keeps (see _provoking_corners)."""
-    if TRIANGLE_IDS_BY_VERTEX is not None:
-        return TRIANGLE_IDS_BY_VERTEX
+    Blender keeps (see _provoking_corners). options.DrawOptions can
+    choose either (tests compare the two)."""
     try:
         return gpu.platform.backend_type_get() == "OPENGL" and gpu.platform.device_type_get() == "SOFTWARE"
     except (AttributeError, RuntimeError):

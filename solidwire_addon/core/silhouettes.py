@@ -35,7 +35,7 @@ import numpy as np
 
 from . import shaders
 from .cache import table_texture
-from .draw import bind_display_transform, quad_batch, shader_variant
+from .draw import DrawTarget, bind_display_transform, quad_batch, shader_variant
 from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
 from .settings import pack_params
 from .view import translation
@@ -83,32 +83,26 @@ def edge_table(mesh):
     return mesh.silhouette_edges
 
 
-def draw_silhouettes(
-    items,
-    view,
-    settings,
-    scene_depth_texture=None,
-    *,
-    overlay_bias: float = 0.0,
-    linear_depth: bool = False,
-    display=None,
-) -> None:
+def draw_silhouettes(items, view, settings, target: DrawTarget, scene_depth_texture=None) -> None:
     """Draw the outer halves into the bound framebuffer.
 
     Render: an R32F intensity target with its own depth buffer cleared to 1,
-    ``scene_depth_texture`` the main pass's depth (see the module docstring).
-    Viewport overlay (``overlay_bias`` > 0): straight into the viewport with
-    "over" blending, occluded by its depth buffer; the caller sets the blend;
-    ``display`` (a display_transform.DisplayLUT) colour-manages the colour."""
-    variant = shader_variant(settings, linear_depth=linear_depth)
-    if display is not None and overlay_bias:
-        variant = replace(variant, display_transform=True)
+    ``scene_depth_texture`` the main pass's depth (see the module docstring);
+    ``target.linear_depth`` as the surface pass wrote it. Viewport overlay
+    (``target.depth_bias`` > 0): straight into the viewport with "over"
+    blending, occluded by its depth buffer; the caller sets the blend;
+    ``target.display`` (a display_transform.DisplayLUT) colour-manages the
+    colour."""
+    overlay_bias = target.depth_bias
+    variant = shader_variant(settings, target)
+    if not overlay_bias:
+        variant = replace(variant, display_transform=False)
     shader = shaders.get_silhouette(variant, overlay_bias)
     ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
     shader.bind()
     shader.uniform_block("params", ubo)
     if variant.display_transform:
-        bind_display_transform(shader, display)
+        bind_display_transform(shader, target.display)
     if overlay_bias:
         gpu.state.depth_test_set("LESS_EQUAL")
         gpu.state.depth_mask_set(False)

@@ -31,7 +31,7 @@ import numpy as np
 
 from . import colors, matcaps, shaders
 from .cache import table_texture
-from .draw import bind_display_transform, clip_space_planes, quad_batch, shader_variant, styled
+from .draw import DrawTarget, bind_display_transform, clip_space_planes, quad_batch, shader_variant, styled
 from .log import one_line, warn_once
 from .settings import pack_params
 from .targets import read_texture
@@ -350,21 +350,23 @@ def _radius_scale(matrix: np.ndarray) -> float:
     return det ** (1.0 / 3.0) if np.isfinite(det) else 0.0
 
 
-def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0, display=None, clip_planes=None) -> int:
+def _draw(items, view, settings, target: DrawTarget, scene_depth=None) -> int:
     """Draw ``items`` into the bound framebuffer (the caller sets blending
-    and the depth test). Returns the number of items drawn."""
-    variant = shader_variant(settings)
+    and the depth test) as ``target`` describes: the overlay form with a
+    depth bias (its display transform and clipping region too), else the
+    render form over ``scene_depth``. Returns the number of items drawn."""
+    overlay_bias = target.depth_bias
+    variant = shader_variant(settings, target)
+    if not overlay_bias:
+        variant = replace(variant, display_transform=False, clip_planes=False)
     matcap = None
     if variant.shading == shaders.SHADING_MATCAP:
         matcap = matcaps.texture(settings.matcap)
         if matcap is None:
             variant = replace(variant, shading=shaders.SHADING_FLAT)
-    if display is not None and overlay_bias:
-        variant = replace(variant, display_transform=True)
     clip_block = None
-    if clip_planes is not None and overlay_bias:
-        variant = replace(variant, clip_planes=True)
-        rows = clip_space_planes(clip_planes, view)
+    if variant.clip_planes:
+        rows = clip_space_planes(target.clip_planes, view)
         clip_block = gpu.types.GPUUniformBuf(np.asarray(rows, dtype=np.float32).tobytes())
     px_per_unit = 0.5 * float(view.viewport[3]) * abs(float(view.projection[1][1]))
     proj = view.projection
@@ -388,7 +390,7 @@ def _draw(items, view, settings, *, scene_depth=None, overlay_bias: float = 0.0,
                         "proj_z", [float(proj[2][2]), float(proj[2][3]), float(proj[3][2]), float(proj[3][3])]
                     )
                     if variant.display_transform:
-                        bind_display_transform(shader, display)
+                        bind_display_transform(shader, target.display)
                     if clip_block is not None:
                         shader.uniform_block("clip_params", clip_block)
                 else:
@@ -444,7 +446,7 @@ def _composite_render(rgba, depth, surface_targets, view, settings, items):
         gpu.state.depth_test_set("LESS")
         gpu.state.face_culling_set("NONE")
         try:
-            drawn = _draw(items, view, settings, scene_depth=surface_targets.depth)
+            drawn = _draw(items, view, settings, DrawTarget(), scene_depth=surface_targets.depth)
         finally:
             gpu.state.depth_test_set("NONE")
             gpu.state.depth_mask_set(False)
@@ -460,17 +462,18 @@ def _composite_render(rgba, depth, surface_targets, view, settings, items):
     return rgba, depth
 
 
-def draw_over_viewport(items, view, settings, depth_bias: float, display=None, clip_planes=None) -> int:
+def draw_over_viewport(items, view, settings, target: DrawTarget) -> int:
     """The strands over the bound viewport framebuffer: "over" blending,
-    occluded by its depth buffer (LESS_EQUAL, no depth write), cut by the
-    viewport's clipping region ``clip_planes`` ((6, 4) world-space planes)
-    when there is one. The caller restores the GPU state."""
+    occluded by its depth buffer (LESS_EQUAL, no depth write), moved towards
+    the camera by ``target.depth_bias``, cut by the viewport's clipping
+    region (``target.clip_planes``, (6, 4) world-space planes) when there is
+    one, through ``target.display``. The caller restores the GPU state."""
     gpu.state.blend_set("ALPHA_PREMULT")
     gpu.state.depth_test_set("LESS_EQUAL")
     gpu.state.depth_mask_set(False)
     gpu.state.face_culling_set("NONE")
     try:
-        return _draw(items, view, settings, overlay_bias=depth_bias, display=display, clip_planes=clip_planes)
+        return _draw(items, view, settings, target)
     except Exception as exc:  # noqa: BLE001 - the meshes' overlay must survive
         warn_once(
             ("strands overlay", type(exc).__name__), f"SolidWire: hair and point clouds not drawn: {one_line(exc)}"

@@ -223,6 +223,8 @@ def _cage_masks(depsgraph, s) -> dict:
             and (m.show_render if render else m.show_viewport)
             and (m.render_levels if render else m.levels) > 0
         ]
+        if subdivides and not _keeps_optimal_display(obj, subdivides, render, depsgraph):
+            continue  # Blender's overlay shows every edge
         if subdivides and "__reference_cage" not in obj.data.attributes:
             attribute = obj.data.attributes.new("__reference_cage", "INT", "EDGE")
             attribute.data.foreach_set("value", np.arange(1, len(obj.data.edges) + 1, dtype=np.int32))
@@ -247,6 +249,83 @@ def _cage_masks(depsgraph, s) -> dict:
             obj.data.attributes.remove(obj.data.attributes["__reference_cage"])
         depsgraph.update()
     return masks
+
+
+# Modifiers after the last subdivision as Blender's overlay treats them
+# (its Optimal Display marks live on the mesh's runtime data): deform
+# modifiers pass the mesh on, Mirror copies the marks to both halves unless
+# it bisects or merges anything, Array to every copy unless Merge is on,
+# Weld keeps its input when it welds nothing; the others make a new mesh
+# without them. The reference knows these types; any other raises, so that
+# no test compares with a guess.
+_REFERENCE_DEFORM = frozenset(
+    {"CAST", "DISPLACE", "SIMPLE_DEFORM", "SMOOTH", "WAVE", "LAPLACIANSMOOTH", "CORRECTIVE_SMOOTH"}
+)
+_REFERENCE_DROPS = frozenset({"TRIANGULATE", "SOLIDIFY", "BEVEL", "EDGE_SPLIT", "DECIMATE", "REMESH", "NODES"})
+
+
+def _keeps_optimal_display(obj, subdivides, render, depsgraph) -> bool:
+    """Whether Blender's overlay hides the inner edges of ``obj``'s last
+    subdivision, found by the rules above and by evaluating the mesh with
+    each merge switched off (a merge that merged anything changes the
+    vertex count)."""
+    if len(subdivides) > 1:
+        raise NotImplementedError("the reference does not model stacked subdivisions with cage edges")
+    last = subdivides[-1]
+    if not last.show_only_control_edges:
+        return False
+    enabled = [m for m in obj.modifiers if (m.show_render if render else m.show_viewport)]
+    after = enabled[enabled.index(last) + 1 :]
+    merging = []
+    for m in after:
+        if m.type in _REFERENCE_DROPS:
+            return False
+        if m.type == "MIRROR":
+            if any(m.use_bisect_axis[axis] and m.use_axis[axis] for axis in range(3)):
+                return False
+            if m.use_mirror_merge:
+                merging.append((m, "use_mirror_merge", False))
+        elif m.type == "ARRAY":
+            if m.use_merge_vertices:
+                return False
+            if m.start_cap is not None or m.end_cap is not None:
+                raise NotImplementedError("the reference does not model Array caps with cage edges")
+        elif m.type == "WELD":
+            merging.append((m, "show_render" if render else "show_viewport", False))
+        elif m.type not in _REFERENCE_DEFORM:
+            raise NotImplementedError(f"the reference does not know how Blender's overlay treats {m.type}")
+    for m, name, off in merging:
+        depsgraph.update()
+        merged = len(obj.evaluated_get(depsgraph).data.vertices)
+        saved = getattr(m, name)
+        setattr(m, name, off)
+        try:
+            depsgraph.update()
+            unmerged = len(obj.evaluated_get(depsgraph).data.vertices)
+        finally:
+            setattr(m, name, saved)
+            depsgraph.update()
+        if merged != unmerged:
+            return False
+    return True
+
+
+def _connected_edges(edges: list, ev) -> list:
+    """``edges`` split into groups joined by shared vertices."""
+    parent = {}
+
+    def root(v):
+        while parent.setdefault(v, v) != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return v
+
+    for e in edges:
+        parent[root(int(ev[e, 0]))] = root(int(ev[e, 1]))
+    groups: dict = {}
+    for e in edges:
+        groups.setdefault(root(int(ev[e, 0])), []).append(e)
+    return list(groups.values())
 
 
 def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
@@ -349,14 +428,17 @@ def _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage):
     members: dict = {}
     for e in range(ne):
         members.setdefault(int(chain[e]), []).append(e)
-    for es in members.values():
-        count: dict = {}
-        for e in es:
-            for v in ev[e]:
-                count[int(v)] = count.get(int(v), 0) + 1
-        odd = [v for v, n in count.items() if n % 2 == 1]
-        for e in es:
-            chain_ends[e] = tuple(odd) if len(odd) == 2 else (int(ev[e, 0]), int(ev[e, 1]))
+    for group in members.values():
+        # One id can name several paths (a Mirror or Array after the
+        # subdivision copies each cage edge's children): one path each.
+        for es in _connected_edges(group, ev):
+            count: dict = {}
+            for e in es:
+                for v in ev[e]:
+                    count[int(v)] = count.get(int(v), 0) + 1
+            odd = [v for v, n in count.items() if n % 2 == 1]
+            for e in es:
+                chain_ends[e] = tuple(odd) if len(odd) == 2 else (int(ev[e, 0]), int(ev[e, 1]))
 
     owner, a, b, style, ca, cb = [], [], [], [], [], []
     for o, e in entries:

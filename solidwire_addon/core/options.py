@@ -1,0 +1,36 @@
+"""How a frame is drawn, apart from what it shows: one frozen value handed
+down from the entry points (render engine, overlay, command line) to the
+passes, the draw calls and the mesh cache.
+
+Every option changes speed or memory, never the image (the benchmarks and
+tests switch them to measure or cross-check the two ways); each default is
+what the add-on ships. Nothing below the entry points keeps a switch of its
+own.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class DrawOptions:
+    # Meshes dense on screen draw their surface in two stages
+    # (docs/image_model.md §2.5, draw.split_deferred); False draws every mesh
+    # directly, the same image.
+    deferred_surface: bool = True
+    # How the deferred surface's visibility stage numbers triangles: by their
+    # provoking vertex (True) or with gl_PrimitiveID (False); None lets
+    # shaders.triangle_ids_by_vertex decide for this GPU. The same frame
+    # either way.
+    triangle_ids_by_vertex: bool | None = None
+    # A frame starts from the GPU meshes of the last one, re-extracting only
+    # what changed (blender/runtime.py); False starts every frame from an
+    # empty cache.
+    reuse_meshes: bool = True
+    # A mesh whose shape alone changed uploads new positions only
+    # (cache.MeshCache.get_validated); False extracts it again in full.
+    reposition_meshes: bool = True
+
+
+DEFAULT = DrawOptions()

@@ -1,0 +1,179 @@
+"""Edge selection on plain arrays, without Blender (image model
+§3.4-§3.6): which edges a region walks, its block and its lines (a region
+past the walk limit included), the segments of an edge of several classes,
+the ends of a chain, the runs of the region-lines pass.
+(tests/test_edge_selection.py renders the same rules against the float64
+reference.)"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from solidwire_addon.core import edge_select, extract
+
+
+def _strip(columns: int):
+    """A 1 x ``columns`` strip of unit quads: arrays, corner ids, offsets,
+    corner edges and edge vertex pairs."""
+    positions = np.array([[x, y, 0] for y in (0, 1) for x in range(columns + 1)], np.float32)
+    top = columns + 1
+    faces = [(x, x + 1, top + x + 1, top + x) for x in range(columns)]
+    corner_vert = np.array([v for f in faces for v in f], np.int32)
+    offsets = np.arange(0, 4 * columns + 1, 4, dtype=np.int32)
+    index: dict = {}
+    corner_edge = []
+    for f in faces:
+        for k in range(4):
+            key = tuple(sorted((f[k], f[(k + 1) % 4])))
+            corner_edge.append(index.setdefault(key, len(index)))
+    verts = np.array(list(index), np.int64)
+    arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
+    return arrays, corner_vert, offsets, np.array(corner_edge), verts, index
+
+
+def test_a_region_walks_every_drawn_edge_around_it():
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(3)
+    drawn = np.ones(len(verts), bool)
+    drawn[index[(1, 5)]] = False  # joins quads 0 and 1
+    stats = edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    assert (stats.hidden_edges, stats.regions, stats.listed_triangles) == (1, 1, 4)
+    listed = (arrays.edge_flags & extract.IN_REGION) != 0
+    assert listed.tolist() == [True] * 4 + [False] * 2  # the third quad keeps its own edges
+    # The region's block: its 6 drawn boundary edges, lower id first, style 0.
+    start = int(arrays.triangles[0, 3]) - len(arrays.ngon_corners)
+    count = int(arrays.edge_flags[0]) >> extract.NGON_SHIFT
+    block = arrays.region_table[start : start + edge_select.TEXELS_PER_SEGMENT * count : 2]
+    assert sorted(map(tuple, block[:, :2].astype(int).tolist())) == sorted(
+        [(0, 1), (1, 2), (4, 5), (5, 6), (0, 4), (2, 6)]
+    )
+    assert (block[:, 2] == 0).all()
+    # The hidden edge is neither a line nor a diagonal of the triangles that own it.
+    tri_edges = [tuple(sorted((int(t[i]), int(t[(i + 1) % 3])))) for t in arrays.triangles[:4] for i in range(3)]
+    flags = np.repeat(arrays.edge_flags[:4], 3)
+    bits = np.tile([extract.EDGE0_HIDDEN, extract.EDGE0_HIDDEN << 1, extract.EDGE0_HIDDEN << 2], 4)
+    hidden = [e for e, f, b in zip(tri_edges, flags, bits) if f & b]
+    assert hidden == [(1, 5), (1, 5)]
+
+
+def test_a_large_region_is_one_block_and_its_lines_one_table():
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(40)
+    drawn = np.ones(len(verts), bool)
+    for x in range(1, 40):
+        drawn[index[(x, 41 + x)]] = False  # one region of 40 quads, 82 drawn edges
+    stats = edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    # No size limit: every triangle walks the region's whole block ...
+    assert stats.regions == 1 and stats.listed_triangles == arrays.triangle_count
+    assert ((arrays.edge_flags >> extract.NGON_SHIFT) == 82).all()
+    # ... and the region-lines table holds each of its 82 drawn edges once,
+    # with the region (face 0's label) on one side and nothing on the other.
+    lines = arrays.region_lines.reshape(-1, 2, 4)
+    assert stats.region_lines == len(lines) == 82
+    ends = {(int(a), int(b)) for a, b in lines[:, 0, :2]}
+    assert ends == {tuple(sorted(map(int, verts[e]))) for e in range(len(verts)) if drawn[e]}
+    assert (lines[:, 0, 3] == 0).all() and (lines[:, 1, 2] == edge_select.NO_REGION).all()
+    assert (arrays.triangle_regions == 0).all()
+
+
+def test_an_edge_between_two_regions_is_one_line_naming_both():
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(4)
+    drawn = np.ones(len(verts), bool)
+    drawn[index[(1, 6)]] = False  # quads 0 + 1 form a region, 2 + 3 another
+    drawn[index[(3, 8)]] = False
+    edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    lines = arrays.region_lines.reshape(-1, 2, 4)
+    shared = [row for row in lines if (int(row[0, 0]), int(row[0, 1])) == (2, 7)]
+    assert len(shared) == 1 and sorted((shared[0][0, 3], shared[0][1, 2])) == [0.0, 2.0]
+    assert sorted(set(arrays.triangle_regions.tolist())) == [0.0, 2.0]
+
+
+def test_an_edge_of_several_classes_gets_a_segment_per_class():
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(1)
+    classes = np.zeros(len(verts), np.int64)
+    classes[index[(0, 1)]] = edge_select.CLASS_BIT["sharp"] | edge_select.CLASS_BIT["seam"]
+    edge_select.select_edges(
+        arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, None, classes, boundary_class=False)
+    )
+    styles = arrays.region_table[0::2]
+    bottom = styles[(styles[:, 0] == 0) & (styles[:, 1] == 1), 2]
+    assert sorted(bottom.tolist()) == [
+        1 + edge_select.EDGE_CLASSES.index("sharp"),
+        1 + edge_select.EDGE_CLASSES.index("seam"),
+    ]
+    assert sorted(styles[:, 2].tolist()).count(0) == 3
+
+
+def test_chain_ends_are_the_ends_of_the_path():
+    verts = np.array([[0, 4], [4, 5], [5, 1], [1, 7]])
+    ends = edge_select._chain_ends(verts, np.array([0, 0, 0, 1]))
+    assert sorted(ends[0]) == [0, 1] and sorted(ends[2]) == [0, 1]
+    assert sorted(ends[3]) == [1, 7]
+
+
+def test_a_region_too_large_to_walk_keeps_all_its_lines_for_the_region_lines_pass():
+    """Past WALK_LIMIT drawn edges a region's faces walk their own edges
+    (where a pixel walks at all), while the region-lines table still holds
+    every drawn edge of the region."""
+    columns = edge_select.WALK_LIMIT  # 2 * columns + 2 drawn edges: over the limit
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(columns)
+    drawn = np.ones(len(verts), bool)
+    top = columns + 1
+    for x in range(1, columns):
+        drawn[index[(x, top + x)]] = False
+    edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    assert len(arrays.region_lines) // 2 == 2 * columns + 2
+    # Every triangle reads the region lines; its own block holds at most its
+    # quad's four edges.
+    assert ((arrays.edge_flags & extract.REGION_LINES) != 0).all()
+    assert ((arrays.edge_flags >> extract.NGON_SHIFT) <= 4).all()
+
+
+def _runs(arrays):
+    """[(first entry, entries)] of the region-lines table's runs."""
+    return [(int(first), int(count)) for first, count in arrays.region_line_runs[:, :2]]
+
+
+def test_consecutive_pieces_of_a_chain_share_a_quad():
+    """The region-lines pass draws runs of up to RUN_SEGMENTS consecutive
+    entries of one chain, style and pair of regions as one quad: a strip
+    whose long sides are two chains (as a cage edge's pieces, numbered one
+    after another) has runs of eight, four and single side edges."""
+    columns = 20
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(columns)
+    top = columns + 1
+    bottom = [index[(x, x + 1)] for x in range(columns)]
+    upper = [index[(top + x, top + x + 1)] for x in range(columns)]
+    # Number the edges as a subdivision does: each chain's pieces in a row.
+    order = bottom + upper + [e for e in range(len(verts)) if e not in set(bottom + upper)]
+    renumber = np.empty(len(verts), np.int64)
+    renumber[order] = np.arange(len(verts))
+    verts, corner_edge = verts[order], renumber[corner_edge]
+    chain = np.arange(len(verts)) + 2
+    chain[:columns], chain[columns : 2 * columns] = 0, 1
+    drawn = np.ones(len(verts), bool)
+    drawn[2 * columns :] = False  # the verticals: one region (but the two ends stay drawn)
+    drawn[[renumber[index[(0, top)]], renumber[index[(columns, top + columns)]]]] = True
+    edge_select.select_edges(
+        arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn, chain=chain)
+    )
+    lines = arrays.region_lines.reshape(-1, 2, 4)
+    assert len(lines) == 2 * columns + 2
+    runs = _runs(arrays)
+    assert arrays.region_run_segments == edge_select.RUN_SEGMENTS
+    assert sorted(count for _, count in runs) == [1, 1, 4, 4, 8, 8, 8, 8]
+    # The runs cover the table once, in order, each one chain, style and
+    # pair of regions.
+    assert [first for first, _ in runs] == list(np.cumsum([0] + [count for _, count in runs[:-1]]))
+    for first, count in runs:
+        run = lines[first : first + count]
+        assert (run[:, 1, :2] == run[0, 1, :2]).all()  # chain ends
+        assert (run[:, 0, 2:] == run[0, 0, 2:]).all() and (run[:, 1, 2] == run[0, 1, 2]).all()
+
+
+def test_edges_that_are_their_own_chains_are_one_quad_each():
+    arrays, corner_vert, offsets, corner_edge, verts, index = _strip(6)
+    drawn = np.ones(len(verts), bool)
+    for x in range(1, 6):
+        drawn[index[(x, 7 + x)]] = False
+    edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
+    assert arrays.region_run_segments == 1
+    assert _runs(arrays) == [(k, 1) for k in range(len(arrays.region_lines) // 2)]
