@@ -133,11 +133,14 @@ DEFERRED_MIN_DENSITY = 0.4
 DEFERRED_BLOCK_WEIGHT = 8.0
 
 
-def split_deferred(items, view: View) -> tuple[list, list]:
+def split_deferred(items, view: View, min_density: float | None = None) -> tuple[list, list]:
     """(items to draw deferred, items to draw directly): a mesh is deferred
-    when its triangles are dense on screen (DEFERRED_MIN_DENSITY), counted
+    when its triangles are dense on screen (``min_density`` triangles per
+    pixel of its window boxes, by default DEFERRED_MIN_DENSITY), counted
     over all its items at once; numbers the visibility record cannot hold
     exactly (DEFERRED_MAX) keep the direct draw."""
+    if min_density is None:
+        min_density = DEFERRED_MIN_DENSITY
     by_mesh: dict = {}
     for item in items:
         by_mesh.setdefault(id(item.mesh), []).append(item)
@@ -153,7 +156,7 @@ def split_deferred(items, view: View) -> tuple[list, list]:
         weight = DEFERRED_BLOCK_WEIGHT if mesh.has_ngons else 1.0
         # Multi-face regions draw their lines over the visibility record
         # (docs/image_model.md §2.6), so such a mesh is always deferred.
-        dense = weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels or mesh.region_line_count > 0
+        dense = weight * mesh.triangle_count * len(group) >= min_density * pixels or mesh.region_line_count > 0
         (deferred if dense and 0 < mesh.triangle_count < DEFERRED_MAX else direct).extend(group)
     return deferred, direct
 
@@ -294,6 +297,7 @@ def draw(
     stage=None,
     visibility=None,
     region_lines=None,
+    record_depth=None,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
 
@@ -310,7 +314,10 @@ def draw(
     same items, view and settings so that they number the draws alike.
     ``stage`` LINES (between the two, with ``visibility``) draws the lines
     of multi-face regions into the bound region-lines target; a RESOLVE
-    given that target (``region_lines``) reads them from it."""
+    given that target (``region_lines``) reads them from it. A RESOLVE
+    given the record's depth texture (``record_depth``, the viewport
+    overlay) writes that depth, depth-tested as ``depth_test`` says, into a
+    framebuffer of someone else's (passes.draw_over_viewport)."""
     stats = DrawStats()
     if not items:
         return stats
@@ -327,8 +334,9 @@ def draw(
         )
     if write_aovs:
         variant = replace(variant, write_aovs=True)
+    over_scene = stage == RESOLVE and record_depth is not None
     if stage == RESOLVE:
-        variant = replace(variant, resolve=True, linear_depth=False)
+        variant = replace(variant, resolve=True, linear_depth=False, resolve_window_depth=over_scene)
     elif stage == VISIBILITY:
         variant = shaders.ShaderVariant(
             visibility=True, linear_depth=linear_depth, triangle_ids_by_vertex=shaders.triangle_ids_by_vertex()
@@ -353,6 +361,8 @@ def draw(
         extras["display"] = display
     if visibility is not None:
         extras["visibility"] = visibility
+    if over_scene:
+        extras["record_depth"] = record_depth
     if clip_rows is not None:
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
     if variant.shading == shaders.SHADING_MATCAP:
@@ -389,8 +399,9 @@ def draw(
             )
         return block
 
-    gpu.state.depth_test_set("NONE" if stage == RESOLVE else depth_test)
-    gpu.state.depth_mask_set(depth_write and stage != RESOLVE)
+    depth_tested = stage != RESOLVE or over_scene
+    gpu.state.depth_test_set(depth_test if depth_tested else "NONE")
+    gpu.state.depth_mask_set(depth_write and depth_tested)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
@@ -498,6 +509,8 @@ def _bind_extras(shader, variant, extras) -> None:
         bind_display_transform(shader, extras["display"])
     if variant.region_lines:
         shader.uniform_sampler("region_line_image", extras["region_line_image"])
+    if variant.resolve_window_depth:
+        shader.uniform_sampler("record_depth", extras["record_depth"])
 
 
 def bind_display_transform(shader, display) -> None:

@@ -297,6 +297,58 @@ def _overlay_region_lines(items, view: View, settings, stats):
     return lines
 
 
+def _overlay_defers(items, settings, clip_planes) -> bool:
+    """Whether the overlay's surface may be deferred: the frame's passes are
+    the surface pass alone (silhouettes may follow), no clipping region, and
+    the deferred stages are in use. (The caller also asks that Blender's
+    depth hold every surface: the record then only has to know which of our
+    own triangles is nearest, and Blender's depth test does the rest.)"""
+    steps = plan(settings)
+    return (
+        clip_planes is None
+        and use_deferred_surface
+        and shaders.deferred_available()
+        and steps[0].kind == SURFACE
+        and all(step.kind in (SURFACE, SILHOUETTES) for step in steps)
+        and all(item.in_scene_depth for item in items)
+    )
+
+
+def _overlay_record(items, view: View, settings, stats):
+    """The deferred overlay's first stage, into the overlay's own targets at
+    the viewport's size: the visibility record of ``items`` over a depth
+    buffer of its own (window depth, as Blender's), then the region lines
+    over it when a mesh has multi-face regions (docs/image_model.md §2.5,
+    §2.6). Returns the targets; the resolve (draw_over_viewport) reads
+    ``visible``, ``depth`` and ``lines``.
+
+    Nothing here depends on Blender's buffers, so a redraw that changes
+    nothing the record depends on (the view, the settings, which meshes in
+    which shape where; _overlay_lines_key) reuses it: a static redraw only
+    resolves, once per pixel shown, without transforming a vertex."""
+    targets = overlay_targets_for(view.width, view.height)
+    key = _overlay_lines_key(items, view, settings)
+    key = None if key is None else ("surface record", key)
+    line_count = sum(item.mesh.region_line_count for item in items)
+    if key is not None and targets.lines_key == key and targets.visible is not None:
+        if line_count:
+            stats.extra["region_line_entries"] = line_count
+            stats.extra["region_lines_reused"] = 1
+        stats.extra["record_reused"] = 1
+        return targets
+    targets.lines_key = None
+    framebuffer = targets.visibility_framebuffer()
+    with framebuffer.bind():
+        _clear(framebuffer, view.width, view.height)
+        draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+    if line_count:
+        _draw_region_lines(targets, items, view, settings, {}, stats)
+    targets.lines_key = key
+    return targets
+
+
 def _overlay_lines_key(items, view: View, settings):
     """What the overlay's region lines depend on, or None when that cannot
     be told (a setting that does not hash): each mesh by its serial and
@@ -354,6 +406,17 @@ def _composite_silhouettes(rgba, targets, items, view, settings):
 OVERLAY_DEPTH_BIAS = 2.0**-18
 
 
+# The overlay defers a mesh from this many triangles per pixel of its
+# window box on (draw.split_deferred). Lower than the render's threshold:
+# the overlay's direct pass shades only what Blender's depth lets through,
+# but its record is kept between redraws, so a redraw that changes nothing
+# only resolves. Measured on llvmpipe at 1280 x 720 (docs/dev/viewport-
+# benchmark.md): Suzanne at 0.1 triangles per pixel redraws faster directly
+# after an edit (+8 ms) and deferred when static (-5 ms); at 0.4 deferred
+# either way (-15 ms, -40 ms).
+OVERLAY_DEFERRED_MIN_DENSITY = 0.2
+
+
 def draw_over_viewport(
     items,
     view: View,
@@ -397,7 +460,26 @@ def draw_over_viewport(
     # surface pass's).
     options = {"display": display} if clip_planes is None else {"clip_planes": clip_planes, "display": display}
     line_stats = draw_mod.DrawStats()
-    if clip_planes is None and _has_region_lines(items):
+    # Where Blender's depth holds every surface, the dense meshes' surface
+    # is deferred: a record in the overlay's own targets, resolved into
+    # Blender's buffer (_overlay_record).
+    deferred, direct = [], list(items)
+    if scene_depth and scene_surfaces and _overlay_defers(items, settings, clip_planes):
+        deferred, direct = draw_mod.split_deferred(items, view, OVERLAY_DEFERRED_MIN_DENSITY)
+    record = None
+    if deferred:
+        saved_viewport = gpu.state.viewport_get()
+        try:
+            record = _overlay_record(deferred, view, settings, line_stats)
+        except shaders.DeferredUnavailable as exc:
+            shaders.disable_deferred()
+            warn_once(
+                ("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly"
+            )
+            deferred, direct = [], list(items)
+        finally:
+            gpu.state.viewport_set(*saved_viewport)
+    if clip_planes is None and not deferred and _has_region_lines(items):
         # (Inside a clipping region the record would keep clipped-away
         # surfaces: there the regions are walked.)
         saved_viewport = gpu.state.viewport_get()
@@ -421,8 +503,22 @@ def draw_over_viewport(
                 if settings.use_hidden_lines and not settings.use_fill:
                     continue
                 surface_stats = draw_mod.draw(
-                    items, view, step.settings, depth_bias=depth_bias, show_wire=step.show_wire, **options
+                    direct, view, step.settings, depth_bias=depth_bias, show_wire=step.show_wire, **options
                 )
+                if record is not None:
+                    surface_stats.add(
+                        draw_mod.draw(
+                            deferred,
+                            view,
+                            step.settings,
+                            depth_bias=depth_bias,
+                            stage=draw_mod.RESOLVE,
+                            visibility=record.visible,
+                            record_depth=record.depth,
+                            region_lines=record.lines if _has_region_lines(deferred) else None,
+                            display=display,
+                        )
+                    )
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
                 walk = {name: value for name, value in options.items() if name != "region_lines"}

@@ -106,6 +106,11 @@ class ShaderVariant:
     # exact path's fragment stage run once per pixel over that record.
     visibility: bool = False
     resolve: bool = False
+    # The viewport overlay's resolve (passes.draw_over_viewport): drawn into
+    # Blender's framebuffer, it writes the record's window depth (less the
+    # overlay's DEPTH_BIAS) so that Blender's depth test decides which pixels
+    # show, as it does for the direct surface pass (RESOLVE_WINDOW_DEPTH).
+    resolve_window_depth: bool = False
     # Visibility pass only: the triangle number comes with the provoking
     # vertex (a "triangle" attribute; cache.GPUMesh.visibility_batch) instead
     # of gl_PrimitiveID (triangle_ids_by_vertex says when).
@@ -238,6 +243,7 @@ SAMPLERS = {
     "triangle_flag_table": (11, "FLOAT_2D"),
     "region_line_image": (12, "FLOAT_2D"),
     "attribute_colors": (13, "FLOAT_2D"),
+    "record_depth": (14, "DEPTH_2D"),
 }
 
 
@@ -352,6 +358,10 @@ def _create_info(variant: ShaderVariant):
         add_sampler(info, "visibility")
         add_sampler(info, "triangle_flag_table")
         info.define("RESOLVE_PASS", "1")
+        if variant.resolve_window_depth:
+            add_sampler(info, "record_depth")
+            info.define("RESOLVE_WINDOW_DEPTH", "1")
+            compat.depth_write(info, "ANY")
     else:
         info.vertex_in(0, "INT", "edge_flags")
     if variant.region_lines:
@@ -416,9 +426,11 @@ def _visibility_create_info(variant: ShaderVariant):
     info.vertex_in(0, "VEC3", "position")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_visible")
-    if not variant.linear_depth:
-        raise ValueError("the visibility pass is for the render's linear depth")
-    compat.depth_write(info, "ANY")
+    if variant.linear_depth:
+        # (Without it the rasteriser's own window depth: the viewport
+        # overlay's record, whose resolve hands it to Blender's depth test.)
+        info.define("LINEAR_DEPTH", "1")
+        compat.depth_write(info, "ANY")
     if variant.instanced:
         info.define("SW_INSTANCED", "1")
         prologue = (
