@@ -22,18 +22,6 @@ void main()
   if (visible.z != float(draw_number)) {
     discard; /* nothing, or another draw's triangle */
   }
-#ifdef RESOLVE_WINDOW_DEPTH
-  /* The viewport overlay: the record's window depth, the rasteriser's own
-   * value for this triangle at this pixel, moved towards the camera by the
-   * direct pass's DEPTH_BIAS (z/w - b in NDC is z - b/2 in window depth),
-   * so Blender's depth test keeps exactly the pixels it would keep of the
-   * direct pass (solidwire_vert.glsl). */
-  float record = texelFetch(record_depth, ivec2(gl_FragCoord.xy), 0).r;
-#  ifdef DEPTH_BIAS
-  record -= 0.5 * DEPTH_BIAS;
-#  endif
-  gl_FragDepth = record;
-#endif
   int triangle = int(visible.x) - 1;
   sw_instance_id = int(visible.y);
   vec2 flag_halves = fetch_texel(triangle_flag_table, triangle).xy;

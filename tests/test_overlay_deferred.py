@@ -143,7 +143,7 @@ def test_the_record_is_reused_until_something_changes():
 
     def frame():
         rgba, stats = _draw(scene, objects)
-        return rgba, bool(stats.get("record_reused"))
+        return rgba, bool(stats.get("surface_reused"))
 
     first, reused = frame()
     assert not reused

@@ -297,7 +297,6 @@ def draw(
     stage=None,
     visibility=None,
     region_lines=None,
-    record_depth=None,
 ) -> DrawStats:
     """Draw ``items`` into the bound framebuffer with depth test and write.
 
@@ -314,10 +313,7 @@ def draw(
     same items, view and settings so that they number the draws alike.
     ``stage`` LINES (between the two, with ``visibility``) draws the lines
     of multi-face regions into the bound region-lines target; a RESOLVE
-    given that target (``region_lines``) reads them from it. A RESOLVE
-    given the record's depth texture (``record_depth``, the viewport
-    overlay) writes that depth, depth-tested as ``depth_test`` says, into a
-    framebuffer of someone else's (passes.draw_over_viewport)."""
+    given that target (``region_lines``) reads them from it."""
     stats = DrawStats()
     if not items:
         return stats
@@ -334,9 +330,8 @@ def draw(
         )
     if write_aovs:
         variant = replace(variant, write_aovs=True)
-    over_scene = stage == RESOLVE and record_depth is not None
     if stage == RESOLVE:
-        variant = replace(variant, resolve=True, linear_depth=False, resolve_window_depth=over_scene)
+        variant = replace(variant, resolve=True, linear_depth=False)
     elif stage == VISIBILITY:
         variant = shaders.ShaderVariant(
             visibility=True, linear_depth=linear_depth, triangle_ids_by_vertex=shaders.triangle_ids_by_vertex()
@@ -361,8 +356,6 @@ def draw(
         extras["display"] = display
     if visibility is not None:
         extras["visibility"] = visibility
-    if over_scene:
-        extras["record_depth"] = record_depth
     if clip_rows is not None:
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
     if variant.shading == shaders.SHADING_MATCAP:
@@ -399,9 +392,8 @@ def draw(
             )
         return block
 
-    depth_tested = stage != RESOLVE or over_scene
-    gpu.state.depth_test_set(depth_test if depth_tested else "NONE")
-    gpu.state.depth_mask_set(depth_write and depth_tested)
+    gpu.state.depth_test_set("NONE" if stage == RESOLVE else depth_test)
+    gpu.state.depth_mask_set(depth_write and stage != RESOLVE)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
@@ -509,8 +501,6 @@ def _bind_extras(shader, variant, extras) -> None:
         bind_display_transform(shader, extras["display"])
     if variant.region_lines:
         shader.uniform_sampler("region_line_image", extras["region_line_image"])
-    if variant.resolve_window_depth:
-        shader.uniform_sampler("record_depth", extras["record_depth"])
 
 
 def bind_display_transform(shader, display) -> None:
@@ -631,6 +621,13 @@ def _rectangle():
         vbo.attr_fill("rect_corner", [0, 1, 3, 0, 3, 2])
         _rectangles.append(gpu.types.GPUBatch(type="TRIS", buf=vbo))
     return _rectangles[0]
+
+
+def draw_rectangle(shader, rect) -> None:
+    """Draw ``shader`` (resolve_vert.glsl's vertex stage) over the NDC
+    rectangle ``rect`` (x0, y0, x1, y1)."""
+    shader.uniform_float("resolve_rect", rect)
+    _rectangle().draw(shader)
 
 
 def release_rectangle() -> None:

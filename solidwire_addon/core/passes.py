@@ -10,9 +10,11 @@ in where the passes land.
 
 * :func:`render` (render engine, command line, tests): float offscreen
   targets, read back as premultiplied RGBA plus view depth.
-* :func:`draw_over_viewport` (viewport overlay): straight into a bound
-  framebuffer that already holds the scene's colour and depth, through the
-  scene's colour management (a display LUT, docs/image_model.md §9).
+* :func:`draw_over_viewport` (viewport overlay): into a bound framebuffer
+  that already holds the scene's colour and depth, through the scene's
+  colour management (a display LUT, docs/image_model.md §9); meshes dense
+  on screen through a deferred surface in the overlay's own targets, kept
+  between redraws and composited against the scene's depth.
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ from .schema import (
     WIRE_PASS,
 )
 from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, targets_for
-from .view import View
+from .view import View, translation, window_boxes
 
 SURFACE, HIDDEN, WIRE, SILHOUETTES = "surface", "hidden", "wire", "silhouettes"
 
@@ -314,39 +316,96 @@ def _overlay_defers(items, settings, clip_planes) -> bool:
     )
 
 
-def _overlay_record(items, view: View, settings, stats):
-    """The deferred overlay's first stage, into the overlay's own targets at
+def _overlay_surface(items, view: View, settings, display, stats):
+    """The deferred overlay's surface, into the overlay's own targets at
     the viewport's size: the visibility record of ``items`` over a depth
-    buffer of its own (window depth, as Blender's), then the region lines
-    over it when a mesh has multi-face regions (docs/image_model.md §2.5,
-    §2.6). Returns the targets; the resolve (draw_over_viewport) reads
-    ``visible``, ``depth`` and ``lines``.
+    buffer of its own (window depth, as Blender's), the region lines over
+    it when a mesh has multi-face regions (docs/image_model.md §2.5, §2.6),
+    then the resolve into ``targets.surface``. Returns the targets, for
+    _composite_overlay_surface; ``stats`` gets the draws' counts.
 
-    Nothing here depends on Blender's buffers, so a redraw that changes
-    nothing the record depends on (the view, the settings, which meshes in
-    which shape where; _overlay_lines_key) reuses it: a static redraw only
-    resolves, once per pixel shown, without transforming a vertex."""
+    Nothing here reads Blender's buffers, so a redraw that changes nothing
+    the image depends on (the view, the settings, which meshes in which
+    shape where, their styles and colour sources, the display transform;
+    _overlay_lines_key) reuses it whole: a static redraw only composites."""
     targets = overlay_targets_for(view.width, view.height)
     key = _overlay_lines_key(items, view, settings)
-    key = None if key is None else ("surface record", key)
+    if key is not None:
+        key = ("surface", key, None if display is None else display.key, tuple(item.source for item in items))
+        try:
+            hash(key)
+        except TypeError:
+            key = None
     line_count = sum(item.mesh.region_line_count for item in items)
-    if key is not None and targets.lines_key == key and targets.visible is not None:
+    record_stats = draw_mod.DrawStats()
+    if key is not None and targets.surface_key == key and targets.lines_key == key:
+        record_stats.objects_drawn = len(items)
+        record_stats.triangles_drawn = sum(item.mesh.triangle_count for item in items)
         if line_count:
-            stats.extra["region_line_entries"] = line_count
-            stats.extra["region_lines_reused"] = 1
-        stats.extra["record_reused"] = 1
+            record_stats.extra.update(region_line_entries=line_count, region_lines_reused=1)
+        record_stats.extra["surface_reused"] = 1
+        stats.add(record_stats)
         return targets
-    targets.lines_key = None
+    targets.lines_key = targets.surface_key = None
+    width, height = view.width, view.height
     framebuffer = targets.visibility_framebuffer()
     with framebuffer.bind():
-        _clear(framebuffer, view.width, view.height)
+        _clear(framebuffer, width, height)
         draw_mod.draw(items, view, settings, stage=draw_mod.VISIBILITY)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
-    if line_count:
-        _draw_region_lines(targets, items, view, settings, {}, stats)
-    targets.lines_key = key
+    lines = _draw_region_lines(targets, items, view, settings, {}, record_stats) if line_count else None
+    with targets.surface_framebuffer().bind():
+        gpu.state.viewport_set(0, 0, width, height)
+        gpu.state.blend_set("NONE")
+        record_stats.add(
+            draw_mod.draw(
+                items,
+                view,
+                settings,
+                stage=draw_mod.RESOLVE,
+                visibility=targets.visible,
+                region_lines=lines,
+                display=display,
+            )
+        )
+    # (One key for the record, its lines and the resolved image: the
+    # direct path's own region lines (_overlay_region_lines) never match it.)
+    targets.lines_key = targets.surface_key = key
+    targets.surface_rect = _window_union(items, view)
+    stats.add(record_stats)
     return targets
+
+
+def _window_union(items, view: View) -> tuple:
+    """The NDC rectangle over every item's window box (view.window_boxes),
+    vectorised per mesh."""
+    by_mesh: dict = {}
+    for item in items:
+        by_mesh.setdefault(id(item.mesh), []).append(item)
+    boxes = []
+    for group in by_mesh.values():
+        mesh = group[0].mesh
+        to_clip = (
+            view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
+        )
+        boxes.append(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max))
+    boxes = np.concatenate(boxes)
+    return (float(boxes[:, 0].min()), float(boxes[:, 1].min()), float(boxes[:, 2].max()), float(boxes[:, 3].max()))
+
+
+def _composite_overlay_surface(targets, depth_bias: float) -> None:
+    """Blend ``targets.surface`` into the bound framebuffer (Blender's)
+    over the items' window boxes, each pixel at the record's depth less the
+    bias, with depth test LESS_EQUAL and write, blending as the caller set
+    (premultiplied "over")."""
+    shader = shaders.get_overlay_composite(depth_bias)
+    shader.bind()
+    shader.uniform_sampler("record_depth", targets.depth)
+    shader.uniform_sampler("surface_image", targets.surface)
+    gpu.state.depth_test_set("LESS_EQUAL")
+    gpu.state.depth_mask_set(True)
+    draw_mod.draw_rectangle(shader, targets.surface_rect)
 
 
 def _overlay_lines_key(items, view: View, settings):
@@ -462,7 +521,7 @@ def draw_over_viewport(
     line_stats = draw_mod.DrawStats()
     # Where Blender's depth holds every surface, the dense meshes' surface
     # is deferred: a record in the overlay's own targets, resolved into
-    # Blender's buffer (_overlay_record).
+    # Blender's buffer (_overlay_surface).
     deferred, direct = [], list(items)
     if scene_depth and scene_surfaces and _overlay_defers(items, settings, clip_planes):
         deferred, direct = draw_mod.split_deferred(items, view, OVERLAY_DEFERRED_MIN_DENSITY)
@@ -470,7 +529,7 @@ def draw_over_viewport(
     if deferred:
         saved_viewport = gpu.state.viewport_get()
         try:
-            record = _overlay_record(deferred, view, settings, line_stats)
+            record = _overlay_surface(deferred, view, settings, display, line_stats)
         except shaders.DeferredUnavailable as exc:
             shaders.disable_deferred()
             warn_once(
@@ -506,19 +565,8 @@ def draw_over_viewport(
                     direct, view, step.settings, depth_bias=depth_bias, show_wire=step.show_wire, **options
                 )
                 if record is not None:
-                    surface_stats.add(
-                        draw_mod.draw(
-                            deferred,
-                            view,
-                            step.settings,
-                            depth_bias=depth_bias,
-                            stage=draw_mod.RESOLVE,
-                            visibility=record.visible,
-                            record_depth=record.depth,
-                            region_lines=record.lines if _has_region_lines(deferred) else None,
-                            display=display,
-                        )
-                    )
+                    _composite_overlay_surface(record, depth_bias)
+                    surface_stats.add(line_stats)
                 stats = stats or surface_stats
             elif step.kind == HIDDEN:
                 walk = {name: value for name, value in options.items() if name != "region_lines"}
@@ -535,5 +583,6 @@ def draw_over_viewport(
         gpu.state.depth_test_set(saved_depth_test)
         gpu.state.depth_mask_set(saved_depth_mask)
     stats = stats if stats is not None else draw_mod.DrawStats()
-    stats.extra.update(line_stats.extra)
+    if record is None:
+        stats.extra.update(line_stats.extra)
     return stats

@@ -106,11 +106,6 @@ class ShaderVariant:
     # exact path's fragment stage run once per pixel over that record.
     visibility: bool = False
     resolve: bool = False
-    # The viewport overlay's resolve (passes.draw_over_viewport): drawn into
-    # Blender's framebuffer, it writes the record's window depth (less the
-    # overlay's DEPTH_BIAS) so that Blender's depth test decides which pixels
-    # show, as it does for the direct surface pass (RESOLVE_WINDOW_DEPTH).
-    resolve_window_depth: bool = False
     # Visibility pass only: the triangle number comes with the provoking
     # vertex (a "triangle" attribute; cache.GPUMesh.visibility_batch) instead
     # of gl_PrimitiveID (triangle_ids_by_vertex says when).
@@ -244,6 +239,7 @@ SAMPLERS = {
     "region_line_image": (12, "FLOAT_2D"),
     "attribute_colors": (13, "FLOAT_2D"),
     "record_depth": (14, "DEPTH_2D"),
+    "surface_image": (15, "FLOAT_2D"),
 }
 
 
@@ -358,10 +354,6 @@ def _create_info(variant: ShaderVariant):
         add_sampler(info, "visibility")
         add_sampler(info, "triangle_flag_table")
         info.define("RESOLVE_PASS", "1")
-        if variant.resolve_window_depth:
-            add_sampler(info, "record_depth")
-            info.define("RESOLVE_WINDOW_DEPTH", "1")
-            compat.depth_write(info, "ANY")
     else:
         info.vertex_in(0, "INT", "edge_flags")
     if variant.region_lines:
@@ -749,6 +741,30 @@ def get_setup(in_front: bool = False):
             read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("setup_comp.glsl")
         )
         shader = _keep(_cache, key, gpu.shader.create_from_info(info))
+    return shader
+
+
+def get_overlay_composite(depth_bias: float):
+    """The viewport overlay's composite (shaders/overlay_composite_frag.glsl
+    over resolve_vert.glsl's rectangle): the kept surface image into
+    Blender's buffer at the record's depth less ``depth_bias``."""
+    key = (_context, "overlay composite", float(depth_bias))
+    shader = _cache.get(key)
+    if shader is None:
+        info = gpu.types.GPUShaderCreateInfo()
+        info.vertex_in(0, "INT", "rect_corner")
+        info.push_constant("VEC4", "resolve_rect")
+        add_sampler(info, "record_depth")
+        add_sampler(info, "surface_image")
+        info.define("DEPTH_BIAS", repr(float(depth_bias)))
+        info.fragment_out(0, "VEC4", "frag_color")
+        compat.depth_write(info, "ANY")
+        info.vertex_source(read_source("resolve_vert.glsl"))
+        info.fragment_source(read_source("overlay_composite_frag.glsl"))
+        try:
+            shader = _keep(_cache, key, gpu.shader.create_from_info(info))
+        except Exception as exc:
+            raise DeferredUnavailable(str(exc)) from exc
     return shader
 
 
