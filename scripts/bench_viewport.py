@@ -44,6 +44,7 @@ import numpy as np
 
 import solidwire_addon
 from solidwire_addon.core import draw as draw_mod
+from solidwire_addon.core import passes
 from tests.support import scenes
 from tests.support.viewport import HeadlessViewport, set_overlays
 
@@ -230,10 +231,19 @@ def table(results) -> list[str]:
 
 # -- where SolidWire's overlay frame goes -------------------------------------------
 
-# The overlay's draw calls by their stage (draw_mod.draw's ``stage``); a
-# call without one is the surface pass, or the depth pre-pass before it
-# where Blender's depth does not hold the surfaces.
-STAGE_NAMES = {"visibility": "region-lines record", "lines": "region lines", None: "surface pass"}
+# The overlay's draw calls by their stage (draw_mod.draw's ``stage``): the
+# deferred surface's record, region lines and resolve into the overlay's own
+# targets (passes._overlay_surface), then its composite into Blender's
+# buffer; a call without a stage is the direct surface pass (meshes sparse on
+# screen, or every mesh where the record cannot serve), or the depth
+# pre-pass before it where Blender's depth does not hold the surfaces.
+STAGE_NAMES = {
+    "visibility": "record (visibility stage)",
+    "lines": "region lines",
+    "resolve": "resolve",
+    None: "direct surface pass",
+}
+COMPOSITE = "composite into Blender's buffer"
 
 
 class OverlayProbe:
@@ -247,22 +257,28 @@ class OverlayProbe:
 
     def __enter__(self):
         self._original = draw_mod.draw
+        self._composite = passes._composite_overlay_surface
         probe = self
 
-        def timed(*args, **kwargs):
-            start = time.perf_counter()
-            result = probe._original(*args, **kwargs)
-            recorded = time.perf_counter()
-            gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "UBYTE")
-            name = STAGE_NAMES.get(kwargs.get("stage"), str(kwargs.get("stage")))
-            probe.calls.append((name, (recorded - start) * 1000.0, (time.perf_counter() - recorded) * 1000.0))
-            return result
+        def timer(function, name_of):
+            def timed(*args, **kwargs):
+                start = time.perf_counter()
+                result = function(*args, **kwargs)
+                recorded = time.perf_counter()
+                gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "UBYTE")
+                name = name_of(kwargs)
+                probe.calls.append((name, (recorded - start) * 1000.0, (time.perf_counter() - recorded) * 1000.0))
+                return result
 
-        draw_mod.draw = timed
+            return timed
+
+        draw_mod.draw = timer(self._original, lambda kw: STAGE_NAMES.get(kw.get("stage"), str(kw.get("stage"))))
+        passes._composite_overlay_surface = timer(self._composite, lambda _kw: COMPOSITE)
         return self
 
     def __exit__(self, *exc):
         draw_mod.draw = self._original
+        passes._composite_overlay_surface = self._composite
 
 
 def profile(kind: str, level: int, size, repeats: int) -> list[str]:

@@ -46,7 +46,10 @@ def _stages(monkeypatch) -> list:
     return calls
 
 
-def _draw(scene, depth_objects, state=ViewportState(), depth_format="DEPTH32F_STENCIL8", size=(WIDTH, HEIGHT)):
+SOLID = ViewportState()
+
+
+def _draw(scene, depth_objects, state=SOLID, depth_format="DEPTH32F_STENCIL8", size=(WIDTH, HEIGHT)):
     """(rgba in 0..1 as the screen shows it, stats) of one overlay frame over
     a Blender-like depth of ``depth_objects``."""
     depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -58,7 +61,7 @@ def _draw(scene, depth_objects, state=ViewportState(), depth_format="DEPTH32F_ST
     return viewport.rgba(), stats
 
 
-def _assert_matches_reference(scene, alpha, state=ViewportState()):
+def _assert_matches_reference(scene, alpha, state=SOLID):
     plan = overlay_state.plan_overlay(state)
     settings = overlay_state.draw_settings(plan, scene.solidwire.snapshot())
     ref = reference.render_reference(scene, size=alpha.shape[::-1], settings=settings)
