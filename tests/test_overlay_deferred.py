@@ -89,11 +89,13 @@ def test_deferred_overlay_matches_reference(look, depth_format, monkeypatch):
     _assert_matches_reference(scene, rgba[..., 3])
 
 
-def test_deferred_overlay_draws_the_direct_image(monkeypatch):
+@pytest.mark.parametrize("silhouettes", [False, True], ids=["plain", "silhouettes"])
+def test_deferred_overlay_draws_the_direct_image(silhouettes, monkeypatch):
     """Colour and alpha as the direct pass draws them, up to float32
     rounding of the resolve's interpolation (within 1/255 of the display
-    encoding), over the same Blender depth."""
-    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    encoding), over the same Blender depth; full-width silhouettes, drawn
+    after the surface against the depth it leaves, alike."""
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID", use_silhouettes=silhouettes)
     deferred, _stats = _draw(scene, objects)
     monkeypatch.setattr(passes, "use_deferred_surface", False)
     calls = _stages(monkeypatch)

@@ -64,10 +64,11 @@ class Targets:
         return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.visible,))
 
     def surface_framebuffer(self):
-        """The viewport overlay's resolved surface (RGBA32F), no depth: the
-        overlay composites it into Blender's buffer at the record's depth."""
+        """The viewport overlay's resolved surface, no depth: the overlay
+        composites it into Blender's buffer at the record's depth. Half
+        floats: that buffer keeps 8 bits, these 11 (0.12/255 at white)."""
         if self.surface is None:
-            self.surface = gpu.types.GPUTexture(self.size, format="RGBA32F")
+            self.surface = gpu.types.GPUTexture(self.size, format="RGBA16F")
         return gpu.types.GPUFrameBuffer(color_slots=(self.surface,))
 
     def resolve_framebuffer(self, aovs: bool = False):
