@@ -329,7 +329,7 @@ def profile(kind: str, level: int, size, repeats: int) -> list[str]:
             rows[redraw] = best
     finally:
         viewport.free()
-    names = list(rows[STATIC][1])
+    names = list(dict.fromkeys([*rows[STATIC][1], *rows[VERTEX][1]]))
     lines = [f"| stage | {STATIC} ms | after {VERTEX} ms |", "|---|---:|---:|"]
     for name in names:
         lines.append(f"| {name} | " + " | ".join(f"{rows[r][1].get(name, 0.0):.1f}" for r in (STATIC, VERTEX)) + " |")
