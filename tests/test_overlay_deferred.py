@@ -184,3 +184,27 @@ def test_clipping_region_and_hidden_lines_stay_direct(monkeypatch):
     calls.clear()
     _draw(scene, objects, ViewportState(clip_planes=((0.0, 0.0, 1.0, 0.5),) * 6))
     assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
+
+
+def test_a_refused_stage_falls_back_to_the_direct_pass(monkeypatch, capsys):
+    """A backend that refuses the composite draws the direct pass's image,
+    with one message, and draws directly from then on."""
+    from solidwire_addon.core import log, shaders
+
+    log.forget()  # messages said by earlier tests are said again
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    monkeypatch.setattr(passes, "use_deferred_surface", False)
+    expected, _stats = _draw(scene, objects)
+    monkeypatch.setattr(passes, "use_deferred_surface", True)
+    monkeypatch.setattr(shaders, "_deferred_support", [True])
+
+    def refuse(*_args):
+        raise shaders.DeferredUnavailable("composite refused")
+
+    monkeypatch.setattr(shaders, "get_overlay_composite", refuse)
+    calls = _stages(monkeypatch)
+    got, _stats = _draw(scene, objects)
+    assert not shaders.deferred_available()
+    assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
+    assert np.array_equal(got, expected)
+    assert "deferred surface pass is not available" in capsys.readouterr().err

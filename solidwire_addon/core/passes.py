@@ -339,8 +339,7 @@ def _overlay_surface(items, view: View, settings, display, stats):
     line_count = sum(item.mesh.region_line_count for item in items)
     record_stats = draw_mod.DrawStats()
     if key is not None and targets.surface_key == key and targets.lines_key == key:
-        record_stats.objects_drawn = len(items)
-        record_stats.triangles_drawn = sum(item.mesh.triangle_count for item in items)
+        record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn = targets.surface_counts
         if line_count:
             record_stats.extra.update(region_line_entries=line_count, region_lines_reused=1)
         record_stats.extra["surface_reused"] = 1
@@ -373,6 +372,7 @@ def _overlay_surface(items, view: View, settings, display, stats):
     # direct path's own region lines (_overlay_region_lines) never match it.)
     targets.lines_key = targets.surface_key = key
     targets.surface_rect = _window_union(items, view)
+    targets.surface_counts = (record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn)
     stats.add(record_stats)
     return targets
 
@@ -468,11 +468,10 @@ OVERLAY_DEPTH_BIAS = 2.0**-18
 # The overlay defers a mesh from this many triangles per pixel of its
 # window box on (draw.split_deferred). Lower than the render's threshold:
 # the overlay's direct pass shades only what Blender's depth lets through,
-# but its record is kept between redraws, so a redraw that changes nothing
-# only resolves. Measured on llvmpipe at 1280 x 720 (docs/dev/viewport-
-# benchmark.md): Suzanne at 0.1 triangles per pixel redraws faster directly
-# after an edit (+8 ms) and deferred when static (-5 ms); at 0.4 deferred
-# either way (-15 ms, -40 ms).
+# but its image is kept between redraws, so a redraw that changes nothing
+# only composites. Measured on llvmpipe at 1280 x 720 (docs/dev/viewport-
+# benchmark.md): Suzanne at 0.1 triangles per pixel redraws an edit faster
+# directly (by ~8 ms of ~35), at 0.4 and above deferred (by ~15 ms of ~75).
 OVERLAY_DEFERRED_MIN_DENSITY = 0.2
 
 
@@ -520,8 +519,8 @@ def draw_over_viewport(
     options = {"display": display} if clip_planes is None else {"clip_planes": clip_planes, "display": display}
     line_stats = draw_mod.DrawStats()
     # Where Blender's depth holds every surface, the dense meshes' surface
-    # is deferred: a record in the overlay's own targets, resolved into
-    # Blender's buffer (_overlay_surface).
+    # is deferred: recorded and resolved in the overlay's own targets
+    # (_overlay_surface), then composited into Blender's buffer.
     deferred, direct = [], list(items)
     if scene_depth and scene_surfaces and _overlay_defers(items, settings, clip_planes):
         deferred, direct = draw_mod.split_deferred(items, view, OVERLAY_DEFERRED_MIN_DENSITY)
@@ -529,6 +528,7 @@ def draw_over_viewport(
     if deferred:
         saved_viewport = gpu.state.viewport_get()
         try:
+            shaders.get_overlay_composite(depth_bias)  # compiled before anything is drawn: a refusal falls back
             record = _overlay_surface(deferred, view, settings, display, line_stats)
         except shaders.DeferredUnavailable as exc:
             shaders.disable_deferred()

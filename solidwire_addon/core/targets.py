@@ -53,6 +53,7 @@ class Targets:
         self.surface = None
         self.surface_key = None
         self.surface_rect = (-1.0, -1.0, 1.0, 1.0)  # NDC rectangle it covers
+        self.surface_counts = (0, 0, 0)  # objects drawn and culled, triangles drawn
         self.kept_readback = None  # [colour, view depth] gpu Buffers, made on first read(keep=True)
 
     def visibility_framebuffer(self):
