@@ -44,6 +44,7 @@ import numpy as np
 
 import solidwire_addon
 from solidwire_addon.core import draw as draw_mod
+from solidwire_addon.core import passes
 from tests.support import scenes
 from tests.support.viewport import HeadlessViewport, set_overlays
 
@@ -147,14 +148,18 @@ class Edits:
             self.obj.location.x += 0.01 * self.scale * self.sign
 
 
-def frame(viewport: HeadlessViewport, solidwire: bool) -> float:
-    """One synchronised frame (ms)."""
-    start = time.perf_counter()
+def frame(viewport: HeadlessViewport, solidwire: bool, cpu: list | None = None) -> float:
+    """One synchronised frame (ms). ``cpu``: gets the frame's CPU time (ms,
+    every thread of the process: llvmpipe's rasteriser threads too), which
+    load on a shared machine moves far less than the wall time."""
+    start, start_cpu = time.perf_counter(), time.process_time()
     depsgraph = bpy.context.evaluated_depsgraph_get()
     viewport.draw_blender()
     if solidwire:
         viewport.draw_solidwire(depsgraph)
     viewport.sync()
+    if cpu is not None:
+        cpu.append((time.process_time() - start_cpu) * 1000.0)
     return (time.perf_counter() - start) * 1000.0
 
 
@@ -174,6 +179,7 @@ def measure(kind: str, level: int, size, repeats: int) -> tuple[dict, dict]:
         edits = Edits(obj)
         once = set()
         times = {name: {redraw: float("inf") for redraw in REDRAWS} for name, _w, _l in CONFIGS}
+        cpu_times = {name: {redraw: float("inf") for redraw in REDRAWS} for name, _w, _l in CONFIGS}
         for turn in range(repeats):
             # Configurations take turns round by round, so that a burst of
             # load on a shared machine hits them alike.
@@ -189,12 +195,15 @@ def measure(kind: str, level: int, size, repeats: int) -> tuple[dict, dict]:
                 for redraw in REDRAWS:
                     if redraw != STATIC:
                         edits.make(redraw)
-                    times[name][redraw] = min(times[name][redraw], frame(viewport, look is not None))
+                    spent = []
+                    times[name][redraw] = min(times[name][redraw], frame(viewport, look is not None, spent))
+                    cpu_times[name][redraw] = min(cpu_times[name][redraw], spent[0])
         evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
         facts = {
             "triangles": sum(len(p.vertices) - 2 for p in evaluated.data.polygons),
             "vertices": len(obj.data.vertices),
             "once": once,
+            "cpu": cpu_times,
         }
     finally:
         viewport.free()
@@ -207,6 +216,7 @@ def table(results) -> list[str]:
     lines = ["| mesh | configuration | " + " | ".join(REDRAWS) + " |", "|---|---|" + "---:|" * len(REDRAWS)]
     for (kind, level), (times, facts) in results.items():
         alone, wire = times[CONFIGS[0][0]], times[CONFIGS[1][0]]
+        wire_cpu = facts["cpu"][CONFIGS[1][0]]
         label = (
             f"{LEVELS.get(level, level)} {kind} ({facts['triangles']:,} tris"
             + (f", cage {facts['vertices']:,} verts" if kind == "modifier" else "")
@@ -221,7 +231,8 @@ def table(results) -> list[str]:
                 elif look is None:
                     cells.append(f"{ms:.0f} (+{ms - alone[redraw]:.0f})")
                 else:
-                    cells.append(f"{ms:.0f} (+{ms - alone[redraw]:.0f}; {ms / wire[redraw]:.2f}x)")
+                    cpu = facts["cpu"][name][redraw] / wire_cpu[redraw]
+                    cells.append(f"{ms:.0f} (+{ms - alone[redraw]:.0f}; {ms / wire[redraw]:.2f}x; CPU {cpu:.2f}x)")
             mark = " ¹" if name in facts["once"] else ""
             lines.append(f"| {label} | {name}{mark} | " + " | ".join(cells) + " |")
             label = ""
@@ -230,10 +241,24 @@ def table(results) -> list[str]:
 
 # -- where SolidWire's overlay frame goes -------------------------------------------
 
-# The overlay's draw calls by their target's stage (draw_mod.DrawTarget); a
-# call without one is the surface pass, or the depth pre-pass before it
-# where Blender's depth does not hold the surfaces.
-STAGE_NAMES = {"visibility": "region-lines record", "lines": "region lines", None: "surface pass"}
+# The overlay's draw calls by their target's stage (draw_mod.DrawTarget): the
+# deferred surface's record, region lines and resolve into the overlay's own
+# targets (passes._overlay_surface), then its composite into Blender's
+# buffer; a call without a stage is the direct surface pass (meshes sparse on
+# screen, or every mesh where the record cannot serve), or the depth
+# pre-pass before it where Blender's depth does not hold the surfaces.
+STAGE_NAMES = {
+    "visibility": "record (visibility stage)",
+    "lines": "region lines",
+    "resolve": "resolve",
+    None: "direct surface pass",
+}
+COMPOSITE = "composite into Blender's buffer"
+
+
+def _stage_name(kwargs) -> str:
+    stage = (kwargs.get("target") or draw_mod.DrawTarget()).stage
+    return STAGE_NAMES.get(stage, str(stage))
 
 
 class OverlayProbe:
@@ -247,23 +272,28 @@ class OverlayProbe:
 
     def __enter__(self):
         self._original = draw_mod.draw
+        self._composite = passes._composite_overlay_surface
         probe = self
 
-        def timed(*args, **kwargs):
-            start = time.perf_counter()
-            result = probe._original(*args, **kwargs)
-            recorded = time.perf_counter()
-            gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "UBYTE")
-            stage = (kwargs.get("target") or draw_mod.DrawTarget()).stage
-            name = STAGE_NAMES.get(stage, str(stage))
-            probe.calls.append((name, (recorded - start) * 1000.0, (time.perf_counter() - recorded) * 1000.0))
-            return result
+        def timer(function, name_of):
+            def timed(*args, **kwargs):
+                start = time.perf_counter()
+                result = function(*args, **kwargs)
+                recorded = time.perf_counter()
+                gpu.state.active_framebuffer_get().read_color(0, 0, 1, 1, 4, 0, "UBYTE")
+                name = name_of(kwargs)
+                probe.calls.append((name, (recorded - start) * 1000.0, (time.perf_counter() - recorded) * 1000.0))
+                return result
 
-        draw_mod.draw = timed
+            return timed
+
+        draw_mod.draw = timer(self._original, _stage_name)
+        passes._composite_overlay_surface = timer(self._composite, lambda _kw: COMPOSITE)
         return self
 
     def __exit__(self, *exc):
         draw_mod.draw = self._original
+        passes._composite_overlay_surface = self._composite
 
 
 def profile(kind: str, level: int, size, repeats: int) -> list[str]:
@@ -314,7 +344,7 @@ def profile(kind: str, level: int, size, repeats: int) -> list[str]:
             rows[redraw] = best
     finally:
         viewport.free()
-    names = list(rows[STATIC][1])
+    names = list(dict.fromkeys([*rows[STATIC][1], *rows[VERTEX][1]]))
     lines = [f"| stage | {STATIC} ms | after {VERTEX} ms |", "|---|---:|---:|"]
     for name in names:
         lines.append(f"| {name} | " + " | ".join(f"{rows[r][1].get(name, 0.0):.1f}" for r in (STATIC, VERTEX)) + " |")
@@ -375,6 +405,7 @@ def main() -> None:
     levels = args.levels or ([3] if args.quick else sorted(LEVELS))
     solidwire_addon.register()
     started = time.perf_counter()
+    load_before = os.getloadavg()[0]
     try:
         results = {}
         for level in levels:
@@ -385,11 +416,14 @@ def main() -> None:
             f"## Viewport redraws at {size[0]} x {size[1]}",
             "",
             (
-                f"Machine: {MACHINE} ({platform.machine()}, {os.cpu_count()} CPUs seen); best of {args.repeats}; "
+                f"Machine: {MACHINE} ({platform.machine()}, {os.cpu_count()} CPUs seen; load average "
+                f"{load_before:.1f} at the start, {os.getloadavg()[0]:.1f} at the end); best of {args.repeats}; "
                 f"GPU subdivision {'on' if bpy.context.preferences.system.use_gpu_subdivision else 'off'}. "
                 "ms per synchronised frame (depsgraph evaluation, Blender's viewport, SolidWire's overlay, "
                 "one-pixel read); (+ms) over Blender's viewport alone; SolidWire's x: its frame over the "
-                "frame with Blender's wireframe overlay instead. ¹: a configuration slower than "
+                "frame with Blender's wireframe overlay instead, and the same for the frames' CPU time (every "
+                "thread of the process, llvmpipe's included: steadier than wall time on a loaded machine). "
+                "¹: a configuration slower than "
                 f"{SLOW_FRAME_MS / 1000:.1f} s a frame, timed in one round."
             ),
             "",

@@ -1,11 +1,14 @@
 /* Visibility pass (visibility_vert.glsl): depth exactly as the exact path
- * writes it, and per pixel (triangle + 1, instance, draw number, view
+ * writes it (the render's linear depth, or the rasteriser's window depth for
+ * the viewport overlay's record), and per pixel (triangle + 1, instance, draw number, view
  * depth). Whole numbers below 2^24 are exact in float32; bigger meshes stay
  * on the direct path (passes.deferred_surface). */
 
 void main()
 {
+#ifdef LINEAR_DEPTH
   gl_FragDepth = view_depth * params.inv_clip_end; /* see LINEAR_DEPTH in solidwire_frag.glsl */
+#endif
 #ifdef SW_INSTANCED
   float instance = visible_instance;
 #else

@@ -79,3 +79,53 @@ def test_a_failing_pre_pass_falls_back_to_the_per_corner_set_up(output_dir, monk
     assert runs == [] and shaders.setup_available() is False
     for name, values in expected.items():
         np.testing.assert_array_equal(got[name], values, err_msg=name)
+
+
+def test_a_redraw_that_changes_nothing_keeps_the_table(monkeypatch):
+    """The viewport overlay's direct pass sets a mesh up once per view: a
+    redraw with the same mesh, matrix and viewport dispatches nothing and
+    draws the same image; a moved vertex, a moved object or another
+    viewport size set it up again, and every frame equals the per-corner
+    set-up's."""
+    if not shaders.setup_available():
+        pytest.skip("no compute shaders here")
+    import bpy
+
+    from solidwire_addon.blender.views import camera_view
+    from tests.test_overlay import FakeViewport
+
+    scene = scenes.empty_scene(160, 120, diagonal_mode="SOLID")
+    monkey = scenes.monkey(scene, "Monkey", subdivisions=1)
+    scenes.add_camera(scene, location=(0.0, -4.0, 1.0), target=(0.0, 0.0, 0.0))
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
+    dispatches = []
+    real_dispatch = draw.gpu.compute.dispatch
+    monkeypatch.setattr(draw.gpu.compute, "dispatch", lambda *args: (dispatches.append(1), real_dispatch(*args)))
+
+    def frame(setup_min=1, size=(160, 120)):
+        monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
+        dispatches.clear()
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        view = camera_view(scene, depsgraph, size)
+        viewport = FakeViewport(*size)
+        viewport.depth_pass(depsgraph, view, [monkey])
+        viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
+        return viewport.rgba(), len(dispatches)
+
+    first, runs = frame()
+    assert runs == 1
+    assert first[..., 3].max() > 0.9
+    again, runs = frame()
+    assert runs == 0 and np.array_equal(first, again)
+    per_corner, runs = frame(setup_min=10**12)
+    assert runs == 0 and np.array_equal(first, per_corner)
+    monkey.data.vertices[0].co.z += 0.2
+    monkey.data.update()
+    edited, runs = frame()
+    assert runs == 1 and np.array_equal(edited, frame(setup_min=10**12)[0])
+    monkey.location.x += 0.05
+    moved, runs = frame()
+    assert runs == 1 and np.array_equal(moved, frame(setup_min=10**12)[0])
+    assert not np.array_equal(edited, moved)
+    bigger, runs = frame(size=(200, 150))
+    assert runs == 1 and np.array_equal(bigger, frame(setup_min=10**12, size=(200, 150))[0])

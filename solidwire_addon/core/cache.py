@@ -142,8 +142,10 @@ class GPUMesh:
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
         # The set-up pre-pass's output for big meshes (draw._run_setup), made
-        # on first use and rewritten by every draw of the mesh.
+        # on first use, and what it was set up for (draw._setup_key): kept
+        # while the mesh, its matrix and the viewport stay the same.
         self.setup_table = None
+        self.setup_key = None
         self._flag_table = None  # flag_table(), made on first use
         self._visibility_batch = None  # visibility_batch(), made on first use
         self._visibility_layout = None  # (by_vertex, bytes) of that batch
@@ -295,8 +297,8 @@ class GPUMesh:
         table is uploaded again, and the corner table when ``corners`` (the
         corner normals follow a deformation). The triangle and outline
         tables, the edge-flag batch and the silhouette edges depend on the
-        faces and the edge selection alone; the set-up table is rewritten by
-        every draw from the position table."""
+        faces and the edge selection alone; the set-up table is set up again
+        from the new positions (its key holds ``version``)."""
         positions = np.zeros((len(local), 4), dtype=np.float32)
         positions[:, :3] = local
         self.positions = table_texture(positions)

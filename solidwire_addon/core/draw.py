@@ -221,11 +221,14 @@ DEFERRED_MIN_DENSITY = 0.4
 DEFERRED_BLOCK_WEIGHT = 8.0
 
 
-def split_deferred(items, view: View) -> tuple[list, list]:
+def split_deferred(items, view: View, min_density: float | None = None) -> tuple[list, list]:
     """(items to draw deferred, items to draw directly): a mesh is deferred
-    when its triangles are dense on screen (DEFERRED_MIN_DENSITY), counted
+    when its triangles are dense on screen (``min_density`` triangles per
+    pixel of its window boxes, by default DEFERRED_MIN_DENSITY), counted
     over all its items at once; numbers the visibility record cannot hold
     exactly (DEFERRED_MAX) keep the direct draw."""
+    if min_density is None:
+        min_density = DEFERRED_MIN_DENSITY
     by_mesh: dict = {}
     for item in items:
         by_mesh.setdefault(id(item.mesh), []).append(item)
@@ -241,7 +244,7 @@ def split_deferred(items, view: View) -> tuple[list, list]:
         weight = DEFERRED_BLOCK_WEIGHT if mesh.has_ngons else 1.0
         # Multi-face regions draw their lines over the visibility record
         # (docs/image_model.md §2.6), so such a mesh is always deferred.
-        dense = weight * mesh.triangle_count * len(group) >= DEFERRED_MIN_DENSITY * pixels or mesh.region_line_count > 0
+        dense = weight * mesh.triangle_count * len(group) >= min_density * pixels or mesh.region_line_count > 0
         (deferred if dense and 0 < mesh.triangle_count < DEFERRED_MAX else direct).extend(group)
     return deferred, direct
 
@@ -629,6 +632,11 @@ class _DrawNumbers:
         self.view = view
 
     @property
+    def viewport(self):
+        """The draw's viewport (x, y, width, height), or None."""
+        return None if self.view is None else self.view.viewport
+
+    @property
     def draws_over_record(self) -> bool:
         """A stage that draws over the visibility record: no face culling
         (its triangles are not the mesh's)."""
@@ -715,6 +723,13 @@ def _rectangle():
     return _rectangles[0]
 
 
+def draw_rectangle(shader, rect) -> None:
+    """Draw ``shader`` (resolve_vert.glsl's vertex stage) over the NDC
+    rectangle ``rect`` (x0, y0, x1, y1)."""
+    shader.uniform_float("resolve_rect", rect)
+    _rectangle().draw(shader)
+
+
 def release_rectangle() -> None:
     """Drop the resolve pass's rectangle and the quad batches (add-on
     unregister frees every GPU object)."""
@@ -798,7 +813,7 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
             if variant.setup_table:
                 # (Before each draw: so a mesh is set up for the matrix of
                 # the one object drawing it.)
-                _run_setup(mesh, object_to_clip, ubo(style), variant.in_front)
+                _run_setup(mesh, object_to_clip, ubo(style), variant.in_front, numbering.viewport)
                 shader.bind()
                 bound = _UNBOUND  # the pre-pass bound its own block
                 shader.uniform_sampler("setup_table", mesh.setup_table)
@@ -857,14 +872,35 @@ def _setup_size(mesh, stage, object_to_clip, view: View) -> bool:
     return stage is None and mesh.triangle_count >= SETUP_TABLE_MIN
 
 
-def _run_setup(mesh, object_to_clip, block, in_front: bool = False) -> None:
+def _setup_key(mesh, object_to_clip, in_front: bool, viewport) -> tuple | None:
+    """Everything a mesh's set-up table depends on: its triangles and
+    positions (serial and shape version, cache.GPUMesh), the matrix as the
+    pre-pass gets it, the viewport (the only parameter the edge set-up
+    reads, edge_geometry.glsl), the variant and the GL context that wrote
+    it (a compute barrier orders the writes for its own context only); None
+    when the viewport is not known."""
+    if viewport is None:
+        return None
+    matrix = np.asarray(object_to_clip, dtype=np.float32).tobytes()
+    viewport = tuple(float(v) for v in viewport)
+    return (mesh.serial, mesh.version, matrix, bool(in_front), viewport, shaders.current_gl_context())
+
+
+def _run_setup(mesh, object_to_clip, block, in_front: bool = False, viewport=None) -> None:
     """The set-up pre-pass of one draw: every triangle's edge set-up into
-    ``mesh.setup_table`` (allocated on first use, rewritten for each pass
-    that draws the mesh; gpu.compute.dispatch ends with the barrier that
-    makes the writes visible to the draw's texture fetches). ``in_front``:
-    the draw lies wholly in front of the near plane (view.wholly_in_front),
-    so the pre-pass runs without its clipping code."""
+    ``mesh.setup_table`` (allocated on first use; gpu.compute.dispatch ends
+    with the barrier that makes the writes visible to the draw's texture
+    fetches). ``in_front``: the draw lies wholly in front of the near plane
+    (view.wholly_in_front), so the pre-pass runs without its clipping code.
+    With the ``viewport`` known, a table already set up for the same mesh,
+    matrix and viewport (_setup_key) is kept: a redraw that changes none of
+    them, or a second pass over the mesh in the same frame, dispatches
+    nothing."""
     count = mesh.triangle_count
+    key = _setup_key(mesh, object_to_clip, in_front, viewport)
+    if key is not None and getattr(mesh, "setup_table", None) is not None and getattr(mesh, "setup_key", None) == key:
+        return
+    mesh.setup_key = None
     if getattr(mesh, "setup_table", None) is None:
         rows = -(-count // shaders.SETUP_ROW_TRIANGLES)
         mesh.setup_table = gpu.types.GPUTexture(
@@ -882,6 +918,7 @@ def _run_setup(mesh, object_to_clip, block, in_front: bool = False) -> None:
     groups = -(-count // shaders.SETUP_GROUP_SIZE)
     groups_x = min(groups, 65535)
     gpu.compute.dispatch(setup, groups_x, -(-groups // groups_x), 1)
+    mesh.setup_key = key
 
 
 def _material_table(mesh, materials, tables: dict):

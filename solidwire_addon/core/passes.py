@@ -18,10 +18,12 @@ sync and draw steps:
 * :meth:`render` of each unit (render engine, command line, tests): float
   offscreen targets, read back as premultiplied RGBA plus view depth; the
   executor is :func:`render_passes`.
-* :meth:`over_viewport` (viewport overlay): straight into a bound
-  framebuffer that already holds the scene's colour and depth, through the
-  scene's colour management (a display LUT, docs/image_model.md §9); the
-  executor is :func:`draw_over_viewport`.
+* :meth:`over_viewport` (viewport overlay): into a bound framebuffer that
+  already holds the scene's colour and depth, through the scene's colour
+  management (a display LUT, docs/image_model.md §9); the executor is
+  :func:`draw_over_viewport`. Its sync step first records the meshes dense
+  on screen into the overlay's own targets (a deferred surface kept between
+  redraws), which the surface pass composites against the scene's depth.
 
 How a frame is drawn apart from what it shows (deferred surface or not,
 say) comes in one options.DrawOptions value, handed down from the caller.
@@ -53,7 +55,7 @@ from .schema import (
     WIRE_PASS,
 )
 from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, targets_for
-from .view import DrawStats, View
+from .view import DrawStats, View, translation, window_boxes
 
 # Written by the surface pass's extra outputs (the rest has its own pass).
 _SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
@@ -64,6 +66,15 @@ _SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_IN
 # float32 matrices); small enough that a surface more than a hair behind
 # another stays hidden. See DEPTH_BIAS in shaders/solidwire_vert.glsl.
 OVERLAY_DEPTH_BIAS = 2.0**-18
+
+# The overlay defers a mesh from this many triangles per pixel of its
+# window box on (draw.split_deferred). Lower than the render's threshold:
+# the overlay's direct pass shades only what Blender's depth lets through,
+# but its image is kept between redraws, so a redraw that changes nothing
+# only composites. Measured on llvmpipe at 1280 x 720 (docs/dev/viewport-
+# benchmark.md): Suzanne at 0.1 triangles per pixel redraws an edit faster
+# directly (by ~8 ms of ~35), at 0.4 and above deferred (by ~15 ms of ~75).
+OVERLAY_DEFERRED_MIN_DENSITY = 0.2
 
 
 @dataclass
@@ -99,6 +110,19 @@ class Frame:
     scene_surfaces: bool = False
     region_lines: object = None
     line_stats: DrawStats = field(default_factory=DrawStats)
+    # The sync step's split (_sync_overlay_surface): items drawn directly,
+    # and the overlay targets holding the deferred ones' resolved image.
+    direct: list | None = None
+    overlay_surface: object = None
+
+    def overlay_stats(self) -> DrawStats:
+        """The surface pass's DrawStats over the viewport, with what the
+        region lines counted (the deferred surface's record and lines are
+        already in them: SurfacePass added them)."""
+        stats = self.stats if self.stats is not None else DrawStats()
+        if self.overlay_surface is None:
+            stats.extra.update(self.line_stats.extra)
+        return stats
 
     @property
     def aovs(self) -> bool:
@@ -130,12 +154,12 @@ class RegionLinesPass(RenderPass):
     def over_viewport(self, frame: Frame) -> None:
         # (Inside a clipping region the record would keep clipped-away
         # surfaces: there the regions are walked.)
-        if frame.base.clip_planes is not None or not _has_region_lines(frame.items):
+        if frame.base.clip_planes is not None or not _has_region_lines(frame.direct):
             return
         saved_viewport = gpu.state.viewport_get()
         try:
             frame.region_lines = _overlay_region_lines(
-                frame.items, frame.view, self.settings, frame.line_stats, frame.options
+                frame.direct, frame.view, self.settings, frame.line_stats, frame.options
             )
         finally:
             gpu.state.viewport_set(*saved_viewport)
@@ -190,7 +214,10 @@ class SurfacePass(RenderPass):
         # pre-pass did not.
         if not self.wire and not self.settings.use_fill:
             return
-        frame.stats = draw_mod.draw(items, view, self.settings, target=_with_lines(base, self.wire))
+        frame.stats = draw_mod.draw(frame.direct, view, self.settings, target=_with_lines(base, self.wire))
+        if frame.overlay_surface is not None:
+            _composite_overlay_surface(frame.overlay_surface, frame.base.depth_bias)
+            frame.stats.add(frame.line_stats)
 
 
 class HiddenLinesPass(RenderPass):
@@ -518,6 +545,137 @@ def _overlay_lines_key(items, view: View, settings):
         return None
 
 
+def _sync_overlay_surface(frame: Frame) -> None:
+    """The overlay's sync step: where Blender's depth holds every surface
+    and the frame is the surface pass alone (silhouettes may follow), the
+    meshes dense on screen (OVERLAY_DEFERRED_MIN_DENSITY, and every mesh
+    with multi-face regions) are recorded and resolved into the overlay's
+    own targets (_overlay_surface); the rest stays in ``frame.direct``. A
+    deferred stage the backend refuses falls back to drawing directly, said
+    once."""
+    frame.direct = list(frame.items)
+    if not (frame.scene_depth and frame.scene_surfaces and _overlay_defers(frame)):
+        return
+    deferred, direct = draw_mod.split_deferred(frame.items, frame.view, OVERLAY_DEFERRED_MIN_DENSITY)
+    if not deferred:
+        return
+    saved_viewport = gpu.state.viewport_get()
+    try:
+        shaders.get_overlay_composite(frame.base.depth_bias)  # compiled before anything is drawn: a refusal falls back
+        frame.overlay_surface = _overlay_surface(deferred, frame.view, frame.settings, frame.base.display, frame)
+        frame.direct = direct
+    except shaders.DeferredUnavailable as exc:
+        shaders.disable_deferred()
+        warn_once(
+            ("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly"
+        )
+    finally:
+        gpu.state.viewport_set(*saved_viewport)
+
+
+def _overlay_defers(frame: Frame) -> bool:
+    """Whether the overlay's surface may be deferred: the frame's passes are
+    the surface pass alone (silhouettes may follow), no clipping region, and
+    the deferred stages are in use. (The caller also asks that Blender's
+    depth hold every surface: the record then only has to know which of our
+    own triangles is nearest, and Blender's depth test does the rest.)"""
+    units = plan(frame.settings)
+    drawing = [unit for unit in units if not isinstance(unit, (RegionLinesPass, OutputsPass, SilhouettePass))]
+    return (
+        frame.base.clip_planes is None
+        and frame.options.deferred_surface
+        and shaders.deferred_available()
+        and len(drawing) == 1
+        and isinstance(drawing[0], SurfacePass)
+        and drawing[0].wire
+        and all(item.in_scene_depth for item in frame.items)
+    )
+
+
+def _overlay_surface(items, view: View, settings, display, frame: Frame):
+    """The deferred overlay's surface, into the overlay's own targets at
+    the viewport's size: the visibility record of ``items`` over a depth
+    buffer of its own (window depth, as Blender's), the region lines over
+    it when a mesh has multi-face regions (docs/image_model.md §2.5, §2.6),
+    then the resolve into ``targets.surface``. Returns the targets, for
+    _composite_overlay_surface; ``frame.line_stats`` gets the draws' counts.
+
+    Nothing here reads Blender's buffers, so a redraw that changes nothing
+    the image depends on (the view, the settings, which meshes in which
+    shape where, their styles and colour sources, the display transform;
+    _overlay_lines_key) reuses it whole: a static redraw only composites."""
+    targets = overlay_targets_for(view.width, view.height)
+    key = _overlay_lines_key(items, view, settings)
+    if key is not None:
+        key = ("surface", key, None if display is None else display.key, tuple(item.source for item in items))
+        try:
+            hash(key)
+        except TypeError:
+            key = None
+    line_count = sum(item.mesh.region_line_count for item in items)
+    record_stats = DrawStats()
+    if key is not None and targets.surface_key == key and targets.lines_key == key:
+        record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn = targets.surface_counts
+        if line_count:
+            record_stats.extra.update(region_line_entries=line_count, region_lines_reused=1)
+        record_stats.extra["surface_reused"] = 1
+        frame.line_stats.add(record_stats)
+        return targets
+    targets.lines_key = targets.surface_key = None
+    width, height = view.width, view.height
+    framebuffer = targets.visibility_framebuffer()
+    with framebuffer.bind():
+        _clear(framebuffer, width, height)
+        record = DrawTarget(stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=_triangle_ids_by_vertex(frame.options))
+        draw_mod.draw(items, view, settings, target=record)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+    lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats) if line_count else None
+    with targets.surface_framebuffer().bind():
+        gpu.state.viewport_set(0, 0, width, height)
+        gpu.state.blend_set("NONE")
+        resolve = DrawTarget(stage=draw_mod.RESOLVE, visibility=targets.visible, region_lines=lines, display=display)
+        record_stats.add(draw_mod.draw(items, view, settings, target=resolve))
+    # (One key for the record, its lines and the resolved image: the
+    # direct path's own region lines (_overlay_region_lines) never match it.)
+    targets.lines_key = targets.surface_key = key
+    targets.surface_rect = _window_union(items, view)
+    targets.surface_counts = (record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn)
+    frame.line_stats.add(record_stats)
+    return targets
+
+
+def _window_union(items, view: View) -> tuple:
+    """The NDC rectangle over every item's window box (view.window_boxes),
+    vectorised per mesh."""
+    by_mesh: dict = {}
+    for item in items:
+        by_mesh.setdefault(id(item.mesh), []).append(item)
+    boxes = []
+    for group in by_mesh.values():
+        mesh = group[0].mesh
+        to_clip = (
+            view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
+        )
+        boxes.append(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max))
+    boxes = np.concatenate(boxes)
+    return (float(boxes[:, 0].min()), float(boxes[:, 1].min()), float(boxes[:, 2].max()), float(boxes[:, 3].max()))
+
+
+def _composite_overlay_surface(targets, depth_bias: float) -> None:
+    """Blend ``targets.surface`` into the bound framebuffer (Blender's)
+    over the items' window boxes, each pixel at the record's depth less the
+    bias, with depth test LESS_EQUAL and write, blending as the caller set
+    (premultiplied "over")."""
+    shader = shaders.get_overlay_composite(depth_bias)
+    shader.bind()
+    shader.uniform_sampler("record_depth", targets.depth)
+    shader.uniform_sampler("surface_image", targets.surface)
+    gpu.state.depth_test_set("LESS_EQUAL")
+    gpu.state.depth_mask_set(True)
+    draw_mod.draw_rectangle(shader, targets.surface_rect)
+
+
 def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:
     """The Hidden Wire pass: H of image model §5.4 (coverage of the hidden
     layers, wire alpha included), whether or not Hidden Lines is on in the
@@ -601,6 +759,7 @@ def draw_over_viewport(
         scene_surfaces=scene_surfaces,
     )
     try:
+        _sync_overlay_surface(frame)
         for unit in plan(settings, strands=bool(strands)):
             unit.over_viewport(frame)
     finally:
@@ -608,6 +767,4 @@ def draw_over_viewport(
         gpu.state.blend_set(saved_blend)
         gpu.state.depth_test_set(saved_depth_test)
         gpu.state.depth_mask_set(saved_depth_mask)
-    stats = frame.stats if frame.stats is not None else DrawStats()
-    stats.extra.update(frame.line_stats.extra)
-    return stats
+    return frame.overlay_stats()

@@ -241,6 +241,8 @@ SAMPLERS = {
     "triangle_flag_table": (11, "FLOAT_2D"),
     "region_line_image": (12, "FLOAT_2D"),
     "attribute_colors": (13, "FLOAT_2D"),
+    "record_depth": (14, "DEPTH_2D"),
+    "surface_image": (15, "FLOAT_2D"),
 }
 
 
@@ -423,9 +425,11 @@ def _visibility_create_info(variant: ShaderVariant):
     info.vertex_in(0, "VEC3", "position")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_visible")
-    if not variant.linear_depth:
-        raise ValueError("the visibility pass is for the render's linear depth")
-    compat.depth_write(info, "ANY")
+    if variant.linear_depth:
+        # (Without it the rasteriser's own window depth: the viewport
+        # overlay's record, whose resolve hands it to Blender's depth test.)
+        info.define("LINEAR_DEPTH", "1")
+        compat.depth_write(info, "ANY")
     if variant.instanced:
         info.define("SW_INSTANCED", "1")
         prologue = (
@@ -747,6 +751,30 @@ def get_setup(in_front: bool = False):
             read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("setup_comp.glsl")
         )
         shader = _keep(_cache, key, gpu.shader.create_from_info(info))
+    return shader
+
+
+def get_overlay_composite(depth_bias: float):
+    """The viewport overlay's composite (shaders/overlay_composite_frag.glsl
+    over resolve_vert.glsl's rectangle): the kept surface image into
+    Blender's buffer at the record's depth less ``depth_bias``."""
+    key = (_context, "overlay composite", float(depth_bias))
+    shader = _cache.get(key)
+    if shader is None:
+        info = gpu.types.GPUShaderCreateInfo()
+        info.vertex_in(0, "INT", "rect_corner")
+        info.push_constant("VEC4", "resolve_rect")
+        add_sampler(info, "record_depth")
+        add_sampler(info, "surface_image")
+        info.define("DEPTH_BIAS", repr(float(depth_bias)))
+        info.fragment_out(0, "VEC4", "frag_color")
+        compat.depth_write(info, "ANY")
+        info.vertex_source(read_source("resolve_vert.glsl"))
+        info.fragment_source(read_source("overlay_composite_frag.glsl"))
+        try:
+            shader = _keep(_cache, key, gpu.shader.create_from_info(info))
+        except Exception as exc:
+            raise DeferredUnavailable(str(exc)) from exc
     return shader
 
 

@@ -47,6 +47,13 @@ class Targets:
         self.lines_key = None  # what the overlay's lines were drawn for (passes._overlay_lines_key)
         self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
         self.visible = None  # the deferred surface's visibility record, made on first use
+        # The viewport overlay's resolved surface (premultiplied, as it
+        # leaves the display transform) and what it was resolved for
+        # (passes._overlay_surface), made on first use.
+        self.surface = None
+        self.surface_key = None
+        self.surface_rect = (-1.0, -1.0, 1.0, 1.0)  # NDC rectangle it covers
+        self.surface_counts = (0, 0, 0)  # objects drawn and culled, triangles drawn
         self.kept_readback = None  # [colour, view depth] gpu Buffers, made on first read(keep=True)
 
     def visibility_framebuffer(self):
@@ -56,6 +63,14 @@ class Targets:
         if self.visible is None:
             self.visible = gpu.types.GPUTexture(self.size, format="RGBA32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.visible,))
+
+    def surface_framebuffer(self):
+        """The viewport overlay's resolved surface, no depth: the overlay
+        composites it into Blender's buffer at the record's depth. Half
+        floats: that buffer keeps 8 bits, these 11 (0.12/255 at white)."""
+        if self.surface is None:
+            self.surface = gpu.types.GPUTexture(self.size, format="RGBA16F")
+        return gpu.types.GPUFrameBuffer(color_slots=(self.surface,))
 
     def resolve_framebuffer(self, aovs: bool = False):
         """The deferred surface's second stage: the colour targets of

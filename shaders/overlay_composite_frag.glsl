@@ -1,0 +1,18 @@
+/* The viewport overlay's deferred surface, composited into Blender's buffer
+ * (passes.draw_over_viewport): the resolved colour the overlay keeps, at the
+ * record's window depth moved towards the camera by the direct pass's
+ * DEPTH_BIAS (z/w - b in NDC is z - b/2 in window depth, solidwire_vert.glsl),
+ * so that Blender's depth test keeps exactly the pixels it keeps of the
+ * direct pass, and the colour blends as that pass's fragment would. Where
+ * the record holds no surface (its cleared depth), nothing is drawn. */
+
+void main()
+{
+  ivec2 pixel = ivec2(gl_FragCoord.xy);
+  float depth = texelFetch(record_depth, pixel, 0).r;
+  if (depth >= 1.0) {
+    discard;
+  }
+  gl_FragDepth = depth - 0.5 * DEPTH_BIAS;
+  frag_color = texelFetch(surface_image, pixel, 0);
+}

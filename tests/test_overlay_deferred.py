@@ -1,0 +1,211 @@
+"""The viewport overlay's deferred surface (docs/image_model.md §2.5, the
+overlay section of docs/dev/viewport-benchmark.md): where Blender's depth
+holds every surface, a mesh dense on screen is recorded into the overlay's
+own targets (which triangle each pixel shows, over a depth of its own) and
+resolved into Blender's buffer, where the record's depth (less the
+overlay's bias) meets Blender's depth test. A redraw that changes nothing
+the record depends on reuses it.
+
+Every mesh is deferred here however sparse (the threshold is set to 0),
+and the image is checked against the float64 reference, against the
+direct pass's image, and frame against fresh frame."""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+import pytest
+
+from solidwire_addon.blender import runtime
+from solidwire_addon.blender.gpu_context import ensure_gpu
+from solidwire_addon.blender.views import camera_view
+from solidwire_addon.core import draw, overlay_state, passes
+from solidwire_addon.core.options import DrawOptions
+from solidwire_addon.core.overlay_state import MATERIAL, ViewportState
+from tests.support import accuracy, reference, scenes
+from tests.test_overlay import HEIGHT, WIDTH, FakeViewport, build_scene
+
+pytestmark = pytest.mark.filterwarnings("ignore:'DEPTH24_STENCIL8' is deprecated:DeprecationWarning")
+
+
+@pytest.fixture(autouse=True)
+def every_mesh_deferred(monkeypatch):
+    ensure_gpu()
+    monkeypatch.setattr(passes, "OVERLAY_DEFERRED_MIN_DENSITY", 0.0)
+
+
+def _stages(monkeypatch) -> list:
+    """The stage of every draw.draw call from now on."""
+    calls = []
+    real = draw.draw
+
+    def spy(*args, **kwargs):
+        calls.append((kwargs.get("target") or draw.DrawTarget()).stage)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(draw, "draw", spy)
+    return calls
+
+
+SOLID = ViewportState()
+
+
+def _draw(scene, depth_objects, state=SOLID, depth_format="DEPTH32F_STENCIL8", size=(WIDTH, HEIGHT)):
+    """(rgba in 0..1 as the screen shows it, stats) of one overlay frame over
+    a Blender-like depth of ``depth_objects``."""
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    view = camera_view(scene, depsgraph, size)
+    plan = overlay_state.plan_overlay(state)
+    viewport = FakeViewport(*size, depth_format)
+    viewport.depth_pass(depsgraph, view, list(depth_objects))
+    stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), plan=plan)
+    return viewport.rgba(), stats
+
+
+def _assert_matches_reference(scene, alpha, state=SOLID):
+    plan = overlay_state.plan_overlay(state)
+    settings = overlay_state.draw_settings(plan, scene.solidwire.snapshot())
+    ref = reference.render_reference(scene, size=alpha.shape[::-1], settings=settings)
+    accuracy.assert_accurate(reference.error_report(alpha, ref))
+    assert ref.intensity.max() > 0.9, "the scene draws visible wires"
+
+
+@pytest.mark.parametrize("depth_format", ["DEPTH32F_STENCIL8", "DEPTH24_STENCIL8"])
+@pytest.mark.parametrize("look", ["default", "flat", "fill_off", "dotted"])
+def test_deferred_overlay_matches_reference(look, depth_format, monkeypatch):
+    """Solid shading over Blender's depth (24-bit as older viewports, or
+    float): the record and resolve draw what the reference draws, and no
+    surface of ours draws directly."""
+    looks = {
+        "default": {},
+        "flat": {"fill_shading": "FLAT"},
+        "fill_off": {"use_fill": False},
+        "dotted": {"diagonal_mode": "DOTTED"},
+    }
+    scene, objects = build_scene(thickness=1.5, **looks[look])
+    calls = _stages(monkeypatch)
+    rgba, stats = _draw(scene, objects, depth_format=depth_format)
+    assert stats["objects_drawn"] == 2
+    assert calls.count(draw.VISIBILITY) == 1 and calls.count(draw.RESOLVE) == 1, calls
+    _assert_matches_reference(scene, rgba[..., 3])
+
+
+@pytest.mark.parametrize("silhouettes", [False, True], ids=["plain", "silhouettes"])
+def test_deferred_overlay_draws_the_direct_image(silhouettes, monkeypatch):
+    """Colour and alpha as the direct pass draws them, up to float32
+    rounding of the resolve's interpolation (within 1/255 of the display
+    encoding), over the same Blender depth; full-width silhouettes, drawn
+    after the surface against the depth it leaves, alike."""
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID", use_silhouettes=silhouettes)
+    deferred, _stats = _draw(scene, objects)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
+    calls = _stages(monkeypatch)
+    direct, _stats = _draw(scene, objects)
+    assert draw.RESOLVE not in calls
+    assert direct[..., 3].max() > 0.9
+    assert np.abs(deferred - direct).max() <= 1.0 / 255.0 + 1e-9
+
+
+def test_material_preview_and_blender_only_occluder():
+    """Material Preview keeps Blender's depth too; a cube that only Blender
+    draws (opted out of SolidWire) hides what lies behind it, though the
+    overlay's own record, which never sees that cube, holds the grid."""
+    scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=2.0, diagonal_mode="SOLID")
+    scenes.add_camera(scene, location=(0.0, -10.0, 0.0))
+    grid = scenes.grid(scene, "Grid", x_segments=8, y_segments=8, size=1.5, rotation=(1.5708, 0, 0))
+    occluder = scenes.cube(scene, "Occluder", size=1.2, location=(0.4, -3.0, 0.2))
+    occluder.solidwire_exclude = True
+    state = ViewportState(shading=MATERIAL)
+    rgba, stats = _draw(scene, (grid, occluder), state)
+    assert stats["objects_drawn"] == 1
+    alpha = rgba[..., 3]
+    occluder.hide_render = occluder.hide_viewport = True
+    without, _stats = _draw(scene, (grid,), state)
+    _assert_matches_reference(scene, without[..., 3], state)
+    occluder.hide_render = occluder.hide_viewport = False
+    # The occluder faces the camera: its window footprint is its front
+    # face's rectangle.
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    view = camera_view(scene, depsgraph, (WIDTH, HEIGHT))
+    corners = np.array([(x, -3.6, z, 1.0) for x in (-0.2, 1.0) for z in (-0.4, 0.8)])
+    clip = (view.projection @ view.view_matrix @ corners.T).T
+    window = (clip[:, :2] / clip[:, 3:] * 0.5 + 0.5) * (WIDTH, HEIGHT)
+    (x0, y0), (x1, y1) = window.min(axis=0), window.max(axis=0)
+    ys, xs = np.mgrid[0:HEIGHT, 0:WIDTH] + 0.5
+    inside = (xs > x0 + 2) & (xs < x1 - 2) & (ys > y0 + 2) & (ys < y1 - 2)
+    outside = (xs < x0 - 3) | (xs > x1 + 3) | (ys < y0 - 3) | (ys > y1 + 3)
+    assert (without[..., 3][inside] > 0.5).sum() > 50, "the grid's wire lies behind the occluder"
+    assert alpha[inside].max() == 0.0
+    assert without[..., 3][outside].max() > 0.9
+    assert np.abs(alpha[outside] - without[..., 3][outside]).max() <= 1.0 / 255.0 + 1e-9
+
+
+def test_the_record_is_reused_until_something_changes():
+    """A redraw that changes nothing resolves the kept record and draws the
+    same image; another setting, a moved vertex, a moved object or another
+    view records again; every frame equals a fresh one."""
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    front, _back = objects
+
+    def frame():
+        rgba, stats = _draw(scene, objects)
+        return rgba, bool(stats.get("surface_reused"))
+
+    first, reused = frame()
+    assert not reused
+    again, reused = frame()
+    assert reused and np.array_equal(first, again)
+    scene.solidwire.thickness = 3.0
+    thicker, reused = frame()
+    assert not reused and not np.array_equal(first, thicker)
+    front.data.vertices[0].co.z += 0.3
+    front.data.update()
+    edited, reused = frame()
+    assert not reused and not np.array_equal(thicker, edited)
+    front.location.x += 0.1
+    moved, reused = frame()
+    assert not reused and not np.array_equal(edited, moved)
+    runtime.mesh_cache.clear()
+    fresh, _reused = frame()
+    assert np.array_equal(moved, fresh)
+    scene.camera.location.z += 0.5
+    other_view, reused = frame()
+    assert not reused and not np.array_equal(moved, other_view)
+    _assert_matches_reference(scene, other_view[..., 3])
+
+
+def test_clipping_region_and_hidden_lines_stay_direct(monkeypatch):
+    """Passes the record cannot serve (a clipping region, hidden lines)
+    keep the direct pass."""
+    scene, objects = build_scene(thickness=1.5, use_hidden_lines=True)
+    calls = _stages(monkeypatch)
+    _draw(scene, objects)
+    assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
+    scene.solidwire.use_hidden_lines = False
+    calls.clear()
+    _draw(scene, objects, ViewportState(clip_planes=((0.0, 0.0, 1.0, 0.5),) * 6))
+    assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
+
+
+def test_a_refused_stage_falls_back_to_the_direct_pass(monkeypatch, capsys):
+    """A backend that refuses the composite draws the direct pass's image,
+    with one message, and draws directly from then on."""
+    from solidwire_addon.core import log, shaders
+
+    log.forget()  # messages said by earlier tests are said again
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
+    expected, _stats = _draw(scene, objects)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=True))
+    monkeypatch.setattr(shaders, "_deferred_support", [True])
+
+    def refuse(*_args):
+        raise shaders.DeferredUnavailable("composite refused")
+
+    monkeypatch.setattr(shaders, "get_overlay_composite", refuse)
+    calls = _stages(monkeypatch)
+    got, _stats = _draw(scene, objects)
+    assert not shaders.deferred_available()
+    assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
+    assert np.array_equal(got, expected)
+    assert "deferred surface pass is not available" in capsys.readouterr().err
