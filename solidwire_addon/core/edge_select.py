@@ -271,7 +271,10 @@ def select_edges(
 
     # Segments of each block.
     by_label = pairs[np.argsort(pairs[:, 0], kind="stable")] if len(pairs) else pairs.reshape(0, 2)
-    block_owner = np.unique(owner[listed_face])
+    # The distinct owners, ascending: marked in a bitmap over [0, 2 F), no sort.
+    owned = np.zeros(2 * face_count, bool)
+    owned[owner[listed_face]] = True
+    block_owner = np.flatnonzero(owned)
     block_face = np.where(block_owner >= face_count, block_owner - face_count, block_owner)
     from_region = walked[block_face] & ~too_large[block_face]
     # Region-fed blocks: every drawn edge of the region.
