@@ -594,11 +594,16 @@ def _mesh_for(
         positions, corner_vert, corner_inputs = context
         try:
             source_mesh = get_source()
+            # Edge selection reads the face offsets too: once for both.
+            face_offsets = mesh_reading.read_face_offsets(source_mesh) if edges.active else None
             arrays = mesh_reading.extract_mesh(
-                source_mesh, positions=positions, corner_vert=corner_vert, corners=corner_inputs if corners else None
+                source_mesh,
+                positions=positions,
+                corner_vert=corner_vert,
+                corners=corner_inputs if corners else None,
+                face_offsets=face_offsets,
             )
             if edges.active:
-                face_offsets = mesh_reading.read_face_offsets(source_mesh)
                 cage_edges = None
                 if outline:
                     cage_edges = outlines.outline_mask(source_mesh, face_offsets)

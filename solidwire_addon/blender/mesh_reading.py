@@ -149,21 +149,22 @@ def read_mesh_fast(mesh) -> dict:
     }
 
 
-def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None) -> MeshArrays:
+def extract_mesh(mesh, *, positions=None, corner_vert=None, corners=None, face_offsets=None) -> MeshArrays:
     """Evaluated Blender mesh -> core.extract.MeshArrays (fast path).
 
     ``positions`` / ``corner_vert`` may be passed when the caller has just
-    read them (the GPU cache reads them for its change fingerprint).
+    read them (the GPU cache reads them for its change fingerprint), and
+    ``face_offsets`` when the caller reads them too (edge selection).
     ``corners``: also build the corner table (shaded fill, material colours);
     True, or the (normals, materials, domain) of :func:`read_corner_inputs` when the
     caller has them already (normals None: read here)."""
     data = (
         read_mesh_fast(mesh)
-        if positions is None
+        if positions is None and face_offsets is None
         else {
-            "positions": positions,
+            "positions": positions if positions is not None else read_positions(mesh),
             "corner_vert": corner_vert if corner_vert is not None else read_corner_verts(mesh),
-            "face_offsets": read_face_offsets(mesh),
+            "face_offsets": face_offsets if face_offsets is not None else read_face_offsets(mesh),
             "blender_tris": blender_triangles(mesh),
         }
     )

@@ -116,19 +116,22 @@ class SelectionStats:
 
 
 def _face_of_corner(sizes: np.ndarray) -> np.ndarray:
+    if len(sizes) and sizes.min() == sizes.max():  # one size (a subdivision's quads): a plain repeat
+        return np.repeat(np.arange(len(sizes), dtype=np.int64), int(sizes[0]))
     return np.repeat(np.arange(len(sizes), dtype=np.int64), sizes)
 
 
 def _region_labels(face_count: int, f1: np.ndarray, f2: np.ndarray) -> np.ndarray:
-    """Connected components of faces joined by the pairs (f1, f2): each face's
-    label is the smallest face id of its component.
+    """Connected components of faces joined by the pairs (f1, f2), f1 <= f2
+    (the faces of an edge's first and last corner): each face's label is the
+    smallest face id of its component.
 
     Runs of consecutive face ids joined pair by pair are one component each
     from the start (a subdivision lays a cage face's children out row by
     row, so a region's rows are such runs, found in one pass); the
     components are then found over the runs, a few thousand nodes where
     there were a million faces."""
-    low, high = np.minimum(f1, f2), np.maximum(f1, f2)
+    low, high = f1, f2  # faces number corners in order: a first corner's face is never the later one
     follows = high == low + 1
     next_joined = np.zeros(face_count, bool)
     next_joined[low[follows]] = True  # face f and f + 1 are joined
@@ -137,7 +140,14 @@ def _region_labels(face_count: int, f1: np.ndarray, f2: np.ndarray) -> np.ndarra
     run_of_face = np.cumsum(starts_run) - 1
     run_start = np.flatnonzero(starts_run)
     across = ~follows
-    run_label = _components(len(run_start), run_of_face[low[across]], run_of_face[high[across]])
+    run_low, run_high = run_of_face[low[across]], run_of_face[high[across]]
+    # Two rows of a grid are joined by one edge per column, and those edges
+    # come one after another: the same pair of runs many times over. Only
+    # distinct pairs join anything, and dropping a repeat of the previous
+    # pair is one pass where finding every duplicate would be a sort.
+    repeat = np.zeros(len(run_low), bool)
+    repeat[1:] = (run_low[1:] == run_low[:-1]) & (run_high[1:] == run_high[:-1])
+    run_label = _components(len(run_start), run_low[~repeat], run_high[~repeat])
     # Runs are numbered in face order: the smallest run is the smallest face.
     return run_start[run_label][run_of_face]
 
@@ -210,16 +220,19 @@ def select_edges(
     classes = np.zeros(edge_count, np.int64) if inputs.classes is None else np.asarray(inputs.classes, np.int64).copy()
     if inputs.boundary_class:
         classes[uses == 1] |= CLASS_BIT["boundary"]
+    has_classes = (inputs.classes is not None or inputs.boundary_class) and bool(classes.any())
     # Boundary and non-manifold edges are always drawn, and so is an edge of
     # an enabled class (asking for sharp edges shows them even where the
     # angle or the cage would not).
-    drawn |= (uses != 2) | (classes != 0)
-    stats.hidden_edges = int((~drawn).sum())
+    drawn |= uses != 2
+    if has_classes:
+        drawn |= classes != 0
 
     # Regions: faces joined across edges that are not drawn (each has two
-    # faces: the one its first corner belongs to, and the other, which the
-    # sum of both gives without sorting corners by edge).
+    # faces: the one its first corner belongs to, and the one its last
+    # corner belongs to).
     hidden_edges = np.flatnonzero(~drawn)
+    stats.hidden_edges = len(hidden_edges)
     first_face = np.empty(edge_count, np.int64)
     first_face[corner_edge[::-1]] = corner_face[::-1]  # the last write is the first corner's
     last_face = np.empty(edge_count, np.int64)
@@ -233,7 +246,7 @@ def select_edges(
     pairs = np.stack([keys // edge_count, keys % edge_count], axis=1)
     walked_region = region_size > 1
     styled_face = np.zeros(face_count, bool)
-    if classes.any():
+    if has_classes:
         styled_face = np.bincount(corner_face, weights=(classes[corner_edge] != 0), minlength=face_count) > 0
     walked = walked_region[label]
     ngon_face = sizes > 4
@@ -258,7 +271,10 @@ def select_edges(
 
     # Segments of each block.
     by_label = pairs[np.argsort(pairs[:, 0], kind="stable")] if len(pairs) else pairs.reshape(0, 2)
-    block_owner = np.unique(owner[listed_face])
+    # The distinct owners, ascending: marked in a bitmap over [0, 2 F), no sort.
+    owned = np.zeros(2 * face_count, bool)
+    owned[owner[listed_face]] = True
+    block_owner = np.flatnonzero(owned)
     block_face = np.where(block_owner >= face_count, block_owner - face_count, block_owner)
     from_region = walked[block_face] & ~too_large[block_face]
     # Region-fed blocks: every drawn edge of the region.
@@ -270,10 +286,12 @@ def select_edges(
     seg_owner = np.repeat(region_owner, count)
     seg_edge = by_label[rows, 1]
     # Face-fed blocks: the face's own drawn edges.
-    face_owned = np.zeros(face_count, bool)
-    face_owned[block_face[~from_region]] = True
-    own_corner = face_owned[corner_face] & drawn_corner
-    own = np.unique(np.stack([face_count + corner_face[own_corner], corner_edge[own_corner]], axis=1), axis=0)
+    own = np.zeros((0, 2), np.int64)
+    if not from_region.all():  # (cage edges on a subdivision's quads: none)
+        face_owned = np.zeros(face_count, bool)
+        face_owned[block_face[~from_region]] = True
+        own_corner = face_owned[corner_face] & drawn_corner
+        own = np.unique(np.stack([face_count + corner_face[own_corner], corner_edge[own_corner]], axis=1), axis=0)
     seg_owner = np.concatenate([seg_owner, own[:, 0]])
     seg_edge = np.concatenate([seg_edge, own[:, 1]])
     # One segment per class of the edge (an edge with no class: one
@@ -287,7 +305,7 @@ def select_edges(
     chain_a, chain_b = ends[seg_edge, 0], ends[seg_edge, 1]
 
     # The diagonals of each listed n-gon, into its own block.
-    diag_owner, diag_a, diag_b = _ngon_diagonals(arrays, owner)
+    diag_owner, diag_a, diag_b = _ngon_diagonals(arrays, owner) if ngon_face.any() else (np.zeros(0, np.int64),) * 3
     seg_owner = np.concatenate([seg_owner, diag_owner])
     seg_a = np.concatenate([seg_a, diag_a])
     seg_b = np.concatenate([seg_b, diag_b])
@@ -315,23 +333,28 @@ def select_edges(
     base = len(arrays.ngon_corners)  # region blocks follow the n-gon blocks in one table
     arrays.region_table = table
 
-    tri_owner = owner[arrays.triangle_polygons]
-    listed = tri_owner >= 0
-    listed_count = int(listed.sum())
-    # Every triangle, as with cage edges: plain slices, no mask to apply.
-    rows = slice(None) if listed_count == len(listed) else listed
-    # Each listed triangle's block: a lookup by owner (owners lie in
-    # [0, 2 F)), far cheaper than a search per triangle.
+    # Each listed face's block: a lookup by owner (owners lie in [0, 2 F)),
+    # far cheaper than a search; its flag bits and table start are made per
+    # face and then handed to its triangles in one gather each.
     block_of_owner = np.zeros(2 * face_count, np.int64)
     block_of_owner[owners] = np.arange(len(owners))
-    at = block_of_owner[tri_owner[rows]]
-    flags = arrays.edge_flags
+    face_block = block_of_owner[owner]  # (meaningless where owner is -1: not listed)
     # Every listed face's lines can come from the region-lines pass
     # (REGION_LINES); its quad edges are in its block instead.
+    face_bits = (count[face_block].astype(np.int32) << NGON_SHIFT) | np.int32(IN_REGION | REGION_LINES)
+    face_start = (base + TEXELS_PER_SEGMENT * first[face_block]).astype(np.int32)
+    polygons = arrays.triangle_polygons
+    if listed_face.all():  # as with cage edges: plain slices, no mask to apply
+        rows, listed_count = slice(None), len(polygons)
+    else:
+        rows = listed_face[polygons]
+        listed_count = int(rows.sum())
+        polygons = polygons[rows]
+    flags = arrays.edge_flags
     keep = ~(HAS_QUAD_CORNER | IS_NGON | REGION_LINES | EDGE3_HIDDEN | EDGE4_HIDDEN | (-1 << NGON_SHIFT))
-    flags[rows] = (flags[rows] & keep) | IN_REGION | REGION_LINES | (count[at].astype(np.int32) << NGON_SHIFT)
-    arrays.triangles[rows, 3] = base + TEXELS_PER_SEGMENT * first[at]
-    stats.regions = int((walked_region & (np.arange(face_count) == label)).sum())
+    flags[rows] = (flags[rows] & keep) | face_bits[polygons]
+    arrays.triangles[rows, 3] = face_start[polygons]
+    stats.regions = int(walked_region.sum())  # sizes are counted at each region's label only
     stats.listed_triangles = listed_count
     stats.segments = len(seg_a)
     _region_lines(arrays, verts, classes, ends, label, walked | styled_face, pairs, stats)
@@ -341,6 +364,8 @@ def select_edges(
 def _one_per_class(bits: np.ndarray, *columns: np.ndarray):
     """(style, columns repeated): one row per class bit set in ``bits`` (its
     style k + 1 for class k), one row of style 0 where no bit is set."""
+    if not bits.any():  # one ordinary row each: nothing to repeat
+        return np.zeros(len(bits), np.int64), columns
     popcount = np.array([b.bit_count() for b in range(1 << len(EDGE_CLASSES))])
     per_row = np.maximum(popcount[bits], 1)
     bits = np.repeat(bits, per_row)
@@ -361,7 +386,7 @@ def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, p
     edge bounding more is one entry per pair; an edge in several classes is
     one entry per class."""
     region_of_face = np.where(lines_face, label, -1)
-    arrays.triangle_regions = region_of_face[arrays.triangle_polygons].astype(np.float32)
+    arrays.triangle_regions = region_of_face.astype(np.float32)[arrays.triangle_polygons]
     keep = lines_face[pairs[:, 0]] if len(pairs) else np.zeros(0, bool)
     pairs = pairs[keep]
     if not len(pairs):
@@ -536,19 +561,30 @@ def _mark_quad_rows(
     ):
         return False
     hidden = ~drawn[np.asarray(corner_edge).reshape(face_count, 4)]  # the edge leaving each corner
+    # Which of its quad's edges are hidden, one bit per corner, and then per
+    # row a lookup of that pattern turned to the row's first corner.
+    pattern = (
+        hidden[:, 0] | (hidden[:, 1] << np.uint8(1)) | (hidden[:, 2] << np.uint8(2)) | (hidden[:, 3] << np.uint8(3))
+    )
+    pattern = pattern.astype(np.intp)
+    clear_of, marks_of = _quad_row_marks()
     # A row starting at corner r: its edges 0, 1 and its quad edges 3, 4
     # leave corners r, r + 1, r + 2, r + 3.
     for rows, plain, flipped in ((slice(0, None, 2), 0, 3), (slice(1, None, 2), 2, 1)):
-        h = [np.where(flip, hidden[:, (flipped + k) % 4], hidden[:, (plain + k) % 4]) for k in range(4)]
-        clear = h[0] * np.int32(EDGE0_REAL) | h[1] * np.int32(EDGE1_REAL)
-        marks = (
-            h[0] * np.int32(EDGE0_HIDDEN)
-            | h[1] * np.int32(EDGE0_HIDDEN << 1)
-            | h[2] * np.int32(EDGE3_HIDDEN)
-            | h[3] * np.int32(EDGE4_HIDDEN)
-        )
-        flags[rows] = (flags[rows] & ~clear) | marks
+        at = np.where(flip, 16 * flipped, 16 * plain) + pattern
+        flags[rows] = (flags[rows] & ~clear_of[at]) | marks_of[at]
     return True
+
+
+def _quad_row_marks():
+    """(clear, marks), each (64,) int32 indexed by 16 * r + p: the flag bits
+    _mark_quad_rows clears and sets on a row starting at its quad's corner
+    r whose quad has the hidden edges p (bit c: the edge leaving corner c)."""
+    r, p = np.divmod(np.arange(64), 16)
+    h = [(p >> ((r + k) % 4)) & 1 for k in range(4)]
+    clear = h[0] * EDGE0_REAL | h[1] * EDGE1_REAL
+    marks = h[0] * EDGE0_HIDDEN | h[1] * (EDGE0_HIDDEN << 1) | h[2] * EDGE3_HIDDEN | h[3] * EDGE4_HIDDEN
+    return clear.astype(np.int32), marks.astype(np.int32)
 
 
 def _corner_in_polygon(vertex, start, size, corner_vert) -> np.ndarray:
