@@ -221,6 +221,28 @@ DEFERRED_MIN_DENSITY = 0.4
 DEFERRED_BLOCK_WEIGHT = 8.0
 
 
+def _items_by_mesh(items) -> list[list]:
+    """``items`` grouped by their mesh, in first-seen order."""
+    by_mesh: dict = {}
+    for item in items:
+        by_mesh.setdefault(id(item.mesh), []).append(item)
+    return list(by_mesh.values())
+
+
+def mesh_window_boxes(group, view: View) -> np.ndarray:
+    """(N, 4) NDC window boxes (view.window_boxes) of the items of
+    ``group``, which share one mesh: one vectorised product for them all."""
+    mesh = group[0].mesh
+    to_clip = view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
+    return window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max)
+
+
+def window_union(items, view: View) -> tuple:
+    """The NDC rectangle (x0, y0, x1, y1) over every item's window box."""
+    boxes = np.concatenate([mesh_window_boxes(group, view) for group in _items_by_mesh(items)])
+    return (float(boxes[:, 0].min()), float(boxes[:, 1].min()), float(boxes[:, 2].max()), float(boxes[:, 3].max()))
+
+
 def split_deferred(items, view: View, min_density: float | None = None) -> tuple[list, list]:
     """(items to draw deferred, items to draw directly): a mesh is deferred
     when its triangles are dense on screen (``min_density`` triangles per
@@ -229,18 +251,13 @@ def split_deferred(items, view: View, min_density: float | None = None) -> tuple
     exactly (DEFERRED_MAX) keep the direct draw."""
     if min_density is None:
         min_density = DEFERRED_MIN_DENSITY
-    by_mesh: dict = {}
-    for item in items:
-        by_mesh.setdefault(id(item.mesh), []).append(item)
+    by_mesh = _items_by_mesh(items)
     if len(by_mesh) >= DEFERRED_MAX or len(items) >= DEFERRED_MAX:
         return [], list(items)
     deferred, direct = [], []
-    for group in by_mesh.values():
+    for group in by_mesh:
         mesh = group[0].mesh
-        to_clip = (
-            view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
-        )
-        pixels = float(box_pixels(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max), view).sum())
+        pixels = float(box_pixels(mesh_window_boxes(group, view), view).sum())
         weight = DEFERRED_BLOCK_WEIGHT if mesh.has_ngons else 1.0
         # Multi-face regions draw their lines over the visibility record
         # (docs/image_model.md §2.6), so such a mesh is always deferred.

@@ -55,7 +55,7 @@ from .schema import (
     WIRE_PASS,
 )
 from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, targets_for
-from .view import DrawStats, View, translation, window_boxes
+from .view import DrawStats, View
 
 # Written by the surface pass's extra outputs (the rest has its own pass).
 _SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
@@ -442,14 +442,8 @@ def _deferred_surface(targets, items, view: View, settings, target: DrawTarget, 
     image as the direct pass; the edge set-up runs once per visible pixel
     instead of at every corner of every triangle."""
     width, height = view.width, view.height
-    framebuffer = targets.visibility_framebuffer()
-    by_vertex = _triangle_ids_by_vertex(options)
-    with framebuffer.bind():
-        _clear(framebuffer, width, height, depth=False)  # keep the direct draws' depth
-        visibility = replace(target, stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=by_vertex)
-        stats = draw_mod.draw(items, view, settings, target=visibility, cull=cull)
-        gpu.state.depth_test_set("NONE")
-        gpu.state.depth_mask_set(False)
+    # (keep_depth: the direct draws' depth stays)
+    stats = _record_visibility(targets, items, view, settings, target, options, cull=cull, keep_depth=True)
     # The lines of multi-face regions as quads over the record, so that no
     # pixel walks a region's edges (docs/image_model.md §2.6). The Edge
     # Distance pass needs d itself, so with the render passes' outputs the
@@ -464,6 +458,23 @@ def _deferred_surface(targets, items, view: View, settings, target: DrawTarget, 
             target, stage=draw_mod.RESOLVE, visibility=targets.visible, view_depth=True, region_lines=lines
         )
         draw_mod.draw(items, view, settings, target=resolve, cull=cull)
+    return stats
+
+
+def _record_visibility(
+    targets, items, view: View, settings, target: DrawTarget, options: DrawOptions, *, cull=True, keep_depth=False
+):
+    """The visibility record of ``items`` into ``targets.visible`` (which
+    triangle each pixel shows; depth test, no shading), drawn as ``target``
+    says apart from its stage; ``keep_depth`` keeps the depth already in the
+    targets. Returns the DrawStats."""
+    framebuffer = targets.visibility_framebuffer()
+    with framebuffer.bind():
+        _clear(framebuffer, view.width, view.height, depth=not keep_depth)
+        record = replace(target, stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=_triangle_ids_by_vertex(options))
+        stats = draw_mod.draw(items, view, settings, target=record, cull=cull)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
     return stats
 
 
@@ -514,15 +525,7 @@ def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptio
         stats.extra["region_lines_reused"] = 1
         return targets.lines
     targets.lines_key = None
-    framebuffer = targets.visibility_framebuffer()
-    with framebuffer.bind():
-        _clear(framebuffer, view.width, view.height)
-        record = DrawTarget(
-            linear_depth=True, stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=_triangle_ids_by_vertex(options)
-        )
-        draw_mod.draw(items, view, settings, target=record)
-        gpu.state.depth_test_set("NONE")
-        gpu.state.depth_mask_set(False)
+    _record_visibility(targets, items, view, settings, DrawTarget(linear_depth=True), options)
     lines = _draw_region_lines(targets, items, view, settings, DrawTarget(linear_depth=True), True, stats)
     targets.lines_key = key
     return lines
@@ -623,13 +626,7 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame):
         return targets
     targets.lines_key = targets.surface_key = None
     width, height = view.width, view.height
-    framebuffer = targets.visibility_framebuffer()
-    with framebuffer.bind():
-        _clear(framebuffer, width, height)
-        record = DrawTarget(stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=_triangle_ids_by_vertex(frame.options))
-        draw_mod.draw(items, view, settings, target=record)
-        gpu.state.depth_test_set("NONE")
-        gpu.state.depth_mask_set(False)
+    _record_visibility(targets, items, view, settings, DrawTarget(), frame.options)
     lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats) if line_count else None
     with targets.surface_framebuffer().bind():
         gpu.state.viewport_set(0, 0, width, height)
@@ -639,27 +636,10 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame):
     # (One key for the record, its lines and the resolved image: the
     # direct path's own region lines (_overlay_region_lines) never match it.)
     targets.lines_key = targets.surface_key = key
-    targets.surface_rect = _window_union(items, view)
+    targets.surface_rect = draw_mod.window_union(items, view)
     targets.surface_counts = (record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn)
     frame.line_stats.add(record_stats)
     return targets
-
-
-def _window_union(items, view: View) -> tuple:
-    """The NDC rectangle over every item's window box (view.window_boxes),
-    vectorised per mesh."""
-    by_mesh: dict = {}
-    for item in items:
-        by_mesh.setdefault(id(item.mesh), []).append(item)
-    boxes = []
-    for group in by_mesh.values():
-        mesh = group[0].mesh
-        to_clip = (
-            view.projection @ view.view_matrix @ np.stack([item.matrix for item in group]) @ translation(mesh.centre)
-        )
-        boxes.append(window_boxes(to_clip, mesh.bounds_min, mesh.bounds_max))
-    boxes = np.concatenate(boxes)
-    return (float(boxes[:, 0].min()), float(boxes[:, 1].min()), float(boxes[:, 2].max()), float(boxes[:, 3].max()))
 
 
 def _composite_overlay_surface(targets, depth_bias: float) -> None:
