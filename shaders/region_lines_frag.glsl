@@ -12,28 +12,82 @@
  * a nudge far below one 16-bit step of intensity. */
 #define STYLE_NUDGE 1.0e-6
 
-/* One segment of the run ((line, span start), span end; unused slots are
- * NO_SEGMENT, far away) at the pixel p: the nearest distance so far, and
- * for a patterned style its P m (each segment's dashes run from its own
- * lower-id end). */
-void run_segment(vec4 line, float span_end, vec2 p, float half_thickness, inout float nearest, inout float strongest)
+/* The squared distance from the pixel p to one segment of the run ((line,
+ * span start), span end; unused slots are NO_SEGMENT, far away) and its
+ * position along the line, from the segment's own lower-id end. */
+float segment_distance_sq(vec4 line, float span_end, vec2 p, out float along_from_start)
 {
   float across = dot(line.xyz, vec3(p, 1.0));
   float along = dot(vec2(-line.y, line.x), p);
   float beyond = max(max(line.w - along, along - span_end), 0.0);
-  float d2 = across * across + beyond * beyond;
+  along_from_start = abs(along - line.w);
+  return across * across + beyond * beyond;
+}
+
+/* One segment at p: the nearest squared distance so far and, for a
+ * patterned style, its P m in `strongest` (each segment's dashes run from
+ * its own lower-id end); `patterned` says whether to take it. */
+void run_segment(vec4 line, float span_end, vec2 p, float half_thickness, bool patterned, inout float nearest,
+                 inout float strongest)
+{
+  float along_from_start;
+  float d2 = segment_distance_sq(line, span_end, p, along_from_start);
   nearest = min(nearest, d2);
 #if STYLE_COUNT > 1
-  float duty = style_duty(line_style);
-  if (duty < 1.0) {
+  if (patterned) {
     strongest = max(strongest, line_profile(sqrt(d2), half_thickness) *
-                                   pattern_mask(abs(along - line.w), params.pattern_period, duty));
+                                   pattern_mask(along_from_start, params.pattern_period, style_duty(line_style)));
+  }
+#endif
+}
+
+/* Every segment of the run at p (RUN_SEGMENTS slots, run_length used). */
+void run_segments(vec2 p, float half_thickness, bool patterned, inout float nearest, inout float strongest)
+{
+  run_segment(run_line0, run_ends0.x, p, half_thickness, patterned, nearest, strongest);
+#if RUN_SEGMENTS > 1
+  if (run_length > 1) {
+    run_segment(run_line1, run_ends0.y, p, half_thickness, patterned, nearest, strongest);
+#  if RUN_SEGMENTS > 2
+    if (run_length > 2) {
+      run_segment(run_line2, run_ends0.z, p, half_thickness, patterned, nearest, strongest);
+      run_segment(run_line3, run_ends0.w, p, half_thickness, patterned, nearest, strongest);
+#    if RUN_SEGMENTS > 4
+      if (run_length > 4) {
+        run_segment(run_line4, run_ends1.x, p, half_thickness, patterned, nearest, strongest);
+        run_segment(run_line5, run_ends1.y, p, half_thickness, patterned, nearest, strongest);
+        run_segment(run_line6, run_ends1.z, p, half_thickness, patterned, nearest, strongest);
+        run_segment(run_line7, run_ends1.w, p, half_thickness, patterned, nearest, strongest);
+      }
+#    endif
+    }
+#  endif
   }
 #endif
 }
 
 void main()
 {
+  vec2 p = gl_FragCoord.xy - viewport_centre();
+#if STYLE_COUNT > 1
+  bool patterned = style_duty(line_style) < 1.0;
+#else
+  const bool patterned = false;
+#endif
+  /* nearest: the squared distance to the nearest segment; strongest: the
+   * largest P m of a patterned style's segments. */
+  float nearest = 1.0e30, strongest = 0.0;
+#if THICKNESS_MODE != 1
+  /* The width does not depend on the visible point's clip w: the distances
+   * come first, and a pixel beyond the reach the vertex stage gave the quad
+   * (the widest the style can be, its 2s fall-off and a hundredth of a
+   * pixel: the profile is 0 there) is dropped before it reads the record. */
+  run_segments(p, 0.0, false, nearest, strongest);
+  float widest = style_half_thickness(line_style, max(params.half_thickness, params.half_thickness_far));
+  if (sqrt(nearest) >= widest + 2.0 * params.softness + 0.01) {
+    discard;
+  }
+#endif
   vec4 visible = texelFetch(visibility, ivec2(gl_FragCoord.xy), 0);
   if (visible.z != float(draw_number)) {
     discard; /* nothing, or another draw's triangle */
@@ -47,40 +101,19 @@ void main()
   if (region < 0.0 || (region != line_regions.x && region != line_regions.y)) {
     discard; /* the visible face is not bounded by this line */
   }
-  vec2 p = gl_FragCoord.xy - viewport_centre();
   /* Width at the visible point: its view depth is in the record, its clip
    * w follows from the projection (clip_w_of_depth). */
   float view_depth = visible.w;
   float half_thickness = half_thickness_at(view_depth, 1.0 / (clip_w_of_depth.x * view_depth + clip_w_of_depth.y));
   half_thickness = style_half_thickness(line_style, half_thickness);
-  /* nearest: the squared distance to the nearest segment; strongest: the
-   * largest P m of a patterned style's segments. */
-  float nearest = 1.0e30, strongest = 0.0;
-  run_segment(run_line0, run_ends0.x, p, half_thickness, nearest, strongest);
-#if RUN_SEGMENTS > 1
-  if (run_length > 1) {
-    run_segment(run_line1, run_ends0.y, p, half_thickness, nearest, strongest);
-#  if RUN_SEGMENTS > 2
-    if (run_length > 2) {
-      run_segment(run_line2, run_ends0.z, p, half_thickness, nearest, strongest);
-      run_segment(run_line3, run_ends0.w, p, half_thickness, nearest, strongest);
-#    if RUN_SEGMENTS > 4
-      if (run_length > 4) {
-        run_segment(run_line4, run_ends1.x, p, half_thickness, nearest, strongest);
-        run_segment(run_line5, run_ends1.y, p, half_thickness, nearest, strongest);
-        run_segment(run_line6, run_ends1.z, p, half_thickness, nearest, strongest);
-        run_segment(run_line7, run_ends1.w, p, half_thickness, nearest, strongest);
-      }
-#    endif
-    }
-#  endif
+#if THICKNESS_MODE == 1
+  run_segments(p, half_thickness, patterned, nearest, strongest);
+#else
+  if (patterned) {
+    run_segments(p, half_thickness, true, nearest, strongest);
   }
 #endif
-#if STYLE_COUNT > 1
-  float intensity = (style_duty(line_style) < 1.0) ? strongest : line_profile(sqrt(nearest), half_thickness);
-#else
-  float intensity = line_profile(sqrt(nearest), half_thickness);
-#endif
+  float intensity = patterned ? strongest : line_profile(sqrt(nearest), half_thickness);
 #ifdef USE_DENSITY_FADE
   intensity *= density_fade(line_chain);
 #endif

@@ -1,12 +1,14 @@
 /* Region lines, vertex stage (docs/image_model.md §2.6): one screen-space
- * quad (two triangles, six corners) per *run* of the `region_lines` table:
+ * quad (two triangles over four shared corners, draw.indexed_quad_batch)
+ * per *run* of the `region_lines` table:
  * up to RUN_SEGMENTS (1, 2, 4 or 8) consecutive entries of one chain (a
  * cage edge cut by subdivision), one style and one pair of regions. The
  * quad covers every entry's window segment widened by the reach of the
  * style's line; each segment's own set-up goes to the fragment stage, which
  * takes the strongest of the run's lines. A rasteriser then pays for one
  * primitive per run instead of one per segment, and the overlapping caps of
- * a chain's short segments are shaded once. The run is gl_VertexID / 6;
+ * a chain's short segments are shaded once. The run is gl_VertexID / 4 (an
+ * indexed draw: gl_VertexID is the corner's index);
  * its texel (first entry's texel, entries) leads the table. An instanced
  * draw repeats every run for each instance. */
 
@@ -85,7 +87,7 @@ void run_segment(int texel, bool used, float half_width, inout RunBox box, out v
 
 void main()
 {
-  int run = gl_VertexID / 6;
+  int run = gl_VertexID / 4;
   int corner = quad_corner;
   if (run >= line_count) {
     /* The batch's padding (an instanced draw draws all of it): read no
@@ -153,9 +155,9 @@ void main()
   /* The box around every segment's window points, widened by the reach,
    * holds every segment's reach. */
   vec2 low = box.low - box.reach, high = box.high + box.reach;
-  /* corners 0..5: (low,low), (high,low), (high,high), (low,low), (high,high), (low,high) */
-  bool at_high = (corner == 1 || corner == 2 || corner == 4);
-  bool plus = (corner == 2 || corner == 4 || corner == 5);
+  /* corners 0..3: (low,low), (high,low), (high,high), (low,high) */
+  bool at_high = (corner == 1 || corner == 2);
+  bool plus = (corner >= 2);
   vec2 w = viewport_centre() + box.along * (at_high ? high.x : low.x) + box.across * (plus ? high.y : low.y);
   gl_Position = vec4((w - params.viewport.xy) / params.viewport.zw * 2.0 - 1.0, 0.0, 1.0);
 }

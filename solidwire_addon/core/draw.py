@@ -687,7 +687,7 @@ class _DrawNumbers:
                 shader.uniform_sampler("region_lines", lines)
                 shader.uniform_sampler("triangle_regions", regions)
                 shader.uniform_int("line_count", count)
-                batch = quad_batch(count)
+                batch = indexed_quad_batch(count)
                 if instance_count:
                     batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
                 else:
@@ -712,7 +712,7 @@ _quad_batches: dict[int, object] = {}
 def quad_batch(count: int):
     """Six corners (two triangles, ``quad_corner`` 0..5) for each of at
     least ``count`` screen-space quads whose shader pulls everything else:
-    the silhouette fins, the region lines, hair segments and points. Shared
+    the silhouette fins, hair segments and points. Shared
     by every draw of the same size class (the next power of two)."""
     size = 1 << max(int(count - 1).bit_length(), 6)
     batch = _quad_batches.get(size)
@@ -722,6 +722,30 @@ def quad_batch(count: int):
         vbo = gpu.types.GPUVertBuf(fmt, 6 * size)
         vbo.attr_fill("quad_corner", np.tile(np.arange(6, dtype=np.int32), size))
         batch = _quad_batches[size] = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+    return batch
+
+
+_indexed_quad_batches: dict[int, object] = {}
+
+
+def indexed_quad_batch(count: int):
+    """Four corners (``quad_corner`` 0..3) and six indices (two triangles)
+    for each of at least ``count`` screen-space quads, for a vertex stage
+    dear enough that sharing corners pays: the region lines' sets up every
+    segment of its run at each corner, and a software rasteriser shades
+    the vertices of an indexed draw once (4 invocations per quad, not 6).
+    Shared by every draw of the same size class (the next power of two)."""
+    size = 1 << max(int(count - 1).bit_length(), 6)
+    batch = _indexed_quad_batches.get(size)
+    if batch is None:
+        fmt = gpu.types.GPUVertFormat()
+        fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
+        vbo = gpu.types.GPUVertBuf(fmt, 4 * size)
+        vbo.attr_fill("quad_corner", np.tile(np.arange(4, dtype=np.int32), size))
+        first = 4 * np.arange(size, dtype=np.int32)[:, None]
+        indices = (first + np.array([0, 1, 2, 0, 2, 3], dtype=np.int32)).reshape(-1, 3)
+        ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=indices)
+        batch = _indexed_quad_batches[size] = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)
     return batch
 
 
@@ -752,6 +776,7 @@ def release_rectangle() -> None:
     unregister frees every GPU object)."""
     _rectangles.clear()
     _quad_batches.clear()
+    _indexed_quad_batches.clear()
 
 
 def _draw_groups(groups, variant, call: _DrawCall) -> None:
