@@ -519,7 +519,14 @@ void main()
 #else
   const bool lines_from_image = false;
 #endif
+#ifdef NO_EDGE_SETUP
+  /* No edge of the triangle's own was set up (every line is in the
+   * region-lines image, no diagonal drawn): measuring them would find
+   * nothing nearer than NO_EDGE. */
+  NearLines found = no_lines();
+#else
   NearLines found = own_edge_lines(p, half_thickness, listed);
+#endif
   walk_blocks(p, half_thickness, listed, lines_from_image, found);
   vec3 real_line;
   vec2 real_span;
