@@ -15,7 +15,7 @@ import pytest
 from mathutils import Matrix
 
 import solidwire_addon
-from solidwire_addon.core import exr
+from solidwire_addon.core import draw, exr
 from tests.support import accuracy, reference, scenes
 
 
@@ -130,6 +130,31 @@ def test_the_angle_threshold_on_a_large_creased_region(output_dir):
     ref = reference.render_reference(scene)
     every_edge = reference.render_reference(scene, settings=reference.SettingsWith(scene.solidwire, edge_angle=0.0))
     assert ref.intensity.sum() < 0.25 * every_edge.intensity.sum()
+
+
+@pytest.mark.parametrize("copies", [3, draw.INSTANCING_MIN + 2])
+def test_one_mesh_with_regions_drawn_by_many_objects(copies, output_dir):
+    """Objects sharing one mesh with multi-face regions: a few draw it one by
+    one, many draw it instanced (the region lines of each instance at its
+    own matrix; a resolve that reads no instance matrix, the flat wire in
+    pixels of lines that all come from the region-lines image)."""
+    scene = scenes.empty_scene(220, 160, edge_angle=math.radians(10.0), thickness=1.5)
+    grid = scenes.grid(scene, x_segments=12, y_segments=12, size=1.0)
+    for vertex in grid.data.vertices:
+        if vertex.co.x > 0.0:
+            vertex.co.z = 0.4 * vertex.co.x
+    grid.data.update()
+    rng = np.random.default_rng(3)
+    for i in range(1, copies):
+        copy = bpy.data.objects.new(f"Grid{i}", grid.data)
+        scene.collection.objects.link(copy)
+        copy.location = (rng.uniform(-2.0, 2.0), rng.uniform(-1.0, 2.0), rng.uniform(-0.3, 0.3))
+        copy.rotation_euler = rng.uniform(-0.6, 0.6, 3)
+    scenes.add_camera(scene, location=(0.5, -5.0, 3.6), target=(0, 0.4, 0))
+    report = accuracy.measure(scene, f"regions_shared_mesh_{copies}", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+    assert (solidwire_addon.stats().get("instanced_draws", 0) > 0) == (copies >= draw.INSTANCING_MIN)
 
 
 def _half_cube(bm):

@@ -1018,6 +1018,9 @@ def _draw_instanced(groups: list[InstancedDraw], variant, call: _DrawCall) -> No
     shader.uniform_sampler("instance_table", table)
     _bind_extras(shader, variant, extras)
     numbering.bind(shader)
+    # (A resolve that needs no corner of the triangle, a cage look's flat
+    # wire in pixels, reads no instance's matrices at all.)
+    uses_instances = shaders.uses_uniform(shader, "instance_base")
     base = 0
     for group in groups:
         mesh, style, object_to_clip, mirrored = group.mesh, group.style, group.object_to_clip, group.mirrored
@@ -1027,7 +1030,8 @@ def _draw_instanced(groups: list[InstancedDraw], variant, call: _DrawCall) -> No
             shader.uniform_block("params", ubo(style))
         if settings.use_backface_culling and not numbering.draws_over_record:
             gpu.state.face_culling_set("FRONT" if mirrored else "BACK")
-        shader.uniform_int("instance_base", base)
+        if uses_instances:
+            shader.uniform_int("instance_base", base)
         _bind_mesh(shader, variant, mesh)
         numbering.draw(shader, mesh, lambda mesh=mesh: mesh.batch, object_to_clip, instance_count=count)
         base += count * shaders.INSTANCE_TEXELS
