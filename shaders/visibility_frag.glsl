@@ -4,10 +4,16 @@
  * depth). Whole numbers below 2^24 are exact in float32; bigger meshes stay
  * on the direct path (passes.deferred_surface). */
 
+/* The largest float below 1.0. */
+#define BELOW_ONE 0.99999994
+
 void main()
 {
 #ifdef LINEAR_DEPTH
-  gl_FragDepth = view_depth * params.inv_clip_end; /* see LINEAR_DEPTH in solidwire_frag.glsl */
+  /* See LINEAR_DEPTH in solidwire_frag.glsl. Kept below 1.0, the cleared
+   * background: a surface right at the far clip plane is recorded as one,
+   * and the resolve, tested GREATER at 1.0, finds it (resolve_vert.glsl). */
+  gl_FragDepth = min(view_depth * params.inv_clip_end, BELOW_ONE);
 #endif
 #ifdef SW_INSTANCED
   float instance = visible_instance;

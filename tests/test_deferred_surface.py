@@ -135,6 +135,22 @@ def test_deferred_surface_with_an_orthographic_camera(output_dir, monkeypatch):
     _assert_same(direct, deferred)
 
 
+def test_deferred_surface_cut_by_the_far_clip_plane(output_dir, monkeypatch):
+    """A floor running out through the far clip plane and a wall right at
+    it: pixels at the far end of the depth range are resolved like every
+    other (the resolve's rectangle, at the far end, is depth-tested against
+    the record)."""
+    scene = scenes.empty_scene(160, 120, use_fill=True, fill_shading="STUDIO")
+    scenes.grid(scene, "Floor", x_segments=40, y_segments=40, size=30.0, location=(0.0, 0.0, -1.0))
+    # Facing the camera right at the far plane: every pixel's depth is 1.
+    wall_rotation = (0.5 * np.pi, 0.0, 0.0)
+    scenes.grid(scene, "Wall", x_segments=24, y_segments=24, size=8.0, location=(0.0, 8.0, 0.0), rotation=wall_rotation)
+    scenes.add_camera(scene, location=(0.0, 0.0, 0.0), target=(0.0, 8.0, 0.0), clip=(0.5, 8.0))
+    direct, deferred, stages = _render_both(scene, output_dir / "deferred_far_plane.exr", monkeypatch)
+    assert draw.RESOLVE in stages
+    _assert_same(direct, deferred)
+
+
 def test_a_deferred_stage_that_does_not_compile_falls_back_to_the_direct_pass(output_dir, monkeypatch, capsys):
     """A backend whose compiler refuses a deferred stage draws the same image
     with the direct pass, says so once, and does not try again."""

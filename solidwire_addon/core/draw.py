@@ -438,7 +438,12 @@ def draw(
             )
         return block
 
-    gpu.state.depth_test_set("NONE" if stage == RESOLVE else target.depth_test)
+    # The render's resolve draws over the record's depth, its rectangle at
+    # the far end of the depth range: it passes only where a surface was
+    # recorded (shaders/resolve_vert.glsl). The overlay's resolves into a
+    # target without depth.
+    resolve_test = "GREATER" if target.linear_depth else "NONE"
+    gpu.state.depth_test_set(resolve_test if stage == RESOLVE else target.depth_test)
     gpu.state.depth_mask_set(target.depth_write and stage != RESOLVE)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).

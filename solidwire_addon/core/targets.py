@@ -74,8 +74,10 @@ class Targets:
 
     def resolve_framebuffer(self, aovs: bool = False):
         """The deferred surface's second stage: the colour targets of
-        :meth:`framebuffer` without depth (the first stage wrote it)."""
-        return gpu.types.GPUFrameBuffer(color_slots=self._color_slots(aovs))
+        :meth:`framebuffer` over the depth the first stage wrote, which the
+        resolve only tests (its rectangle passes where a surface was
+        recorded, shaders/resolve_vert.glsl)."""
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self._color_slots(aovs))
 
     def framebuffer(self, aovs: bool = False):
         """A framebuffer over the textures. Made per use: textures are shared
