@@ -14,7 +14,7 @@ import pytest
 
 import solidwire_addon
 from solidwire_addon.blender import runtime
-from solidwire_addon.core import draw, shaders
+from solidwire_addon.core import draw, passes, shaders
 from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 from tests.test_render_passes import _enable_all
@@ -148,6 +148,32 @@ def test_deferred_surface_cut_by_the_far_clip_plane(output_dir, monkeypatch):
     scenes.add_camera(scene, location=(0.0, 0.0, 0.0), target=(0.0, 8.0, 0.0), clip=(0.5, 8.0))
     direct, deferred, stages = _render_both(scene, output_dir / "deferred_far_plane.exr", monkeypatch)
     assert draw.RESOLVE in stages
+    _assert_same(direct, deferred)
+
+
+def test_a_deferred_frame_reads_nothing_of_the_last_frames_record(output_dir, monkeypatch):
+    """Every mesh deferred, nothing drawn directly: the record is not
+    cleared between frames, so a frame whose surfaces cover other pixels
+    than the last one's (the object moved off them) must still resolve
+    only its own."""
+    scene = scenes.empty_scene(160, 120, use_cage_edges=True, use_fill=True, fill_shading="STUDIO")
+    monkey = scenes.monkey(scene, rotation=(0.0, 0.0, 0.5))
+    modifier = monkey.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = modifier.render_levels = 1
+    scenes.add_camera(scene, location=(1.2, -3.4, 1.0), target=(0.0, 0.0, 0.0))
+    cleared = []
+    real_record = passes._record_visibility
+
+    def record(*args, **kwargs):
+        cleared.append(kwargs.get("clear_record", True))
+        return real_record(*args, **kwargs)
+
+    monkeypatch.setattr(passes, "_record_visibility", record)
+    _render_both(scene, output_dir / "deferred_first_frame.exr", monkeypatch)
+    monkey.location = (0.9, 0.0, -0.4)
+    monkey.scale = (0.5, 0.5, 0.5)
+    direct, deferred, _stages = _render_both(scene, output_dir / "deferred_second_frame.exr", monkeypatch)
+    assert cleared == [False, False]
     _assert_same(direct, deferred)
 
 

@@ -394,6 +394,14 @@ def _clear(framebuffer, width: int, height: int, depth: bool = True) -> None:
     gpu.state.viewport_set(0, 0, width, height)
 
 
+def _no_clear(width: int, height: int) -> None:
+    """The state _clear leaves, without clearing anything."""
+    gpu.state.depth_mask_set(False)
+    gpu.state.color_mask_set(True, True, True, True)
+    gpu.state.blend_set("NONE")
+    gpu.state.viewport_set(0, 0, width, height)
+
+
 def draw_surface(
     targets,
     items,
@@ -425,7 +433,9 @@ def draw_surface(
         gpu.state.depth_mask_set(False)
     if deferred:
         try:
-            stats.add(_deferred_surface(targets, deferred, view, settings, target, cull, options))
+            stats.add(
+                _deferred_surface(targets, deferred, view, settings, target, cull, options, after_direct=bool(direct))
+            )
         except shaders.DeferredUnavailable as exc:
             shaders.disable_deferred()
             warn_once(
@@ -435,15 +445,34 @@ def draw_surface(
     return stats
 
 
-def _deferred_surface(targets, items, view: View, settings, target: DrawTarget, cull: bool, options: DrawOptions):
+def _deferred_surface(
+    targets,
+    items,
+    view: View,
+    settings,
+    target: DrawTarget,
+    cull: bool,
+    options: DrawOptions,
+    *,
+    after_direct: bool = True,
+):
     """The surface pass of ``items`` in two stages over the depth the direct
     draws left: which triangle each pixel shows (depth test, no shading),
     then the exact fragment stage once per pixel shown. Same depth, same
     image as the direct pass; the edge set-up runs once per visible pixel
-    instead of at every corner of every triangle."""
+    instead of at every corner of every triangle.
+
+    The resolve is depth-tested against the record, so it reads the record
+    only where a surface is; where nothing was drawn directly first
+    (``after_direct`` False) every such pixel gets its record from this
+    pass, and the record needs no clear. (The region-lines pass may read a
+    stale record beside the surface, and write lines there that no resolve
+    reads.)"""
     width, height = view.width, view.height
     # (keep_depth: the direct draws' depth stays)
-    stats = _record_visibility(targets, items, view, settings, target, options, cull=cull, keep_depth=True)
+    stats = _record_visibility(
+        targets, items, view, settings, target, options, cull=cull, keep_depth=True, clear_record=after_direct
+    )
     # The lines of multi-face regions as quads over the record, so that no
     # pixel walks a region's edges (docs/image_model.md §2.6). The Edge
     # Distance pass needs d itself, so with the render passes' outputs the
@@ -462,15 +491,28 @@ def _deferred_surface(targets, items, view: View, settings, target: DrawTarget, 
 
 
 def _record_visibility(
-    targets, items, view: View, settings, target: DrawTarget, options: DrawOptions, *, cull=True, keep_depth=False
+    targets,
+    items,
+    view: View,
+    settings,
+    target: DrawTarget,
+    options: DrawOptions,
+    *,
+    cull=True,
+    keep_depth=False,
+    clear_record=True,
 ):
     """The visibility record of ``items`` into ``targets.visible`` (which
     triangle each pixel shows; depth test, no shading), drawn as ``target``
     says apart from its stage; ``keep_depth`` keeps the depth already in the
-    targets. Returns the DrawStats."""
+    targets, ``clear_record`` False leaves the last record where nothing is
+    drawn now (for a reader that tests depth first). Returns the DrawStats."""
     framebuffer = targets.visibility_framebuffer()
     with framebuffer.bind():
-        _clear(framebuffer, view.width, view.height, depth=not keep_depth)
+        if clear_record or not keep_depth:
+            _clear(framebuffer, view.width, view.height, depth=not keep_depth)
+        else:
+            _no_clear(view.width, view.height)
         record = replace(target, stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=_triangle_ids_by_vertex(options))
         stats = draw_mod.draw(items, view, settings, target=record, cull=cull)
         gpu.state.depth_test_set("NONE")
