@@ -24,8 +24,15 @@ void main()
   }
   int triangle = int(visible.x) - 1;
   sw_instance_id = int(visible.y);
+#ifdef NO_EDGE_SETUP
+  /* Every triangle of the draw takes its lines from the region-lines image
+   * (ShaderVariant.no_edge_setup): of its flags only these two are read
+   * (the rest describe its own edges, which are not set up). */
+  edge_flags = IN_REGION | REGION_LINES;
+#else
   vec2 flag_halves = fetch_texel(triangle_flag_table, triangle).xy;
   edge_flags = int(flag_halves.x) | (int(flag_halves.y) << 12); /* cache.GPUMesh.flag_table */
+#endif
   sw_vertex_id = 3 * triangle + 2;
   solidwire_corner();
 
