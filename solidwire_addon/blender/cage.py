@@ -303,7 +303,7 @@ def _cage_layout(obj, mesh, *, render: bool):
         return None  # not the layout of these copies (a merge, a weld)
     # What _known_regions needs of the cage mesh when it is the object's own.
     cage_mesh = (verts_num, cage_faces_num, faces_num) if own_input else None
-    return cage_children, per_edge, cage, steps, cage_mesh
+    return cage_children, per_edge, cage, steps, cage_mesh, edges
 
 
 def _carried_copies(after, edges, verts_num: int, faces_num: int):
@@ -443,7 +443,7 @@ def cage_edge_mask(obj, mesh, *, render: bool):
     layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
         return None
-    children, _per_edge, _cage, steps, _cage_mesh = layout
+    children, _per_edge, _cage, steps, _cage_mesh, _edges = layout
     if steps:
         return cage_edges(obj, mesh, render=render, layout=layout)[0]
     mask = np.zeros(len(mesh.edges), dtype=bool)
@@ -462,15 +462,16 @@ def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
         layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
         return None
-    children, per_edge, cage, steps, _cage_mesh = layout
+    children, per_edge, cage, steps, _cage_mesh, edges = layout
     known = _known_regions(obj, mesh, layout) if regions else None
-    edges = _read_edges(mesh).astype(np.int64)
-    size = len(edges) if not steps else _subdivided_edge_count(steps, len(edges))
-    index = np.arange(size, dtype=np.int64)
-    mask = index < children
+    size = _subdivided_edge_count(steps, len(edges))
+    mask = np.zeros(size, bool)
+    mask[:children] = True
     ends = edges[:size].copy()
-    ends[:children] = np.repeat(np.asarray(cage, np.int64), per_edge, axis=0)
-    chain = np.where(mask, index // per_edge, -1 - index)
+    ends[:children] = np.repeat(cage, per_edge, axis=0)
+    chain = np.empty(size, np.int32 if size < 2**31 else np.int64)
+    chain[:children] = np.repeat(np.arange(len(cage), dtype=chain.dtype), per_edge)
+    chain[children:] = -1 - np.arange(children, size, dtype=chain.dtype)
     if not steps:
         return mask, chain, ends, known
     return (*_carry(steps, mask, chain, ends), known)
@@ -492,7 +493,7 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | None:
     exactly its children, bounded by the children of its cage edges. The
     cage mesh read here is checked to be the one the layout was peeled to
     (its vertex, face and corner counts and every edge)."""
-    _children, per_edge, cage, steps, cage_mesh = layout
+    _children, per_edge, cage, steps, cage_mesh, _edges = layout
     if cage_mesh is None or any(caps for _copies, _verts, caps in steps):
         return None
     original = getattr(obj, "original", None) or obj

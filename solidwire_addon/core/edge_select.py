@@ -445,11 +445,11 @@ def _select_known_regions(
     label = face_start[:-1]
     seg_owner = np.repeat(label, per_region)
     ends = np.asarray(inputs.chain_ends)
-    seg_verts = verts[edges]
+    seg_a, seg_b = verts[edges, 0], verts[edges, 1]
     table = np.zeros((TEXELS_PER_SEGMENT * len(edges), 4), dtype=np.float32)
-    table[0::2, 0] = seg_verts.min(axis=1)
-    table[0::2, 1] = seg_verts.max(axis=1)
-    table[1::2, :2] = ends[edges]
+    table[0::2, 0] = np.minimum(seg_a, seg_b)
+    table[0::2, 1] = np.maximum(seg_a, seg_b)
+    table[1::2, 0], table[1::2, 1] = ends[edges, 0], ends[edges, 1]
     arrays.region_table = table
     base = len(arrays.ngon_corners)
     region_bits = (per_region.astype(np.int32) << NGON_SHIFT) | np.int32(IN_REGION | REGION_LINES)
@@ -462,7 +462,7 @@ def _select_known_regions(
     pattern = _hidden_pattern(drawn, corner_edge, face_count)
     at = pattern + (flip.view(np.uint8) << np.uint8(4))
     rows = np.repeat(region_bits.astype(np.uint64) * np.uint64(1 | 1 << 32), region_faces)
-    rows |= _listed_quad_rows()[at]
+    rows |= _LISTED_QUAD_ROWS[at]
     flags = arrays.edge_flags
     if flags.dtype == np.int32 and flags.flags.c_contiguous and flags.ctypes.data % 8 == 0:
         flags.view(np.uint64)[:] = rows
@@ -574,7 +574,8 @@ def _line_runs(chain_ends: np.ndarray, style: np.ndarray, region: np.ndarray, pa
     same = np.zeros(count, bool)
     if count > 1:
         same[1:] = (
-            (chain_ends[1:] == chain_ends[:-1]).all(axis=1)
+            (chain_ends[1:, 0] == chain_ends[:-1, 0])
+            & (chain_ends[1:, 1] == chain_ends[:-1, 1])
             & (style[1:] == style[:-1])
             & (region[1:] == region[:-1])
             & (partner[1:] == partner[:-1])
@@ -730,7 +731,12 @@ def _hidden_pattern(drawn: np.ndarray, corner_edge: np.ndarray, face_count: int)
     the quad's corner c is not drawn. The four corners' drawn flags are one
     little-endian 32-bit word of 0/1 bytes; one multiplication gathers their
     bits into the top byte (no partial product carries into it)."""
-    corner_drawn = np.take(np.asarray(drawn, bool), corner_edge)
+    drawn = np.asarray(drawn, bool)
+    count = int(np.count_nonzero(drawn))
+    if drawn[:count].all():  # the drawn edges come first (a subdivision's cage children): a compare, no gather
+        corner_drawn = np.asarray(corner_edge) < count
+    else:
+        corner_drawn = np.take(drawn, corner_edge)
     if not np.little_endian:
         hidden = ~corner_drawn.reshape(face_count, 4)
         return (hidden * np.array([1, 2, 4, 8], np.uint32)).sum(axis=1, dtype=np.uint32)
@@ -747,6 +753,10 @@ def _quad_row_marks():
     clear = h[0] * EDGE0_REAL | h[1] * EDGE1_REAL
     marks = h[0] * EDGE0_HIDDEN | h[1] * (EDGE0_HIDDEN << 1) | h[2] * EDGE3_HIDDEN | h[3] * EDGE4_HIDDEN
     return clear.astype(np.int32), marks.astype(np.int32)
+
+
+# Computed once: the lookup _select_known_regions writes quad rows from.
+_LISTED_QUAD_ROWS = _listed_quad_rows()
 
 
 def _corner_in_polygon(vertex, start, size, corner_vert) -> np.ndarray:
