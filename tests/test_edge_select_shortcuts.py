@@ -176,3 +176,17 @@ def test_concave_quads_split_along_their_other_diagonal(monkeypatch):
     quads = mesh_reading.read_corner_verts(mesh).reshape(-1, 4)
     assert (arrays.triangles[0::2, 0] != quads[:, 0]).any()  # some quads split the other way
     _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+
+
+def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
+    """A modifier before the subdivision (its input is not the object's own
+    mesh) and a cage face whose region is past WALK_LIMIT (a 24-gon at level
+    3: 192 drawn edges) take the regions found from the mesh."""
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene)
+    obj.modifiers.new("Mirror", "MIRROR").use_mirror_merge = False
+    _subdivide(obj, 2)
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
+    cylinder = _cylinder(scene, segments=24)
+    _subdivide(cylinder, 3)
+    _assert_same_as_general(cylinder, CAGE, monkeypatch, rows_expected=True, regions_expected=False)

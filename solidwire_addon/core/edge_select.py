@@ -92,7 +92,7 @@ class KnownRegions:
     ``face_start[k]`` to ``face_start[k + 1] - 1``: consecutive, every face
     in one, each region joined across edges that are not drawn and no such
     edge between two regions. Its drawn edges are
-    ``edges[edge_start[k]:edge_start[k + 1]]``, ascending. The caller
+    ``region_edges[edge_start[k]:edge_start[k + 1]]``, ascending. The caller
     vouches for this and for every edge that is not drawn having exactly two
     face corners (an edge inside a cage face), for the ``drawn`` mask it
     passes with these regions and no edge classes; select_edges checks the
@@ -100,8 +100,8 @@ class KnownRegions:
     itself."""
 
     face_start: np.ndarray  # (R + 1,) ascending, from 0 to the face count
-    edge_start: np.ndarray  # (R + 1,) offsets into ``edges``
-    edges: np.ndarray  # (S,) edge ids
+    edge_start: np.ndarray  # (R + 1,) offsets into ``region_edges``
+    region_edges: np.ndarray  # (S,) edge ids
 
 
 @dataclass
@@ -415,7 +415,7 @@ def _select_known_regions(
     drawn = np.asarray(drawn, bool)
     face_start = np.asarray(regions.face_start, np.int64)
     edge_start = np.asarray(regions.edge_start, np.int64)
-    edges = np.asarray(regions.edges, np.int64)
+    edges = np.asarray(regions.region_edges, np.int64)
     if face_count <= 0 or len(face_start) < 2 or len(edge_start) != len(face_start) or len(drawn) != len(verts):
         return None
     region_faces, per_region = np.diff(face_start), np.diff(edge_start)
@@ -464,7 +464,7 @@ def _select_known_regions(
     rows = np.repeat(region_bits.astype(np.uint64) * np.uint64(1 | 1 << 32), region_faces)
     rows |= _LISTED_QUAD_ROWS[at]
     flags = arrays.edge_flags
-    if flags.dtype == np.int32 and flags.flags.c_contiguous and flags.ctypes.data % 8 == 0:
+    if flags.dtype == np.int32 and flags.flags.c_contiguous:
         flags.view(np.uint64)[:] = rows
     else:
         flags[:] = rows.view(np.int32)
