@@ -473,8 +473,28 @@ def _select_known_regions(
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
     stats.segments = len(edges)
-    _region_line_table(arrays, verts, None, ends, np.stack([seg_owner, edges], axis=1), stats)
+    _known_region_lines(arrays, verts, ends, seg_owner, edges, stats)
     return stats
+
+
+def _known_region_lines(arrays: MeshArrays, verts, ends, seg_owner, edges, stats: SelectionStats) -> None:
+    """_region_line_table for the blocks of _select_known_regions (owners
+    ascending, no class). Where no edge bounds more than two regions (a
+    manifold cage) each edge is one entry, its first region the one that
+    lists it first and its partner the one that lists it last: found by
+    two scatters instead of a sort."""
+    counts = np.bincount(edges)
+    if counts.max() > 2:
+        _region_line_table(arrays, verts, None, ends, np.stack([seg_owner, edges], axis=1), stats)
+        return
+    edge = np.flatnonzero(counts)
+    first = np.empty(len(counts), seg_owner.dtype)
+    first[edges[::-1]] = seg_owner[::-1]  # the last write is the first listing's
+    last = np.empty(len(counts), seg_owner.dtype)
+    last[edges] = seg_owner
+    region = first[edge]
+    partner = np.where(counts[edge] == 2, last[edge], -1)
+    _write_region_lines(arrays, verts, ends, np.zeros(len(edge), np.int64), edge, region, partner, stats)
 
 
 def _listed_quad_rows() -> np.ndarray:
@@ -548,15 +568,23 @@ def _region_line_table(arrays: MeshArrays, verts, classes, ends, pairs, stats: S
     # (_line_runs).
     order = np.argsort(style, kind="stable")
     style, edge, region, partner = style[order], edge[order], region[order], partner[order]
+    _write_region_lines(arrays, verts, ends, style, edge, region, partner, stats)
+
+
+def _write_region_lines(arrays: MeshArrays, verts, ends, style, edge, region, partner, stats: SelectionStats) -> None:
+    """``region_lines`` and its runs from its entries in table order: each
+    entry's style, edge, region and partner region (-1: none)."""
     table = np.zeros((TEXELS_PER_REGION_LINE * len(edge), 4), np.float32)
-    table[0::2, 0] = np.minimum(verts[edge, 0], verts[edge, 1])
-    table[0::2, 1] = np.maximum(verts[edge, 0], verts[edge, 1])
+    lower, upper = verts[edge, 0], verts[edge, 1]
+    table[0::2, 0] = np.minimum(lower, upper)
+    table[0::2, 1] = np.maximum(lower, upper)
     table[0::2, 2] = style
     table[0::2, 3] = region
-    table[1::2, 0], table[1::2, 1] = ends[edge, 0], ends[edge, 1]
+    edge_ends = ends[edge]
+    table[1::2, 0], table[1::2, 1] = edge_ends[:, 0], edge_ends[:, 1]
     table[1::2, 2] = np.where(partner >= 0, partner, NO_REGION)
     arrays.region_lines = table
-    arrays.region_line_runs, arrays.region_run_segments = _line_runs(ends[edge], style, region, partner)
+    arrays.region_line_runs, arrays.region_run_segments = _line_runs(edge_ends, style, region, partner)
     stats.region_lines = len(edge)
 
 
