@@ -452,24 +452,25 @@ def _select_known_regions(
     table[0::2, 1] = np.maximum(seg_verts[:, 0], seg_verts[:, 1])
     table[1::2, 0], table[1::2, 1] = seg_ends[:, 0], seg_ends[:, 1]
     arrays.region_table = table
-    base = len(arrays.ngon_corners)
-    region_bits = (per_region.astype(np.int32) << NGON_SHIFT) | np.int32(IN_REGION | REGION_LINES)
-    region_table_start = (base + TEXELS_PER_SEGMENT * edge_start[:-1]).astype(np.int32)
+    region_table_start = (len(arrays.ngon_corners) + TEXELS_PER_SEGMENT * edge_start[:-1]).astype(np.int32)
 
-    # Each quad's two rows in one 64-bit write (row 2i the low half): their
-    # final flags are the row lookup of _mark_quad_rows for the quad's
-    # hidden edges and split, with the bits a listed face drops cleared,
-    # and its block's bits.
-    pattern = _hidden_pattern(drawn, corner_edge, face_count)
-    at = pattern + (flip.view(np.uint8) << np.uint8(4))
-    rows = np.repeat(region_bits.astype(np.uint64) * np.uint64(1 | 1 << 32), region_faces)
-    rows |= np.take(_LISTED_QUAD_ROWS, at)
+    # Each quad's two rows in one 64-bit write (row 2i the low half), looked
+    # up by its block's segment count, its split and its hidden edges
+    # (_listed_quad_rows); written in place, as a million-row temporary
+    # costs more in fresh pages than the arithmetic.
+    at = _hidden_pattern(drawn, corner_edge, face_count)
+    at |= flip.view(np.uint8) << np.uint8(4)
+    at |= np.repeat((per_region << 5).astype(np.uint32), region_faces)
     flags = arrays.edge_flags
     if flags.dtype == np.int32 and flags.flags.c_contiguous:
-        flags.view(np.uint64)[:] = rows
+        np.take(_LISTED_QUAD_ROWS, at, out=flags.view(np.uint64), mode="clip")
     else:
-        flags[:] = rows.view(np.int32)
-    arrays.triangles[:, 3] = np.repeat(region_table_start, 2 * region_faces)
+        flags[:] = np.take(_LISTED_QUAD_ROWS, at).view(np.int32)
+    face_table_start = np.repeat(region_table_start, region_faces)
+    if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one (2, 4) block
+        arrays.triangles.reshape(face_count, 2, 4)[:, :, 3] = face_table_start[:, None]
+    else:
+        arrays.triangles[:, 3] = np.repeat(face_table_start, 2)
     arrays.triangle_regions = np.repeat(label.astype(np.float32), 2 * region_faces)
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
@@ -499,11 +500,12 @@ def _known_region_lines(arrays: MeshArrays, verts, ends, seg_owner, edges, stats
 
 
 def _listed_quad_rows() -> np.ndarray:
-    """(32,) uint64 indexed by 16 * split + hidden-edge pattern (see
-    _mark_quad_rows): a listed quad's two rows' flags, row 2i in the low 32
-    bits, before its block's bits: the row marks of _quad_row_marks applied
-    to a quad row's flags, less what a listed face drops (its quad edges
-    are in its block)."""
+    """(32 * (WALK_LIMIT + 1),) uint64 indexed by 32 * block segments + 16 *
+    split + hidden-edge pattern (see _mark_quad_rows): a listed quad's two
+    rows' flags, row 2i in the low 32 bits: the row marks of
+    _quad_row_marks applied to a quad row's flags, less what a listed face
+    drops (its quad edges are in its block), with its block's bits (the
+    segment count, IN_REGION and REGION_LINES) as select_edges sets them."""
     clear_of, marks_of = _quad_row_marks()
     quad_row = EDGE0_REAL | EDGE1_REAL | HAS_QUAD_CORNER
     row = ((quad_row & ~clear_of) | marks_of) & ~LISTED_FACE_DROPS  # indexed by 16 * first corner + pattern
@@ -511,7 +513,10 @@ def _listed_quad_rows() -> np.ndarray:
     # Not split: rows from corners 0 and 2; split: from corners 3 and 1.
     even = np.concatenate([row[pattern], row[48 + pattern]]).astype(np.uint64)
     odd = np.concatenate([row[32 + pattern], row[16 + pattern]]).astype(np.uint64)
-    return even | (odd << np.uint64(32))
+    segments = np.arange(WALK_LIMIT + 1, dtype=np.uint64)
+    block = (segments << np.uint64(NGON_SHIFT)) | np.uint64(IN_REGION | REGION_LINES)
+    both = np.uint64(1 | 1 << 32)
+    return ((even | (odd << np.uint64(32)))[None, :] | (block * both)[:, None]).reshape(-1)
 
 
 def _one_per_class(bits: np.ndarray, *columns: np.ndarray):
@@ -769,8 +774,11 @@ def _hidden_pattern(drawn: np.ndarray, corner_edge: np.ndarray, face_count: int)
     if not np.little_endian:
         hidden = ~corner_drawn.reshape(face_count, 4)
         return (hidden * np.array([1, 2, 4, 8], np.uint32)).sum(axis=1, dtype=np.uint32)
-    words = corner_drawn.view(np.uint32)
-    return ((words ^ np.uint32(0x01010101)) * np.uint32(0x01020408)) >> np.uint32(24)
+    words = corner_drawn.view(np.uint32)  # a fresh array: changed in place
+    words ^= np.uint32(0x01010101)
+    words *= np.uint32(0x01020408)
+    words >>= np.uint32(24)
+    return words
 
 
 def _quad_row_marks():
