@@ -456,8 +456,7 @@ def _select_known_regions(
 
     # Each quad's two rows in one 64-bit write (row 2i the low half), looked
     # up by its block's segment count, its split and its hidden edges
-    # (_listed_quad_rows); written in place, as a million-row temporary
-    # costs more in fresh pages than the arithmetic.
+    # (_listed_quad_rows), written in place: no million-row temporaries.
     at = _hidden_pattern(drawn, corner_edge, face_count)
     at |= flip.view(np.uint8) << np.uint8(4)
     at |= np.repeat((per_region << 5).astype(np.uint32), region_faces)
