@@ -414,27 +414,21 @@ def _copies_match(steps, edges, size: int) -> bool:
     return size == len(edges)
 
 
-def _carry(steps, mask, chain, ends):
-    """Follow the subdivided mesh's (drawn mask, chain id, chain ends)
-    through the copies of ``steps`` (_carried_copies): each copy keeps its
-    edges' marks, its chains (new ids) and its ends (shifted with its
-    vertices); a cap's edges are their own chains."""
+def _carry(steps, mask, ends):
+    """Follow the subdivided mesh's (drawn mask, chain ends) through the
+    copies of ``steps`` (_carried_copies): each copy keeps its edges' marks
+    and its ends (shifted with its vertices); a cap's edges are their own
+    chains (their own ends)."""
     for copies, verts_in, caps in steps:
         size = len(mask)
         ends = (np.broadcast_to(ends, (copies, size, 2)) + (np.arange(copies) * verts_in)[:, None, None]).reshape(-1, 2)
-        ids = np.broadcast_to(chain, (copies, size))
-        chain = np.where(ids >= 0, ids + (np.arange(copies) * size)[:, None], -1).reshape(-1)
         mask = np.tile(mask, copies)
         first_vertex = copies * verts_in
         for cap_edges, cap_verts, cap_mask in caps:
             ends = np.concatenate([ends, cap_edges + first_vertex])
             mask = np.concatenate([mask, cap_mask])
-            chain = np.concatenate([chain, np.full(len(cap_edges), -1, np.int64)])
             first_vertex += cap_verts
-    # Every edge that is no piece of a longer one: a chain of its own.
-    alone = chain < 0
-    chain[alone] = -1 - np.flatnonzero(alone)
-    return mask, chain, ends
+    return mask, ends
 
 
 def cage_edge_mask(obj, mesh, *, render: bool):
@@ -452,12 +446,13 @@ def cage_edge_mask(obj, mesh, *, render: bool):
 
 
 def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
-    """(drawn mask, chain id per edge, (E, 2) chain ends per edge, regions)
-    for core/edge_select.py, or None: the children of one cage edge share a
-    chain id and ends, so the density fade measures the whole cage edge,
-    not its pieces (an edge that is no cage child is its own chain).
-    ``regions``: also the regions of that mask as the layout gives them
-    (_known_regions; None where it cannot tell), else None."""
+    """(drawn mask, None, (E, 2) chain ends per edge, regions) for
+    core/edge_select.py (its EdgeInputs: no chain ids, as the ends say
+    which edges are pieces of one), or None: the children of one cage edge
+    share their chain's ends, so the density fade measures the whole cage
+    edge, not its pieces (an edge that is no cage child is its own chain,
+    its own ends). ``regions``: also the regions of that mask as the layout
+    gives them (_known_regions; None where it cannot tell), else None."""
     if layout is None:
         layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
@@ -469,12 +464,9 @@ def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
     mask[:children] = True
     ends = edges[:size].copy()
     ends[:children] = np.repeat(cage, per_edge, axis=0)
-    chain = np.empty(size, np.int32 if size < 2**31 else np.int64)
-    chain[:children] = np.repeat(np.arange(len(cage), dtype=chain.dtype), per_edge)
-    chain[children:] = -1 - np.arange(children, size, dtype=chain.dtype)
-    if not steps:
-        return mask, chain, ends, known
-    return (*_carry(steps, mask, chain, ends), known)
+    if steps:
+        mask, ends = _carry(steps, mask, ends)
+    return mask, None, ends, known
 
 
 def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | None:
