@@ -474,28 +474,38 @@ def _select_known_regions(
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
     stats.segments = len(edges)
-    _known_region_lines(arrays, verts, ends, seg_owner, edges, stats)
+    _known_region_lines(arrays, verts, ends, table, seg_ends, seg_owner, edges, stats)
     return stats
 
 
-def _known_region_lines(arrays: MeshArrays, verts, ends, seg_owner, edges, stats: SelectionStats) -> None:
-    """_region_line_table for the blocks of _select_known_regions (owners
-    ascending, no class). Where no edge bounds more than two regions (a
-    manifold cage) each edge is one entry, its first region the one that
-    lists it first and its partner the one that lists it last: found by
-    two scatters instead of a sort."""
+def _known_region_lines(arrays: MeshArrays, verts, ends, table, seg_ends, seg_owner, edges, stats) -> None:
+    """_region_line_table for the blocks of _select_known_regions (``table``
+    its block rows, owners ascending, no class). Where no edge bounds more
+    than two regions (a manifold cage) each edge is one entry, its region
+    the one that lists it first and its partner the one that lists it last:
+    found by two scatters instead of a sort, and its texels are its first
+    listing's block texels with the regions filled in."""
     counts = np.bincount(edges)
     if counts.max() > 2:
         _region_line_table(arrays, verts, None, ends, np.stack([seg_owner, edges], axis=1), stats)
         return
     edge = np.flatnonzero(counts)
-    first = np.empty(len(counts), seg_owner.dtype)
-    first[edges[::-1]] = seg_owner[::-1]  # the last write is the first listing's
-    last = np.empty(len(counts), seg_owner.dtype)
-    last[edges] = seg_owner
-    region = np.take(first, edge)
-    partner = np.where(np.take(counts, edge) == 2, np.take(last, edge), -1)
-    _write_region_lines(arrays, verts, ends, np.zeros(len(edge), np.int64), edge, region, partner, stats)
+    listing = np.arange(len(edges))
+    first = np.empty(len(counts), np.intp)
+    first[edges[::-1]] = listing[::-1]  # the last write is the first listing's
+    last = np.empty(len(counts), np.intp)
+    last[edges] = listing
+    first, last = np.take(first, edge), np.take(last, edge)
+    region = np.take(seg_owner, first)
+    partner = np.where(first != last, np.take(seg_owner, last), -1)
+    lines = np.take(table.reshape(-1, TEXELS_PER_SEGMENT * 4), first, axis=0)
+    lines[:, 3] = region
+    lines[:, 6] = np.where(partner >= 0, partner, NO_REGION)
+    arrays.region_lines = lines.reshape(-1, 4)
+    style = np.zeros(len(edge), np.int64)
+    runs = _line_runs(np.take(seg_ends, first, axis=0), style, region, partner)
+    arrays.region_line_runs, arrays.region_run_segments = runs
+    stats.region_lines = len(edge)
 
 
 def _listed_quad_rows() -> np.ndarray:
