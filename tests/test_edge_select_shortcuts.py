@@ -1,11 +1,13 @@
 """Edge selection's shortcuts for a subdivision's layout give the general
-path's arrays bit for bit (core/edge_select.py): region labels found over
-runs of consecutive joined faces against the components of the faces
-themselves, and a quad-only mesh's hidden-edge marks by row lookup against
-the search by vertex pair. On real evaluated meshes: Suzanne's cage at
-levels 1-5, an n-gon cage, Mirror and Array copies after the subdivision,
-and meshes where the quad-row check must refuse (triangles and n-gons under
-the edge angle, a subdivision whose quads a modifier triangulated)."""
+path's arrays bit for bit (core/edge_select.py): the regions the cage
+layout gives (blender/cage.py) written per region, region labels found over
+runs of consecutive joined faces, and a quad-only mesh's hidden-edge marks
+by row lookup, each against the components of the faces themselves and the
+search by vertex pair. On real evaluated meshes: Suzanne's cage at levels
+1-5, an n-gon cage, Multiresolution, Mirror and Array copies after the
+subdivision, and meshes where a shortcut must refuse (triangles and n-gons
+under the edge angle, a subdivision whose quads a modifier triangulated, a
+modifier before the subdivision, a cage face past the walk limit)."""
 
 from __future__ import annotations
 
@@ -190,3 +192,17 @@ def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
     cylinder = _cylinder(scene, segments=24)
     _subdivide(cylinder, 3)
     _assert_same_as_general(cylinder, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
+
+
+def test_multires_cage(monkeypatch):
+    """Multiresolution subdivides through the same layout as Subdivision
+    Surface: its cage regions give the general path's arrays too."""
+    import bpy
+
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene)
+    modifier = obj.modifiers.new("Multires", "MULTIRES")
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        for _ in range(2):
+            bpy.ops.object.multires_subdivide(modifier=modifier.name, mode="CATMULL_CLARK")
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
