@@ -329,8 +329,9 @@ def apply_edge_selection(
     cage: tuple | None = None,
 ) -> SelectionStats:
     """Read ``mesh``'s edges and apply ``selection`` to ``arrays``
-    (core.edge_select.select_edges). ``cage``: (drawn mask, chain ids[, chain
-    ends[, regions]]) of the evaluated edges from the cage detection, or
+    (core.edge_select.select_edges). ``cage``: (drawn mask, chain ids or
+    None[, chain ends[, regions]]) of the evaluated edges from the cage
+    detection (blender/cage.py) or an outline mask (blender/outlines.py), or
     None (no subdivision, or cage edges off). The regions (KnownRegions) are
     those of the mask alone: used only where nothing else hides an edge."""
     verts, corner_edge = read_edge_topology(mesh)
