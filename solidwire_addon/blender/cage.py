@@ -490,7 +490,7 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | None:
         return None
     original = getattr(obj, "original", None) or obj
     data = getattr(original, "data", None)
-    if getattr(original, "mode", "OBJECT") == "EDIT" or data is None:
+    if getattr(original, "type", None) != "MESH" or data is None or getattr(original, "mode", "OBJECT") == "EDIT":
         return None
     verts_num, faces_num, sub_faces_num = cage_mesh
     children_per_corner = (per_edge // 2) ** 2  # 4**(L-1)
