@@ -140,38 +140,74 @@ def test_material_preview_and_blender_only_occluder():
     assert np.abs(alpha[outside] - without[..., 3][outside]).max() <= 1.0 / 255.0 + 1e-9
 
 
-def test_the_record_is_reused_until_something_changes():
-    """A redraw that changes nothing resolves the kept record and draws the
-    same image; another setting, a moved vertex, a moved object or another
-    view records again; every frame equals a fresh one."""
+def _path(stats) -> str:
+    """How the frame drew its deferred surface (passes._overlay_surface)."""
+    paths = [name for name in ("surface_straight", "record_reused", "surface_reused") if stats.get(name)]
+    assert len(paths) == 1, stats
+    return paths[0]
+
+
+def test_what_is_kept_between_redraws():
+    """A redraw after a change (the first one, another setting, a moved
+    vertex, a moved object, another view) records again and resolves
+    straight into Blender's buffer; the next redraw that changes nothing
+    resolves the kept record into an image it keeps, and the ones after
+    only composite that image. Every frame equals a fresh one."""
     scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
     front, _back = objects
 
     def frame():
         rgba, stats = _draw(scene, objects)
-        return rgba, bool(stats.get("surface_reused"))
+        return rgba, _path(stats)
 
-    first, reused = frame()
-    assert not reused
-    again, reused = frame()
-    assert reused and np.array_equal(first, again)
+    first, path = frame()
+    assert path == "surface_straight"
+    again, path = frame()
+    assert path == "record_reused" and np.array_equal(first, again)
+    third, path = frame()
+    assert path == "surface_reused" and np.array_equal(first, third)
     scene.solidwire.thickness = 3.0
-    thicker, reused = frame()
-    assert not reused and not np.array_equal(first, thicker)
+    thicker, path = frame()
+    assert path == "surface_straight" and not np.array_equal(first, thicker)
     front.data.vertices[0].co.z += 0.3
     front.data.update()
-    edited, reused = frame()
-    assert not reused and not np.array_equal(thicker, edited)
+    edited, path = frame()
+    assert path == "surface_straight" and not np.array_equal(thicker, edited)
+    front.data.vertices[0].co.z += 0.1  # a drag: every redraw an edit
+    front.data.update()
+    dragged, path = frame()
+    assert path == "surface_straight" and not np.array_equal(edited, dragged)
+    kept, path = frame()
+    assert path == "record_reused" and np.array_equal(dragged, kept)
     front.location.x += 0.1
-    moved, reused = frame()
-    assert not reused and not np.array_equal(edited, moved)
+    moved, path = frame()
+    assert path == "surface_straight" and not np.array_equal(dragged, moved)
     runtime.mesh_cache.clear()
-    fresh, _reused = frame()
-    assert np.array_equal(moved, fresh)
+    fresh, path = frame()
+    assert path == "surface_straight" and np.array_equal(moved, fresh)
     scene.camera.location.z += 0.5
-    other_view, reused = frame()
-    assert not reused and not np.array_equal(moved, other_view)
+    other_view, path = frame()
+    assert path == "surface_straight" and not np.array_equal(moved, other_view)
     _assert_matches_reference(scene, other_view[..., 3])
+
+
+def test_cage_look_alike_on_every_path():
+    """The cage look (multi-face regions: their lines drawn over the record,
+    docs/image_model.md §2.6), Suzanne-like dense: resolved straight, resolved
+    from the kept record and composited from the kept image, the same image,
+    which matches the reference."""
+    scene = scenes.empty_scene(WIDTH, HEIGHT, use_cage_edges=True, thickness=1.5)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    modifier = cube.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = modifier.render_levels = 3
+    images = []
+    for expected in ("surface_straight", "record_reused", "surface_reused"):
+        rgba, stats = _draw(scene, [cube])
+        assert _path(stats) == expected and stats.get("region_line_entries", 0) > 0
+        images.append(rgba)
+    assert all(np.array_equal(images[0], image) for image in images[1:])
+    _assert_matches_reference(scene, images[0][..., 3])
 
 
 def test_clipping_region_and_hidden_lines_stay_direct(monkeypatch):
@@ -209,3 +245,33 @@ def test_a_refused_stage_falls_back_to_the_direct_pass(monkeypatch, capsys):
     assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
     assert np.array_equal(got, expected)
     assert "deferred surface pass is not available" in capsys.readouterr().err
+
+
+def test_a_refused_straight_resolve_draws_directly(monkeypatch, capsys):
+    """A backend that refuses the resolve straight into Blender's buffer
+    draws those meshes directly instead (the direct pass's image), with one
+    message, and draws directly from then on."""
+    from solidwire_addon.core import log, shaders
+
+    log.forget()
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
+    expected, _stats = _draw(scene, objects)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=True))
+    monkeypatch.setattr(shaders, "_deferred_support", [True])
+    real_get = shaders.get
+
+    def refuse_straight(variant):
+        if variant.record_depth:
+            raise shaders.DeferredUnavailable("straight resolve refused")
+        return real_get(variant)
+
+    monkeypatch.setattr(shaders, "get", refuse_straight)
+    got, stats = _draw(scene, objects)
+    assert stats["objects_drawn"] == 2
+    assert not shaders.deferred_available()
+    assert np.abs(got - expected).max() <= 1.0 / 255.0 + 1e-9
+    assert "deferred surface pass is not available" in capsys.readouterr().err
+    calls = _stages(monkeypatch)
+    _draw(scene, objects)
+    assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls

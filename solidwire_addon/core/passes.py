@@ -111,9 +111,9 @@ class Frame:
     region_lines: object = None
     line_stats: DrawStats = field(default_factory=DrawStats)
     # The sync step's split (_sync_overlay_surface): items drawn directly,
-    # and the overlay targets holding the deferred ones' resolved image.
+    # and the deferred ones' OverlaySurface.
     direct: list | None = None
-    overlay_surface: object = None
+    overlay_surface: OverlaySurface | None = None
 
     def overlay_stats(self) -> DrawStats:
         """The surface pass's DrawStats over the viewport, with what the
@@ -216,7 +216,7 @@ class SurfacePass(RenderPass):
             return
         frame.stats = draw_mod.draw(frame.direct, view, self.settings, target=_with_lines(base, self.wire))
         if frame.overlay_surface is not None:
-            _composite_overlay_surface(frame.overlay_surface, frame.base.depth_bias)
+            _draw_overlay_surface(frame, _with_lines(base, self.wire))
             frame.stats.add(frame.line_stats)
 
 
@@ -552,10 +552,10 @@ def _sync_overlay_surface(frame: Frame) -> None:
     """The overlay's sync step: where Blender's depth holds every surface
     and the frame is the surface pass alone (silhouettes may follow), the
     meshes dense on screen (OVERLAY_DEFERRED_MIN_DENSITY, and every mesh
-    with multi-face regions) are recorded and resolved into the overlay's
-    own targets (_overlay_surface); the rest stays in ``frame.direct``. A
-    deferred stage the backend refuses falls back to drawing directly, said
-    once."""
+    with multi-face regions) are recorded into the overlay's own targets
+    (_overlay_surface) for the surface pass to draw (_draw_overlay_surface);
+    the rest stays in ``frame.direct``. A deferred stage the backend
+    refuses falls back to drawing directly, said once."""
     frame.direct = list(frame.items)
     if not (frame.scene_depth and frame.scene_surfaces and _overlay_defers(frame)):
         return
@@ -568,12 +568,14 @@ def _sync_overlay_surface(frame: Frame) -> None:
         frame.overlay_surface = _overlay_surface(deferred, frame.view, frame.settings, frame.base.display, frame)
         frame.direct = direct
     except shaders.DeferredUnavailable as exc:
-        shaders.disable_deferred()
-        warn_once(
-            ("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly"
-        )
+        _refused(exc)
     finally:
         gpu.state.viewport_set(*saved_viewport)
+
+
+def _refused(exc: Exception) -> None:
+    shaders.disable_deferred()
+    warn_once(("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly")
 
 
 def _overlay_defers(frame: Frame) -> bool:
@@ -595,18 +597,43 @@ def _overlay_defers(frame: Frame) -> bool:
     )
 
 
-def _overlay_surface(items, view: View, settings, display, frame: Frame):
-    """The deferred overlay's surface, into the overlay's own targets at
-    the viewport's size: the visibility record of ``items`` over a depth
-    buffer of its own (window depth, as Blender's), the region lines over
-    it when a mesh has multi-face regions (docs/image_model.md §2.5, §2.6),
-    then the resolve into ``targets.surface``. Returns the targets, for
-    _composite_overlay_surface; ``frame.line_stats`` gets the draws' counts.
+@dataclass
+class OverlaySurface:
+    """The deferred overlay's surface of one frame (_overlay_surface): the
+    deferred ``items``, the overlay's ``targets`` holding their record,
+    their region-lines image ``lines`` (None without multi-face regions),
+    and whether ``targets.surface`` holds their resolved image (``kept``:
+    the surface pass composites it) or not (the surface pass resolves the
+    record straight into Blender's buffer)."""
 
-    Nothing here reads Blender's buffers, so a redraw that changes nothing
-    the image depends on (the view, the settings, which meshes in which
-    shape where, their styles and colour sources, the display transform;
-    _overlay_lines_key) reuses it whole: a static redraw only composites."""
+    targets: object
+    items: list
+    lines: object
+    kept: bool
+
+
+def _overlay_surface(items, view: View, settings, display, frame: Frame) -> OverlaySurface:
+    """The deferred overlay's surface, in the overlay's own targets at the
+    viewport's size: the visibility record of ``items`` over a depth buffer
+    of its own (window depth, as Blender's), and the region lines over it
+    when a mesh has multi-face regions (docs/image_model.md §2.5, §2.6);
+    ``frame.line_stats`` gets the draws' counts.
+
+    Nothing here reads Blender's buffers, so what it draws depends only on
+    its key (the view, the settings, which meshes in which shape where,
+    their styles and colour sources, the display transform;
+    _overlay_lines_key), and what was drawn for the last key is kept:
+
+    * the resolved image of this key: the surface pass only composites it
+      (a static redraw);
+    * the record and lines of this key (the redraw before had the same
+      key): they are resolved into ``targets.surface`` now and kept, so
+      from the next redraw on a static redraw only composites;
+    * neither (an edit, a move, another view): record and lines again, and
+      the surface pass resolves them straight into Blender's buffer. That
+      costs what a resolve into our own target costs and saves the
+      composite, while an image kept for a key that changes at every
+      redraw (a drag, an orbit) is never used."""
     targets = overlay_targets_for(view.width, view.height)
     key = _overlay_lines_key(items, view, settings)
     if key is not None:
@@ -623,23 +650,64 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame):
             record_stats.extra.update(region_line_entries=line_count, region_lines_reused=1)
         record_stats.extra["surface_reused"] = 1
         frame.line_stats.add(record_stats)
-        return targets
-    targets.lines_key = targets.surface_key = None
-    width, height = view.width, view.height
-    _record_visibility(targets, items, view, settings, DrawTarget(), frame.options)
-    lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats) if line_count else None
+        return OverlaySurface(targets, items, targets.lines if line_count else None, kept=True)
+    lines = targets.lines if line_count else None
+    if key is not None and targets.lines_key == key:
+        if line_count:
+            record_stats.extra.update(region_line_entries=line_count, region_lines_reused=1)
+        record_stats.extra["record_reused"] = 1
+    else:
+        targets.lines_key = targets.surface_key = None
+        _record_visibility(targets, items, view, settings, DrawTarget(), frame.options)
+        if line_count:
+            lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats)
+        # (One key for the record, its lines and the resolved image: the
+        # direct path's own region lines (_overlay_region_lines) never
+        # match it.)
+        targets.lines_key = key
+        frame.line_stats.add(record_stats)
+        return OverlaySurface(targets, items, lines, kept=False)
     with targets.surface_framebuffer().bind():
-        gpu.state.viewport_set(0, 0, width, height)
+        gpu.state.viewport_set(0, 0, view.width, view.height)
         gpu.state.blend_set("NONE")
         resolve = DrawTarget(stage=draw_mod.RESOLVE, visibility=targets.visible, region_lines=lines, display=display)
         record_stats.add(draw_mod.draw(items, view, settings, target=resolve))
-    # (One key for the record, its lines and the resolved image: the
-    # direct path's own region lines (_overlay_region_lines) never match it.)
-    targets.lines_key = targets.surface_key = key
+    targets.surface_key = key
     targets.surface_rect = draw_mod.window_union(items, view)
     targets.surface_counts = (record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn)
     frame.line_stats.add(record_stats)
-    return targets
+    return OverlaySurface(targets, items, lines, kept=True)
+
+
+def _draw_overlay_surface(frame: Frame, target: DrawTarget) -> None:
+    """The deferred meshes (``frame.overlay_surface``) into the bound
+    framebuffer (Blender's), each pixel at the record's depth less the
+    bias, depth test LESS_EQUAL and write, blended as the caller set
+    (premultiplied "over"): the kept image composited, or the record
+    resolved straight. The two give the same image: the kept image is
+    float32, resolved by the same fragment code. A backend that refuses the
+    straight resolve draws these meshes directly (``target``, walking their
+    regions), said once."""
+    surface = frame.overlay_surface
+    targets = surface.targets
+    if surface.kept:
+        _composite_overlay_surface(targets, frame.base.depth_bias)
+        return
+    resolve = DrawTarget(
+        stage=draw_mod.RESOLVE,
+        visibility=targets.visible,
+        region_lines=surface.lines,
+        display=frame.base.display,
+        depth_bias=frame.base.depth_bias,
+        record_depth=targets.depth,
+    )
+    try:
+        stats = draw_mod.draw(surface.items, frame.view, frame.settings, target=resolve)
+        stats.extra["surface_straight"] = 1
+    except shaders.DeferredUnavailable as exc:
+        _refused(exc)
+        stats = draw_mod.draw(surface.items, frame.view, frame.settings, target=replace(target, region_lines=None))
+    frame.line_stats.add(stats)
 
 
 def _composite_overlay_surface(targets, depth_bias: float) -> None:
