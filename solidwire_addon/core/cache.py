@@ -348,16 +348,26 @@ class GPUMesh:
             )
         ):
             return None
-        vertex_moved = (local != old).any(axis=1)
-        triangles = np.asarray(self.triangles_cpu)[:, :3].astype(np.int64)
-        triangle_changed = vertex_moved[triangles].any(axis=1)
+        # Column-wise ORs and whole-row compares: numpy reduces the short
+        # axis of an (N, 3) array slowly.
+        differs = (local != old).view(np.uint8)
+        vertex_moved = (differs[:, 0] | differs[:, 1] | differs[:, 2]).view(bool)
+        triangles = self.triangles_cpu
+        corner_vertices = [triangles[:, k] for k in range(3)]
+
+        def touching(vertex_mask):
+            return vertex_mask[corner_vertices[0]] | vertex_mask[corner_vertices[1]] | vertex_mask[corner_vertices[2]]
+
+        triangle_changed = touching(vertex_moved)
         if corners is not None:
             if old_corners is None or old_corners.shape != corners.shape:
                 return None
-            rows = np.flatnonzero((old_corners != corners).any(axis=1))
+            # (A row is 16 bytes: one complex128 compare per row; a NaN
+            # compares unequal, which only redraws more.)
+            rows = np.flatnonzero(_row_view(old_corners) != _row_view(corners))
             if self.normal_domain == NORMALS_BY_VERTEX:
                 vertex_moved[rows] = True
-                triangle_changed |= vertex_moved[triangles].any(axis=1)
+                triangle_changed = touching(vertex_moved)
             elif self.normal_domain == NORMALS_BY_TRIANGLE:
                 triangle_changed[rows] = True
             else:
@@ -367,11 +377,16 @@ class GPUMesh:
         polygons = np.asarray(self.triangle_polygons_cpu)
         touched = np.zeros(int(polygons.max(initial=-1)) + 1, dtype=bool)
         touched[polygons[triangle_changed]] = True
-        vertices = np.unique(triangles[touched[polygons]])
+        vertices = np.unique(triangles[touched[polygons], :3])
         if not len(vertices):
             return (None,)
         points = np.concatenate([old[vertices], local[vertices]]).astype(np.float64) + np.asarray(self.centre)
         return ((points.min(axis=0), points.max(axis=0)),)
+
+
+def _row_view(table: np.ndarray) -> np.ndarray:
+    """An (N, 4) float32 table as N complex128 values, one per row."""
+    return np.ascontiguousarray(table, dtype=np.float32).view(np.complex128).reshape(-1)
 
 
 class MeshCache:
