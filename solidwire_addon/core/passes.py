@@ -746,12 +746,6 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame) -> Over
     return OverlaySurface(targets, items, lines, kept=True)
 
 
-# An edit redraws the kept image only where it changed while that is at
-# most this share of the view; past it, recording everything and resolving
-# straight into Blender's buffer costs less (no composite).
-OVERLAY_PARTIAL_MAX_SHARE = 0.5
-
-
 def _moved_items(before_key, key, items):
     """[(item, the move)] for the items whose mesh moved vertices since
     ``before_key`` was drawn, when that is all that changed: every other
@@ -783,10 +777,10 @@ def _redraw_rect(moved, view: View, settings, items):
     """The window rectangle (x, y, width, height) that the moves ``moved``
     (_moved_items) changed: each box's window box widened by the reach of
     the widest line (docs/image_model.md §3.1: nothing farther than h + 2s
-    from a line sees it); () where nothing changed; None where that is not
-    worth it (over OVERLAY_PARTIAL_MAX_SHARE of the view) or cannot be told
-    (widths not in pixels; the density fade, whose lines fade by the
-    length of whole chains)."""
+    from a line sees it); () where nothing changed; None where that cannot
+    be told (a move not known, widths not in pixels, the density fade,
+    whose lines fade by the length of whole chains). (However big, it costs
+    no more than recording and resolving everything again.)"""
     reach = _line_reach_px(settings, items)
     if reach is None or any(box is UNKNOWN_MOVE for _item, box in moved):
         return None
@@ -802,8 +796,6 @@ def _redraw_rect(moved, view: View, settings, items):
     y1 = min(int(np.ceil((ndc[:, 3].max() + 1.0) * 0.5 * height + reach)), height)
     if x1 <= x0 or y1 <= y0:
         return ()
-    if (x1 - x0) * (y1 - y0) > OVERLAY_PARTIAL_MAX_SHARE * width * height:
-        return None
     return (x0, y0, x1 - x0, y1 - y0)
 
 
