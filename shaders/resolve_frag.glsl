@@ -22,6 +22,11 @@ void main()
   if (visible.z != float(draw_number)) {
     discard; /* nothing, or another draw's triangle */
   }
+#ifdef RECORD_DEPTH
+  /* Straight into Blender's buffer (viewport overlay): the record's window
+   * depth less the bias, as overlay_composite_frag.glsl writes it. */
+  gl_FragDepth = texelFetch(record_depth, ivec2(gl_FragCoord.xy), 0).r - 0.5 * DEPTH_BIAS;
+#endif
   int triangle = int(visible.x) - 1;
   sw_instance_id = int(visible.y);
 #ifdef NO_EDGE_SETUP

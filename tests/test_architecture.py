@@ -622,19 +622,25 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "aovs": (True, lambda v: v.write_aovs),
         "lines": (draw.HIDDEN_LINES, lambda v: v.hidden_pass),
     }
-    state_or_input = {"depth_test", "depth_write", "visibility", "triangle_ids_by_vertex"}
+    state_or_input = {"depth_test", "depth_write", "visibility", "triangle_ids_by_vertex", "record_depth"}
     names = {f.name for f in fields(draw.DrawTarget)}
     assert names == set(selects_code) | state_or_input, "classify every DrawTarget field here"
     for name, (value, says) in selects_code.items():
         variant = draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value}))
         assert variant != plain and says(variant), name
-    for name in state_or_input - {"triangle_ids_by_vertex"}:
+    for name in state_or_input - {"triangle_ids_by_vertex", "record_depth"}:
         value = {"depth_test": "GREATER", "depth_write": False, "visibility": object()}[name]
         assert draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value})) == plain, name
     # The visibility stage's numbering is compiled code of that stage only.
     record = draw.DrawTarget(stage=draw.VISIBILITY, linear_depth=True)
     numbered = draw.shader_variant(settings, replace(record, triangle_ids_by_vertex=True))
     assert numbered.triangle_ids_by_vertex and not draw.shader_variant(settings, record).triangle_ids_by_vertex
+    # So is the resolve's writing of the record's depth (the overlay's
+    # resolve straight into Blender's buffer).
+    resolve = draw.DrawTarget(stage=draw.RESOLVE, depth_bias=2.0**-18)
+    straight = draw.shader_variant(settings, replace(resolve, record_depth=object()))
+    assert straight.record_depth and not draw.shader_variant(settings, resolve).record_depth
+    assert not draw.shader_variant(settings, replace(draw.DrawTarget(), record_depth=object())).record_depth
     # "No wire" is said once, by the description: the plan leaves the
     # settings' wire colour alone.
     from solidwire_addon.core import passes

@@ -1,11 +1,13 @@
 """Edge selection's shortcuts for a subdivision's layout give the general
-path's arrays bit for bit (core/edge_select.py): region labels found over
-runs of consecutive joined faces against the components of the faces
-themselves, and a quad-only mesh's hidden-edge marks by row lookup against
-the search by vertex pair. On real evaluated meshes: Suzanne's cage at
-levels 1-5, an n-gon cage, Mirror and Array copies after the subdivision,
-and meshes where the quad-row check must refuse (triangles and n-gons under
-the edge angle, a subdivision whose quads a modifier triangulated)."""
+path's arrays bit for bit (core/edge_select.py): the regions the cage
+layout gives (blender/cage.py) written per region, region labels found over
+runs of consecutive joined faces, and a quad-only mesh's hidden-edge marks
+by row lookup, each against the components of the faces themselves and the
+search by vertex pair. On real evaluated meshes: Suzanne's cage at levels
+1-5, an n-gon cage, Multiresolution, Mirror and Array copies after the
+subdivision, and meshes where a shortcut must refuse (triangles and n-gons
+under the edge angle, a subdivision whose quads a modifier triangulated, a
+modifier before the subdivision, a cage face past the walk limit)."""
 
 from __future__ import annotations
 
@@ -36,50 +38,56 @@ def _general_labels(face_count, f1, f2):
     return edge_select._components(face_count, np.asarray(f1, np.int64), np.asarray(f2, np.int64))
 
 
-def _select(obj, selection, monkeypatch=None):
-    """(arrays, whether the quad-row marks applied) after the selection on
-    ``obj``'s evaluated mesh, through the general path under ``monkeypatch``."""
+def _select(obj, selection, path, monkeypatch):
+    """(arrays, stats, whether the shortcut of ``path`` applied) after the
+    selection on ``obj``'s evaluated mesh. ``path``: "regions" (the regions
+    the cage layout gives, the quad rows as extracted), "shortcuts" (regions
+    found over runs, the quad rows checked on the triangles), "general"
+    (neither)."""
     import bpy
 
     mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
     arrays = mesh_reading.extract_mesh(mesh)
     corner_vert = mesh_reading.read_corner_verts(mesh)
     offsets = mesh_reading.read_face_offsets(mesh)
-    cage_edges = cage.cage_edges(obj, mesh, render=False) if selection.use_cage else None
+    cage_edges = None
     if selection.use_cage:
+        cage_edges = cage.cage_edges(obj, mesh, render=False, regions=path == "regions")
         assert cage_edges is not None
-    used_rows = []
-    if monkeypatch is not None:
-        monkeypatch.setattr(edge_select, "_mark_quad_rows", lambda *args: False)
-        monkeypatch.setattr(edge_select, "_region_labels", _general_labels)
-    else:
-        quad_rows = edge_select._mark_quad_rows
+    applied = []
+    with monkeypatch.context() as patch:
+        if path == "general":
+            patch.setattr(edge_select, "_mark_quad_rows", lambda *args: False)
+            patch.setattr(edge_select, "_region_labels", _general_labels)
+        else:
+            spied = "_select_known_regions" if path == "regions" else "_mark_quad_rows"
+            real = getattr(edge_select, spied)
 
-        def spy(*args):
-            used_rows.append(quad_rows(*args))
-            return used_rows[-1]
+            def spy(*args):
+                result = real(*args)
+                applied.append(result is not None and result is not False)
+                return result
 
-        original = edge_select._mark_quad_rows
-        edge_select._mark_quad_rows = spy
-    try:
-        mesh_reading.apply_edge_selection(arrays, mesh, corner_vert, offsets, selection, cage_edges)
-    finally:
-        if monkeypatch is None:
-            edge_select._mark_quad_rows = original
-    return arrays, any(used_rows)
+            patch.setattr(edge_select, spied, spy)
+            if path == "shortcuts":
+                arrays.quad_flip = None  # the rows are checked on the triangles
+        stats = mesh_reading.apply_edge_selection(arrays, mesh, corner_vert, offsets, selection, cage_edges)
+    return arrays, stats, any(applied)
 
 
-def _assert_same_as_general(obj, selection, monkeypatch, *, rows_expected: bool):
-    fast, used_rows = _select(obj, selection)
-    assert used_rows == rows_expected
-    general, _ = _select(obj, selection, monkeypatch)
-    for field in ARRAY_FIELDS:
-        a, b = getattr(fast, field), getattr(general, field)
-        assert (a is None) == (b is None), field
-        if a is not None:
-            assert a.dtype == b.dtype and np.array_equal(a, b), field
-    assert fast.region_run_segments == general.region_run_segments
-    assert fast.region_lines is not None and len(fast.region_lines)
+def _assert_same_as_general(obj, selection, monkeypatch, *, rows_expected: bool, regions_expected: bool = False):
+    general, general_stats, _ = _select(obj, selection, "general", monkeypatch)
+    for path, expected in (("shortcuts", rows_expected), ("regions", regions_expected)):
+        other, stats, applied = _select(obj, selection, path, monkeypatch)
+        assert applied == expected, path
+        assert stats == general_stats, path
+        for field in ARRAY_FIELDS:
+            a, b = getattr(other, field), getattr(general, field)
+            assert (a is None) == (b is None), (path, field)
+            if a is not None:
+                assert a.dtype == b.dtype and np.array_equal(a, b), (path, field)
+        assert other.region_run_segments == general.region_run_segments, path
+    assert general.region_lines is not None and len(general.region_lines)
 
 
 def _subdivide(obj, level):
@@ -96,7 +104,7 @@ def test_suzanne_cage_at_every_level(level, monkeypatch):
     scene = scenes.empty_scene()
     obj = scenes.monkey(scene)
     _subdivide(obj, level)
-    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True)
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
 
 
 def _cylinder(scene, segments=12):
@@ -111,7 +119,7 @@ def test_ngon_cage(level, monkeypatch):
     scene = scenes.empty_scene()
     obj = _cylinder(scene)
     _subdivide(obj, level)
-    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True)
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
 
 
 def test_mirror_and_array_copies_after_the_subdivision(monkeypatch):
@@ -123,7 +131,7 @@ def test_mirror_and_array_copies_after_the_subdivision(monkeypatch):
     array = obj.modifiers.new("Array", "ARRAY")
     array.count = 3
     array.use_merge_vertices = False
-    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True)
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
 
 
 def test_triangles_and_ngons_under_the_edge_angle_take_the_general_marks(monkeypatch):
@@ -169,4 +177,32 @@ def test_concave_quads_split_along_their_other_diagonal(monkeypatch):
     arrays = mesh_reading.extract_mesh(mesh)
     quads = mesh_reading.read_corner_verts(mesh).reshape(-1, 4)
     assert (arrays.triangles[0::2, 0] != quads[:, 0]).any()  # some quads split the other way
-    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True)
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+
+
+def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
+    """A modifier before the subdivision (its input is not the object's own
+    mesh) and a cage face whose region is past WALK_LIMIT (a 24-gon at level
+    3: 192 drawn edges) take the regions found from the mesh."""
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene)
+    obj.modifiers.new("Mirror", "MIRROR").use_mirror_merge = False
+    _subdivide(obj, 2)
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
+    cylinder = _cylinder(scene, segments=24)
+    _subdivide(cylinder, 3)
+    _assert_same_as_general(cylinder, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
+
+
+def test_multires_cage(monkeypatch):
+    """Multiresolution subdivides through the same layout as Subdivision
+    Surface: its cage regions give the general path's arrays too."""
+    import bpy
+
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene)
+    modifier = obj.modifiers.new("Multires", "MULTIRES")
+    with bpy.context.temp_override(object=obj, active_object=obj):
+        for _ in range(2):
+            bpy.ops.object.multires_subdivide(modifier=modifier.name, mode="CATMULL_CLARK")
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import bpy
 import numpy as np
 import pytest
+from mathutils import Vector
 
 from solidwire_addon.blender import runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
@@ -140,38 +141,189 @@ def test_material_preview_and_blender_only_occluder():
     assert np.abs(alpha[outside] - without[..., 3][outside]).max() <= 1.0 / 255.0 + 1e-9
 
 
-def test_the_record_is_reused_until_something_changes():
-    """A redraw that changes nothing resolves the kept record and draws the
-    same image; another setting, a moved vertex, a moved object or another
-    view records again; every frame equals a fresh one."""
+def _path(stats) -> str:
+    """How the frame drew its deferred surface (passes._overlay_surface)."""
+    names = ("surface_straight", "record_reused", "surface_reused", "surface_edited", "surface_partial")
+    paths = [name for name in names if stats.get(name)]
+    assert len(paths) == 1, stats
+    return paths[0]
+
+
+def test_what_is_kept_between_redraws():
+    """A redraw after a change (the first one, another setting, a moved
+    object, another view) records again and resolves straight into
+    Blender's buffer; the next redraw that changes nothing resolves the
+    kept record into an image it keeps, and the ones after only composite
+    that image. An edit (vertices moved) keeps its image, for the next edit
+    of a drag. Every frame equals a fresh one."""
     scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
     front, _back = objects
 
     def frame():
         rgba, stats = _draw(scene, objects)
-        return rgba, bool(stats.get("surface_reused"))
+        return rgba, _path(stats)
 
-    first, reused = frame()
-    assert not reused
-    again, reused = frame()
-    assert reused and np.array_equal(first, again)
+    first, path = frame()
+    assert path == "surface_straight"
+    again, path = frame()
+    assert path == "record_reused" and np.array_equal(first, again)
+    third, path = frame()
+    assert path == "surface_reused" and np.array_equal(first, third)
     scene.solidwire.thickness = 3.0
-    thicker, reused = frame()
-    assert not reused and not np.array_equal(first, thicker)
+    thicker, path = frame()
+    assert path == "surface_straight" and not np.array_equal(first, thicker)
+    _thicker, path = frame()
+    assert path == "record_reused"
+    # Vertices moved within the bounds (flat fill: no shading normals)
+    # redraw only what they changed in the kept image.
     front.data.vertices[0].co.z += 0.3
     front.data.update()
-    edited, reused = frame()
-    assert not reused and not np.array_equal(thicker, edited)
+    edited, path = frame()
+    assert path == "surface_partial" and not np.array_equal(thicker, edited)
+    kept, path = frame()
+    assert path == "surface_reused" and np.array_equal(edited, kept)
+    # Past the bounds: everything again, kept for the next edit.
+    front.data.vertices[0].co.z -= 0.8
+    front.data.update()
+    past, path = frame()
+    assert path == "surface_edited" and not np.array_equal(edited, past)
+    front.data.vertices[0].co.z += 0.1
+    front.data.update()
+    dragged, path = frame()
+    assert path == "surface_partial" and not np.array_equal(past, dragged)
+    scene.solidwire.thickness = 1.5  # the same meshes drawn afresh
+    frame()
+    scene.solidwire.thickness = 3.0
+    again, path = frame()
+    assert path == "surface_straight" and np.array_equal(dragged, again)
     front.location.x += 0.1
-    moved, reused = frame()
-    assert not reused and not np.array_equal(edited, moved)
+    moved, path = frame()
+    assert path == "surface_straight" and not np.array_equal(dragged, moved)
     runtime.mesh_cache.clear()
-    fresh, _reused = frame()
-    assert np.array_equal(moved, fresh)
+    fresh, path = frame()
+    assert path == "surface_straight" and np.array_equal(moved, fresh)
     scene.camera.location.z += 0.5
-    other_view, reused = frame()
-    assert not reused and not np.array_equal(moved, other_view)
+    other_view, path = frame()
+    assert path == "surface_straight" and not np.array_equal(moved, other_view)
     _assert_matches_reference(scene, other_view[..., 3])
+
+
+@pytest.mark.parametrize("look", ["default", "cage"])
+def test_a_drag_redraws_only_what_it_changes(look):
+    """Vertices that move within the mesh's bounds (a drag) redraw the kept
+    image only inside the window rectangle they changed, shading normals
+    and region lines included, and equal a fresh frame (which the tests
+    above hold to the reference). A move the image cannot follow so (the first
+    move of a shaded mesh, whose earlier normals were not kept) redraws
+    everything and keeps the image."""
+    looks = {"default": {"diagonal_mode": "SOLID"}, "cage": {"use_cage_edges": True}}
+    scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=1.5, use_fill=True, fill_shading="STUDIO", **looks[look])
+    scenes.add_camera(scene, location=(6.0, -5.0, 4.0))
+    front = scenes.cube(scene, "Front", size=1.6, location=(1.2, -0.4, 0.0))
+    sphere = scenes.uv_sphere(scene, "Back", radius=1.2, location=(-1.6, 1.8, -0.3))
+    for polygon in sphere.data.polygons:  # shading normals that follow the move
+        polygon.use_smooth = True
+    if look == "cage":
+        modifier = sphere.modifiers.new("Subdivision", "SUBSURF")
+        modifier.levels = 2
+    objects = [front, sphere]
+
+    def frame():
+        rgba, stats = _draw(scene, objects)
+        return rgba, _path(stats)
+
+    # Vertices off every axis, so that they stay within the bounds: the one
+    # that faces the camera most, dented deep (its neighbours' shading
+    # normals turn), and one on the silhouette's side, pulled out (its
+    # lines reach past every vertex the move changed).
+    towards = Vector(scene.camera.location) - sphere.location
+    inside = [v for v in sphere.data.vertices if min(abs(c) for c in v.co) > 0.15]
+    dented = max(inside, key=lambda v: v.co.normalized().dot(towards.normalized()))
+    pulled = min(inside, key=lambda v: abs(v.co.normalized().dot(towards.normalized()) - 0.3))
+
+    def drag(step):
+        dented.co *= 0.85 - 0.1 * step
+        pulled.co *= 1.03 + 0.02 * step
+        sphere.data.update()
+
+    frame()
+    frame()
+    drag(0)
+    first_edit, path = frame()
+    assert path == "surface_edited"
+    for step in (1, 2):
+        drag(step)
+        edited, path = frame()
+        assert path == "surface_partial"
+        assert not np.array_equal(first_edit, edited)
+    runtime.mesh_cache.clear()
+    fresh, path = frame()
+    assert path == "surface_straight" and np.array_equal(edited, fresh)
+
+
+@pytest.mark.parametrize("look", ["default", "cage"])
+def test_an_edit_redraws_up_to_the_lines_reach(look):
+    """A grid facing the camera, smooth-shaded: a vertex moved across and
+    out of the plane changes its lines up to their reach past every vertex
+    it moved, and the shading of faces that do not touch it (their corners'
+    normals turn). The partial redraw equals a fresh frame at every step."""
+    looks = {"default": {"diagonal_mode": "SOLID"}, "cage": {"use_cage_edges": True}}
+    scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=2.5, use_fill=True, fill_shading="STUDIO", **looks[look])
+    scenes.add_camera(scene, location=(0.0, -10.0, 0.0))
+    plane = scenes.grid(scene, "Grid", x_segments=6, y_segments=6, size=1.5, rotation=(1.5708, 0, 0))
+    for polygon in plane.data.polygons:
+        polygon.use_smooth = True
+    if look == "cage":
+        plane.modifiers.new("Subdivision", "SUBSURF").levels = 1
+    vertices = plane.data.vertices
+    # Two corners off the plane set the bounds the moves stay within.
+    corners = sorted(vertices, key=lambda v: (v.co.x, v.co.y))
+    corners[0].co.z, corners[-1].co.z = 0.5, -0.5
+    moved = min(vertices, key=lambda v: (v.co.x - 0.25) ** 2 + (v.co.y - 0.25) ** 2)
+    plane.data.update()
+
+    def frame():
+        rgba, stats = _draw(scene, [plane])
+        return rgba, _path(stats)
+
+    frame()
+    frame()
+    for _drag in range(2):
+        # A drag: the first move of a freshly extracted shaded mesh redraws
+        # everything (its earlier normals were not kept), the next only
+        # what it changed.
+        before, path = frame()
+        assert path == "surface_reused"
+        for expected in ("surface_edited", "surface_partial"):
+            moved.co.x += 0.06
+            moved.co.z += 0.12
+            plane.data.update()
+            edited, path = frame()
+            assert path == expected and not np.array_equal(before, edited)
+            before = edited
+        runtime.mesh_cache.clear()
+        fresh, _path_fresh = frame()
+        assert np.array_equal(edited, fresh), np.abs(edited - fresh).max()
+        frame()  # kept from now on
+
+
+def test_cage_look_alike_on_every_path():
+    """The cage look (multi-face regions: their lines drawn over the record,
+    docs/image_model.md §2.6), Suzanne-like dense: resolved straight, resolved
+    from the kept record and composited from the kept image, the same image,
+    which matches the reference."""
+    scene = scenes.empty_scene(WIDTH, HEIGHT, use_cage_edges=True, thickness=1.5)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    modifier = cube.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = modifier.render_levels = 3
+    images = []
+    for expected in ("surface_straight", "record_reused", "surface_reused"):
+        rgba, stats = _draw(scene, [cube])
+        assert _path(stats) == expected and stats.get("region_line_entries", 0) > 0
+        images.append(rgba)
+    assert all(np.array_equal(images[0], image) for image in images[1:])
+    _assert_matches_reference(scene, images[0][..., 3])
 
 
 def test_clipping_region_and_hidden_lines_stay_direct(monkeypatch):
@@ -209,3 +361,33 @@ def test_a_refused_stage_falls_back_to_the_direct_pass(monkeypatch, capsys):
     assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls
     assert np.array_equal(got, expected)
     assert "deferred surface pass is not available" in capsys.readouterr().err
+
+
+def test_a_refused_straight_resolve_draws_directly(monkeypatch, capsys):
+    """A backend that refuses the resolve straight into Blender's buffer
+    draws those meshes directly instead (the direct pass's image), with one
+    message, and draws directly from then on."""
+    from solidwire_addon.core import log, shaders
+
+    log.forget()
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
+    expected, _stats = _draw(scene, objects)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=True))
+    monkeypatch.setattr(shaders, "_deferred_support", [True])
+    real_get = shaders.get
+
+    def refuse_straight(variant):
+        if variant.record_depth:
+            raise shaders.DeferredUnavailable("straight resolve refused")
+        return real_get(variant)
+
+    monkeypatch.setattr(shaders, "get", refuse_straight)
+    got, stats = _draw(scene, objects)
+    assert stats["objects_drawn"] == 2
+    assert not shaders.deferred_available()
+    assert np.abs(got - expected).max() <= 1.0 / 255.0 + 1e-9
+    assert "deferred surface pass is not available" in capsys.readouterr().err
+    calls = _stages(monkeypatch)
+    _draw(scene, objects)
+    assert draw.VISIBILITY not in calls and draw.RESOLVE not in calls

@@ -45,6 +45,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core import edge_select
+from . import mesh_reading
+
 SUBDIVISION_TYPES = frozenset({"SUBSURF", "MULTIRES"})
 
 # Modifiers that keep the topology (vertex/edge/face counts and order): they
@@ -287,7 +290,7 @@ def _cage_layout(obj, mesh, *, render: bool):
             break
     else:
         return None  # left coarse: every edge is a cage edge
-    cage, verts_num, _faces_num = peeled
+    cage, verts_num, cage_faces_num = peeled
     if own_input:
         counts = _cage_counts(obj)
         if counts is not None and (verts_num, len(cage)) not in counts:
@@ -298,7 +301,9 @@ def _cage_layout(obj, mesh, *, render: bool):
         return None  # a mesh without faces: every edge comes from a cage edge
     if steps and not _copies_match(steps, edges, sub_edges_num):
         return None  # not the layout of these copies (a merge, a weld)
-    return cage_children, per_edge, cage, steps
+    # What _known_regions needs of the cage mesh when it is the object's own.
+    cage_mesh = (verts_num, cage_faces_num, faces_num) if own_input else None
+    return cage_children, per_edge, cage, steps, cage_mesh, edges
 
 
 def _carried_copies(after, edges, verts_num: int, faces_num: int):
@@ -409,27 +414,21 @@ def _copies_match(steps, edges, size: int) -> bool:
     return size == len(edges)
 
 
-def _carry(steps, mask, chain, ends):
-    """Follow the subdivided mesh's (drawn mask, chain id, chain ends)
-    through the copies of ``steps`` (_carried_copies): each copy keeps its
-    edges' marks, its chains (new ids) and its ends (shifted with its
-    vertices); a cap's edges are their own chains."""
+def _carry(steps, mask, ends):
+    """Follow the subdivided mesh's (drawn mask, chain ends) through the
+    copies of ``steps`` (_carried_copies): each copy keeps its edges' marks
+    and its ends (shifted with its vertices); a cap's edges are their own
+    chains (their own ends)."""
     for copies, verts_in, caps in steps:
         size = len(mask)
         ends = (np.broadcast_to(ends, (copies, size, 2)) + (np.arange(copies) * verts_in)[:, None, None]).reshape(-1, 2)
-        ids = np.broadcast_to(chain, (copies, size))
-        chain = np.where(ids >= 0, ids + (np.arange(copies) * size)[:, None], -1).reshape(-1)
         mask = np.tile(mask, copies)
         first_vertex = copies * verts_in
         for cap_edges, cap_verts, cap_mask in caps:
             ends = np.concatenate([ends, cap_edges + first_vertex])
             mask = np.concatenate([mask, cap_mask])
-            chain = np.concatenate([chain, np.full(len(cap_edges), -1, np.int64)])
             first_vertex += cap_verts
-    # Every edge that is no piece of a longer one: a chain of its own.
-    alone = chain < 0
-    chain[alone] = -1 - np.flatnonzero(alone)
-    return mask, chain, ends
+    return mask, ends
 
 
 def cage_edge_mask(obj, mesh, *, render: bool):
@@ -438,7 +437,7 @@ def cage_edge_mask(obj, mesh, *, render: bool):
     layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
         return None
-    children, _per_edge, _cage, steps = layout
+    children, _per_edge, _cage, steps, _cage_mesh, _edges = layout
     if steps:
         return cage_edges(obj, mesh, render=render, layout=layout)[0]
     mask = np.zeros(len(mesh.edges), dtype=bool)
@@ -446,26 +445,86 @@ def cage_edge_mask(obj, mesh, *, render: bool):
     return mask
 
 
-def cage_edges(obj, mesh, *, render: bool, layout=None):
-    """(drawn mask, chain id per edge, (E, 2) chain ends per edge) for
-    core/edge_select.py, or None: the children of one cage edge share a
-    chain id and ends, so the density fade measures the whole cage edge,
-    not its pieces (an edge that is no cage child is its own chain)."""
+def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
+    """(drawn mask, None, (E, 2) chain ends per edge, regions) for
+    core/edge_select.py (its EdgeInputs: no chain ids, as the ends say
+    which edges are pieces of one), or None: the children of one cage edge
+    share their chain's ends, so the density fade measures the whole cage
+    edge, not its pieces (an edge that is no cage child is its own chain,
+    its own ends). ``regions``: also the regions of that mask as the layout
+    gives them (_known_regions; None where it cannot tell), else None."""
     if layout is None:
         layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
         return None
-    children, per_edge, cage, steps = layout
-    edges = _read_edges(mesh).astype(np.int64)
-    size = len(edges) if not steps else _subdivided_edge_count(steps, len(edges))
-    index = np.arange(size, dtype=np.int64)
-    mask = index < children
+    children, per_edge, cage, steps, _cage_mesh, edges = layout
+    known = _known_regions(obj, mesh, layout) if regions else None
+    size = _subdivided_edge_count(steps, len(edges))
+    mask = np.zeros(size, bool)
+    mask[:children] = True
     ends = edges[:size].copy()
-    ends[:children] = np.repeat(np.asarray(cage, np.int64), per_edge, axis=0)
-    chain = np.where(mask, index // per_edge, -1 - index)
-    if not steps:
-        return mask, chain, ends
-    return _carry(steps, mask, chain, ends)
+    ends[:children] = np.repeat(cage, per_edge, axis=0)
+    if steps:
+        mask, ends = _carry(steps, mask, ends)
+    return mask, None, ends, known
+
+
+def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | None:
+    """The regions of the cage mask (core/edge_select.py) from the layout,
+    or None where it cannot tell: the subdivision's input is not the
+    object's own mesh (a modifier before it made another; Edit Mode, whose
+    mesh datablock lags the edited one), or an Array copy has caps.
+
+    Blender's subdivision (``subdiv_foreach.cc``, ``subdiv_foreach_faces``)
+    makes the children of each cage face one after another, in cage face
+    order: a quad's 4**L as one grid, an n-gon's n * 4**(L-1) as one grid per
+    corner; so a cage face of n corners has n * 4**(L-1) children either way.
+    Every edge inside a cage face is hidden and joins two of its children,
+    which form one connected patch, and every edge on its outline is a child
+    of one of its cage edges, all drawn: the region of each cage face is
+    exactly its children, bounded by the children of its cage edges. The
+    cage mesh read here is checked to be the one the layout was peeled to
+    (its vertex, face and corner counts and every edge)."""
+    _children, per_edge, cage, steps, cage_mesh, _edges = layout
+    if cage_mesh is None or any(caps for _copies, _verts, caps in steps):
+        return None
+    original = getattr(obj, "original", None) or obj
+    data = getattr(original, "data", None)
+    if getattr(original, "type", None) != "MESH" or data is None or getattr(original, "mode", "OBJECT") == "EDIT":
+        return None
+    verts_num, faces_num, sub_faces_num = cage_mesh
+    children_per_corner = (per_edge // 2) ** 2  # 4**(L-1)
+    if (
+        len(data.vertices) != verts_num
+        or len(data.polygons) != faces_num
+        or len(data.loops) * children_per_corner != sub_faces_num
+    ):
+        return None
+    cage_edge_verts, corner_edge = mesh_reading.read_edge_topology(data)
+    if not np.array_equal(cage_edge_verts, cage):
+        return None
+    offsets = mesh_reading.read_face_offsets(data).astype(np.int64)
+    sizes = np.diff(offsets)
+    # Each cage face's distinct edges, ascending; their children ascend too.
+    keys = np.unique(np.repeat(np.arange(faces_num, dtype=np.int64), sizes) * len(cage) + corner_edge)
+    face, edge = np.divmod(keys, len(cage))
+    edges = (edge[:, None] * per_edge + np.arange(per_edge, dtype=np.int64)).reshape(-1)
+    face_start = np.zeros(faces_num + 1, np.int64)
+    np.cumsum(sizes * children_per_corner, out=face_start[1:])
+    edge_start = np.zeros(faces_num + 1, np.int64)
+    np.cumsum(np.bincount(face, minlength=faces_num) * per_edge, out=edge_start[1:])
+    # Mirror and Array copies: each copy's faces and edges follow its input's,
+    # numbered on by the input's counts.
+    faces_in, edges_in = int(face_start[-1]), _subdivided_edge_count(steps, len(mesh.edges))
+    for copies, _verts_in, _caps in steps:
+        shift = np.arange(copies, dtype=np.int64)[:, None]
+        face_start = np.append((face_start[:-1] + shift * faces_in).reshape(-1), copies * faces_in)
+        edge_start = np.append((edge_start[:-1] + shift * len(edges)).reshape(-1), copies * len(edges))
+        edges = (edges + shift * edges_in).reshape(-1)
+        faces_in, edges_in = copies * faces_in, copies * edges_in
+    if faces_in != len(mesh.polygons) or edges_in != len(mesh.edges):
+        return None
+    return edge_select.KnownRegions(face_start, edge_start, edges)
 
 
 def _subdivided_edge_count(steps, edges_num: int) -> int:

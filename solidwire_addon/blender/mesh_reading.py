@@ -329,14 +329,17 @@ def apply_edge_selection(
     cage: tuple | None = None,
 ) -> SelectionStats:
     """Read ``mesh``'s edges and apply ``selection`` to ``arrays``
-    (core.edge_select.select_edges). ``cage``: (drawn mask, chain ids[, chain
-    ends]) of the evaluated edges from the cage detection, or None (no
-    subdivision, or cage edges off)."""
+    (core.edge_select.select_edges). ``cage``: (drawn mask, chain ids or
+    None[, chain ends[, regions]]) of the evaluated edges from the cage
+    detection (blender/cage.py) or an outline mask (blender/outlines.py), or
+    None (no subdivision, or cage edges off). The regions (KnownRegions) are
+    those of the mask alone: used only where nothing else hides an edge."""
     verts, corner_edge = read_edge_topology(mesh)
-    drawn = chain = chain_ends = None
+    drawn = chain = chain_ends = regions = None
     if cage is not None:
         drawn, chain = np.asarray(cage[0], bool).copy(), cage[1]
         chain_ends = cage[2] if len(cage) > 2 else None
+        regions = cage[3] if len(cage) > 3 and not selection.edge_angle > 0.0 else None
     if selection.edge_angle > 0.0:
         state = edge_select.EdgeAngleState(
             corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle
@@ -351,6 +354,7 @@ def apply_edge_selection(
         "boundary" in selection.classes,
         chain,
         chain_ends,
+        regions,
     )
     if not inputs.selects_anything:
         return SelectionStats()

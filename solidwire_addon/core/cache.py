@@ -17,7 +17,7 @@ import gpu
 import numpy as np
 
 from .edge_select import TEXELS_PER_REGION_LINE
-from .extract import IN_REGION, REGION_LINES, MeshArrays
+from .extract import IN_REGION, NORMALS_BY_TRIANGLE, NORMALS_BY_VERTEX, REGION_LINES, MeshArrays
 
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
@@ -82,6 +82,7 @@ class GPUMesh:
         # position uploads): what a cached image drawn from it depends on.
         self.serial = next(_serials)
         self.version = 0
+        self._corner_rows_uploaded = None  # the corner rows of the last move (last_move)
         self.triangle_count = arrays.triangle_count
         self.centre = arrays.centre
         self.bounds_min = arrays.bounds_min - arrays.centre
@@ -306,12 +307,86 @@ class GPUMesh:
             self.corners = table_texture(corners)
         self._drop_visibility_batch()  # made again from the new positions on first use
         self.version += 1
+        # The shape before, for last_move(): asked of a viewport overlay only.
+        self._before_move = (self._local_positions, self.centre, self.mesh_bounds, self._corner_rows_uploaded)
+        self._moved_box = None
+        self._corner_rows_uploaded = corners
         self._local_positions = positions[:, :3]
         self.centre = centre
         self.bounds_min = bounds_min - centre
         self.bounds_max = bounds_max - centre
         self.mesh_bounds = (bounds_min, bounds_max)
         self.source_positions = source_positions
+
+    def last_move(self):
+        """What the last replace_positions() changed, for a viewport overlay
+        that keeps its image and draws again only where it changed
+        (passes._overlay_surface): ``(version, box)``, ``box`` the
+        mesh-space (low, high) around every vertex of every face whose
+        drawing inputs changed (a moved vertex, a changed corner row),
+        before and after, or None when no face changed. None when that
+        cannot be told: never moved, the centre or the bounds moved
+        (positions are stored relative to the centre, and the bounds decide
+        a draw's variant), or the corner rows changed with no earlier ones
+        kept (a shaded mesh keeps them from its first move on)."""
+        before = getattr(self, "_before_move", None)
+        if before is None:
+            return None
+        if self._moved_box is None:
+            self._moved_box = (self._change_box(*before),)
+        box = self._moved_box[0]
+        return box if box is None else (self.version, box[0])
+
+    def _change_box(self, old, old_centre, old_bounds, old_corners):
+        local, corners = self._local_positions, self._corner_rows_uploaded
+        if (
+            old.shape != local.shape
+            or not np.array_equal(np.asarray(old_centre), np.asarray(self.centre))
+            or not (
+                np.array_equal(old_bounds[0], self.mesh_bounds[0])
+                and np.array_equal(old_bounds[1], self.mesh_bounds[1])
+            )
+        ):
+            return None
+        # Column-wise ORs and whole-row compares: numpy reduces the short
+        # axis of an (N, 3) array slowly.
+        differs = (local != old).view(np.uint8)
+        vertex_moved = (differs[:, 0] | differs[:, 1] | differs[:, 2]).view(bool)
+        triangles = self.triangles_cpu
+        corner_vertices = [triangles[:, k] for k in range(3)]
+
+        def touching(vertex_mask):
+            return vertex_mask[corner_vertices[0]] | vertex_mask[corner_vertices[1]] | vertex_mask[corner_vertices[2]]
+
+        triangle_changed = touching(vertex_moved)
+        if corners is not None:
+            if old_corners is None or old_corners.shape != corners.shape:
+                return None
+            # (A row is 16 bytes: one complex128 compare per row; a NaN
+            # compares unequal, which only redraws more.)
+            rows = np.flatnonzero(_row_view(old_corners) != _row_view(corners))
+            if self.normal_domain == NORMALS_BY_VERTEX:
+                vertex_moved[rows] = True
+                triangle_changed = touching(vertex_moved)
+            elif self.normal_domain == NORMALS_BY_TRIANGLE:
+                triangle_changed[rows] = True
+            else:
+                triangle_changed[rows // 3] = True
+        # A face's triangles set up its outline together (a quad's fourth
+        # corner, an n-gon's corners): a changed face redraws every one.
+        polygons = np.asarray(self.triangle_polygons_cpu)
+        touched = np.zeros(int(polygons.max(initial=-1)) + 1, dtype=bool)
+        touched[polygons[triangle_changed]] = True
+        vertices = np.unique(triangles[touched[polygons], :3])
+        if not len(vertices):
+            return (None,)
+        points = np.concatenate([old[vertices], local[vertices]]).astype(np.float64) + np.asarray(self.centre)
+        return ((points.min(axis=0), points.max(axis=0)),)
+
+
+def _row_view(table: np.ndarray) -> np.ndarray:
+    """An (N, 4) float32 table as N complex128 values, one per row."""
+    return np.ascontiguousarray(table, dtype=np.float32).view(np.complex128).reshape(-1)
 
 
 class MeshCache:

@@ -62,7 +62,11 @@ class DrawTarget:
     or RESOLVE one half of the deferred surface (RESOLVE reads the record
     in ``visibility``), LINES the lines of multi-face regions over that
     record into the bound region-lines target; ``region_lines`` is that
-    target's image, which a surface draw then reads. Outputs: the view
+    target's image, which a surface draw then reads. ``record_depth`` (the
+    viewport overlay's record depth, RESOLVE only): the resolve writes that
+    window depth less ``depth_bias`` and meets the bound depth with
+    ``depth_test``, as the overlay's composite would, so it can resolve
+    straight into Blender's buffer. Outputs: the view
     depth in a second colour target, the render passes' targets (``aovs``),
     and which ``lines`` the colour shows (WIRE_LINES, NO_LINES,
     HIDDEN_LINES). ``triangle_ids_by_vertex``: how the VISIBILITY stage
@@ -77,6 +81,7 @@ class DrawTarget:
     stage: str | None = None
     visibility: object = None
     region_lines: object = None
+    record_depth: object = None
     view_depth: bool = False
     aovs: bool = False
     lines: str = WIRE_LINES
@@ -133,7 +138,7 @@ def shader_variant(settings, target: DrawTarget | None = None) -> shaders.Shader
     if target.aovs:
         variant = replace(variant, write_aovs=True)
     if target.stage == RESOLVE:
-        variant = replace(variant, resolve=True, linear_depth=False)
+        variant = replace(variant, resolve=True, linear_depth=False, record_depth=target.record_depth is not None)
     elif target.stage == VISIBILITY:
         variant = shaders.ShaderVariant(
             visibility=True, linear_depth=target.linear_depth, triangle_ids_by_vertex=target.triangle_ids_by_vertex
@@ -411,6 +416,8 @@ def draw(
         extras["display"] = target.display
     if target.visibility is not None:
         extras["visibility"] = target.visibility
+    if target.record_depth is not None:
+        extras["record_depth"] = target.record_depth
     if target.clip_planes is not None:
         clip_rows = clip_space_planes(target.clip_planes, view)
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
@@ -438,13 +445,17 @@ def draw(
             )
         return block
 
-    # The render's resolve draws over the record's depth, its rectangle at
-    # the far end of the depth range: it passes only where a surface was
-    # recorded (shaders/resolve_vert.glsl). The overlay's resolves into a
-    # target without depth.
-    resolve_test = "GREATER" if target.linear_depth else "NONE"
-    gpu.state.depth_test_set(resolve_test if stage == RESOLVE else target.depth_test)
-    gpu.state.depth_mask_set(target.depth_write and stage != RESOLVE)
+    # A resolve writes no depth (the record did) unless it writes the
+    # record's depth into another buffer (``record_depth``). The render's
+    # resolve draws over the record's depth, its rectangle at the far end of
+    # the depth range: it passes only where a surface was recorded
+    # (shaders/resolve_vert.glsl). The overlay's kept image has no depth.
+    if stage != RESOLVE or target.record_depth is not None:
+        depth_test, depth_write = target.depth_test, target.depth_write
+    else:
+        depth_test, depth_write = ("GREATER" if target.linear_depth else "NONE"), False
+    gpu.state.depth_test_set(depth_test)
+    gpu.state.depth_mask_set(depth_write)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
     flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
@@ -618,6 +629,8 @@ def _bind_extras(shader, variant, extras) -> None:
         bind_display_transform(shader, extras["display"])
     if variant.region_lines:
         shader.uniform_sampler("region_line_image", extras["region_line_image"])
+    if variant.record_depth:
+        shader.uniform_sampler("record_depth", extras["record_depth"])
 
 
 def bind_display_transform(shader, display) -> None:

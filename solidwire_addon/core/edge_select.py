@@ -78,6 +78,30 @@ NO_REGION = -1.0
 # pays per primitive and per covered pixel. Eight segments fill 40 varying
 # components, within every backend's limit.
 RUN_SEGMENTS = 8
+# The flag bits a listed triangle drops before its block's bits are set: its
+# quad edges and n-gon outline are in its block, and its block's segment
+# count takes the bits from NGON_SHIFT up.
+LISTED_FACE_DROPS = HAS_QUAD_CORNER | IS_NGON | REGION_LINES | EDGE3_HIDDEN | EDGE4_HIDDEN | (-1 << NGON_SHIFT)
+
+
+@dataclass
+class KnownRegions:
+    """A mesh's regions as the caller knows them from how the mesh was made
+    (blender/cage.py: the children of each cage face of a subdivision), so
+    that select_edges need not find them. Region k is the faces
+    ``face_start[k]`` to ``face_start[k + 1] - 1``: consecutive, every face
+    in one, each region joined across edges that are not drawn and no such
+    edge between two regions. Its drawn edges are
+    ``region_edges[edge_start[k]:edge_start[k + 1]]``, ascending. The caller
+    vouches for this and for every edge that is not drawn having exactly two
+    face corners (an edge inside a cage face), for the ``drawn`` mask it
+    passes with these regions and no edge classes; select_edges checks the
+    rest of what its shortcut assumes and otherwise finds the regions
+    itself."""
+
+    face_start: np.ndarray  # (R + 1,) ascending, from 0 to the face count
+    edge_start: np.ndarray  # (R + 1,) offsets into ``region_edges``
+    region_edges: np.ndarray  # (S,) edge ids
 
 
 @dataclass
@@ -100,6 +124,9 @@ class EdgeInputs:
     # (E, 2) the ends of each edge's chain when the caller knows them (cage
     # edges); else found from ``chain``.
     chain_ends: np.ndarray | None = None
+    # The regions of ``drawn`` when the caller knows them from how the mesh
+    # was made (a subdivision's cage faces); None: found here.
+    regions: KnownRegions | None = None
 
     @property
     def selects_anything(self) -> bool:
@@ -204,6 +231,10 @@ def select_edges(
 ) -> SelectionStats:
     """Apply ``inputs`` to ``arrays`` in place (edge flags, column 3 of
     listed triangles, ``region_table``) and say what it did."""
+    if inputs.regions is not None and inputs.classes is None and not inputs.boundary_class:
+        known = _select_known_regions(arrays, corner_vert, face_offsets, corner_edge, inputs)
+        if known is not None:
+            return known
     stats = SelectionStats()
     verts = np.asarray(inputs.verts, dtype=np.int64).reshape(-1, 2)
     edge_count = len(verts)
@@ -351,14 +382,150 @@ def select_edges(
         listed_count = int(rows.sum())
         polygons = polygons[rows]
     flags = arrays.edge_flags
-    keep = ~(HAS_QUAD_CORNER | IS_NGON | REGION_LINES | EDGE3_HIDDEN | EDGE4_HIDDEN | (-1 << NGON_SHIFT))
-    flags[rows] = (flags[rows] & keep) | face_bits[polygons]
+    flags[rows] = (flags[rows] & ~LISTED_FACE_DROPS) | face_bits[polygons]
     arrays.triangles[rows, 3] = face_start[polygons]
     stats.regions = int(walked_region.sum())  # sizes are counted at each region's label only
     stats.listed_triangles = listed_count
     stats.segments = len(seg_a)
     _region_lines(arrays, verts, classes, ends, label, walked | styled_face, pairs, stats)
     return stats
+
+
+def _select_known_regions(
+    arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray, inputs: EdgeInputs
+) -> SelectionStats | None:
+    """select_edges for regions the caller knows (``inputs.regions``, no
+    classes) on a mesh of quads only: the same arrays as the general path,
+    written per region and per quad instead of found from every corner, or
+    None (nothing written) where the shortcut does not apply: faces other
+    than extract.build_arrays_fast's quad rows, a region of one face, a
+    region past WALK_LIMIT (walked face by face), a region list that does
+    not cover the faces or names an edge that is not drawn.
+
+    Every face is then in a multi-face region, so every face is listed, its
+    block is its region's (id = the region's first face) and its lines come
+    from the region-lines pass; each block holds its region's drawn edges,
+    ascending, one segment each (no class, no n-gon diagonal)."""
+    regions, drawn = inputs.regions, inputs.drawn
+    if drawn is None or inputs.chain_ends is None:
+        return None
+    offsets = np.asarray(face_offsets)
+    face_count = len(offsets) - 1
+    verts = np.asarray(inputs.verts).reshape(-1, 2)
+    drawn = np.asarray(drawn, bool)
+    face_start = np.asarray(regions.face_start, np.int64)
+    edge_start = np.asarray(regions.edge_start, np.int64)
+    edges = np.asarray(regions.region_edges, np.int64)
+    if face_count <= 0 or len(face_start) < 2 or len(edge_start) != len(face_start) or len(drawn) != len(verts):
+        return None
+    region_faces, per_region = np.diff(face_start), np.diff(edge_start)
+    if (
+        face_start[0] != 0
+        or face_start[-1] != face_count
+        or region_faces.min() < 2
+        or edge_start[0] != 0
+        or edge_start[-1] != len(edges)
+        or per_region.min() < 1
+        or per_region.max() > WALK_LIMIT
+        or edges.min() < 0
+        or edges.max() >= len(verts)
+        or not drawn[edges].all()
+    ):
+        return None
+    ascending = np.diff(edges) > 0
+    ascending[edge_start[1:-1] - 1] = True  # each region's list starts afresh
+    if not ascending.all():
+        return None
+    flip = _quad_row_flip(arrays, corner_vert, np.diff(offsets))
+    if flip is None:
+        return None
+    stats = SelectionStats(hidden_edges=len(drawn) - int(np.count_nonzero(drawn)))
+
+    # The blocks: region k's drawn edges from table row first[k], in region order.
+    label = face_start[:-1]
+    seg_owner = np.repeat(label, per_region)
+    ends = np.asarray(inputs.chain_ends)
+    # (np.take gathers rows several times faster than fancy indexing.)
+    seg_verts, seg_ends = np.take(verts, edges, axis=0), np.take(ends, edges, axis=0)
+    table = np.zeros((TEXELS_PER_SEGMENT * len(edges), 4), dtype=np.float32)
+    table[0::2, 0] = np.minimum(seg_verts[:, 0], seg_verts[:, 1])
+    table[0::2, 1] = np.maximum(seg_verts[:, 0], seg_verts[:, 1])
+    table[1::2, 0], table[1::2, 1] = seg_ends[:, 0], seg_ends[:, 1]
+    arrays.region_table = table
+    region_table_start = (len(arrays.ngon_corners) + TEXELS_PER_SEGMENT * edge_start[:-1]).astype(np.int32)
+
+    # Each quad's two rows in one 64-bit write (row 2i the low half), looked
+    # up by its block's segment count, its split and its hidden edges
+    # (_listed_quad_rows), written in place: no million-row temporaries.
+    at = _hidden_pattern(drawn, corner_edge, face_count)
+    at |= flip.view(np.uint8) << np.uint8(4)
+    at |= np.repeat((per_region << 5).astype(np.uint32), region_faces)
+    flags = arrays.edge_flags
+    if flags.dtype == np.int32 and flags.flags.c_contiguous:
+        np.take(_LISTED_QUAD_ROWS, at, out=flags.view(np.uint64), mode="clip")
+    else:
+        flags[:] = np.take(_LISTED_QUAD_ROWS, at).view(np.int32)
+    face_table_start = np.repeat(region_table_start, region_faces)
+    if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one (2, 4) block
+        arrays.triangles.reshape(face_count, 2, 4)[:, :, 3] = face_table_start[:, None]
+    else:
+        arrays.triangles[:, 3] = np.repeat(face_table_start, 2)
+    arrays.triangle_regions = np.repeat(label.astype(np.float32), 2 * region_faces)
+    stats.regions = len(label)
+    stats.listed_triangles = arrays.triangle_count
+    stats.segments = len(edges)
+    _known_region_lines(arrays, verts, ends, table, seg_ends, seg_owner, edges, stats)
+    return stats
+
+
+def _known_region_lines(arrays: MeshArrays, verts, ends, table, seg_ends, seg_owner, edges, stats) -> None:
+    """_region_line_table for the blocks of _select_known_regions (``table``
+    its block rows, owners ascending, no class). Where no edge bounds more
+    than two regions (a manifold cage) each edge is one entry, its region
+    the one that lists it first and its partner the one that lists it last:
+    found by two scatters instead of a sort, and its texels are its first
+    listing's block texels with the regions filled in."""
+    counts = np.bincount(edges)
+    if counts.max() > 2:
+        _region_line_table(arrays, verts, None, ends, np.stack([seg_owner, edges], axis=1), stats)
+        return
+    edge = np.flatnonzero(counts)
+    listing = np.arange(len(edges))
+    first = np.empty(len(counts), np.intp)
+    first[edges[::-1]] = listing[::-1]  # the last write is the first listing's
+    last = np.empty(len(counts), np.intp)
+    last[edges] = listing
+    first, last = np.take(first, edge), np.take(last, edge)
+    region = np.take(seg_owner, first)
+    partner = np.where(first != last, np.take(seg_owner, last), -1)
+    lines = np.take(table.reshape(-1, TEXELS_PER_SEGMENT * 4), first, axis=0)
+    lines[:, 3] = region
+    lines[:, 6] = np.where(partner >= 0, partner, NO_REGION)
+    arrays.region_lines = lines.reshape(-1, 4)
+    style = np.zeros(len(edge), np.int64)
+    runs = _line_runs(np.take(seg_ends, first, axis=0), style, region, partner)
+    arrays.region_line_runs, arrays.region_run_segments = runs
+    stats.region_lines = len(edge)
+
+
+def _listed_quad_rows() -> np.ndarray:
+    """(32 * (WALK_LIMIT + 1),) uint64 indexed by 32 * block segments + 16 *
+    split + hidden-edge pattern (see _mark_quad_rows): a listed quad's two
+    rows' flags, row 2i in the low 32 bits: the row marks of
+    _quad_row_marks applied to a quad row's flags, less what a listed face
+    drops (its quad edges are in its block), with its block's bits (the
+    segment count, IN_REGION and REGION_LINES) as select_edges sets them."""
+    clear_of, marks_of = _quad_row_marks()
+    quad_row = EDGE0_REAL | EDGE1_REAL | HAS_QUAD_CORNER
+    row = ((quad_row & ~clear_of) | marks_of) & ~LISTED_FACE_DROPS  # indexed by 16 * first corner + pattern
+    pattern = np.arange(16)
+    # Not split: rows from corners 0 and 2; split: from corners 3 and 1.
+    even = np.concatenate([row[pattern], row[48 + pattern]]).astype(np.uint64)
+    odd = np.concatenate([row[32 + pattern], row[16 + pattern]]).astype(np.uint64)
+    segments = np.arange(WALK_LIMIT + 1, dtype=np.uint64)
+    block = (segments << np.uint64(NGON_SHIFT)) | np.uint64(IN_REGION | REGION_LINES)
+    both = np.uint64(1 | 1 << 32)
+    return ((even | (odd << np.uint64(32)))[None, :] | (block * both)[:, None]).reshape(-1)
 
 
 def _one_per_class(bits: np.ndarray, *columns: np.ndarray):
@@ -388,7 +555,13 @@ def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, p
     region_of_face = np.where(lines_face, label, -1)
     arrays.triangle_regions = region_of_face.astype(np.float32)[arrays.triangle_polygons]
     keep = lines_face[pairs[:, 0]] if len(pairs) else np.zeros(0, bool)
-    pairs = pairs[keep]
+    _region_line_table(arrays, verts, classes, ends, pairs[keep], stats)
+
+
+def _region_line_table(arrays: MeshArrays, verts, classes, ends, pairs, stats: SelectionStats) -> None:
+    """``region_lines`` and its runs from the (region, drawn edge) pairs of
+    the regions whose lines the region-lines pass draws (see _region_lines).
+    ``classes`` None: no edge has a class."""
     if not len(pairs):
         arrays.region_lines = arrays.region_line_runs = None
         return
@@ -404,20 +577,29 @@ def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, p
     partner = np.where(has_partner, np.append(region[1:], -1), -1)
     edge, region, partner = edge[head], region[head], partner[head]
     # One entry per class of the edge (an edge with no class: one entry).
-    style, (edge, region, partner) = _one_per_class(classes[edge], edge, region, partner)
+    bits = np.zeros(len(edge), np.int64) if classes is None else classes[edge]
+    style, (edge, region, partner) = _one_per_class(bits, edge, region, partner)
     # By style, then edge: a chain's entries of one class follow each other
     # (_line_runs).
     order = np.argsort(style, kind="stable")
     style, edge, region, partner = style[order], edge[order], region[order], partner[order]
+    _write_region_lines(arrays, verts, ends, style, edge, region, partner, stats)
+
+
+def _write_region_lines(arrays: MeshArrays, verts, ends, style, edge, region, partner, stats: SelectionStats) -> None:
+    """``region_lines`` and its runs from its entries in table order: each
+    entry's style, edge, region and partner region (-1: none)."""
     table = np.zeros((TEXELS_PER_REGION_LINE * len(edge), 4), np.float32)
-    table[0::2, 0] = np.minimum(verts[edge, 0], verts[edge, 1])
-    table[0::2, 1] = np.maximum(verts[edge, 0], verts[edge, 1])
+    edge_verts = np.take(verts, edge, axis=0)
+    table[0::2, 0] = np.minimum(edge_verts[:, 0], edge_verts[:, 1])
+    table[0::2, 1] = np.maximum(edge_verts[:, 0], edge_verts[:, 1])
     table[0::2, 2] = style
     table[0::2, 3] = region
-    table[1::2, 0], table[1::2, 1] = ends[edge, 0], ends[edge, 1]
+    edge_ends = np.take(ends, edge, axis=0)
+    table[1::2, 0], table[1::2, 1] = edge_ends[:, 0], edge_ends[:, 1]
     table[1::2, 2] = np.where(partner >= 0, partner, NO_REGION)
     arrays.region_lines = table
-    arrays.region_line_runs, arrays.region_run_segments = _line_runs(ends[edge], style, region, partner)
+    arrays.region_line_runs, arrays.region_run_segments = _line_runs(edge_ends, style, region, partner)
     stats.region_lines = len(edge)
 
 
@@ -435,7 +617,8 @@ def _line_runs(chain_ends: np.ndarray, style: np.ndarray, region: np.ndarray, pa
     same = np.zeros(count, bool)
     if count > 1:
         same[1:] = (
-            (chain_ends[1:] == chain_ends[:-1]).all(axis=1)
+            (chain_ends[1:, 0] == chain_ends[:-1, 0])
+            & (chain_ends[1:, 1] == chain_ends[:-1, 1])
             & (style[1:] == style[:-1])
             & (region[1:] == region[:-1])
             & (partner[1:] == partner[:-1])
@@ -540,9 +723,32 @@ def _mark_quad_rows(
     the quad is split along its other diagonal. Each row's edges are then
     its quad's corner edges in a known order: a few column picks instead of
     finding every row's corners. False (nothing done) for any other mesh."""
+    flip = _quad_row_flip(arrays, corner_vert, sizes)
+    if flip is None:
+        return False
+    flags = arrays.edge_flags
+    # Which of its quad's edges are hidden, one bit per corner, and then per
+    # row a lookup of that pattern turned to the row's first corner.
+    pattern = _hidden_pattern(drawn, corner_edge, len(sizes)).astype(np.intp)
+    clear_of, marks_of = _quad_row_marks()
+    # A row starting at corner r: its edges 0, 1 and its quad edges 3, 4
+    # leave corners r, r + 1, r + 2, r + 3.
+    for rows, plain, flipped in ((slice(0, None, 2), 0, 3), (slice(1, None, 2), 2, 1)):
+        at = np.where(flip, 16 * flipped, 16 * plain) + pattern
+        flags[rows] = (flags[rows] & ~clear_of[at]) | marks_of[at]
+    return True
+
+
+def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, sizes: np.ndarray) -> np.ndarray | None:
+    """(F,) bool for a mesh of quads only whose triangle rows are those
+    extract.build_arrays_fast writes (see _mark_quad_rows): True where the
+    quad is split along its other diagonal. None for any other mesh."""
     face_count = len(sizes)
     if face_count == 0 or arrays.triangle_count != 2 * face_count or sizes.min() != 4 or sizes.max() != 4:
-        return False
+        return None
+    known = arrays.quad_flip
+    if known is not None and len(known) == face_count:
+        return known  # the rows build_arrays_fast wrote for a mesh of quads only, as it says
     tri, flags = arrays.triangles, arrays.edge_flags
     quad = np.asarray(corner_vert).reshape(face_count, 4)
     even, odd = tri[0::2], tri[1::2]
@@ -559,21 +765,29 @@ def _mark_quad_rows(
             == (EDGE0_REAL | EDGE1_REAL | HAS_QUAD_CORNER)
         ).all()
     ):
-        return False
-    hidden = ~drawn[np.asarray(corner_edge).reshape(face_count, 4)]  # the edge leaving each corner
-    # Which of its quad's edges are hidden, one bit per corner, and then per
-    # row a lookup of that pattern turned to the row's first corner.
-    pattern = (
-        hidden[:, 0] | (hidden[:, 1] << np.uint8(1)) | (hidden[:, 2] << np.uint8(2)) | (hidden[:, 3] << np.uint8(3))
-    )
-    pattern = pattern.astype(np.intp)
-    clear_of, marks_of = _quad_row_marks()
-    # A row starting at corner r: its edges 0, 1 and its quad edges 3, 4
-    # leave corners r, r + 1, r + 2, r + 3.
-    for rows, plain, flipped in ((slice(0, None, 2), 0, 3), (slice(1, None, 2), 2, 1)):
-        at = np.where(flip, 16 * flipped, 16 * plain) + pattern
-        flags[rows] = (flags[rows] & ~clear_of[at]) | marks_of[at]
-    return True
+        return None
+    return flip
+
+
+def _hidden_pattern(drawn: np.ndarray, corner_edge: np.ndarray, face_count: int) -> np.ndarray:
+    """(F,) uint32 for a mesh of quads only: bit c set where the edge leaving
+    the quad's corner c is not drawn. The four corners' drawn flags are one
+    little-endian 32-bit word of 0/1 bytes; one multiplication gathers their
+    bits into the top byte (no partial product carries into it)."""
+    drawn = np.asarray(drawn, bool)
+    count = int(np.count_nonzero(drawn))
+    if drawn[:count].all():  # the drawn edges come first (a subdivision's cage children): a compare, no gather
+        corner_drawn = np.asarray(corner_edge) < count
+    else:
+        corner_drawn = np.take(drawn, corner_edge)
+    if not np.little_endian:
+        hidden = ~corner_drawn.reshape(face_count, 4)
+        return (hidden * np.array([1, 2, 4, 8], np.uint32)).sum(axis=1, dtype=np.uint32)
+    words = corner_drawn.view(np.uint32)  # a fresh array: changed in place
+    words ^= np.uint32(0x01010101)
+    words *= np.uint32(0x01020408)
+    words >>= np.uint32(24)
+    return words
 
 
 def _quad_row_marks():
@@ -585,6 +799,10 @@ def _quad_row_marks():
     clear = h[0] * EDGE0_REAL | h[1] * EDGE1_REAL
     marks = h[0] * EDGE0_HIDDEN | h[1] * (EDGE0_HIDDEN << 1) | h[2] * EDGE3_HIDDEN | h[3] * EDGE4_HIDDEN
     return clear.astype(np.int32), marks.astype(np.int32)
+
+
+# Computed once: the lookup _select_known_regions writes quad rows from.
+_LISTED_QUAD_ROWS = _listed_quad_rows()
 
 
 def _corner_in_polygon(vertex, start, size, corner_vert) -> np.ndarray:

@@ -31,12 +31,13 @@ say) comes in one options.DrawOptions value, handed down from the caller.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 
 import gpu
 import numpy as np
 
-from . import compositing, shaders, silhouettes
+from . import compositing, schema, shaders, silhouettes
 from . import draw as draw_mod
 from . import strands as strands_mod
 from .draw import DrawTarget
@@ -54,8 +55,9 @@ from .schema import (
     OBJECT_INDEX_PASS,
     WIRE_PASS,
 )
+from .settings import pack_params
 from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, targets_for
-from .view import DrawStats, View
+from .view import DrawStats, View, window_boxes
 
 # Written by the surface pass's extra outputs (the rest has its own pass).
 _SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
@@ -111,9 +113,9 @@ class Frame:
     region_lines: object = None
     line_stats: DrawStats = field(default_factory=DrawStats)
     # The sync step's split (_sync_overlay_surface): items drawn directly,
-    # and the overlay targets holding the deferred ones' resolved image.
+    # and the deferred ones' OverlaySurface.
     direct: list | None = None
-    overlay_surface: object = None
+    overlay_surface: OverlaySurface | None = None
 
     def overlay_stats(self) -> DrawStats:
         """The surface pass's DrawStats over the viewport, with what the
@@ -216,7 +218,7 @@ class SurfacePass(RenderPass):
             return
         frame.stats = draw_mod.draw(frame.direct, view, self.settings, target=_with_lines(base, self.wire))
         if frame.overlay_surface is not None:
-            _composite_overlay_surface(frame.overlay_surface, frame.base.depth_bias)
+            _draw_overlay_surface(frame, _with_lines(base, self.wire))
             frame.stats.add(frame.line_stats)
 
 
@@ -500,15 +502,17 @@ def _record_visibility(
     *,
     cull=True,
     keep_depth=False,
+    scissor=None,
     clear_record=True,
 ):
     """The visibility record of ``items`` into ``targets.visible`` (which
     triangle each pixel shows; depth test, no shading), drawn as ``target``
     says apart from its stage; ``keep_depth`` keeps the depth already in the
-    targets, ``clear_record`` False leaves the last record where nothing is
-    drawn now (for a reader that tests depth first). Returns the DrawStats."""
+    targets; ``scissor`` (x, y, width, height) records that rectangle alone;
+    ``clear_record`` False leaves the last record where nothing is drawn
+    now (for a reader that tests depth first). Returns the DrawStats."""
     framebuffer = targets.visibility_framebuffer()
-    with framebuffer.bind():
+    with framebuffer.bind(), _scissored(scissor):
         if clear_record or not keep_depth:
             _clear(framebuffer, view.width, view.height, depth=not keep_depth)
         else:
@@ -518,6 +522,21 @@ def _record_visibility(
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     return stats
+
+
+@contextmanager
+def _scissored(scissor):
+    """Clears and draws inside the bound framebuffer limited to ``scissor``
+    (x, y, width, height; None: the whole framebuffer)."""
+    if scissor is None:
+        yield
+        return
+    gpu.state.scissor_test_set(True)
+    gpu.state.scissor_set(*scissor)
+    try:
+        yield
+    finally:
+        gpu.state.scissor_test_set(False)
 
 
 def _triangle_ids_by_vertex(options: DrawOptions) -> bool:
@@ -530,12 +549,13 @@ def _has_region_lines(items) -> bool:
     return any(item.mesh.region_line_count for item in items)
 
 
-def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget, cull: bool, stats):
+def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget, cull: bool, stats, scissor=None):
     """The region-lines pass over ``targets.visible`` (the visibility
     record of ``items``, numbered as draw() numbers them): the strongest
-    line per pixel into ``targets.lines``, which it returns."""
+    line per pixel into ``targets.lines``, which it returns; ``scissor``
+    as _record_visibility's."""
     framebuffer = targets.region_lines_framebuffer()
-    with framebuffer.bind():
+    with framebuffer.bind(), _scissored(scissor):
         _clear(framebuffer, view.width, view.height)
         lines = replace(target, stage=draw_mod.LINES, visibility=targets.visible)
         draw_mod.draw(items, view, settings, target=lines, cull=cull)
@@ -594,10 +614,10 @@ def _sync_overlay_surface(frame: Frame) -> None:
     """The overlay's sync step: where Blender's depth holds every surface
     and the frame is the surface pass alone (silhouettes may follow), the
     meshes dense on screen (OVERLAY_DEFERRED_MIN_DENSITY, and every mesh
-    with multi-face regions) are recorded and resolved into the overlay's
-    own targets (_overlay_surface); the rest stays in ``frame.direct``. A
-    deferred stage the backend refuses falls back to drawing directly, said
-    once."""
+    with multi-face regions) are recorded into the overlay's own targets
+    (_overlay_surface) for the surface pass to draw (_draw_overlay_surface);
+    the rest stays in ``frame.direct``. A deferred stage the backend
+    refuses falls back to drawing directly, said once."""
     frame.direct = list(frame.items)
     if not (frame.scene_depth and frame.scene_surfaces and _overlay_defers(frame)):
         return
@@ -610,12 +630,14 @@ def _sync_overlay_surface(frame: Frame) -> None:
         frame.overlay_surface = _overlay_surface(deferred, frame.view, frame.settings, frame.base.display, frame)
         frame.direct = direct
     except shaders.DeferredUnavailable as exc:
-        shaders.disable_deferred()
-        warn_once(
-            ("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly"
-        )
+        _refused(exc)
     finally:
         gpu.state.viewport_set(*saved_viewport)
+
+
+def _refused(exc: Exception) -> None:
+    shaders.disable_deferred()
+    warn_once(("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly")
 
 
 def _overlay_defers(frame: Frame) -> bool:
@@ -637,18 +659,50 @@ def _overlay_defers(frame: Frame) -> bool:
     )
 
 
-def _overlay_surface(items, view: View, settings, display, frame: Frame):
-    """The deferred overlay's surface, into the overlay's own targets at
-    the viewport's size: the visibility record of ``items`` over a depth
-    buffer of its own (window depth, as Blender's), the region lines over
-    it when a mesh has multi-face regions (docs/image_model.md §2.5, §2.6),
-    then the resolve into ``targets.surface``. Returns the targets, for
-    _composite_overlay_surface; ``frame.line_stats`` gets the draws' counts.
+@dataclass
+class OverlaySurface:
+    """The deferred overlay's surface of one frame (_overlay_surface): the
+    deferred ``items``, the overlay's ``targets`` holding their record,
+    their region-lines image ``lines`` (None without multi-face regions),
+    and whether ``targets.surface`` holds their resolved image (``kept``:
+    the surface pass composites it) or not (the surface pass resolves the
+    record straight into Blender's buffer)."""
 
-    Nothing here reads Blender's buffers, so a redraw that changes nothing
-    the image depends on (the view, the settings, which meshes in which
-    shape where, their styles and colour sources, the display transform;
-    _overlay_lines_key) reuses it whole: a static redraw only composites."""
+    targets: object
+    items: list
+    lines: object
+    kept: bool
+
+
+def _overlay_surface(items, view: View, settings, display, frame: Frame) -> OverlaySurface:
+    """The deferred overlay's surface, in the overlay's own targets at the
+    viewport's size: the visibility record of ``items`` over a depth buffer
+    of its own (window depth, as Blender's), and the region lines over it
+    when a mesh has multi-face regions (docs/image_model.md §2.5, §2.6);
+    ``frame.line_stats`` gets the draws' counts.
+
+    Nothing here reads Blender's buffers, so what it draws depends only on
+    its key (the view, the settings, which meshes in which shape where,
+    their styles and colour sources, the display transform;
+    _overlay_lines_key), and what was drawn for the last key is kept:
+
+    * the resolved image of this key: the surface pass only composites it
+      (a static redraw);
+    * the record and lines of this key (the redraw before had the same
+      key): they are resolved into ``targets.surface`` now and kept, so
+      from the next redraw on a static redraw only composites;
+    * the image of a key that differs only by meshes that moved some
+      vertices (an edit, a drag; _moved_items): record, lines and resolve
+      again only inside the window rectangle the moves changed
+      (_redraw_rect), then composite;
+    * an edit that is not known so well, or changed too much: record and
+      lines again, resolved into ``targets.surface`` and kept, so that the
+      next edit of a drag can be the one above;
+    * none of these (a moved object, another view, other settings): record and lines again, and
+      the surface pass resolves them straight into Blender's buffer. That
+      costs what a resolve into our own target costs and saves the
+      composite, while an image kept for a key that changes at every
+      redraw (a drag, an orbit) is never used."""
     targets = overlay_targets_for(view.width, view.height)
     key = _overlay_lines_key(items, view, settings)
     if key is not None:
@@ -665,23 +719,178 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame):
             record_stats.extra.update(region_line_entries=line_count, region_lines_reused=1)
         record_stats.extra["surface_reused"] = 1
         frame.line_stats.add(record_stats)
-        return targets
-    targets.lines_key = targets.surface_key = None
-    width, height = view.width, view.height
-    _record_visibility(targets, items, view, settings, DrawTarget(), frame.options)
-    lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats) if line_count else None
-    with targets.surface_framebuffer().bind():
-        gpu.state.viewport_set(0, 0, width, height)
-        gpu.state.blend_set("NONE")
-        resolve = DrawTarget(stage=draw_mod.RESOLVE, visibility=targets.visible, region_lines=lines, display=display)
-        record_stats.add(draw_mod.draw(items, view, settings, target=resolve))
-    # (One key for the record, its lines and the resolved image: the
-    # direct path's own region lines (_overlay_region_lines) never match it.)
-    targets.lines_key = targets.surface_key = key
+        return OverlaySurface(targets, items, targets.lines if line_count else None, kept=True)
+    lines = targets.lines if line_count else None
+    kept_key = targets.surface_key if targets.lines_key == targets.surface_key else None
+    moved = _moved_items(kept_key, key, items)
+    scissor = None if moved is None else _redraw_rect(moved, view, settings, items)
+    # An edit that moved vertices of the meshes recorded last: the next
+    # redraw is likely another (a drag), which redraws only what it
+    # changes if this one keeps its image.
+    edited = scissor is None and _moved_items(targets.lines_key, key, items) is not None
+    if scissor is not None:
+        # Only vertices moved since the kept image: record, lines and
+        # resolve again inside the rectangle they changed, into the kept
+        # targets (the same pixels as a whole record there: each pixel's
+        # record, lines and colour depend on what covers it alone).
+        record_stats.extra["surface_partial"] = 1
+        if scissor:
+            _record_visibility(targets, items, view, settings, DrawTarget(), frame.options, scissor=scissor)
+            if line_count:
+                _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats, scissor=scissor)
+        elif line_count:
+            record_stats.extra.update(region_line_entries=line_count, region_lines_reused=1)
+        targets.lines_key = key
+    elif key is not None and targets.lines_key == key:
+        if line_count:
+            record_stats.extra.update(region_line_entries=line_count, region_lines_reused=1)
+        record_stats.extra["record_reused"] = 1
+    elif edited:
+        targets.lines_key = targets.surface_key = None
+        _record_visibility(targets, items, view, settings, DrawTarget(), frame.options)
+        if line_count:
+            lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats)
+        targets.lines_key = key
+        record_stats.extra["surface_edited"] = 1
+    else:
+        targets.lines_key = targets.surface_key = None
+        _record_visibility(targets, items, view, settings, DrawTarget(), frame.options)
+        if line_count:
+            lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats)
+        # (One key for the record, its lines and the resolved image: the
+        # direct path's own region lines (_overlay_region_lines) never
+        # match it.)
+        targets.lines_key = key
+        frame.line_stats.add(record_stats)
+        return OverlaySurface(targets, items, lines, kept=False)
+    if scissor != ():
+        with targets.surface_framebuffer().bind(), _scissored(scissor):
+            gpu.state.viewport_set(0, 0, view.width, view.height)
+            gpu.state.blend_set("NONE")
+            resolve = DrawTarget(
+                stage=draw_mod.RESOLVE, visibility=targets.visible, region_lines=lines, display=display
+            )
+            record_stats.add(draw_mod.draw(items, view, settings, target=resolve))
+    else:
+        record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn = targets.surface_counts
+    targets.surface_key = key
     targets.surface_rect = draw_mod.window_union(items, view)
     targets.surface_counts = (record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn)
     frame.line_stats.add(record_stats)
-    return targets
+    return OverlaySurface(targets, items, lines, kept=True)
+
+
+def _moved_items(before_key, key, items):
+    """[(item, the move)] for the items whose mesh moved vertices since
+    ``before_key`` was drawn, when that is all that changed: every other
+    part of the two keys (_overlay_surface) alike; the move is the
+    mesh-space box it changed, or None where nothing (_redraw_rect), and
+    ``UNKNOWN_MOVE`` where that is not known (not one move further on, or
+    cache.GPUMesh.last_move cannot tell). Else None."""
+    if before_key is None or key is None or before_key[0] != key[0] or before_key[2:] != key[2:]:
+        return None
+    before_lines, now_lines = before_key[1], key[1]
+    if before_lines[:4] != now_lines[:4] or len(before_lines[4]) != len(now_lines[4]):
+        return None
+    moved = []
+    for item, before, now in zip(items, before_lines[4], now_lines[4]):
+        if before == now:
+            continue
+        serial, version, matrix, style = now
+        if (before[0], before[2], before[3]) != (serial, matrix, style):
+            return None
+        move = item.mesh.last_move() if version == before[1] + 1 else None
+        moved.append((item, UNKNOWN_MOVE if move is None or move[0] != version else move[1]))
+    return moved
+
+
+UNKNOWN_MOVE = "unknown"
+
+
+def _redraw_rect(moved, view: View, settings, items):
+    """The window rectangle (x, y, width, height) that the moves ``moved``
+    (_moved_items) changed: each box's window box widened by the reach of
+    the widest line (docs/image_model.md §3.1: nothing farther than h + 2s
+    from a line sees it); () where nothing changed; None where that cannot
+    be told (a move not known, widths not in pixels, the density fade,
+    whose lines fade by the length of whole chains). (However big, it costs
+    no more than recording and resolving everything again.)"""
+    reach = _line_reach_px(settings, items)
+    if reach is None or any(box is UNKNOWN_MOVE for _item, box in moved):
+        return None
+    to_clip = view.projection @ view.view_matrix
+    boxes = [window_boxes((to_clip @ item.matrix)[None], *box) for item, box in moved if box is not None]
+    if not boxes:
+        return ()
+    ndc = np.concatenate(boxes)
+    width, height = view.width, view.height
+    x0 = max(int(np.floor((ndc[:, 0].min() + 1.0) * 0.5 * width - reach)), 0)
+    y0 = max(int(np.floor((ndc[:, 1].min() + 1.0) * 0.5 * height - reach)), 0)
+    x1 = min(int(np.ceil((ndc[:, 2].max() + 1.0) * 0.5 * width + reach)), width)
+    y1 = min(int(np.ceil((ndc[:, 3].max() + 1.0) * 0.5 * height + reach)), height)
+    if x1 <= x0 or y1 <= y0:
+        return ()
+    return (x0, y0, x1 - x0, y1 - y0)
+
+
+def _param_slots(names) -> list:
+    """Float offsets of the parameter block's members ``names``."""
+    slots, offset = {}, 0
+    for member in schema.PARAM_BLOCK:
+        slots[member.glsl] = offset
+        offset += 4 if member.glsl_type == "vec4" else 1
+    return [slots[name] for name in names]
+
+
+_HALF_WIDTH_SLOTS = _param_slots(
+    ["half_thickness", "half_thickness_far"] + [f"{name}_half_thickness" for name in draw_mod.EDGE_CLASSES]
+)
+(_SOFTNESS_SLOT,) = _param_slots(["softness"])
+
+
+def _line_reach_px(settings, items) -> float | None:
+    """The widest reach in pixels of any line ``items`` draw with
+    ``settings`` (the widest half width of every style, class widths
+    included, plus 2s, and 2 px to spare), or None where it is not a
+    fixed number of pixels."""
+    if settings.thickness_mode != "PIXELS" or settings.use_density_fade:
+        return None
+    reach = 0.0
+    for style in {item.style for item in items} | {None}:
+        values = np.frombuffer(pack_params(draw_mod.styled(settings, style), (0.0, 0.0, 1.0, 1.0)), np.float32)
+        reach = max(reach, float(values[_HALF_WIDTH_SLOTS].max() + 2.0 * values[_SOFTNESS_SLOT]))
+    return reach + 2.0
+
+
+def _draw_overlay_surface(frame: Frame, target: DrawTarget) -> None:
+    """The deferred meshes (``frame.overlay_surface``) into the bound
+    framebuffer (Blender's), each pixel at the record's depth less the
+    bias, depth test LESS_EQUAL and write, blended as the caller set
+    (premultiplied "over"): the kept image composited, or the record
+    resolved straight. The two give the same image: the kept image is
+    float32, resolved by the same fragment code. A backend that refuses the
+    straight resolve draws these meshes directly (``target``, walking their
+    regions), said once."""
+    surface = frame.overlay_surface
+    targets = surface.targets
+    if surface.kept:
+        _composite_overlay_surface(targets, frame.base.depth_bias)
+        return
+    resolve = DrawTarget(
+        stage=draw_mod.RESOLVE,
+        visibility=targets.visible,
+        region_lines=surface.lines,
+        display=frame.base.display,
+        depth_bias=frame.base.depth_bias,
+        record_depth=targets.depth,
+    )
+    try:
+        stats = draw_mod.draw(surface.items, frame.view, frame.settings, target=resolve)
+        stats.extra["surface_straight"] = 1
+    except shaders.DeferredUnavailable as exc:
+        _refused(exc)
+        stats = draw_mod.draw(surface.items, frame.view, frame.settings, target=replace(target, region_lines=None))
+    frame.line_stats.add(stats)
 
 
 def _composite_overlay_surface(targets, depth_bias: float) -> None:

@@ -130,6 +130,10 @@ class ShaderVariant:
     # region-lines image and no diagonal is drawn (a cage look), so no
     # triangle edge is set up per pixel (NO_EDGE_SETUP).
     no_edge_setup: bool = False
+    # Resolve only, viewport overlay: the resolve writes the record's window
+    # depth less DEPTH_BIAS (RECORD_DEPTH), as the overlay's composite does,
+    # to resolve straight into Blender's buffer.
+    record_depth: bool = False
     # A surface pass that measures no line of a class itself (every class
     # line comes from the region-lines pass) but colours the winning style:
     # the class colours without the per-style distance code (STYLE_COLORS).
@@ -357,6 +361,12 @@ def _create_info(variant: ShaderVariant):
         add_sampler(info, "visibility")
         add_sampler(info, "triangle_flag_table")
         info.define("RESOLVE_PASS", "1")
+        if variant.record_depth:
+            if not variant.depth_bias:
+                raise ValueError("a resolve that writes the record's depth needs the overlay's depth bias")
+            add_sampler(info, "record_depth")
+            info.define("RECORD_DEPTH", "1")
+            compat.depth_write(info, "ANY")
     else:
         info.vertex_in(0, "INT", "edge_flags")
     if variant.region_lines:

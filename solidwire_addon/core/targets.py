@@ -66,10 +66,13 @@ class Targets:
 
     def surface_framebuffer(self):
         """The viewport overlay's resolved surface, no depth: the overlay
-        composites it into Blender's buffer at the record's depth. Half
-        floats: that buffer keeps 8 bits, these 11 (0.12/255 at white)."""
+        composites it into Blender's buffer at the record's depth. Full
+        floats: the composite then blends exactly what the resolve wrote,
+        so a kept image draws what a resolve straight into Blender's buffer
+        draws (passes._draw_overlay_surface); on llvmpipe a half-float
+        target also resolved no faster."""
         if self.surface is None:
-            self.surface = gpu.types.GPUTexture(self.size, format="RGBA16F")
+            self.surface = gpu.types.GPUTexture(self.size, format="RGBA32F")
         return gpu.types.GPUFrameBuffer(color_slots=(self.surface,))
 
     def resolve_framebuffer(self, aovs: bool = False):

@@ -177,3 +177,73 @@ def test_edges_that_are_their_own_chains_are_one_quad_each():
     edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, edge_select.EdgeInputs(verts, drawn))
     assert arrays.region_run_segments == 1
     assert _runs(arrays) == [(k, 1) for k in range(len(arrays.region_lines) // 2)]
+
+
+def _known_strip_regions(index, drawn, verts, pairs_of_quads: int):
+    """KnownRegions of a strip whose quads 2k and 2k + 1 form region k."""
+    face_start = np.arange(0, 2 * pairs_of_quads + 1, 2)
+    edges, edge_start = [], [0]
+    for k in range(pairs_of_quads):
+        x = 2 * k
+        own = {
+            index[key]
+            for key in index
+            if set(key) <= {x, x + 1, x + 2, *(v + 2 * pairs_of_quads + 1 for v in (x, x + 1, x + 2))}
+        }
+        edges += sorted(e for e in own if drawn[e])
+        edge_start.append(len(edges))
+    return edge_select.KnownRegions(face_start, np.array(edge_start), np.array(edges))
+
+
+def _select_both(columns, regions_for, monkeypatch):
+    """The arrays through the known regions (the same as the general
+    path's) and whether the known regions were taken."""
+    taken = []
+    real = edge_select._select_known_regions
+    monkeypatch.setattr(edge_select, "_select_known_regions", lambda *args: taken.append(real(*args)) or taken[-1])
+    results = []
+    for known in (True, False):
+        arrays, corner_vert, offsets, corner_edge, verts, index = _strip(columns)
+        drawn = np.ones(len(verts), bool)
+        top = columns + 1
+        for x in range(1, columns, 2):
+            drawn[index[(x, top + x)]] = False  # quads 2k and 2k + 1 form a region
+        ends = verts.copy()
+        regions = regions_for(index, drawn, verts) if known else None
+        inputs = edge_select.EdgeInputs(verts, drawn, chain_ends=ends, regions=regions)
+        results.append((arrays, edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, inputs)))
+    (fast, fast_stats), (general, general_stats) = results
+    assert fast_stats == general_stats
+    for field in ("triangles", "edge_flags", "region_table", "region_lines", "region_line_runs", "triangle_regions"):
+        a, b = getattr(fast, field), getattr(general, field)
+        assert (a is None) == (b is None) and (a is None or (a.dtype == b.dtype and np.array_equal(a, b))), field
+    return fast, taken[0] is not None
+
+
+def test_known_regions_give_the_general_path_arrays(monkeypatch):
+    """Regions the caller knows (a subdivision's cage faces) are written per
+    region and per quad: the same arrays as finding them."""
+    fast, taken = _select_both(6, lambda index, drawn, verts: _known_strip_regions(index, drawn, verts, 3), monkeypatch)
+    assert taken
+    assert sorted(set(fast.triangle_regions.tolist())) == [0.0, 2.0, 4.0]
+
+
+def test_known_regions_that_do_not_fit_the_mesh_are_found_instead(monkeypatch):
+    """A list that does not cover the faces, names an edge that is not
+    drawn or has a region of one face: the general path decides."""
+
+    def short(index, drawn, verts):
+        known = _known_strip_regions(index, drawn, verts, 3)
+        return edge_select.KnownRegions(known.face_start[:-1], known.edge_start[:-1], known.region_edges)
+
+    def hidden_edge(index, drawn, verts):
+        known = _known_strip_regions(index, drawn, verts, 3)
+        known.region_edges[0] = int(np.flatnonzero(~drawn)[0])
+        return known
+
+    def single_faces(index, drawn, verts):
+        return edge_select.KnownRegions(np.arange(7), np.arange(7), np.flatnonzero(drawn)[:6])
+
+    for regions_for in (short, hidden_edge, single_faces):
+        assert not _select_both(6, regions_for, monkeypatch)[1]
+        monkeypatch.undo()
