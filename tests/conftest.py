@@ -87,6 +87,16 @@ def _addon_registered(request):
         request.getfixturevalue("addon")
 
 
+@pytest.fixture(autouse=True)
+def _messages_said_afresh():
+    """Every test starts with no one-line message said yet: a message is said
+    once per session (core/log.py), so a test that expects one must not
+    depend on whether an earlier test, in whatever order, said it first."""
+    from solidwire_addon.core import log
+
+    log.forget()
+
+
 @pytest.fixture
 def output_dir() -> Path:
     """Where tests write images a person can look at (ignored by git)."""
