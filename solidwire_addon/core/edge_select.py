@@ -105,6 +105,31 @@ class KnownRegions:
 
 
 @dataclass
+class SubdivisionLayout:
+    """What a subdivision's evaluated edge layout says (blender/cage.py's
+    peel) when the caller cannot read the mesh it started from (a modifier
+    before the subdivision made it, or Edit Mode): select_edges then reads
+    the regions of the cage mask from the mesh's own corners
+    (regions_from_layout). At ``level`` (n = 2**level children per coarse
+    edge) the subdivided mesh is the first ``faces`` faces, ``verts``
+    vertices and ``edges`` edges; its vertices are the ``coarse_verts``
+    coarse ones, then n - 1 inside each of the ``coarse_edges`` coarse
+    edges, then each coarse face's own, face by face; its first
+    ``coarse_edges * n`` edges are the drawn ones. ``copies``: how many
+    copies each Mirror or Array step after the subdivision made, in stack
+    order (each copy's faces and edges follow its input's)."""
+
+    level: int
+    coarse_verts: int
+    coarse_edges: int
+    coarse_faces: int
+    verts: int
+    edges: int
+    faces: int
+    copies: tuple[int, ...] = ()
+
+
+@dataclass
 class EdgeInputs:
     """What Blender's data says about each evaluated edge (mesh.edges order).
 
@@ -125,8 +150,9 @@ class EdgeInputs:
     # edges); else found from ``chain``.
     chain_ends: np.ndarray | None = None
     # The regions of ``drawn`` when the caller knows them from how the mesh
-    # was made (a subdivision's cage faces); None: found here.
-    regions: KnownRegions | None = None
+    # was made (a subdivision's cage faces), or the layout they are read
+    # from; None: found here.
+    regions: KnownRegions | SubdivisionLayout | None = None
 
     @property
     def selects_anything(self) -> bool:
@@ -391,11 +417,108 @@ def select_edges(
     return stats
 
 
+def regions_from_layout(
+    layout: SubdivisionLayout,
+    corner_vert: np.ndarray,
+    corner_edge: np.ndarray,
+    verts: np.ndarray,
+    drawn: np.ndarray,
+    face_count: int,
+) -> KnownRegions | None:
+    """The regions of a subdivision's cage mask (``drawn``) read from the
+    evaluated mesh's own corners (``face_count`` faces, edges ``verts``) as
+    ``layout`` lays them out, or None where what the layout says does not
+    hold exactly.
+
+    Blender's subdivision (``subdiv_foreach.cc``) makes each coarse face's
+    children one after another in coarse face order, and each coarse face's
+    own vertices (its centre and those inside it, 1 + c*m*(m-1) for c
+    corners, m = n/2) one after another in the same order, after every
+    vertex on a coarse edge; every child touches one of them and every edge
+    inside a coarse face (a hidden one) ends at one. So a coarse face's
+    children end where every such inner vertex so far is below every one
+    still to come. Checked here: as many runs as coarse faces, each of
+    c * m**2 children (c >= 3) whose inner vertices lie in the face's own
+    range, the ranges filling the inner vertices exactly, every hidden edge
+    ending at an inner vertex, the drawn edges exactly the first
+    ``coarse_edges * n``. Then no hidden edge joins two runs (each run's
+    inner vertices are its own); that each run is one patch, not two, is
+    the layout's word (Blender's children of a face are one grid, or one
+    per corner around its centre). A run's drawn edges are those its
+    children's corners name, ascending."""
+    n = 1 << layout.level
+    m = n >> 1
+    faces, edges_num, drawn_count = layout.faces, layout.edges, layout.coarse_edges * n
+    corner_vert, corner_edge = np.asarray(corner_vert), np.asarray(corner_edge)
+    if (
+        faces <= 0
+        or faces % (m * m)
+        or min(len(corner_vert), len(corner_edge)) < 4 * faces
+        or min(len(drawn), len(verts)) < edges_num
+        or not 0 < drawn_count < edges_num
+        or not drawn[:drawn_count].all()
+        or drawn[drawn_count:edges_num].any()
+    ):
+        return None
+    inner = layout.coarse_verts + (n - 1) * layout.coarse_edges  # the first coarse face's first own vertex
+    if np.asarray(verts[drawn_count:edges_num]).max(axis=1).min() < inner:
+        return None
+    quads = corner_vert[: 4 * faces].reshape(faces, 4)
+    top = quads.max(axis=1)  # an inner vertex of the child's coarse face
+    if top.min() < inner:
+        return None
+    low = np.where(quads >= inner, quads, top[:, None]).min(axis=1)
+    reach, floor = np.maximum.accumulate(top), np.minimum.accumulate(low[::-1])[::-1]
+    face_start = np.concatenate(([0], np.flatnonzero(reach[:-1] < floor[1:]) + 1, [faces])).astype(np.int64)
+    if len(face_start) - 1 != layout.coarse_faces:
+        return None
+    run_corners, rest = np.divmod(np.diff(face_start), m * m)
+    if rest.any() or run_corners.min() < 3:
+        return None
+    inner_start = np.full(len(face_start), inner, np.int64)
+    inner_start[1:] += np.cumsum(1 + run_corners * (m * (m - 1)))
+    first = face_start[:-1]
+    if (
+        inner_start[-1] != layout.verts
+        or (np.minimum.reduceat(low, first) < inner_start[:-1]).any()
+        or (np.maximum.reduceat(top, first) >= inner_start[1:]).any()
+    ):
+        return None
+    at = np.flatnonzero(corner_edge[: 4 * faces] < drawn_count)
+    run = np.searchsorted(face_start, at >> 2, side="right") - 1
+    region, edge = np.divmod(np.unique(run * drawn_count + np.take(corner_edge, at)), drawn_count)
+    edge_start = np.zeros(len(face_start), np.int64)
+    np.cumsum(np.bincount(region, minlength=len(first)), out=edge_start[1:])
+    known = KnownRegions(face_start, edge_start, edge)
+    return copied_regions(known, layout.copies, faces, edges_num, face_count, len(drawn))
+
+
+def copied_regions(
+    regions: KnownRegions, copies, faces_in: int, edges_in: int, face_count: int, edge_count: int
+) -> KnownRegions | None:
+    """``regions`` of a mesh of ``faces_in`` faces and ``edges_in`` edges
+    carried through the copies Mirror and Array make of it (``copies``: how
+    many per step, in stack order; each copy's faces and edges follow its
+    input's, numbered on by the input's counts), or None where the result
+    is not ``face_count`` faces and ``edge_count`` edges."""
+    face_start, edge_start, edges = regions.face_start, regions.edge_start, regions.region_edges
+    for count in copies:
+        shift = np.arange(count, dtype=np.int64)[:, None]
+        face_start = np.append((face_start[:-1] + shift * faces_in).reshape(-1), count * faces_in)
+        edge_start = np.append((edge_start[:-1] + shift * len(edges)).reshape(-1), count * len(edges))
+        edges = (edges + shift * edges_in).reshape(-1)
+        faces_in, edges_in = count * faces_in, count * edges_in
+    if faces_in != face_count or edges_in != edge_count:
+        return None
+    return KnownRegions(face_start, edge_start, edges)
+
+
 def _select_known_regions(
     arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray, inputs: EdgeInputs
 ) -> SelectionStats | None:
-    """select_edges for regions the caller knows (``inputs.regions``, no
-    classes) on a mesh of quads only: the same arrays as the general path,
+    """select_edges for regions the caller knows (``inputs.regions``, or
+    read from the layout it gives: regions_from_layout; no classes) on a
+    mesh of quads only: the same arrays as the general path,
     written per region and per quad instead of found from every corner, or
     None (nothing written) where the shortcut does not apply: faces other
     than extract.build_arrays_fast's quad rows, a region of one face, a
@@ -413,6 +536,10 @@ def _select_known_regions(
     face_count = len(offsets) - 1
     verts = np.asarray(inputs.verts).reshape(-1, 2)
     drawn = np.asarray(drawn, bool)
+    if isinstance(regions, SubdivisionLayout):
+        regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn, face_count)
+        if regions is None:
+            return None
     face_start = np.asarray(regions.face_start, np.int64)
     edge_start = np.asarray(regions.edge_start, np.int64)
     edges = np.asarray(regions.region_edges, np.int64)
