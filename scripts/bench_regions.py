@@ -29,8 +29,8 @@ import gpu
 import solidwire_addon
 from solidwire_addon.blender import engine, overlay, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
-from solidwire_addon.core import edge_select
 from solidwire_addon.blender.views import camera_view
+from solidwire_addon.core import edge_select
 from tests.support import scenes
 
 PLAIN = dict(
@@ -183,6 +183,7 @@ def stack_table(size, levels, repeats: int) -> None:
 
             looks = {"all": (False, spy), "found": (True, lambda *args: None), "layout": (True, spy)}
             best: dict = {}
+            refused = False
             try:
                 for round_ in range(repeats + 1):  # the first round warms up
                     for look, (use_cage, select) in looks.items():
@@ -190,8 +191,8 @@ def stack_table(size, levels, repeats: int) -> None:
                         edge_select._select_known_regions = select
                         taken.clear()
                         ms = first_extract_ms(scene, size)
-                        if look == "layout" and not any(taken):
-                            raise SystemExit(f"{name} at level {level}: the cage regions were not taken")
+                        if look == "layout":
+                            refused = not any(taken)
                         if round_:
                             best[look] = min(best.get(look, math.inf), ms)
             finally:
@@ -199,9 +200,10 @@ def stack_table(size, levels, repeats: int) -> None:
                 if edit:
                     bpy.ops.object.mode_set(mode="OBJECT")
             a, f, k = best["all"], best["found"], best["layout"]
+            # Refused: a cage face past WALK_LIMIT (a Bevel's n-gons at level 5).
+            layout_cells = "refused | –" if refused else f"{k:.1f} | {k / a:.2f}x"
             print(
-                f"| {name} | {level} | {triangles:,} | {a:.1f} | {f:.1f} | {f / a:.2f}x | {k:.1f} | {k / a:.2f}x |",
-                flush=True,
+                f"| {name} | {level} | {triangles:,} | {a:.1f} | {f:.1f} | {f / a:.2f}x | {layout_cells} |", flush=True
             )
 
 
