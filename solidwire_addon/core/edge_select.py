@@ -424,6 +424,7 @@ def regions_from_layout(
     verts: np.ndarray,
     drawn: np.ndarray,
     face_count: int,
+    corner_drawn: np.ndarray | None = None,
 ) -> KnownRegions | None:
     """The regions of a subdivision's cage mask (``drawn``) read from the
     evaluated mesh's own corners (``face_count`` faces, edges ``verts``) as
@@ -445,7 +446,8 @@ def regions_from_layout(
     inner vertices are its own); that each run is one patch, not two, is
     the layout's word (Blender's children of a face are one grid, or one
     per corner around its centre). A run's drawn edges are those its
-    children's corners name, ascending."""
+    children's corners name, ascending (``corner_drawn``: each corner's
+    edge drawn, _corner_drawn, when the caller has it)."""
     n = 1 << layout.level
     m = n >> 1
     faces, edges_num, drawn_count = layout.faces, layout.edges, layout.coarse_edges * n
@@ -472,11 +474,15 @@ def regions_from_layout(
     # (Column by column: a reduction along rows of four is several times
     # slower.)
     own = np.subtract(corner_vert[: 4 * faces], inner, dtype=np.int32).reshape(faces, 4)
-    top = np.maximum(np.maximum(own[:, 0], own[:, 1]), np.maximum(own[:, 2], own[:, 3]))
+    top = np.maximum(own[:, 0], own[:, 1])
+    np.maximum(top, own[:, 2], out=top)
+    np.maximum(top, own[:, 3], out=top)
     if top.min() < 0:
         return None  # a child that touches none of its coarse face's own vertices
     unsigned = own.view(np.uint32)
-    low = np.minimum(np.minimum(unsigned[:, 0], unsigned[:, 1]), np.minimum(unsigned[:, 2], unsigned[:, 3]))
+    low = np.minimum(unsigned[:, 0], unsigned[:, 1])
+    np.minimum(low, unsigned[:, 2], out=low)
+    np.minimum(low, unsigned[:, 3], out=low)
     low = low.view(np.int32)  # every child has one inner vertex: below 2**31
     # A coarse face's children end where every inner vertex so far is below
     # every one to come: only where a child's lowest is above the previous
@@ -501,7 +507,9 @@ def regions_from_layout(
         or (np.maximum.reduceat(top, first) >= inner_start[1:]).any()
     ):
         return None
-    at = np.flatnonzero(corner_edge[: 4 * faces] < drawn_count)
+    if corner_drawn is None:
+        corner_drawn = _corner_drawn(drawn, corner_edge)
+    at = np.flatnonzero(corner_drawn[: 4 * faces])
     run = np.searchsorted(face_start, at >> 2, side="right") - 1
     region, edge = np.divmod(np.unique(run * drawn_count + np.take(corner_edge, at)), drawn_count)
     edge_start = np.zeros(len(face_start), np.int64)
@@ -553,8 +561,10 @@ def _select_known_regions(
     face_count = len(offsets) - 1
     verts = np.asarray(inputs.verts).reshape(-1, 2)
     drawn = np.asarray(drawn, bool)
+    corner_drawn = None  # shared with _hidden_pattern, which consumes it
     if isinstance(regions, SubdivisionLayout):
-        regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn, face_count)
+        corner_drawn = _corner_drawn(drawn, corner_edge)
+        regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn, face_count, corner_drawn)
         if regions is None:
             return None
     face_start = np.asarray(regions.face_start, np.int64)
@@ -601,7 +611,7 @@ def _select_known_regions(
     # Each quad's two rows in one 64-bit write (row 2i the low half), looked
     # up by its block's segment count, its split and its hidden edges
     # (_listed_quad_rows), written in place: no million-row temporaries.
-    at = _hidden_pattern(drawn, corner_edge, face_count)
+    at = _hidden_pattern(drawn, corner_edge, face_count, corner_drawn)
     at |= flip.view(np.uint8) << np.uint8(4)
     at |= np.repeat((per_region << 5).astype(np.uint32), region_faces)
     flags = arrays.edge_flags
@@ -913,17 +923,26 @@ def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, sizes: np.ndarra
     return flip
 
 
-def _hidden_pattern(drawn: np.ndarray, corner_edge: np.ndarray, face_count: int) -> np.ndarray:
-    """(F,) uint32 for a mesh of quads only: bit c set where the edge leaving
-    the quad's corner c is not drawn. The four corners' drawn flags are one
-    little-endian 32-bit word of 0/1 bytes; one multiplication gathers their
-    bits into the top byte (no partial product carries into it)."""
+def _corner_drawn(drawn: np.ndarray, corner_edge: np.ndarray) -> np.ndarray:
+    """(L,) bool, a fresh array: whether each corner's edge is drawn."""
     drawn = np.asarray(drawn, bool)
     count = int(np.count_nonzero(drawn))
     if drawn[:count].all():  # the drawn edges come first (a subdivision's cage children): a compare, no gather
-        corner_drawn = np.asarray(corner_edge) < count
-    else:
-        corner_drawn = np.take(drawn, corner_edge)
+        return np.asarray(corner_edge) < count
+    return np.take(drawn, corner_edge)
+
+
+def _hidden_pattern(
+    drawn: np.ndarray, corner_edge: np.ndarray, face_count: int, corner_drawn: np.ndarray | None = None
+) -> np.ndarray:
+    """(F,) uint32 for a mesh of quads only: bit c set where the edge leaving
+    the quad's corner c is not drawn. The four corners' drawn flags are one
+    little-endian 32-bit word of 0/1 bytes; one multiplication gathers their
+    bits into the top byte (no partial product carries into it).
+    ``corner_drawn``: _corner_drawn's answer when the caller has it (it is
+    written over)."""
+    if corner_drawn is None:
+        corner_drawn = _corner_drawn(drawn, corner_edge)
     if not np.little_endian:
         hidden = ~corner_drawn.reshape(face_count, 4)
         return (hidden * np.array([1, 2, 4, 8], np.uint32)).sum(axis=1, dtype=np.uint32)
