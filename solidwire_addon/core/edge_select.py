@@ -470,19 +470,22 @@ def regions_from_layout(
     if hidden[:, 1].min() < inner and np.maximum(hidden[:, 0], hidden[:, 1]).min() < inner:
         return None
     # Inner vertices counted from the first: a vertex on a coarse edge or a
-    # coarse vertex is negative, so as unsigned it is above every inner one.
-    # (Column by column: a reduction along rows of four is several times
-    # slower.)
-    own = np.subtract(corner_vert[: 4 * faces], inner, dtype=np.int32).reshape(faces, 4)
-    top = np.maximum(own[:, 0], own[:, 1])
-    np.maximum(top, own[:, 2], out=top)
-    np.maximum(top, own[:, 3], out=top)
+    # coarse vertex is negative, so as unsigned (wrapping) it is above every
+    # inner one. Column by column into two face-sized arrays: a reduction
+    # along rows of four, or a shifted copy of every corner, costs several
+    # times more.
+    quads = np.asarray(corner_vert[: 4 * faces], np.int32).reshape(faces, 4)
+    top = np.maximum(quads[:, 0], quads[:, 1])
+    np.maximum(top, quads[:, 2], out=top)
+    np.maximum(top, quads[:, 3], out=top)
+    top -= np.int32(inner)
     if top.min() < 0:
         return None  # a child that touches none of its coarse face's own vertices
-    unsigned = own.view(np.uint32)
-    low = np.minimum(unsigned[:, 0], unsigned[:, 1])
-    np.minimum(low, unsigned[:, 2], out=low)
-    np.minimum(low, unsigned[:, 3], out=low)
+    unsigned, first_inner = quads.view(np.uint32), np.uint32(inner)
+    low = np.subtract(unsigned[:, 0], first_inner)
+    column = np.empty_like(low)
+    for k in (1, 2, 3):
+        np.minimum(low, np.subtract(unsigned[:, k], first_inner, out=column), out=low)
     low = low.view(np.int32)  # every child has one inner vertex: below 2**31
     # A coarse face's children end where every inner vertex so far is below
     # every one to come: only where a child's lowest is above the previous
@@ -510,7 +513,9 @@ def regions_from_layout(
     if corner_drawn is None:
         corner_drawn = _corner_drawn(drawn, corner_edge)
     at = np.flatnonzero(corner_drawn[: 4 * faces])
-    run = np.searchsorted(face_start, at >> 2, side="right") - 1
+    # Each run's drawn corners are one stretch of ``at``: R searches, not one per corner.
+    per_run = np.diff(np.searchsorted(at, 4 * face_start))
+    run = np.repeat(np.arange(len(first), dtype=np.int64), per_run)
     region, edge = np.divmod(np.unique(run * drawn_count + np.take(corner_edge, at)), drawn_count)
     edge_start = np.zeros(len(face_start), np.int64)
     np.cumsum(np.bincount(region, minlength=len(first)), out=edge_start[1:])
