@@ -164,6 +164,13 @@ def stack_table(size, levels, repeats: int) -> None:
     )
     print("|---|---:|---:|" + "---:|" * 5)
     shortcut = edge_select._select_known_regions
+    taken = []  # whether each call took the regions it was given
+
+    def spy(*args):
+        result = shortcut(*args)
+        taken.append(result is not None)
+        return result
+
     for name, before, edit in STACKS:
         for level in levels:
             bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -174,13 +181,6 @@ def stack_table(size, levels, repeats: int) -> None:
                 monkey.select_set(True)
                 bpy.ops.object.mode_set(mode="EDIT")
             triangles = len(monkey.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
-            taken = []
-
-            def spy(*args):
-                result = shortcut(*args)
-                taken.append(result is not None)
-                return result
-
             looks = {"all": (False, spy), "found": (True, lambda *args: None), "layout": (True, spy)}
             best: dict = {}
             refused = False
