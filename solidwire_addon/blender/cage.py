@@ -453,7 +453,8 @@ def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
     share their chain's ends, so the density fade measures the whole cage
     edge, not its pieces (an edge that is no cage child is its own chain,
     its own ends). ``regions``: also the regions of that mask as the layout
-    gives them (_known_regions; None where it cannot tell), else None."""
+    gives them, or the layout to read them from (_known_regions; None where
+    it cannot tell), else None."""
     if layout is None:
         layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
