@@ -319,7 +319,7 @@ def test_a_layout_that_does_not_hold_gives_no_regions():
     moved[0, 1] = moved[16 * 4, 0]  # a vertex of a later coarse face's own
     assert refused(corner_vert=moved.reshape(-1))
     assert refused(layout=dataclasses.replace(layout, coarse_faces=layout.coarse_faces - 1))
-    assert refused(layout=dataclasses.replace(layout, verts=layout.verts + 1))
+    assert refused(layout=dataclasses.replace(layout, subdivided_verts=layout.subdivided_verts + 1))
     assert refused(layout=dataclasses.replace(layout, coarse_edges=layout.coarse_edges - 1))
     shifted = drawn.copy()
     shifted[layout.coarse_edges * n - 1] = False

@@ -506,9 +506,9 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
             coarse_verts=verts_num,
             coarse_edges=len(cage),
             coarse_faces=faces_num,
-            verts=sub_verts_num,
-            edges=sub_edges_num,
-            faces=sub_faces_num,
+            subdivided_verts=sub_verts_num,
+            subdivided_edges=sub_edges_num,
+            subdivided_faces=sub_faces_num,
             copies=tuple(copies for copies, _verts, _caps in steps),
         )
     children_per_corner = (per_edge // 2) ** 2  # 4**(L-1)

@@ -111,8 +111,8 @@ class SubdivisionLayout:
     before the subdivision made it, or Edit Mode): select_edges then reads
     the regions of the cage mask from the mesh's own corners
     (regions_from_layout). At ``level`` (n = 2**level children per coarse
-    edge) the subdivided mesh is the first ``faces`` faces, ``verts``
-    vertices and ``edges`` edges; its vertices are the ``coarse_verts``
+    edge) the subdivided mesh is the first ``subdivided_faces`` faces,
+    ``subdivided_verts`` vertices and ``subdivided_edges`` edges; its vertices are the ``coarse_verts``
     coarse ones, then n - 1 inside each of the ``coarse_edges`` coarse
     edges, then each coarse face's own, face by face; its first
     ``coarse_edges * n`` edges are the drawn ones. ``copies``: how many
@@ -123,9 +123,9 @@ class SubdivisionLayout:
     coarse_verts: int
     coarse_edges: int
     coarse_faces: int
-    verts: int
-    edges: int
-    faces: int
+    subdivided_verts: int
+    subdivided_edges: int
+    subdivided_faces: int
     copies: tuple[int, ...] = ()
 
 
@@ -450,7 +450,7 @@ def regions_from_layout(
     edge drawn, _corner_drawn, when the caller has it)."""
     n = 1 << layout.level
     m = n >> 1
-    faces, edges_num, drawn_count = layout.faces, layout.edges, layout.coarse_edges * n
+    faces, edges_num, drawn_count = layout.subdivided_faces, layout.subdivided_edges, layout.coarse_edges * n
     corner_vert, corner_edge = np.asarray(corner_vert), np.asarray(corner_edge)
     if (
         faces <= 0
@@ -463,7 +463,7 @@ def regions_from_layout(
     ):
         return None
     inner = layout.coarse_verts + (n - 1) * layout.coarse_edges  # the first coarse face's first own vertex
-    if layout.verts >= 1 << 31 or inner <= 0:
+    if layout.subdivided_verts >= 1 << 31 or inner <= 0:
         return None
     hidden = np.asarray(verts[drawn_count:edges_num])
     # Blender puts the inner end second: one column is checked first.
@@ -505,7 +505,7 @@ def regions_from_layout(
     np.cumsum(1 + run_corners * (m * (m - 1)), out=inner_start[1:])
     first = face_start[:-1]
     if (
-        inner_start[-1] != layout.verts - inner
+        inner_start[-1] != layout.subdivided_verts - inner
         or (np.minimum.reduceat(low, first) < inner_start[:-1]).any()
         or (np.maximum.reduceat(top, first) >= inner_start[1:]).any()
     ):
