@@ -3,8 +3,13 @@ every edge of the same mesh: F12 (a warm render), the viewport overlay (a
 static redraw and a redraw after one vertex moved) and the first render's
 extraction, for Suzanne under a Subdivision Surface modifier at levels 2-5;
 then the angle threshold and edge classes against a plain frame.
+``--stacks`` instead measures the first extraction alone for the stacks
+whose cage regions are read from the evaluated mesh's layout (a modifier
+before the subdivision, Edit Mode) and for the object's own mesh, the cage
+look with those regions and with the regions found from the mesh, against
+every edge.
 
-    .venv/bin/python -m scripts.bench_regions [--size 1280x720] [--repeats 3] [--levels 2 3 4 5]
+    .venv/bin/python -m scripts.bench_regions [--size 1280x720] [--repeats 3] [--levels 2 3 4 5] [--stacks]
 
 Every ratio is taken within one process, rounds alternating between the two
 looks so that a change in machine load hits both alike; the table gives the
@@ -25,6 +30,7 @@ import solidwire_addon
 from solidwire_addon.blender import engine, overlay, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.blender.views import camera_view
+from solidwire_addon.core import edge_select
 from tests.support import scenes
 
 PLAIN = dict(
@@ -41,12 +47,22 @@ PLAIN = dict(
 )
 
 
-def build_scene(size, level: int):
+def build_scene(size, level: int, before=()):
+    """Suzanne under a Subdivision Surface at ``level``, the modifiers
+    ``before`` (types) ahead of it."""
     scene = scenes.empty_scene(*size, transparent=False)
     monkey = scenes.monkey(scene, rotation=(0.0, 0.0, 0.5))
     for edge in monkey.data.edges[:80]:  # marked edges for the edge classes
         edge.use_seam = edge.index % 2 == 0
         edge.use_edge_sharp = edge.index % 2 == 1
+    for kind in before:
+        modifier = monkey.modifiers.new(kind, kind)
+        if kind == "MIRROR":
+            modifier.use_mirror_merge = False
+        elif kind == "BEVEL":
+            modifier.width, modifier.segments = 0.02, 2
+        elif kind == "SOLIDIFY":
+            modifier.thickness = 0.05
     modifier = monkey.modifiers.new("Subdivision", "SUBSURF")
     modifier.levels = modifier.render_levels = level
     scenes.add_camera(scene, location=(1.2, -3.4, 1.0), target=(0.0, 0.0, 0.0), lens=45.0)
@@ -127,16 +143,85 @@ def compare(scene, monkey, size, looks, repeats: int, viewport: Viewport | None)
     return best
 
 
+# (name, modifier types before the subdivision, Edit Mode)
+STACKS = (
+    ("own mesh", (), False),
+    ("Mirror, Subdivision", ("MIRROR",), False),
+    ("Bevel, Subdivision", ("BEVEL",), False),
+    ("Solidify, Subdivision", ("SOLIDIFY",), False),
+    ("Edit Mode", (), True),
+    ("Edit Mode, Mirror, Subdivision", ("MIRROR",), True),
+)
+
+
+def stack_table(size, levels, repeats: int) -> None:
+    """First extraction of the cage look against every edge for STACKS,
+    with the regions the cage layout gives and with the regions found from
+    the mesh (the layout's shortcut switched off), rounds alternating."""
+    print(
+        "| stack | level | triangles | every edge (ms) | cage, regions found (ms) | ratio |"
+        " cage, regions from the layout (ms) | ratio |"
+    )
+    print("|---|---:|---:|" + "---:|" * 5)
+    shortcut = edge_select._select_known_regions
+    taken = []  # whether each call took the regions it was given
+
+    def spy(*args):
+        result = shortcut(*args)
+        taken.append(result is not None)
+        return result
+
+    for name, before, edit in STACKS:
+        for level in levels:
+            bpy.ops.wm.read_factory_settings(use_empty=True)
+            solidwire_addon.register()
+            scene, monkey = build_scene(size, level, before)
+            if edit:
+                bpy.context.view_layer.objects.active = monkey
+                monkey.select_set(True)
+                bpy.ops.object.mode_set(mode="EDIT")
+            triangles = len(monkey.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
+            looks = {"all": (False, spy), "found": (True, lambda *args: None), "layout": (True, spy)}
+            best: dict = {}
+            refused = False
+            try:
+                for round_ in range(repeats + 1):  # the first round warms up
+                    for look, (use_cage, select) in looks.items():
+                        apply(scene, dict(use_cage_edges=use_cage))
+                        edge_select._select_known_regions = select
+                        taken.clear()
+                        ms = first_extract_ms(scene, size)
+                        if look == "layout":
+                            refused = not any(taken)
+                        if round_:
+                            best[look] = min(best.get(look, math.inf), ms)
+            finally:
+                edge_select._select_known_regions = shortcut
+                if edit:
+                    bpy.ops.object.mode_set(mode="OBJECT")
+            a, f, k = best["all"], best["found"], best["layout"]
+            # Refused: a cage face past WALK_LIMIT (a Bevel's n-gons at level 5).
+            layout_cells = "refused | –" if refused else f"{k:.1f} | {k / a:.2f}x"
+            print(
+                f"| {name} | {level} | {triangles:,} | {a:.1f} | {f:.1f} | {f / a:.2f}x | {layout_cells} |", flush=True
+            )
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="1280x720")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--levels", type=int, nargs="+", default=[2, 3, 4, 5])
+    parser.add_argument("--stacks", action="store_true", help="the first extraction behind other stacks only")
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.split("x"))
     solidwire_addon.register()
     try:
         ensure_gpu()
+        if args.stacks:
+            print(f"{size[0]}x{size[1]}, first extraction, best of {args.repeats} alternating rounds\n")
+            stack_table(size, args.levels, args.repeats)
+            return 0
         viewport = Viewport(size)
         print(f"{size[0]}x{size[1]}, best of {args.repeats} alternating rounds; ratio = cage / every edge\n")
         print(

@@ -5,9 +5,11 @@ runs of consecutive joined faces, and a quad-only mesh's hidden-edge marks
 by row lookup, each against the components of the faces themselves and the
 search by vertex pair. On real evaluated meshes: Suzanne's cage at levels
 1-5, an n-gon cage, Multiresolution, Mirror and Array copies after the
-subdivision, and meshes where a shortcut must refuse (triangles and n-gons
-under the edge angle, a subdivision whose quads a modifier triangulated, a
-modifier before the subdivision, a cage face past the walk limit)."""
+subdivision, the regions read from the evaluated mesh's own layout (a
+modifier before the subdivision, Edit Mode), and meshes where a shortcut
+must refuse (triangles and n-gons under the edge angle, a subdivision whose
+quads a modifier triangulated, a cage face past the walk limit, a layout
+that does not hold)."""
 
 from __future__ import annotations
 
@@ -46,7 +48,9 @@ def _select(obj, selection, path, monkeypatch):
     (neither)."""
     import bpy
 
-    mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    obj_eval = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    # Edit Mode: to_mesh() gives the edited geometry, as the extraction reads it.
+    mesh = obj_eval.to_mesh() if obj.mode == "EDIT" else obj_eval.data
     arrays = mesh_reading.extract_mesh(mesh)
     corner_vert = mesh_reading.read_corner_verts(mesh)
     offsets = mesh_reading.read_face_offsets(mesh)
@@ -181,17 +185,145 @@ def test_concave_quads_split_along_their_other_diagonal(monkeypatch):
 
 
 def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
-    """A modifier before the subdivision (its input is not the object's own
-    mesh) and a cage face whose region is past WALK_LIMIT (a 24-gon at level
-    3: 192 drawn edges) take the regions found from the mesh."""
+    """A cage face whose region is past WALK_LIMIT (a 24-gon at level 3:
+    192 drawn edges), from the object's own mesh or behind a modifier, and
+    an Array with caps take the regions found from the mesh."""
     scene = scenes.empty_scene()
-    obj = scenes.monkey(scene)
-    obj.modifiers.new("Mirror", "MIRROR").use_mirror_merge = False
-    _subdivide(obj, 2)
-    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
     cylinder = _cylinder(scene, segments=24)
     _subdivide(cylinder, 3)
     _assert_same_as_general(cylinder, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
+    behind = _cylinder(scene, segments=24)
+    behind.modifiers.new("Mirror", "MIRROR").use_mirror_merge = False
+    _subdivide(behind, 3)
+    _assert_same_as_general(behind, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
+    capped = scenes.monkey(scene)
+    _subdivide(capped, 1)
+    array = capped.modifiers.new("Array", "ARRAY")
+    array.use_merge_vertices = False
+    array.end_cap = scenes.monkey(scene)  # its triangles: no quad rows either
+    _assert_same_as_general(capped, CAGE, monkeypatch, rows_expected=False, regions_expected=False)
+
+
+def _modifier_before(obj, kind):
+    modifier = obj.modifiers.new(kind, kind)
+    if kind == "MIRROR":
+        modifier.use_mirror_merge = False
+    elif kind == "BEVEL":
+        modifier.width = 0.02
+        modifier.segments = 2
+    elif kind == "SOLIDIFY":
+        modifier.thickness = 0.05
+    return modifier
+
+
+@pytest.mark.parametrize(
+    ("kind", "level"), [("MIRROR", 1), ("MIRROR", 2), ("MIRROR", 4), ("BEVEL", 2), ("SOLIDIFY", 3)]
+)
+def test_cage_regions_behind_a_modifier_before_the_subdivision(kind, level, monkeypatch):
+    """The subdivision's input is not the object's own mesh: its regions are
+    read from the evaluated mesh's layout (edge_select.regions_from_layout)."""
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene)
+    _modifier_before(obj, kind)
+    _subdivide(obj, level)
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+
+
+def test_ngon_cage_behind_a_merging_mirror_with_copies_after(monkeypatch):
+    """n-gon cage faces, a Mirror that merges vertices before the
+    subdivision, Mirror and Array copies after it."""
+    scene = scenes.empty_scene()
+    obj = _cylinder(scene, segments=9)
+    obj.modifiers.new("Mirror", "MIRROR").use_mirror_merge = True
+    _subdivide(obj, 2)
+    after = obj.modifiers.new("MirrorAfter", "MIRROR")
+    after.use_axis = (False, True, False)
+    after.use_mirror_merge = False
+    array = obj.modifiers.new("Array", "ARRAY")
+    array.count = 2
+    array.use_merge_vertices = False
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+
+
+@pytest.mark.parametrize("before", [None, "MIRROR"])
+def test_cage_regions_in_edit_mode(before, monkeypatch):
+    """Edit Mode: the regions come from the evaluated mesh's layout, before
+    and after a topology edit of the BMesh (n-gons made by cutting edges)."""
+    import bpy
+
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene)
+    if before:
+        _modifier_before(obj, before)
+    _subdivide(obj, 2)
+    bpy.context.view_layer.objects.active = obj
+    obj.select_set(True)
+    bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+        bm = bmesh.from_edit_mesh(obj.data)
+        bm.edges.ensure_lookup_table()
+        bmesh.ops.subdivide_edges(bm, edges=[bm.edges[i] for i in range(0, 40, 3)], cuts=1)  # n-gons
+        bmesh.update_edit_mesh(obj.data)
+        _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+    finally:
+        bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def _layout_inputs(obj):
+    """(layout, corner_vert, corner_edge, edge verts, drawn, face count) of
+    ``obj``'s evaluated mesh, a modifier before its subdivision."""
+    import bpy
+
+    mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
+    drawn, _chain, _ends, layout = cage.cage_edges(obj, mesh, render=False, regions=True)
+    assert isinstance(layout, edge_select.SubdivisionLayout)
+    verts, corner_edge = mesh_reading.read_edge_topology(mesh)
+    corner_vert = mesh_reading.read_corner_verts(mesh)
+    return layout, corner_vert, corner_edge, verts, drawn, len(mesh.polygons)
+
+
+def test_a_layout_that_does_not_hold_gives_no_regions():
+    """Each thing regions_from_layout reads is checked: children of two
+    coarse faces swapped, a child of one moved into another's run, a count
+    one off, a drawn mask that is not the first edges."""
+    import dataclasses
+
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene)
+    _modifier_before(obj, "MIRROR")
+    _subdivide(obj, 2)
+    layout, corner_vert, corner_edge, verts, drawn, faces = _layout_inputs(obj)
+    known = edge_select.regions_from_layout(layout, corner_vert, corner_edge, verts, drawn, faces)
+    assert known is not None and len(known.face_start) == layout.coarse_faces + 1
+    n = 1 << layout.level
+
+    def refused(**changed):
+        args = dict(corner_vert=corner_vert, corner_edge=corner_edge, verts=verts, drawn=drawn, layout=layout)
+        args.update(changed)
+        return (
+            edge_select.regions_from_layout(
+                args["layout"], args["corner_vert"], args["corner_edge"], args["verts"], args["drawn"], faces
+            )
+            is None
+        )
+
+    quads = corner_vert.reshape(-1, 4)
+    swapped = quads.copy()
+    swapped[[0, -1]] = swapped[[-1, 0]]  # a child of the first coarse face and of the last
+    assert refused(
+        corner_vert=swapped.reshape(-1),
+        corner_edge=corner_edge.reshape(-1, 4)[[-1, *range(1, faces - 1), 0]].reshape(-1),
+    )
+    moved = quads.copy()
+    moved[0, 1] = moved[16 * 4, 0]  # a vertex of a later coarse face's own
+    assert refused(corner_vert=moved.reshape(-1))
+    assert refused(layout=dataclasses.replace(layout, coarse_faces=layout.coarse_faces - 1))
+    assert refused(layout=dataclasses.replace(layout, subdivided_verts=layout.subdivided_verts + 1))
+    assert refused(layout=dataclasses.replace(layout, coarse_edges=layout.coarse_edges - 1))
+    shifted = drawn.copy()
+    shifted[layout.coarse_edges * n - 1] = False
+    assert refused(drawn=shifted)
 
 
 def test_multires_cage(monkeypatch):

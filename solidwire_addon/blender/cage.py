@@ -281,6 +281,7 @@ def _cage_layout(obj, mesh, *, render: bool):
     if carried is None:
         return None
     steps, (sub_edges_num, verts_num, faces_num) = carried
+    sub_verts_num = verts_num
     sub_edges = edges[:sub_edges_num]  # every copy keeps its input first
     # Simplify can lower a level (and 0 skips the modifier): the first level
     # whose layout fits is the one used; none fits -> left coarse.
@@ -301,8 +302,8 @@ def _cage_layout(obj, mesh, *, render: bool):
         return None  # a mesh without faces: every edge comes from a cage edge
     if steps and not _copies_match(steps, edges, sub_edges_num):
         return None  # not the layout of these copies (a merge, a weld)
-    # What _known_regions needs of the cage mesh when it is the object's own.
-    cage_mesh = (verts_num, cage_faces_num, faces_num) if own_input else None
+    # What _known_regions needs of the cage mesh and the subdivided one.
+    cage_mesh = (verts_num, cage_faces_num, faces_num, own_input, sub_verts_num, sub_edges_num)
     return cage_children, per_edge, cage, steps, cage_mesh, edges
 
 
@@ -452,7 +453,8 @@ def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
     share their chain's ends, so the density fade measures the whole cage
     edge, not its pieces (an edge that is no cage child is its own chain,
     its own ends). ``regions``: also the regions of that mask as the layout
-    gives them (_known_regions; None where it cannot tell), else None."""
+    gives them, or the layout to read them from (_known_regions; None where
+    it cannot tell), else None."""
     if layout is None:
         layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
@@ -469,11 +471,13 @@ def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
     return mask, None, ends, known
 
 
-def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | None:
-    """The regions of the cage mask (core/edge_select.py) from the layout,
-    or None where it cannot tell: the subdivision's input is not the
-    object's own mesh (a modifier before it made another; Edit Mode, whose
-    mesh datablock lags the edited one), or an Array copy has caps.
+def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.SubdivisionLayout | None:
+    """The regions of the cage mask (core/edge_select.py) from the layout:
+    read from the object's own mesh where that is the subdivision's input,
+    else (a modifier before the subdivision made its input; Edit Mode, whose
+    mesh datablock lags the edited one) the layout itself, for
+    core/edge_select.py to read them from the evaluated mesh's corners
+    (``regions_from_layout``); None where an Array copy has caps.
 
     Blender's subdivision (``subdiv_foreach.cc``, ``subdiv_foreach_faces``)
     makes the children of each cage face one after another, in cage face
@@ -486,13 +490,27 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | None:
     cage mesh read here is checked to be the one the layout was peeled to
     (its vertex, face and corner counts and every edge)."""
     _children, per_edge, cage, steps, cage_mesh, _edges = layout
-    if cage_mesh is None or any(caps for _copies, _verts, caps in steps):
+    if any(caps for _copies, _verts, caps in steps):
         return None
+    verts_num, faces_num, sub_faces_num, own_input, sub_verts_num, sub_edges_num = cage_mesh
     original = getattr(obj, "original", None) or obj
     data = getattr(original, "data", None)
-    if getattr(original, "type", None) != "MESH" or data is None or getattr(original, "mode", "OBJECT") == "EDIT":
-        return None
-    verts_num, faces_num, sub_faces_num = cage_mesh
+    if (
+        not own_input
+        or getattr(original, "type", None) != "MESH"
+        or data is None
+        or getattr(original, "mode", "OBJECT") == "EDIT"
+    ):
+        return edge_select.SubdivisionLayout(
+            level=per_edge.bit_length() - 1,
+            coarse_verts=verts_num,
+            coarse_edges=len(cage),
+            coarse_faces=faces_num,
+            subdivided_verts=sub_verts_num,
+            subdivided_edges=sub_edges_num,
+            subdivided_faces=sub_faces_num,
+            copies=tuple(copies for copies, _verts, _caps in steps),
+        )
     children_per_corner = (per_edge // 2) ** 2  # 4**(L-1)
     if (
         len(data.vertices) != verts_num
@@ -513,18 +531,9 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | None:
     np.cumsum(sizes * children_per_corner, out=face_start[1:])
     edge_start = np.zeros(faces_num + 1, np.int64)
     np.cumsum(np.bincount(face, minlength=faces_num) * per_edge, out=edge_start[1:])
-    # Mirror and Array copies: each copy's faces and edges follow its input's,
-    # numbered on by the input's counts.
-    faces_in, edges_in = int(face_start[-1]), _subdivided_edge_count(steps, len(mesh.edges))
-    for copies, _verts_in, _caps in steps:
-        shift = np.arange(copies, dtype=np.int64)[:, None]
-        face_start = np.append((face_start[:-1] + shift * faces_in).reshape(-1), copies * faces_in)
-        edge_start = np.append((edge_start[:-1] + shift * len(edges)).reshape(-1), copies * len(edges))
-        edges = (edges + shift * edges_in).reshape(-1)
-        faces_in, edges_in = copies * faces_in, copies * edges_in
-    if faces_in != len(mesh.polygons) or edges_in != len(mesh.edges):
-        return None
-    return edge_select.KnownRegions(face_start, edge_start, edges)
+    known = edge_select.KnownRegions(face_start, edge_start, edges)
+    copies = tuple(copies for copies, _verts, _caps in steps)
+    return edge_select.copied_regions(known, copies, sub_faces_num, sub_edges_num, len(mesh.polygons), len(mesh.edges))
 
 
 def _subdivided_edge_count(steps, edges_num: int) -> int:

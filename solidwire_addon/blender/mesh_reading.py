@@ -332,8 +332,9 @@ def apply_edge_selection(
     (core.edge_select.select_edges). ``cage``: (drawn mask, chain ids or
     None[, chain ends[, regions]]) of the evaluated edges from the cage
     detection (blender/cage.py) or an outline mask (blender/outlines.py), or
-    None (no subdivision, or cage edges off). The regions (KnownRegions) are
-    those of the mask alone: used only where nothing else hides an edge."""
+    None (no subdivision, or cage edges off). The regions (KnownRegions, or
+    the SubdivisionLayout core/edge_select.py reads them from) are those of
+    the mask alone: used only where nothing else hides an edge."""
     verts, corner_edge = read_edge_topology(mesh)
     drawn = chain = chain_ends = regions = None
     if cage is not None:

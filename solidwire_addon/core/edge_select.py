@@ -105,6 +105,31 @@ class KnownRegions:
 
 
 @dataclass
+class SubdivisionLayout:
+    """What a subdivision's evaluated edge layout says (blender/cage.py's
+    peel) when the caller cannot read the mesh it started from (a modifier
+    before the subdivision made it, or Edit Mode): select_edges then reads
+    the regions of the cage mask from the mesh's own corners
+    (regions_from_layout). At ``level`` (n = 2**level children per coarse
+    edge) the subdivided mesh is the first ``subdivided_faces`` faces,
+    ``subdivided_verts`` vertices and ``subdivided_edges`` edges; its vertices are the ``coarse_verts``
+    coarse ones, then n - 1 inside each of the ``coarse_edges`` coarse
+    edges, then each coarse face's own, face by face; its first
+    ``coarse_edges * n`` edges are the drawn ones. ``copies``: how many
+    copies each Mirror or Array step after the subdivision made, in stack
+    order (each copy's faces and edges follow its input's)."""
+
+    level: int
+    coarse_verts: int
+    coarse_edges: int
+    coarse_faces: int
+    subdivided_verts: int
+    subdivided_edges: int
+    subdivided_faces: int
+    copies: tuple[int, ...] = ()
+
+
+@dataclass
 class EdgeInputs:
     """What Blender's data says about each evaluated edge (mesh.edges order).
 
@@ -125,8 +150,9 @@ class EdgeInputs:
     # edges); else found from ``chain``.
     chain_ends: np.ndarray | None = None
     # The regions of ``drawn`` when the caller knows them from how the mesh
-    # was made (a subdivision's cage faces); None: found here.
-    regions: KnownRegions | None = None
+    # was made (a subdivision's cage faces), or the layout they are read
+    # from; None: found here.
+    regions: KnownRegions | SubdivisionLayout | None = None
 
     @property
     def selects_anything(self) -> bool:
@@ -391,11 +417,138 @@ def select_edges(
     return stats
 
 
+def regions_from_layout(
+    layout: SubdivisionLayout,
+    corner_vert: np.ndarray,
+    corner_edge: np.ndarray,
+    verts: np.ndarray,
+    drawn: np.ndarray,
+    face_count: int,
+    corner_drawn: np.ndarray | None = None,
+) -> KnownRegions | None:
+    """The regions of a subdivision's cage mask (``drawn``) read from the
+    evaluated mesh's own corners (``face_count`` faces, edges ``verts``) as
+    ``layout`` lays them out, or None where what the layout says does not
+    hold exactly.
+
+    Blender's subdivision (``subdiv_foreach.cc``) makes each coarse face's
+    children one after another in coarse face order, and each coarse face's
+    own vertices (its centre and those inside it, 1 + c*m*(m-1) for c
+    corners, m = n/2) one after another in the same order, after every
+    vertex on a coarse edge; every child touches one of them and every edge
+    inside a coarse face (a hidden one) ends at one. So a coarse face's
+    children end where every such inner vertex so far is below every one
+    still to come. Checked here: as many runs as coarse faces, each of
+    c * m**2 children (c >= 3) whose inner vertices lie in the face's own
+    range, the ranges filling the inner vertices exactly, every hidden edge
+    ending at an inner vertex, the drawn edges exactly the first
+    ``coarse_edges * n``. Then no hidden edge joins two runs (each run's
+    inner vertices are its own); that each run is one patch, not two, is
+    the layout's word (Blender's children of a face are one grid, or one
+    per corner around its centre). A run's drawn edges are those its
+    children's corners name, ascending (``corner_drawn``: each corner's
+    edge drawn, _corner_drawn, when the caller has it)."""
+    n = 1 << layout.level
+    m = n >> 1
+    faces, edges_num, drawn_count = layout.subdivided_faces, layout.subdivided_edges, layout.coarse_edges * n
+    corner_vert, corner_edge = np.asarray(corner_vert), np.asarray(corner_edge)
+    if (
+        faces <= 0
+        or faces % (m * m)
+        or min(len(corner_vert), len(corner_edge)) < 4 * faces
+        or min(len(drawn), len(verts)) < edges_num
+        or not 0 < drawn_count < edges_num
+        or not drawn[:drawn_count].all()
+        or drawn[drawn_count:edges_num].any()
+    ):
+        return None
+    inner = layout.coarse_verts + (n - 1) * layout.coarse_edges  # the first coarse face's first own vertex
+    if layout.subdivided_verts >= 1 << 31 or inner <= 0:
+        return None
+    hidden = np.asarray(verts[drawn_count:edges_num])
+    # Blender puts the inner end second: one column is checked first.
+    if hidden[:, 1].min() < inner and np.maximum(hidden[:, 0], hidden[:, 1]).min() < inner:
+        return None
+    # Inner vertices counted from the first: a vertex on a coarse edge or a
+    # coarse vertex is negative, so as unsigned (wrapping) it is above every
+    # inner one. Column by column into two face-sized arrays: a reduction
+    # along rows of four, or a shifted copy of every corner, costs several
+    # times more.
+    quads = np.asarray(corner_vert[: 4 * faces], np.int32).reshape(faces, 4)
+    top = np.maximum(quads[:, 0], quads[:, 1])
+    np.maximum(top, quads[:, 2], out=top)
+    np.maximum(top, quads[:, 3], out=top)
+    top -= np.int32(inner)
+    if top.min() < 0:
+        return None  # a child that touches none of its coarse face's own vertices
+    unsigned, first_inner = quads.view(np.uint32), np.uint32(inner)
+    low = np.subtract(unsigned[:, 0], first_inner)
+    column = np.empty_like(low)
+    for k in (1, 2, 3):
+        np.minimum(low, np.subtract(unsigned[:, k], first_inner, out=column), out=low)
+    low = low.view(np.int32)  # every child has one inner vertex: below 2**31
+    # A coarse face's children end where every inner vertex so far is below
+    # every one to come: only where a child's lowest is above the previous
+    # child's highest, then decided on the pieces between those places (a
+    # cumulative max over every child is several times slower).
+    cut = np.flatnonzero(low[1:] > top[:-1]) + 1
+    piece = np.concatenate(([0], cut))
+    reach = np.maximum.accumulate(np.maximum.reduceat(top, piece))
+    floor = np.minimum.accumulate(np.minimum.reduceat(low, piece)[::-1])[::-1]
+    face_start = np.concatenate(([0], cut[reach[:-1] < floor[1:]], [faces])).astype(np.int64)
+    if len(face_start) - 1 != layout.coarse_faces:
+        return None
+    run_corners, rest = np.divmod(np.diff(face_start), m * m)
+    if rest.any() or run_corners.min() < 3:
+        return None
+    inner_start = np.zeros(len(face_start), np.int64)
+    np.cumsum(1 + run_corners * (m * (m - 1)), out=inner_start[1:])
+    first = face_start[:-1]
+    if (
+        inner_start[-1] != layout.subdivided_verts - inner
+        or (np.minimum.reduceat(low, first) < inner_start[:-1]).any()
+        or (np.maximum.reduceat(top, first) >= inner_start[1:]).any()
+    ):
+        return None
+    if corner_drawn is None:
+        corner_drawn = _corner_drawn(drawn, corner_edge)
+    at = np.flatnonzero(corner_drawn[: 4 * faces])
+    # Each run's drawn corners are one stretch of ``at``: R searches, not one per corner.
+    per_run = np.diff(np.searchsorted(at, 4 * face_start))
+    run = np.repeat(np.arange(len(first), dtype=np.int64), per_run)
+    region, edge = np.divmod(np.unique(run * drawn_count + np.take(corner_edge, at)), drawn_count)
+    edge_start = np.zeros(len(face_start), np.int64)
+    np.cumsum(np.bincount(region, minlength=len(first)), out=edge_start[1:])
+    known = KnownRegions(face_start, edge_start, edge)
+    return copied_regions(known, layout.copies, faces, edges_num, face_count, len(drawn))
+
+
+def copied_regions(
+    regions: KnownRegions, copies, faces_in: int, edges_in: int, face_count: int, edge_count: int
+) -> KnownRegions | None:
+    """``regions`` of a mesh of ``faces_in`` faces and ``edges_in`` edges
+    carried through the copies Mirror and Array make of it (``copies``: how
+    many per step, in stack order; each copy's faces and edges follow its
+    input's, numbered on by the input's counts), or None where the result
+    is not ``face_count`` faces and ``edge_count`` edges."""
+    face_start, edge_start, edges = regions.face_start, regions.edge_start, regions.region_edges
+    for count in copies:
+        shift = np.arange(count, dtype=np.int64)[:, None]
+        face_start = np.append((face_start[:-1] + shift * faces_in).reshape(-1), count * faces_in)
+        edge_start = np.append((edge_start[:-1] + shift * len(edges)).reshape(-1), count * len(edges))
+        edges = (edges + shift * edges_in).reshape(-1)
+        faces_in, edges_in = count * faces_in, count * edges_in
+    if faces_in != face_count or edges_in != edge_count:
+        return None
+    return KnownRegions(face_start, edge_start, edges)
+
+
 def _select_known_regions(
     arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray, inputs: EdgeInputs
 ) -> SelectionStats | None:
-    """select_edges for regions the caller knows (``inputs.regions``, no
-    classes) on a mesh of quads only: the same arrays as the general path,
+    """select_edges for regions the caller knows (``inputs.regions``, or
+    read from the layout it gives: regions_from_layout; no classes) on a
+    mesh of quads only: the same arrays as the general path,
     written per region and per quad instead of found from every corner, or
     None (nothing written) where the shortcut does not apply: faces other
     than extract.build_arrays_fast's quad rows, a region of one face, a
@@ -413,6 +566,12 @@ def _select_known_regions(
     face_count = len(offsets) - 1
     verts = np.asarray(inputs.verts).reshape(-1, 2)
     drawn = np.asarray(drawn, bool)
+    corner_drawn = None  # shared with _hidden_pattern, which consumes it
+    if isinstance(regions, SubdivisionLayout):
+        corner_drawn = _corner_drawn(drawn, corner_edge)
+        regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn, face_count, corner_drawn)
+        if regions is None:
+            return None
     face_start = np.asarray(regions.face_start, np.int64)
     edge_start = np.asarray(regions.edge_start, np.int64)
     edges = np.asarray(regions.region_edges, np.int64)
@@ -457,7 +616,7 @@ def _select_known_regions(
     # Each quad's two rows in one 64-bit write (row 2i the low half), looked
     # up by its block's segment count, its split and its hidden edges
     # (_listed_quad_rows), written in place: no million-row temporaries.
-    at = _hidden_pattern(drawn, corner_edge, face_count)
+    at = _hidden_pattern(drawn, corner_edge, face_count, corner_drawn)
     at |= flip.view(np.uint8) << np.uint8(4)
     at |= np.repeat((per_region << 5).astype(np.uint32), region_faces)
     flags = arrays.edge_flags
@@ -769,17 +928,26 @@ def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, sizes: np.ndarra
     return flip
 
 
-def _hidden_pattern(drawn: np.ndarray, corner_edge: np.ndarray, face_count: int) -> np.ndarray:
-    """(F,) uint32 for a mesh of quads only: bit c set where the edge leaving
-    the quad's corner c is not drawn. The four corners' drawn flags are one
-    little-endian 32-bit word of 0/1 bytes; one multiplication gathers their
-    bits into the top byte (no partial product carries into it)."""
+def _corner_drawn(drawn: np.ndarray, corner_edge: np.ndarray) -> np.ndarray:
+    """(L,) bool, a fresh array: whether each corner's edge is drawn."""
     drawn = np.asarray(drawn, bool)
     count = int(np.count_nonzero(drawn))
     if drawn[:count].all():  # the drawn edges come first (a subdivision's cage children): a compare, no gather
-        corner_drawn = np.asarray(corner_edge) < count
-    else:
-        corner_drawn = np.take(drawn, corner_edge)
+        return np.asarray(corner_edge) < count
+    return np.take(drawn, corner_edge)
+
+
+def _hidden_pattern(
+    drawn: np.ndarray, corner_edge: np.ndarray, face_count: int, corner_drawn: np.ndarray | None = None
+) -> np.ndarray:
+    """(F,) uint32 for a mesh of quads only: bit c set where the edge leaving
+    the quad's corner c is not drawn. The four corners' drawn flags are one
+    little-endian 32-bit word of 0/1 bytes; one multiplication gathers their
+    bits into the top byte (no partial product carries into it).
+    ``corner_drawn``: _corner_drawn's answer when the caller has it (it is
+    written over)."""
+    if corner_drawn is None:
+        corner_drawn = _corner_drawn(drawn, corner_edge)
     if not np.little_endian:
         hidden = ~corner_drawn.reshape(face_count, 4)
         return (hidden * np.array([1, 2, 4, 8], np.uint32)).sum(axis=1, dtype=np.uint32)
