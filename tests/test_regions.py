@@ -113,15 +113,22 @@ def test_an_ngon_cage_keeps_its_whole_outline(level, diagonals, output_dir):
     assert (ref.intensity > 0.99).sum() > 100
 
 
+def _folded_grid(scene, *, segments: int, size: float, slope: float):
+    """A square grid folded once along x = 0: under a small angle threshold
+    each half is one flat region."""
+    grid = scenes.grid(scene, x_segments=segments, y_segments=segments, size=size)
+    for vertex in grid.data.vertices:
+        if vertex.co.x > 0.0:
+            vertex.co.z = slope * vertex.co.x
+    grid.data.update()
+    return grid
+
+
 def test_the_angle_threshold_on_a_large_creased_region(output_dir):
     """A 40 x 40 grid folded once: under the angle threshold each half is one
     flat region of about 120 drawn edges."""
     scene = scenes.empty_scene(220, 160, edge_angle=math.radians(10.0), thickness=2.0)
-    grid = scenes.grid(scene, x_segments=40, y_segments=40, size=4.0)
-    for vertex in grid.data.vertices:
-        if vertex.co.x > 0.0:
-            vertex.co.z = 0.6 * vertex.co.x
-    grid.data.update()
+    _folded_grid(scene, segments=40, size=4.0, slope=0.6)
     scenes.add_camera(scene, location=(0.8, -4.4, 3.6), target=(0, 0, 0.3))
     report = accuracy.measure(scene, "regions_creased_grid", output_dir)
     accuracy.assert_accurate(report)
@@ -139,11 +146,7 @@ def test_one_mesh_with_regions_drawn_by_many_objects(copies, output_dir):
     own matrix; a resolve that reads no instance matrix, the flat wire in
     pixels of lines that all come from the region-lines image)."""
     scene = scenes.empty_scene(220, 160, edge_angle=math.radians(10.0), thickness=1.5)
-    grid = scenes.grid(scene, x_segments=12, y_segments=12, size=1.0)
-    for vertex in grid.data.vertices:
-        if vertex.co.x > 0.0:
-            vertex.co.z = 0.4 * vertex.co.x
-    grid.data.update()
+    grid = _folded_grid(scene, segments=12, size=1.0, slope=0.4)
     rng = np.random.default_rng(3)
     for i in range(1, copies):
         copy = bpy.data.objects.new(f"Grid{i}", grid.data)
