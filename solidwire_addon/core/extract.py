@@ -289,8 +289,12 @@ def _recentre(
 def _finite_vertices(positions: np.ndarray) -> np.ndarray | None:
     """None when every vertex is finite, else the per-vertex mask. One
     contiguous sum answers the common case (NaN/Inf propagate; a sum that
-    overflows only sends us to the exact check)."""
-    if np.isfinite(positions.sum(dtype=np.float64)):
+    overflows only sends us to the exact check). Inf + -Inf in that sum is
+    expected here, not a fault: numpy's warning about it is silenced, as
+    it would otherwise reach Blender's console for every such mesh."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        total = positions.sum(dtype=np.float64)
+    if np.isfinite(total):
         return None
     finite = np.isfinite(positions).all(axis=1)
     return None if finite.all() else finite

@@ -6,6 +6,8 @@ or is refused; the corner table holds each row's normal and material.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -212,3 +214,20 @@ def test_reposition_refuses_what_changes_the_triangles():
     )
     assert ngon.quads is None
     assert extract.reposition(ngon, hexagon * 1.1, np.arange(6, dtype=np.int32), np.array([0, 6])) is None
+
+
+def test_infinite_vertices_of_both_signs_leave_their_faces_out_without_a_numpy_warning():
+    """A mesh with a vertex at +Inf and one at -Inf: the faces that use them
+    are left out (the one-line message is the caller's), and numpy's
+    warning about Inf - Inf, which would reach Blender's console, is not
+    raised."""
+    positions = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [2, 1, 0]], dtype=np.float32)
+    corner_vert = np.array([0, 1, 2, 3, 1, 4, 5, 2], dtype=np.int32)
+    offsets = np.array([0, 4, 8], dtype=np.int32)
+    positions[4, 0] = np.inf
+    positions[5, 1] = -np.inf
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
+    assert arrays.triangle_count == 2  # the first quad only
+    assert set(np.unique(arrays.triangles[:, :3])) <= {0, 1, 2, 3}
