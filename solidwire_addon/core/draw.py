@@ -724,7 +724,7 @@ class _DrawNumbers:
         _rectangle().draw(shader)
 
 
-_quad_batches: dict[int, object] = {}
+_quad_batches: dict[tuple[int, bool], object] = {}
 
 
 def quad_batch(count: int):
@@ -732,18 +732,7 @@ def quad_batch(count: int):
     least ``count`` screen-space quads whose shader pulls everything else:
     the silhouette fins, hair segments and points. Shared
     by every draw of the same size class (the next power of two)."""
-    size = 1 << max(int(count - 1).bit_length(), 6)
-    batch = _quad_batches.get(size)
-    if batch is None:
-        fmt = gpu.types.GPUVertFormat()
-        fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
-        vbo = gpu.types.GPUVertBuf(fmt, 6 * size)
-        vbo.attr_fill("quad_corner", np.tile(np.arange(6, dtype=np.int32), size))
-        batch = _quad_batches[size] = gpu.types.GPUBatch(type="TRIS", buf=vbo)
-    return batch
-
-
-_indexed_quad_batches: dict[int, object] = {}
+    return _shared_quads(count, indexed=False)
 
 
 def indexed_quad_batch(count: int):
@@ -753,17 +742,25 @@ def indexed_quad_batch(count: int):
     segment of its run at each corner, and a software rasteriser shades
     the vertices of an indexed draw once (4 invocations per quad, not 6).
     Shared by every draw of the same size class (the next power of two)."""
+    return _shared_quads(count, indexed=True)
+
+
+def _shared_quads(count: int, *, indexed: bool):
     size = 1 << max(int(count - 1).bit_length(), 6)
-    batch = _indexed_quad_batches.get(size)
+    batch = _quad_batches.get((size, indexed))
     if batch is None:
+        corners = 4 if indexed else 6
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
-        vbo = gpu.types.GPUVertBuf(fmt, 4 * size)
-        vbo.attr_fill("quad_corner", np.tile(np.arange(4, dtype=np.int32), size))
-        first = 4 * np.arange(size, dtype=np.int32)[:, None]
-        indices = (first + np.array([0, 1, 2, 0, 2, 3], dtype=np.int32)).reshape(-1, 3)
-        ibo = gpu.types.GPUIndexBuf(type="TRIS", seq=indices)
-        batch = _indexed_quad_batches[size] = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)
+        vbo = gpu.types.GPUVertBuf(fmt, corners * size)
+        vbo.attr_fill("quad_corner", np.tile(np.arange(corners, dtype=np.int32), size))
+        if indexed:
+            first = 4 * np.arange(size, dtype=np.int32)[:, None]
+            indices = (first + np.array([0, 1, 2, 0, 2, 3], dtype=np.int32)).reshape(-1, 3)
+            batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=indices))
+        else:
+            batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+        _quad_batches[(size, indexed)] = batch
     return batch
 
 
@@ -794,7 +791,6 @@ def release_rectangle() -> None:
     unregister frees every GPU object)."""
     _rectangles.clear()
     _quad_batches.clear()
-    _indexed_quad_batches.clear()
 
 
 def _draw_groups(groups, variant, call: _DrawCall) -> None:
