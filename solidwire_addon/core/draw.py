@@ -724,7 +724,7 @@ class _DrawNumbers:
         _rectangle().draw(shader)
 
 
-_quad_batches: dict[tuple[int, bool], object] = {}
+_quad_batches: dict[tuple[int, int], object] = {}  # (quads, corners per quad): batch
 
 
 def quad_batch(count: int):
@@ -747,9 +747,9 @@ def indexed_quad_batch(count: int):
 
 def _shared_quads(count: int, *, indexed: bool):
     size = 1 << max(int(count - 1).bit_length(), 6)
-    batch = _quad_batches.get((size, indexed))
+    corners = 4 if indexed else 6
+    batch = _quad_batches.get((size, corners))
     if batch is None:
-        corners = 4 if indexed else 6
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
         vbo = gpu.types.GPUVertBuf(fmt, corners * size)
@@ -760,7 +760,7 @@ def _shared_quads(count: int, *, indexed: bool):
             batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=indices))
         else:
             batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
-        _quad_batches[(size, indexed)] = batch
+        _quad_batches[(size, corners)] = batch
     return batch
 
 
