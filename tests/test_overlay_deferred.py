@@ -24,6 +24,7 @@ from solidwire_addon.core import draw, overlay_state, passes
 from solidwire_addon.core.options import DrawOptions
 from solidwire_addon.core.overlay_state import MATERIAL, ViewportState
 from tests.support import accuracy, reference, scenes
+from tests.test_deferred_surface import _stages
 from tests.test_overlay import HEIGHT, WIDTH, FakeViewport, build_scene
 
 pytestmark = pytest.mark.filterwarnings("ignore:'DEPTH24_STENCIL8' is deprecated:DeprecationWarning")
@@ -33,19 +34,6 @@ pytestmark = pytest.mark.filterwarnings("ignore:'DEPTH24_STENCIL8' is deprecated
 def every_mesh_deferred(monkeypatch):
     ensure_gpu()
     monkeypatch.setattr(passes, "OVERLAY_DEFERRED_MIN_DENSITY", 0.0)
-
-
-def _stages(monkeypatch) -> list:
-    """The stage of every draw.draw call from now on."""
-    calls = []
-    real = draw.draw
-
-    def spy(*args, **kwargs):
-        calls.append((kwargs.get("target") or draw.DrawTarget()).stage)
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(draw, "draw", spy)
-    return calls
 
 
 SOLID = ViewportState()
