@@ -24,6 +24,19 @@ from tests.test_render_passes import _enable_all
 COLOUR_TOLERANCE = 2e-5
 
 
+def refuse_variants(monkeypatch, refused, reason: str) -> None:
+    """Make the shader compiler refuse every variant for which
+    ``refused(variant)`` holds, as a backend without that stage would."""
+    real_get = shaders.get
+
+    def get(variant):
+        if refused(variant):
+            raise shaders.DeferredUnavailable(reason)
+        return real_get(variant)
+
+    monkeypatch.setattr(shaders, "get", get)
+
+
 def _stages(monkeypatch):
     """Record the stage of every draw.draw call."""
     calls = []
@@ -185,14 +198,7 @@ def test_a_deferred_stage_that_does_not_compile_falls_back_to_the_direct_pass(ou
     monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
     expected = scenes.render_multilayer_exr(scene, output_dir / "deferred_fallback_expected.exr")
     monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=True))
-    real_get = shaders.get
-
-    def refuse_resolve(variant):
-        if variant.resolve:
-            raise shaders.DeferredUnavailable("resolve refused")
-        return real_get(variant)
-
-    monkeypatch.setattr(shaders, "get", refuse_resolve)
+    refuse_variants(monkeypatch, lambda variant: variant.resolve, "resolve refused")
     monkeypatch.setattr(shaders, "_deferred_support", [True])
     got = scenes.render_multilayer_exr(scene, output_dir / "deferred_fallback.exr")
     assert shaders.deferred_available() is False

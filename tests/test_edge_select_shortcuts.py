@@ -130,11 +130,7 @@ def test_mirror_and_array_copies_after_the_subdivision(monkeypatch):
     scene = scenes.empty_scene()
     obj = scenes.monkey(scene)
     _subdivide(obj, 2)
-    mirror = obj.modifiers.new("Mirror", "MIRROR")
-    mirror.use_mirror_merge = False
-    array = obj.modifiers.new("Array", "ARRAY")
-    array.count = 3
-    array.use_merge_vertices = False
+    scenes.add_mirror_and_array(obj, count=3)
     _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
 
 

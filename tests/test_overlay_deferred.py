@@ -24,7 +24,7 @@ from solidwire_addon.core import draw, overlay_state, passes
 from solidwire_addon.core.options import DrawOptions
 from solidwire_addon.core.overlay_state import MATERIAL, ViewportState
 from tests.support import accuracy, reference, scenes
-from tests.test_deferred_surface import _stages
+from tests.test_deferred_surface import _stages, refuse_variants
 from tests.test_overlay import HEIGHT, WIDTH, FakeViewport, build_scene
 
 pytestmark = pytest.mark.filterwarnings("ignore:'DEPTH24_STENCIL8' is deprecated:DeprecationWarning")
@@ -363,14 +363,7 @@ def test_a_refused_straight_resolve_draws_directly(monkeypatch, capsys):
     expected, _stats = _draw(scene, objects)
     monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=True))
     monkeypatch.setattr(shaders, "_deferred_support", [True])
-    real_get = shaders.get
-
-    def refuse_straight(variant):
-        if variant.record_depth:
-            raise shaders.DeferredUnavailable("straight resolve refused")
-        return real_get(variant)
-
-    monkeypatch.setattr(shaders, "get", refuse_straight)
+    refuse_variants(monkeypatch, lambda variant: variant.record_depth, "straight resolve refused")
     got, stats = _draw(scene, objects)
     assert stats["objects_drawn"] == 2
     assert not shaders.deferred_available()

@@ -178,12 +178,7 @@ def test_cage_edges_through_a_mirror_and_an_array(merge, output_dir):
     scene.solidwire.density_fade_length = 6.0
     obj = scenes.mesh_object(scene, "Half", _half_cube, rotation=(0.2, 0.1, 0.5))
     _subdivided(obj, 3)
-    mirror = obj.modifiers.new("Mirror", "MIRROR")
-    mirror.use_mirror_merge = merge
-    array = obj.modifiers.new("Array", "ARRAY")
-    array.count = 2
-    array.use_merge_vertices = False
-    array.relative_offset_displace = (0.0, 1.4, 0.0)
+    scenes.add_mirror_and_array(obj, merge=merge, count=2, offset=(0.0, 1.4, 0.0))
     scenes.add_camera(scene, location=(3.0, -7.5, 5.0), target=(0.3, 1.1, 0.0))
     report = accuracy.measure(scene, f"regions_mirror_array_{'merged' if merge else 'copied'}", output_dir)
     accuracy.assert_accurate(report)

@@ -202,6 +202,19 @@ def add_bend_rig(scene, obj, frames: tuple, *, joint_z: float = 0.0, blend: floa
     return rig
 
 
+def add_mirror_and_array(obj, *, merge: bool = False, count: int = 2, offset=None):
+    """A Mirror (merging its halves or not) then an Array of ``count``
+    copies that merges nothing, after whatever ``obj`` already has: the
+    modifiers Blender's overlay keeps the cage through unless they merge."""
+    obj.modifiers.new("Mirror", "MIRROR").use_mirror_merge = merge
+    array = obj.modifiers.new("Array", "ARRAY")
+    array.count = count
+    array.use_merge_vertices = False
+    if offset is not None:
+        array.relative_offset_displace = offset
+    return array
+
+
 def uv_sphere(scene, name="Sphere", segments=16, rings=8, radius=1.0, **kwargs):
     return mesh_object(
         scene,
