@@ -521,17 +521,23 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     cage_edge_verts, corner_edge = mesh_reading.read_edge_topology(data)
     if not np.array_equal(cage_edge_verts, cage):
         return None
-    offsets = mesh_reading.read_face_offsets(data).astype(np.int64)
-    sizes = np.diff(offsets)
-    # Each cage face's distinct edges, ascending; their children ascend too.
-    keys = np.unique(np.repeat(np.arange(faces_num, dtype=np.int64), sizes) * len(cage) + corner_edge)
-    face, edge = np.divmod(keys, len(cage))
-    edges = (edge[:, None] * per_edge + np.arange(per_edge, dtype=np.int64)).reshape(-1)
-    face_start = np.zeros(faces_num + 1, np.int64)
-    np.cumsum(sizes * children_per_corner, out=face_start[1:])
-    edge_start = np.zeros(faces_num + 1, np.int64)
-    np.cumsum(np.bincount(face, minlength=faces_num) * per_edge, out=edge_start[1:])
-    known = edge_select.KnownRegions(face_start, edge_start, edges)
+    offsets = mesh_reading.read_face_offsets(data)
+    # Each cage face's edges, ascending: (face, edge) keys sorted, which
+    # moves each key only among its own face's corners (the faces' keys
+    # are len(cage) apart). A face that names an edge twice (a corrupt
+    # face) is left to the general path.
+    face_key = np.repeat(np.arange(0, faces_num * len(cage), len(cage), dtype=np.int64), np.diff(offsets))
+    keys = face_key + corner_edge
+    keys.sort()
+    if not (keys[1:] > keys[:-1]).all():
+        return None
+    # Every edge's children, consecutive (whole chains: KnownRegions.chain_edges).
+    keys -= face_key
+    keys *= per_edge
+    edges = edge_select.whole_chains(keys, per_edge)
+    face_start = np.multiply(offsets, children_per_corner, dtype=np.int64)
+    edge_start = np.multiply(offsets, per_edge, dtype=np.int64)
+    known = edge_select.KnownRegions(face_start, edge_start, edges, per_edge)
     copies = tuple(copies for copies, _verts, _caps in steps)
     return edge_select.copied_regions(known, copies, sub_faces_num, sub_edges_num, len(mesh.polygons), len(mesh.edges))
 

@@ -97,11 +97,20 @@ class KnownRegions:
     face corners (an edge inside a cage face), for the ``drawn`` mask it
     passes with these regions and no edge classes; select_edges checks the
     rest of what its shortcut assumes and otherwise finds the regions
-    itself."""
+    itself.
+
+    ``chain_edges`` > 1 (a subdivision at level L: 2**L) says more, which
+    the caller vouches for too: the listed edges come in whole chains of
+    that many consecutive edges (``region_edges`` in groups of
+    ``chain_edges``, each ``e, e + 1, ...``), every edge of a chain with
+    the same chain ends (EdgeInputs.chain_ends) and listed by the same
+    regions. The region lines are then written per chain
+    (_chain_region_lines)."""
 
     face_start: np.ndarray  # (R + 1,) ascending, from 0 to the face count
     edge_start: np.ndarray  # (R + 1,) offsets into ``region_edges``
     region_edges: np.ndarray  # (S,) edge ids
+    chain_edges: int = 1
 
 
 @dataclass
@@ -519,8 +528,29 @@ def regions_from_layout(
     region, edge = np.divmod(np.unique(run * drawn_count + np.take(corner_edge, at)), drawn_count)
     edge_start = np.zeros(len(face_start), np.int64)
     np.cumsum(np.bincount(region, minlength=len(first)), out=edge_start[1:])
-    known = KnownRegions(face_start, edge_start, edge)
+    # Whole chains (a coarse edge's n children, from a multiple of n), none
+    # split between regions: the region lines are then written per chain.
+    chains = edge.reshape(-1, n) if len(edge) % n == 0 else None
+    whole = (
+        chains is not None
+        and not (edge_start % n).any()
+        and not (chains[:, 0] % n).any()
+        and np.array_equal(chains - chains[:, :1], np.broadcast_to(np.arange(n), chains.shape))
+    )
+    known = KnownRegions(face_start, edge_start, edge, n if whole else 1)
     return copied_regions(known, layout.copies, faces, edges_num, face_count, len(drawn))
+
+
+def whole_chains(firsts: np.ndarray, chain_edges: int) -> np.ndarray:
+    """(len(firsts) * chain_edges,) int64: each chain's consecutive edges
+    ``first, first + 1, ...`` (KnownRegions.chain_edges), chain by chain."""
+    edges = np.empty((len(firsts), chain_edges), np.int64)
+    if chain_edges <= 8:  # a column at a time: a broadcast over short rows costs several times more
+        for k in range(chain_edges):
+            np.add(firsts, k, out=edges[:, k])
+    else:
+        np.add(firsts[:, None], np.arange(chain_edges, dtype=np.int64), out=edges)
+    return edges.reshape(-1)
 
 
 def copied_regions(
@@ -540,7 +570,7 @@ def copied_regions(
         faces_in, edges_in = count * faces_in, count * edges_in
     if faces_in != face_count or edges_in != edge_count:
         return None
-    return KnownRegions(face_start, edge_start, edges)
+    return KnownRegions(face_start, edge_start, edges, regions.chain_edges)
 
 
 def _select_known_regions(
@@ -578,6 +608,10 @@ def _select_known_regions(
     if face_count <= 0 or len(face_start) < 2 or len(edge_start) != len(face_start) or len(drawn) != len(verts):
         return None
     region_faces, per_region = np.diff(face_start), np.diff(edge_start)
+    # Whole chains of consecutive edges (KnownRegions.chain_edges): their
+    # first edges bound the ids and ascend where the list does.
+    chain_edges = max(1, int(regions.chain_edges))
+    firsts = edges[::chain_edges]
     if (
         face_start[0] != 0
         or face_start[-1] != face_count
@@ -586,23 +620,22 @@ def _select_known_regions(
         or edge_start[-1] != len(edges)
         or per_region.min() < 1
         or per_region.max() > WALK_LIMIT
-        or edges.min() < 0
-        or edges.max() >= len(verts)
+        or firsts.min() < 0
+        or firsts.max() + chain_edges > len(verts)
         or not drawn[edges].all()
     ):
         return None
-    ascending = np.diff(edges) > 0
-    ascending[edge_start[1:-1] - 1] = True  # each region's list starts afresh
+    ascending = np.diff(firsts) > 0
+    ascending[edge_start[1:-1] // chain_edges - 1] = True  # each region's list starts afresh
     if not ascending.all():
         return None
-    flip = _quad_row_flip(arrays, corner_vert, np.diff(offsets))
+    flip = _quad_row_flip(arrays, corner_vert, offsets)
     if flip is None:
         return None
     stats = SelectionStats(hidden_edges=len(drawn) - int(np.count_nonzero(drawn)))
 
     # The blocks: region k's drawn edges from table row first[k], in region order.
     label = face_start[:-1]
-    seg_owner = np.repeat(label, per_region)
     ends = np.asarray(inputs.chain_ends)
     # (np.take gathers rows several times faster than fancy indexing.)
     seg_verts, seg_ends = np.take(verts, edges, axis=0), np.take(ends, edges, axis=0)
@@ -625,16 +658,64 @@ def _select_known_regions(
     else:
         flags[:] = np.take(_LISTED_QUAD_ROWS, at).view(np.int32)
     face_table_start = np.repeat(region_table_start, region_faces)
-    if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one (2, 4) block
-        arrays.triangles.reshape(face_count, 2, 4)[:, :, 3] = face_table_start[:, None]
+    if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one row of 8: two column writes
+        quads = arrays.triangles.reshape(face_count, 8)
+        quads[:, 3] = face_table_start
+        quads[:, 7] = face_table_start
     else:
         arrays.triangles[:, 3] = np.repeat(face_table_start, 2)
     arrays.triangle_regions = np.repeat(label.astype(np.float32), 2 * region_faces)
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
     stats.segments = len(edges)
-    _known_region_lines(arrays, verts, ends, table, seg_ends, seg_owner, edges, stats)
+    if chain_edges > 1 and _chain_region_lines(
+        arrays, table, firsts, np.repeat(label, per_region // chain_edges), chain_edges, stats
+    ):
+        return stats
+    _known_region_lines(arrays, verts, ends, table, seg_ends, np.repeat(label, per_region), edges, stats)
     return stats
+
+
+def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: int, stats) -> bool:
+    """_known_region_lines for regions listed in whole chains
+    (KnownRegions.chain_edges; ``firsts``: the first edge of each listed
+    chain, ``owners``: its region), done per chain: a chain's edges are
+    listed together by the same regions, so they are consecutive entries
+    with its first edge's regions, and their texels are consecutive block
+    rows. Consecutive chains with different ends or regions make the runs
+    whole chains cut into pieces of the run length, with no search. False
+    (nothing written) where an edge bounds more than two regions or two
+    consecutive entries' chains would join into one run."""
+    counts = np.bincount(firsts)
+    if counts.max() > 2:
+        return False
+    chain = np.flatnonzero(counts)
+    listing = np.arange(len(firsts))
+    first = np.empty(len(counts), np.intp)
+    first[firsts[::-1]] = listing[::-1]  # the last write is the first listing's
+    last = np.empty(len(counts), np.intp)
+    last[firsts] = listing
+    first, last = np.take(first, chain), np.take(last, chain)
+    # A listed chain's block rows are one row of the table seen as (chains, n * texels).
+    lines = np.take(table.reshape(len(firsts), -1), first, axis=0).reshape(len(chain), chain_edges, -1)
+    lines[:, :, 3] = np.take(owners, first)[:, None]
+    lines[:, :, 6] = np.where(first != last, np.take(owners, last), NO_REGION)[:, None]
+    # A chain's first texels from its region on: region, chain ends,
+    # partner. Equal for two consecutive chains (as float32: equal ids
+    # always are), they would be one run.
+    key = lines[:, 0, 3:7]
+    if (key[1:] == key[:-1]).all(axis=1).any():
+        return False
+    arrays.region_lines = lines.reshape(-1, 4)
+    # _line_runs of groups of chain_edges entries each.
+    length = _run_length(chain_edges)
+    within = np.arange(0, chain_edges, length)
+    runs = np.zeros((len(chain), len(within), 4), np.float32)
+    runs[:, :, 0] = np.arange(0, len(chain) * chain_edges, chain_edges)[:, None] + within
+    runs[:, :, 1] = np.minimum(length, chain_edges - within)
+    arrays.region_line_runs, arrays.region_run_segments = runs.reshape(-1, 4), length
+    stats.region_lines = len(chain) * chain_edges
+    return True
 
 
 def _known_region_lines(arrays: MeshArrays, verts, ends, table, seg_ends, seg_owner, edges, stats) -> None:
@@ -787,15 +868,22 @@ def _line_runs(chain_ends: np.ndarray, style: np.ndarray, region: np.ndarray, pa
     # The group size at which half of the entries are in groups no larger.
     sizes = np.sort(group_size)
     typical = sizes[np.searchsorted(np.cumsum(sizes), count / 2.0)]
-    length = 1
-    while length < min(typical, RUN_SEGMENTS):
-        length *= 2
+    length = _run_length(typical)
     rank = np.arange(count) - np.repeat(group_start, group_size)
     first = np.flatnonzero(rank % length == 0)
     runs = np.zeros((len(first), 4), np.float32)
     runs[:, 0] = first
     runs[:, 1] = np.diff(np.append(first, count))
     return runs, length
+
+
+def _run_length(typical: int) -> int:
+    """The entries a run holds for chains of ``typical`` entries: the
+    power of two that holds them, up to RUN_SEGMENTS (see _line_runs)."""
+    length = 1
+    while length < min(typical, RUN_SEGMENTS):
+        length *= 2
+    return length
 
 
 def _mark_own_edges(
@@ -812,7 +900,7 @@ def _mark_own_edges(
     quad's edges to its 4th corner and an n-gon's outline slots."""
     if drawn.all():
         return
-    if _mark_quad_rows(arrays, drawn, corner_vert, sizes, corner_edge):
+    if _mark_quad_rows(arrays, drawn, corner_vert, offsets, corner_edge):
         return
     vertex_count = np.int64(max(arrays.vertex_count, int(verts.max()) + 1))
     sorted_keys = []  # the hidden edges' vertex-pair keys, sorted on first use
@@ -874,7 +962,7 @@ def _mark_own_edges(
 
 
 def _mark_quad_rows(
-    arrays: MeshArrays, drawn: np.ndarray, corner_vert: np.ndarray, sizes: np.ndarray, corner_edge: np.ndarray
+    arrays: MeshArrays, drawn: np.ndarray, corner_vert: np.ndarray, offsets: np.ndarray, corner_edge: np.ndarray
 ) -> bool:
     """_mark_own_edges for a mesh of quads only (what a subdivision makes)
     whose triangle rows are those extract.build_arrays_fast writes: quad i
@@ -882,13 +970,13 @@ def _mark_quad_rows(
     the quad is split along its other diagonal. Each row's edges are then
     its quad's corner edges in a known order: a few column picks instead of
     finding every row's corners. False (nothing done) for any other mesh."""
-    flip = _quad_row_flip(arrays, corner_vert, sizes)
+    flip = _quad_row_flip(arrays, corner_vert, offsets)
     if flip is None:
         return False
     flags = arrays.edge_flags
     # Which of its quad's edges are hidden, one bit per corner, and then per
     # row a lookup of that pattern turned to the row's first corner.
-    pattern = _hidden_pattern(drawn, corner_edge, len(sizes)).astype(np.intp)
+    pattern = _hidden_pattern(drawn, corner_edge, len(flip)).astype(np.intp)
     clear_of, marks_of = _quad_row_marks()
     # A row starting at corner r: its edges 0, 1 and its quad edges 3, 4
     # leave corners r, r + 1, r + 2, r + 3.
@@ -898,16 +986,22 @@ def _mark_quad_rows(
     return True
 
 
-def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, sizes: np.ndarray) -> np.ndarray | None:
-    """(F,) bool for a mesh of quads only whose triangle rows are those
-    extract.build_arrays_fast writes (see _mark_quad_rows): True where the
-    quad is split along its other diagonal. None for any other mesh."""
-    face_count = len(sizes)
-    if face_count == 0 or arrays.triangle_count != 2 * face_count or sizes.min() != 4 or sizes.max() != 4:
+def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, offsets: np.ndarray) -> np.ndarray | None:
+    """(F,) bool for a mesh of quads only (``offsets``: its F + 1 face
+    offsets) whose triangle rows are those extract.build_arrays_fast writes
+    (see _mark_quad_rows): True where the quad is split along its other
+    diagonal. None for any other mesh."""
+    face_count = len(offsets) - 1
+    if face_count <= 0 or arrays.triangle_count != 2 * face_count:
         return None
     known = arrays.quad_flip
     if known is not None and len(known) == face_count:
-        return known  # the rows build_arrays_fast wrote for a mesh of quads only, as it says
+        # build_arrays_fast keeps a split per quad for a mesh without
+        # n-gons: one per face is a mesh of quads only, its rows as it says.
+        return known
+    sizes = np.diff(offsets)
+    if sizes.min() != 4 or sizes.max() != 4:
+        return None
     tri, flags = arrays.triangles, arrays.edge_flags
     quad = np.asarray(corner_vert).reshape(face_count, 4)
     even, odd = tri[0::2], tri[1::2]
