@@ -272,7 +272,7 @@ def _layout_inputs(obj):
     import bpy
 
     mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
-    drawn, _chain, _ends, layout = cage.cage_edges(obj, mesh, render=False, regions=True)
+    drawn, _chain, _ends, layout, _verts = cage.cage_edges(obj, mesh, render=False, regions=True)
     assert isinstance(layout, edge_select.SubdivisionLayout)
     verts, corner_edge = mesh_reading.read_edge_topology(mesh)
     corner_vert = mesh_reading.read_corner_verts(mesh)

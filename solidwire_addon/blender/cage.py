@@ -222,13 +222,13 @@ def peel(edges: np.ndarray, verts_num: int, faces_num: int, level: int):
         return None
     if (corners == 0) != (coarse_faces_num == 0):
         return None
-    ends = chains[:, [0, -1]]
+    ends = chains[:, :: 2 * n - 1]  # columns 0 and 2n - 1
     if ends.min() < 0 or ends.max() >= coarse_verts_num:
         return None
-    inside = chains[:, 1:-1]  # (V + e*(n-1)) + (0, 0, 1, 1, ..., n-2, n-2)
-    start = coarse_verts_num + (n - 1) * np.arange(coarse_edges_num, dtype=np.int64)
-    step = np.repeat(np.arange(n - 1, dtype=np.int64), 2)
-    if not np.array_equal(inside, start[:, None] + step[None, :]):
+    # Row e inside: V + e*(n-1) + (0, 0, 1, 1, ..., n-2, n-2), so all rows
+    # together are the vertices V, V + 1, ... each twice.
+    inside = np.arange(coarse_verts_num, coarse_verts_num + coarse_edges_num * (n - 1), dtype=np.int64).repeat(2)
+    if not np.array_equal(chains[:, 1:-1], inside.reshape(coarse_edges_num, 2 * n - 2)):
         return None
     return np.ascontiguousarray(ends), coarse_verts_num, coarse_faces_num
 
@@ -447,14 +447,14 @@ def cage_edge_mask(obj, mesh, *, render: bool):
 
 
 def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
-    """(drawn mask, None, (E, 2) chain ends per edge, regions) for
-    core/edge_select.py (its EdgeInputs: no chain ids, as the ends say
-    which edges are pieces of one), or None: the children of one cage edge
-    share their chain's ends, so the density fade measures the whole cage
-    edge, not its pieces (an edge that is no cage child is its own chain,
-    its own ends). ``regions``: also the regions of that mask as the layout
-    gives them, or the layout to read them from (_known_regions; None where
-    it cannot tell), else None."""
+    """(drawn mask, None, (E, 2) chain ends per edge, regions, (E, 2) edge
+    vertex ids as read) for core/edge_select.py (its EdgeInputs: no chain
+    ids, as the ends say which edges are pieces of one), or None: the
+    children of one cage edge share their chain's ends, so the density
+    fade measures the whole cage edge, not its pieces (an edge that is no
+    cage child is its own chain, its own ends). ``regions``: also the
+    regions of that mask as the layout gives them, or the layout to read
+    them from (_known_regions; None where it cannot tell), else None."""
     if layout is None:
         layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
@@ -468,7 +468,7 @@ def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
     ends[:children] = np.repeat(cage, per_edge, axis=0)
     if steps:
         mask, ends = _carry(steps, mask, ends)
-    return mask, None, ends, known
+    return mask, None, ends, known, edges
 
 
 def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.SubdivisionLayout | None:
@@ -525,12 +525,11 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     # Each cage face's edges, ascending: (face, edge) keys sorted, which
     # moves each key only among its own face's corners (the faces' keys
     # are len(cage) apart). A face that names an edge twice (a corrupt
-    # face) is left to the general path.
+    # face) lists it twice: core/edge_select.py, which checks that each
+    # list ascends strictly, then finds the regions itself.
     face_key = np.repeat(np.arange(0, faces_num * len(cage), len(cage), dtype=np.int64), np.diff(offsets))
     keys = face_key + corner_edge
     keys.sort()
-    if not (keys[1:] > keys[:-1]).all():
-        return None
     # Every edge's children, consecutive (whole chains: KnownRegions.chain_edges).
     keys -= face_key
     keys *= per_edge

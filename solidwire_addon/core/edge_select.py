@@ -682,10 +682,10 @@ def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: 
     chain, ``owners``: its region), done per chain: a chain's edges are
     listed together by the same regions, so they are consecutive entries
     with its first edge's regions, and their texels are consecutive block
-    rows. Consecutive chains with different ends or regions make the runs
-    whole chains cut into pieces of the run length, with no search. False
+    rows. Consecutive chains with different ends make the runs whole
+    chains cut into pieces of the run length, with no search. False
     (nothing written) where an edge bounds more than two regions or two
-    consecutive entries' chains would join into one run."""
+    consecutive chains have the same ends."""
     counts = np.bincount(firsts)
     if counts.max() > 2:
         return False
@@ -698,23 +698,28 @@ def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: 
     first, last = np.take(first, chain), np.take(last, chain)
     # A listed chain's block rows are one row of the table seen as (chains, n * texels).
     lines = np.take(table.reshape(len(firsts), -1), first, axis=0).reshape(len(chain), chain_edges, -1)
+    # Two consecutive chains with the same ends (texels 4 and 5 of a
+    # chain's first entry, compared as one 64-bit word: equal ids always
+    # are) could join into one run: left to _known_region_lines.
+    chain_ends = lines.reshape(len(chain), -1).view(np.int64)[:, 2]
+    if (chain_ends[1:] == chain_ends[:-1]).any():
+        return False
     lines[:, :, 3] = np.take(owners, first)[:, None]
     lines[:, :, 6] = np.where(first != last, np.take(owners, last), NO_REGION)[:, None]
-    # A chain's first texels from its region on: region, chain ends,
-    # partner. Equal for two consecutive chains (as float32: equal ids
-    # always are), they would be one run.
-    key = lines[:, 0, 3:7]
-    if (key[1:] == key[:-1]).all(axis=1).any():
-        return False
     arrays.region_lines = lines.reshape(-1, 4)
     # _line_runs of groups of chain_edges entries each.
-    length = _run_length(chain_edges)
-    within = np.arange(0, chain_edges, length)
-    runs = np.zeros((len(chain), len(within), 4), np.float32)
-    runs[:, :, 0] = np.arange(0, len(chain) * chain_edges, chain_edges)[:, None] + within
-    runs[:, :, 1] = np.minimum(length, chain_edges - within)
+    count, length = len(chain) * chain_edges, _run_length(chain_edges)
+    if chain_edges % length == 0:  # (a subdivision's 2**L: always)
+        runs = np.zeros((count // length, 4), np.float32)
+        runs[:, 0] = np.arange(0, count, length)
+        runs[:, 1] = length
+    else:
+        within = np.arange(0, chain_edges, length)
+        runs = np.zeros((len(chain), len(within), 4), np.float32)
+        runs[:, :, 0] = np.arange(0, count, chain_edges)[:, None] + within
+        runs[:, :, 1] = np.minimum(length, chain_edges - within)
     arrays.region_line_runs, arrays.region_run_segments = runs.reshape(-1, 4), length
-    stats.region_lines = len(chain) * chain_edges
+    stats.region_lines = count
     return True
 
 
