@@ -222,15 +222,15 @@ def peel(edges: np.ndarray, verts_num: int, faces_num: int, level: int):
         return None
     if (corners == 0) != (coarse_faces_num == 0):
         return None
-    ends = chains[:, :: 2 * n - 1]  # columns 0 and 2n - 1
-    if ends.min() < 0 or ends.max() >= coarse_verts_num:
+    ends = np.ascontiguousarray(chains[:, :: 2 * n - 1])  # columns 0 and 2n - 1
+    if ends.view(f"u{ends.dtype.itemsize}").max() >= coarse_verts_num:  # a negative id is a large unsigned one
         return None
     # Row e inside: V + e*(n-1) + (0, 0, 1, 1, ..., n-2, n-2), so all rows
     # together are the vertices V, V + 1, ... each twice.
-    inside = np.arange(coarse_verts_num, coarse_verts_num + coarse_edges_num * (n - 1), dtype=np.int64).repeat(2)
+    inside = np.arange(coarse_verts_num, coarse_verts_num + coarse_edges_num * (n - 1), dtype=edges.dtype).repeat(2)
     if not np.array_equal(chains[:, 1:-1], inside.reshape(coarse_edges_num, 2 * n - 2)):
         return None
-    return np.ascontiguousarray(ends), coarse_verts_num, coarse_faces_num
+    return ends, coarse_verts_num, coarse_faces_num
 
 
 def _cage_counts(obj):

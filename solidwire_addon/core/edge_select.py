@@ -625,9 +625,9 @@ def _select_known_regions(
         or not drawn[edges].all()
     ):
         return None
-    ascending = np.diff(firsts) > 0
-    ascending[edge_start[1:-1] // chain_edges - 1] = True  # each region's list starts afresh
-    if not ascending.all():
+    step = np.diff(firsts)
+    step[edge_start[1:-1] // chain_edges - 1] = 1  # each region's list starts afresh
+    if len(step) and step.min() <= 0:
         return None
     flip = _quad_row_flip(arrays, corner_vert, offsets)
     if flip is None:
@@ -644,14 +644,16 @@ def _select_known_regions(
     table[0::2, 1] = np.maximum(seg_verts[:, 0], seg_verts[:, 1])
     table[1::2, 0], table[1::2, 1] = seg_ends[:, 0], seg_ends[:, 1]
     arrays.region_table = table
-    region_table_start = (len(arrays.ngon_corners) + TEXELS_PER_SEGMENT * edge_start[:-1]).astype(np.int32)
+    region_table_start = np.multiply(edge_start[:-1], TEXELS_PER_SEGMENT, dtype=np.int32)
+    if len(arrays.ngon_corners):
+        region_table_start += len(arrays.ngon_corners)
 
     # Each quad's two rows in one 64-bit write (row 2i the low half), looked
     # up by its block's segment count, its split and its hidden edges
     # (_listed_quad_rows), written in place: no million-row temporaries.
     at = _hidden_pattern(drawn, corner_edge, face_count, corner_drawn)
     at |= flip.view(np.uint8) << np.uint8(4)
-    at |= np.repeat((per_region << 5).astype(np.uint32), region_faces)
+    at |= np.repeat(np.left_shift(per_region, 5, dtype=np.uint32, casting="unsafe"), region_faces)
     flags = arrays.edge_flags
     if flags.dtype == np.int32 and flags.flags.c_contiguous:
         np.take(_LISTED_QUAD_ROWS, at, out=flags.view(np.uint64), mode="clip")
