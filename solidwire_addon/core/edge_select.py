@@ -596,9 +596,9 @@ def _select_known_regions(
     face_count = len(offsets) - 1
     verts = np.asarray(inputs.verts).reshape(-1, 2)
     drawn = np.asarray(drawn, bool)
-    corner_drawn = None  # shared with _hidden_pattern, which consumes it
+    prefix = _drawn_prefix(drawn)
+    corner_drawn = _corner_drawn(drawn, corner_edge, prefix)  # shared with _hidden_pattern, which consumes it
     if isinstance(regions, SubdivisionLayout):
-        corner_drawn = _corner_drawn(drawn, corner_edge)
         regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn, face_count, corner_drawn)
         if regions is None:
             return None
@@ -621,8 +621,8 @@ def _select_known_regions(
         or per_region.min() < 1
         or per_region.max() > WALK_LIMIT
         or firsts.min() < 0
-        or firsts.max() + chain_edges > len(verts)
-        or not drawn[edges].all()
+        or firsts.max() + chain_edges > (prefix[0] if prefix[1] else len(verts))
+        or not (prefix[1] or drawn[edges].all())  # (drawn edges first: all below their count)
     ):
         return None
     step = np.diff(firsts)
@@ -632,7 +632,7 @@ def _select_known_regions(
     flip = _quad_row_flip(arrays, corner_vert, offsets)
     if flip is None:
         return None
-    stats = SelectionStats(hidden_edges=len(drawn) - int(np.count_nonzero(drawn)))
+    stats = SelectionStats(hidden_edges=len(drawn) - prefix[0])
 
     # The blocks: region k's drawn edges from table row first[k], in region order.
     label = face_start[:-1]
@@ -1029,11 +1029,19 @@ def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, offsets: np.ndar
     return flip
 
 
-def _corner_drawn(drawn: np.ndarray, corner_edge: np.ndarray) -> np.ndarray:
-    """(L,) bool, a fresh array: whether each corner's edge is drawn."""
-    drawn = np.asarray(drawn, bool)
+def _drawn_prefix(drawn: np.ndarray) -> tuple[int, bool]:
+    """(how many edges are drawn, whether they are the first ones: a
+    subdivision's cage children)."""
     count = int(np.count_nonzero(drawn))
-    if drawn[:count].all():  # the drawn edges come first (a subdivision's cage children): a compare, no gather
+    return count, bool(drawn[:count].all())
+
+
+def _corner_drawn(drawn: np.ndarray, corner_edge: np.ndarray, prefix: tuple[int, bool] | None = None) -> np.ndarray:
+    """(L,) bool, a fresh array: whether each corner's edge is drawn.
+    ``prefix``: _drawn_prefix's answer when the caller has it."""
+    drawn = np.asarray(drawn, bool)
+    count, first = _drawn_prefix(drawn) if prefix is None else prefix
+    if first:  # the drawn edges come first: a compare, no gather
         return np.asarray(corner_edge) < count
     return np.take(drawn, corner_edge)
 
