@@ -486,7 +486,9 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     Every edge inside a cage face is hidden and joins two of its children,
     which form one connected patch, and every edge on its outline is a child
     of one of its cage edges, all drawn: the region of each cage face is
-    exactly its children, bounded by the children of its cage edges. The
+    exactly its children, bounded by the children of its cage edges, which
+    it lists in whole chains (KnownRegions.chain_edges: each cage edge's
+    children consecutive, with the cage edge's ends as chain ends). The
     cage mesh read here is checked to be the one the layout was peeled to
     (its vertex, face and corner counts and every edge)."""
     _children, per_edge, cage, steps, cage_mesh, _edges = layout

@@ -456,7 +456,11 @@ def regions_from_layout(
     the layout's word (Blender's children of a face are one grid, or one
     per corner around its centre). A run's drawn edges are those its
     children's corners name, ascending (``corner_drawn``: each corner's
-    edge drawn, _corner_drawn, when the caller has it)."""
+    edge drawn, _corner_drawn, when the caller has it); where they are
+    whole chains (each coarse edge's n children from a multiple of n, none
+    split between runs: checked) the regions say so
+    (KnownRegions.chain_edges; the chain ends the caller passes with a
+    SubdivisionLayout give each child its coarse edge's ends)."""
     n = 1 << layout.level
     m = n >> 1
     faces, edges_num, drawn_count = layout.subdivided_faces, layout.subdivided_edges, layout.coarse_edges * n
@@ -588,7 +592,9 @@ def _select_known_regions(
     Every face is then in a multi-face region, so every face is listed, its
     block is its region's (id = the region's first face) and its lines come
     from the region-lines pass; each block holds its region's drawn edges,
-    ascending, one segment each (no class, no n-gon diagonal)."""
+    ascending, one segment each (no class, no n-gon diagonal). Regions
+    listed in whole chains (KnownRegions.chain_edges) have their list
+    order checked and their region lines written per chain."""
     regions, drawn = inputs.regions, inputs.drawn
     if drawn is None or inputs.chain_ends is None:
         return None
