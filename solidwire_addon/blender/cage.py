@@ -531,7 +531,7 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     # list ascends strictly, then finds the regions itself.
     face_key = np.repeat(np.arange(0, faces_num * len(cage), len(cage), dtype=np.int64), np.diff(offsets))
     keys = face_key + corner_edge
-    keys.sort()
+    keys.sort(kind="stable")  # timsort: the keys ascend face to face, which it exploits (2-3x the default)
     # Every edge's children, consecutive (whole chains: KnownRegions.chain_edges).
     keys -= face_key
     keys *= per_edge
