@@ -228,7 +228,7 @@ def peel(edges: np.ndarray, verts_num: int, faces_num: int, level: int):
     # Row e inside: V + e*(n-1) + (0, 0, 1, 1, ..., n-2, n-2), so all rows
     # together are the vertices V, V + 1, ... each twice.
     inside = np.arange(coarse_verts_num, coarse_verts_num + coarse_edges_num * (n - 1), dtype=edges.dtype).repeat(2)
-    if not np.array_equal(chains[:, 1:-1], inside.reshape(coarse_edges_num, 2 * n - 2)):
+    if not (chains[:, 1:-1] == inside.reshape(coarse_edges_num, 2 * n - 2)).all():
         return None
     return ends, coarse_verts_num, coarse_faces_num
 

@@ -672,12 +672,13 @@ def _select_known_regions(
         quads[:, 7] = face_table_start
     else:
         arrays.triangles[:, 3] = np.repeat(face_table_start, 2)
-    arrays.triangle_regions = np.repeat(label.astype(np.float32), 2 * region_faces)
+    label_texel = label.astype(np.float32)  # as the tables hold it
+    arrays.triangle_regions = np.repeat(label_texel, 2 * region_faces)
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
     stats.segments = len(edges)
     if chain_edges > 1 and _chain_region_lines(
-        arrays, table, firsts, np.repeat(label, per_region // chain_edges), chain_edges, stats
+        arrays, table, firsts, np.repeat(label_texel, per_region // chain_edges), chain_edges, stats
     ):
         return stats
     _known_region_lines(arrays, verts, ends, table, seg_ends, np.repeat(label, per_region), edges, stats)
@@ -687,7 +688,7 @@ def _select_known_regions(
 def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: int, stats) -> bool:
     """_known_region_lines for regions listed in whole chains
     (KnownRegions.chain_edges; ``firsts``: the first edge of each listed
-    chain, ``owners``: its region), done per chain: a chain's edges are
+    chain, ``owners``: its region as a float32 texel), done per chain: a chain's edges are
     listed together by the same regions, so they are consecutive entries
     with its first edge's regions, and their texels are consecutive block
     rows. Consecutive chains with different ends make the runs whole
@@ -713,7 +714,7 @@ def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: 
     if (chain_ends[1:] == chain_ends[:-1]).any():
         return False
     lines[:, :, 3] = np.take(owners, first)[:, None]
-    lines[:, :, 6] = np.where(first != last, np.take(owners, last), NO_REGION)[:, None]
+    lines[:, :, 6] = np.where(first != last, np.take(owners, last), np.float32(NO_REGION))[:, None]
     arrays.region_lines = lines.reshape(-1, 4)
     # _line_runs of groups of chain_edges entries each.
     count, length = len(chain) * chain_edges, _run_length(chain_edges)
