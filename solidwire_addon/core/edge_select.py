@@ -688,13 +688,13 @@ def _select_known_regions(
 def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: int, stats) -> bool:
     """_known_region_lines for regions listed in whole chains
     (KnownRegions.chain_edges; ``firsts``: the first edge of each listed
-    chain, ``owners``: its region as a float32 texel), done per chain: a chain's edges are
-    listed together by the same regions, so they are consecutive entries
-    with its first edge's regions, and their texels are consecutive block
-    rows. Consecutive chains with different ends make the runs whole
-    chains cut into pieces of the run length, with no search. False
-    (nothing written) where an edge bounds more than two regions or two
-    consecutive chains have the same ends."""
+    chain, ``owners``: its region as a float32 texel), done per chain: a
+    chain's edges are listed together by the same regions, so they are
+    consecutive entries with its first edge's regions, and their texels
+    are consecutive block rows. Consecutive chains with different ends
+    make the runs whole chains cut into pieces of the run length, with no
+    search. False (nothing written) where an edge bounds more than two
+    regions or two consecutive chains have the same ends."""
     counts = np.bincount(firsts)
     if counts.max() > 2:
         return False
