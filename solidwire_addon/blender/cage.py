@@ -521,7 +521,7 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     ):
         return None
     cage_edge_verts, corner_edge = mesh_reading.read_edge_topology(data)
-    if not np.array_equal(cage_edge_verts, cage):
+    if cage_edge_verts.shape != cage.shape or not (cage_edge_verts == cage).all():
         return None
     offsets = mesh_reading.read_face_offsets(data)
     # Each cage face's edges, ascending: (face, edge) keys sorted, which
@@ -529,7 +529,7 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     # are len(cage) apart). A face that names an edge twice (a corrupt
     # face) lists it twice: core/edge_select.py, which checks that each
     # list ascends strictly, then finds the regions itself.
-    face_key = np.repeat(np.arange(0, faces_num * len(cage), len(cage), dtype=np.int64), np.diff(offsets))
+    face_key = np.arange(0, faces_num * len(cage), len(cage), dtype=np.int64).repeat(offsets[1:] - offsets[:-1])
     keys = face_key + corner_edge
     keys.sort(kind="stable")  # timsort: the keys ascend face to face, which it exploits (2-3x the default)
     # Every edge's children, consecutive (whole chains: KnownRegions.chain_edges).

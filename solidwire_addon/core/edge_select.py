@@ -613,7 +613,7 @@ def _select_known_regions(
     edges = np.asarray(regions.region_edges, np.int64)
     if face_count <= 0 or len(face_start) < 2 or len(edge_start) != len(face_start) or len(drawn) != len(verts):
         return None
-    region_faces, per_region = np.diff(face_start), np.diff(edge_start)
+    region_faces, per_region = face_start[1:] - face_start[:-1], edge_start[1:] - edge_start[:-1]
     # Whole chains of consecutive edges (KnownRegions.chain_edges): their
     # first edges bound the ids and ascend where the list does.
     chain_edges = max(1, int(regions.chain_edges))
@@ -631,7 +631,7 @@ def _select_known_regions(
         or not (prefix[1] or drawn[edges].all())  # (drawn edges first: all below their count)
     ):
         return None
-    step = np.diff(firsts)
+    step = firsts[1:] - firsts[:-1]
     step[edge_start[1:-1] // chain_edges - 1] = 1  # each region's list starts afresh
     if len(step) and step.min() <= 0:
         return None
@@ -643,8 +643,9 @@ def _select_known_regions(
     # The blocks: region k's drawn edges from table row first[k], in region order.
     label = face_start[:-1]
     ends = np.asarray(inputs.chain_ends)
-    # (np.take gathers rows several times faster than fancy indexing.)
-    seg_verts, seg_ends = np.take(verts, edges, axis=0), np.take(ends, edges, axis=0)
+    # (take gathers rows several times faster than fancy indexing; the
+    # methods, here and below, skip numpy's function wrappers.)
+    seg_verts, seg_ends = verts.take(edges, axis=0), ends.take(edges, axis=0)
     table = np.zeros((TEXELS_PER_SEGMENT * len(edges), 4), dtype=np.float32)
     table[0::2, 0] = np.minimum(seg_verts[:, 0], seg_verts[:, 1])
     table[0::2, 1] = np.maximum(seg_verts[:, 0], seg_verts[:, 1])
@@ -659,13 +660,13 @@ def _select_known_regions(
     # (_listed_quad_rows), written in place: no million-row temporaries.
     at = _hidden_pattern(drawn, corner_edge, face_count, corner_drawn)
     at |= flip.view(np.uint8) << np.uint8(4)
-    at |= np.repeat(np.left_shift(per_region, 5, dtype=np.uint32, casting="unsafe"), region_faces)
+    at |= np.left_shift(per_region, 5, dtype=np.uint32, casting="unsafe").repeat(region_faces)
     flags = arrays.edge_flags
     if flags.dtype == np.int32 and flags.flags.c_contiguous:
-        np.take(_LISTED_QUAD_ROWS, at, out=flags.view(np.uint64), mode="clip")
+        _LISTED_QUAD_ROWS.take(at, out=flags.view(np.uint64), mode="clip")
     else:
         flags[:] = np.take(_LISTED_QUAD_ROWS, at).view(np.int32)
-    face_table_start = np.repeat(region_table_start, region_faces)
+    face_table_start = region_table_start.repeat(region_faces)
     if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one row of 8: two column writes
         quads = arrays.triangles.reshape(face_count, 8)
         quads[:, 3] = face_table_start
@@ -673,12 +674,12 @@ def _select_known_regions(
     else:
         arrays.triangles[:, 3] = np.repeat(face_table_start, 2)
     label_texel = label.astype(np.float32)  # as the tables hold it
-    arrays.triangle_regions = np.repeat(label_texel, 2 * region_faces)
+    arrays.triangle_regions = label_texel.repeat(2 * region_faces)
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
     stats.segments = len(edges)
     if chain_edges > 1 and _chain_region_lines(
-        arrays, table, firsts, np.repeat(label_texel, per_region // chain_edges), chain_edges, stats
+        arrays, table, firsts, label_texel.repeat(per_region // chain_edges), chain_edges, stats
     ):
         return stats
     _known_region_lines(arrays, verts, ends, table, seg_ends, np.repeat(label, per_region), edges, stats)
@@ -698,23 +699,23 @@ def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: 
     counts = np.bincount(firsts)
     if counts.max() > 2:
         return False
-    chain = np.flatnonzero(counts)
+    chain = counts.nonzero()[0]
     listing = np.arange(len(firsts))
     first = np.empty(len(counts), np.intp)
     first[firsts[::-1]] = listing[::-1]  # the last write is the first listing's
     last = np.empty(len(counts), np.intp)
     last[firsts] = listing
-    first, last = np.take(first, chain), np.take(last, chain)
+    first, last = first.take(chain), last.take(chain)
     # A listed chain's block rows are one row of the table seen as (chains, n * texels).
-    lines = np.take(table.reshape(len(firsts), -1), first, axis=0).reshape(len(chain), chain_edges, -1)
+    lines = table.reshape(len(firsts), -1).take(first, axis=0).reshape(len(chain), chain_edges, -1)
     # Two consecutive chains with the same ends (texels 4 and 5 of a
     # chain's first entry, compared as one 64-bit word: equal ids always
     # are) could join into one run: left to _known_region_lines.
     chain_ends = lines.reshape(len(chain), -1).view(np.int64)[:, 2]
     if (chain_ends[1:] == chain_ends[:-1]).any():
         return False
-    lines[:, :, 3] = np.take(owners, first)[:, None]
-    lines[:, :, 6] = np.where(first != last, np.take(owners, last), np.float32(NO_REGION))[:, None]
+    lines[:, :, 3] = owners.take(first)[:, None]
+    lines[:, :, 6] = np.where(first != last, owners.take(last), np.float32(NO_REGION))[:, None]
     arrays.region_lines = lines.reshape(-1, 4)
     # _line_runs of groups of chain_edges entries each.
     count, length = len(chain) * chain_edges, _run_length(chain_edges)
