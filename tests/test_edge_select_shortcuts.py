@@ -40,12 +40,14 @@ def _general_labels(face_count, f1, f2):
     return edge_select._components(face_count, np.asarray(f1, np.int64), np.asarray(f2, np.int64))
 
 
-def _select(obj, selection, path, monkeypatch):
-    """(arrays, stats, whether the shortcut of ``path`` applied) after the
-    selection on ``obj``'s evaluated mesh. ``path``: "regions" (the regions
-    the cage layout gives, the quad rows as extracted), "shortcuts" (regions
-    found over runs, the quad rows checked on the triangles), "general"
-    (neither)."""
+def _select(obj, selection, path, monkeypatch, *, cage_edges_of=None):
+    """(arrays, stats, whether the shortcut of ``path`` applied, whether
+    the region lines were written per chain) after the selection on
+    ``obj``'s evaluated mesh. ``path``: "regions" (the regions the cage
+    layout gives, the quad rows as extracted), "shortcuts" (regions found
+    over runs, the quad rows checked on the triangles), "general" (neither).
+    ``cage_edges_of``: changes the cage's (mask, chains, ends, regions,
+    verts) before they are used."""
     import bpy
 
     obj_eval = obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
@@ -58,7 +60,9 @@ def _select(obj, selection, path, monkeypatch):
     if selection.use_cage:
         cage_edges = cage.cage_edges(obj, mesh, render=False, regions=path == "regions")
         assert cage_edges is not None
-    applied = []
+        if cage_edges_of is not None:
+            cage_edges = cage_edges_of(cage_edges)
+    applied, per_chain = [], []
     with monkeypatch.context() as patch:
         if path == "general":
             patch.setattr(edge_select, "_mark_quad_rows", lambda *args: False)
@@ -75,15 +79,37 @@ def _select(obj, selection, path, monkeypatch):
             patch.setattr(edge_select, spied, spy)
             if path == "shortcuts":
                 arrays.quad_flip = None  # the rows are checked on the triangles
+            real_chains = edge_select._chain_region_lines
+            patch.setattr(
+                edge_select,
+                "_chain_region_lines",
+                lambda *args: per_chain.append(real_chains(*args)) or per_chain[-1],
+            )
         stats = mesh_reading.apply_edge_selection(arrays, mesh, corner_vert, offsets, selection, cage_edges)
-    return arrays, stats, any(applied)
+    return arrays, stats, any(applied), any(per_chain)
 
 
-def _assert_same_as_general(obj, selection, monkeypatch, *, rows_expected: bool, regions_expected: bool = False):
-    general, general_stats, _ = _select(obj, selection, "general", monkeypatch)
+def _assert_same_as_general(
+    obj,
+    selection,
+    monkeypatch,
+    *,
+    rows_expected: bool,
+    regions_expected: bool = False,
+    chains_expected: bool | None = None,
+    cage_edges_of=None,
+):
+    """The shortcuts give the general path's arrays; ``regions_expected``:
+    the known regions apply, and (unless ``chains_expected`` says
+    otherwise) write the region lines per chain."""
+    if chains_expected is None:
+        chains_expected = regions_expected
+    general, general_stats, _, _ = _select(obj, selection, "general", monkeypatch, cage_edges_of=cage_edges_of)
     for path, expected in (("shortcuts", rows_expected), ("regions", regions_expected)):
-        other, stats, applied = _select(obj, selection, path, monkeypatch)
+        other, stats, applied, per_chain = _select(obj, selection, path, monkeypatch, cage_edges_of=cage_edges_of)
         assert applied == expected, path
+        if path == "regions":
+            assert per_chain == chains_expected
         assert stats == general_stats, path
         for field in ARRAY_FIELDS:
             a, b = getattr(other, field), getattr(general, field)
@@ -132,6 +158,31 @@ def test_mirror_and_array_copies_after_the_subdivision(monkeypatch):
     _subdivide(obj, 2)
     scenes.add_mirror_and_array(obj, count=3)
     _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+
+
+def test_chains_with_the_same_ends_take_the_lines_per_edge(monkeypatch):
+    """Two consecutive cage edges whose pieces name the same chain ends
+    could be one run of the region-lines pass: the lines are then written
+    edge by edge (and still give the general path's arrays)."""
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene)
+    _subdivide(obj, 2)
+
+    def same_ends(cage_edges):
+        mask, chains, ends, regions, verts = cage_edges
+        ends = ends.copy()
+        ends[4:8] = ends[0]  # cage edge 1's four pieces end where cage edge 0's do
+        return mask, chains, ends, regions, verts
+
+    _assert_same_as_general(
+        obj,
+        CAGE,
+        monkeypatch,
+        rows_expected=True,
+        regions_expected=True,
+        chains_expected=False,
+        cage_edges_of=same_ends,
+    )
 
 
 def test_triangles_and_ngons_under_the_edge_angle_take_the_general_marks(monkeypatch):
@@ -238,7 +289,9 @@ def test_ngon_cage_behind_a_merging_mirror_with_copies_after(monkeypatch):
     array = obj.modifiers.new("Array", "ARRAY")
     array.count = 2
     array.use_merge_vertices = False
-    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+    # Merged on the mirror plane, some cage edges bound four faces: their
+    # lines are one entry per pair of regions, not one per chain.
+    _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True, chains_expected=False)
 
 
 @pytest.mark.parametrize("before", [None, "MIRROR"])
@@ -272,7 +325,7 @@ def _layout_inputs(obj):
     import bpy
 
     mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
-    drawn, _chain, _ends, layout = cage.cage_edges(obj, mesh, render=False, regions=True)
+    drawn, _chain, _ends, layout, _verts = cage.cage_edges(obj, mesh, render=False, regions=True)
     assert isinstance(layout, edge_select.SubdivisionLayout)
     verts, corner_edge = mesh_reading.read_edge_topology(mesh)
     corner_vert = mesh_reading.read_corner_verts(mesh)
@@ -293,6 +346,7 @@ def test_a_layout_that_does_not_hold_gives_no_regions():
     known = edge_select.regions_from_layout(layout, corner_vert, corner_edge, verts, drawn, faces)
     assert known is not None and len(known.face_start) == layout.coarse_faces + 1
     n = 1 << layout.level
+    assert known.chain_edges == n  # each coarse edge's children listed whole
 
     def refused(**changed):
         args = dict(corner_vert=corner_vert, corner_edge=corner_edge, verts=verts, drawn=drawn, layout=layout)

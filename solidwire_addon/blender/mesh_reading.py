@@ -301,13 +301,19 @@ def read_edge_topology(mesh) -> tuple[np.ndarray, np.ndarray]:
     """((E, 2) edge vertex ids, (L,) the edge of each face corner): raw
     attribute reads where Blender has them (a memcpy, ~50x faster than the
     per-element ``edges.vertices`` / ``loops.edge_index``)."""
+    return read_edge_verts(mesh), read_corner_edges(mesh)
+
+
+def read_corner_edges(mesh) -> np.ndarray:
+    """(L,) int32 the edge of each face corner (the raw attribute where
+    Blender has it)."""
     corner_count = len(mesh.loops)
     corner_edge = _read_raw(mesh, ".corner_edge", corner_count, 1)
     if corner_edge is None:
         corner_edge = np.empty(corner_count, np.int32)
         if corner_count:
             mesh.loops.foreach_get("edge_index", corner_edge)
-    return read_edge_verts(mesh), corner_edge
+    return corner_edge
 
 
 def _read_raw(mesh, name: str, count: int, width: int):
@@ -330,15 +336,21 @@ def apply_edge_selection(
 ) -> SelectionStats:
     """Read ``mesh``'s edges and apply ``selection`` to ``arrays``
     (core.edge_select.select_edges). ``cage``: (drawn mask, chain ids or
-    None[, chain ends[, regions]]) of the evaluated edges from the cage
-    detection (blender/cage.py) or an outline mask (blender/outlines.py), or
-    None (no subdivision, or cage edges off). The regions (KnownRegions, or
-    the SubdivisionLayout core/edge_select.py reads them from) are those of
-    the mask alone: used only where nothing else hides an edge."""
-    verts, corner_edge = read_edge_topology(mesh)
+    None[, chain ends[, regions[, (E, 2) edge vertex ids as read]]]) of the
+    evaluated edges from the cage detection (blender/cage.py) or an outline
+    mask (blender/outlines.py), or None (no subdivision, or cage edges
+    off). The regions (KnownRegions, or the SubdivisionLayout
+    core/edge_select.py reads them from) are those of the mask alone: used
+    only where nothing else hides an edge. (select_edges copies the mask
+    where it changes it.)"""
+    verts = cage[4] if cage is not None and len(cage) > 4 else None
+    if verts is None:
+        verts, corner_edge = read_edge_topology(mesh)
+    else:
+        corner_edge = read_corner_edges(mesh)
     drawn = chain = chain_ends = regions = None
     if cage is not None:
-        drawn, chain = np.asarray(cage[0], bool).copy(), cage[1]
+        drawn, chain = np.asarray(cage[0], bool), cage[1]
         chain_ends = cage[2] if len(cage) > 2 else None
         regions = cage[3] if len(cage) > 3 and not selection.edge_angle > 0.0 else None
     if selection.edge_angle > 0.0:

@@ -97,11 +97,20 @@ class KnownRegions:
     face corners (an edge inside a cage face), for the ``drawn`` mask it
     passes with these regions and no edge classes; select_edges checks the
     rest of what its shortcut assumes and otherwise finds the regions
-    itself."""
+    itself.
+
+    ``chain_edges`` > 1 (a subdivision at level L: 2**L) says more, which
+    the caller vouches for too: the listed edges come in whole chains of
+    that many consecutive edges (``region_edges`` in groups of
+    ``chain_edges``, each ``e, e + 1, ...``), every edge of a chain with
+    the same chain ends (EdgeInputs.chain_ends) and listed by the same
+    regions. The region lines are then written per chain
+    (_chain_region_lines)."""
 
     face_start: np.ndarray  # (R + 1,) ascending, from 0 to the face count
     edge_start: np.ndarray  # (R + 1,) offsets into ``region_edges``
     region_edges: np.ndarray  # (S,) edge ids
+    chain_edges: int = 1
 
 
 @dataclass
@@ -447,7 +456,11 @@ def regions_from_layout(
     the layout's word (Blender's children of a face are one grid, or one
     per corner around its centre). A run's drawn edges are those its
     children's corners name, ascending (``corner_drawn``: each corner's
-    edge drawn, _corner_drawn, when the caller has it)."""
+    edge drawn, _corner_drawn, when the caller has it); where they are
+    whole chains (each coarse edge's n children from a multiple of n, none
+    split between runs: checked) the regions say so
+    (KnownRegions.chain_edges; the chain ends the caller passes with a
+    SubdivisionLayout give each child its coarse edge's ends)."""
     n = 1 << layout.level
     m = n >> 1
     faces, edges_num, drawn_count = layout.subdivided_faces, layout.subdivided_edges, layout.coarse_edges * n
@@ -519,8 +532,29 @@ def regions_from_layout(
     region, edge = np.divmod(np.unique(run * drawn_count + np.take(corner_edge, at)), drawn_count)
     edge_start = np.zeros(len(face_start), np.int64)
     np.cumsum(np.bincount(region, minlength=len(first)), out=edge_start[1:])
-    known = KnownRegions(face_start, edge_start, edge)
+    # Whole chains (a coarse edge's n children, from a multiple of n), none
+    # split between regions: the region lines are then written per chain.
+    chains = edge.reshape(-1, n) if len(edge) % n == 0 else None
+    whole = (
+        chains is not None
+        and not (edge_start % n).any()
+        and not (chains[:, 0] % n).any()
+        and np.array_equal(chains - chains[:, :1], np.broadcast_to(np.arange(n), chains.shape))
+    )
+    known = KnownRegions(face_start, edge_start, edge, n if whole else 1)
     return copied_regions(known, layout.copies, faces, edges_num, face_count, len(drawn))
+
+
+def whole_chains(firsts: np.ndarray, chain_edges: int) -> np.ndarray:
+    """(len(firsts) * chain_edges,) int64: each chain's consecutive edges
+    ``first, first + 1, ...`` (KnownRegions.chain_edges), chain by chain."""
+    edges = np.empty((len(firsts), chain_edges), np.int64)
+    if chain_edges <= 8:  # a column at a time: a broadcast over short rows costs several times more
+        for k in range(chain_edges):
+            np.add(firsts, k, out=edges[:, k])
+    else:
+        np.add(firsts[:, None], np.arange(chain_edges, dtype=np.int64), out=edges)
+    return edges.reshape(-1)
 
 
 def copied_regions(
@@ -540,7 +574,7 @@ def copied_regions(
         faces_in, edges_in = count * faces_in, count * edges_in
     if faces_in != face_count or edges_in != edge_count:
         return None
-    return KnownRegions(face_start, edge_start, edges)
+    return KnownRegions(face_start, edge_start, edges, regions.chain_edges)
 
 
 def _select_known_regions(
@@ -558,7 +592,9 @@ def _select_known_regions(
     Every face is then in a multi-face region, so every face is listed, its
     block is its region's (id = the region's first face) and its lines come
     from the region-lines pass; each block holds its region's drawn edges,
-    ascending, one segment each (no class, no n-gon diagonal)."""
+    ascending, one segment each (no class, no n-gon diagonal). Regions
+    listed in whole chains (KnownRegions.chain_edges) have their list
+    order checked and their region lines written per chain."""
     regions, drawn = inputs.regions, inputs.drawn
     if drawn is None or inputs.chain_ends is None:
         return None
@@ -566,9 +602,9 @@ def _select_known_regions(
     face_count = len(offsets) - 1
     verts = np.asarray(inputs.verts).reshape(-1, 2)
     drawn = np.asarray(drawn, bool)
-    corner_drawn = None  # shared with _hidden_pattern, which consumes it
+    prefix = _drawn_prefix(drawn)
+    corner_drawn = _corner_drawn(drawn, corner_edge, prefix)  # shared with _hidden_pattern, which consumes it
     if isinstance(regions, SubdivisionLayout):
-        corner_drawn = _corner_drawn(drawn, corner_edge)
         regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn, face_count, corner_drawn)
         if regions is None:
             return None
@@ -577,7 +613,11 @@ def _select_known_regions(
     edges = np.asarray(regions.region_edges, np.int64)
     if face_count <= 0 or len(face_start) < 2 or len(edge_start) != len(face_start) or len(drawn) != len(verts):
         return None
-    region_faces, per_region = np.diff(face_start), np.diff(edge_start)
+    region_faces, per_region = face_start[1:] - face_start[:-1], edge_start[1:] - edge_start[:-1]
+    # Whole chains of consecutive edges (KnownRegions.chain_edges): their
+    # first edges bound the ids and ascend where the list does.
+    chain_edges = max(1, int(regions.chain_edges))
+    firsts = edges[::chain_edges]
     if (
         face_start[0] != 0
         or face_start[-1] != face_count
@@ -586,55 +626,111 @@ def _select_known_regions(
         or edge_start[-1] != len(edges)
         or per_region.min() < 1
         or per_region.max() > WALK_LIMIT
-        or edges.min() < 0
-        or edges.max() >= len(verts)
-        or not drawn[edges].all()
+        or firsts.min() < 0
+        or firsts.max() + chain_edges > (prefix[0] if prefix[1] else len(verts))
+        or not (prefix[1] or drawn[edges].all())  # (drawn edges first: all below their count)
     ):
         return None
-    ascending = np.diff(edges) > 0
-    ascending[edge_start[1:-1] - 1] = True  # each region's list starts afresh
-    if not ascending.all():
+    step = firsts[1:] - firsts[:-1]
+    step[edge_start[1:-1] // chain_edges - 1] = 1  # each region's list starts afresh
+    if len(step) and step.min() <= 0:
         return None
-    flip = _quad_row_flip(arrays, corner_vert, np.diff(offsets))
+    flip = _quad_row_flip(arrays, corner_vert, offsets)
     if flip is None:
         return None
-    stats = SelectionStats(hidden_edges=len(drawn) - int(np.count_nonzero(drawn)))
+    stats = SelectionStats(hidden_edges=len(drawn) - prefix[0])
 
     # The blocks: region k's drawn edges from table row first[k], in region order.
     label = face_start[:-1]
-    seg_owner = np.repeat(label, per_region)
     ends = np.asarray(inputs.chain_ends)
-    # (np.take gathers rows several times faster than fancy indexing.)
-    seg_verts, seg_ends = np.take(verts, edges, axis=0), np.take(ends, edges, axis=0)
+    # (take gathers rows several times faster than fancy indexing; the
+    # methods, here and below, skip numpy's function wrappers.)
+    seg_verts, seg_ends = verts.take(edges, axis=0), ends.take(edges, axis=0)
     table = np.zeros((TEXELS_PER_SEGMENT * len(edges), 4), dtype=np.float32)
     table[0::2, 0] = np.minimum(seg_verts[:, 0], seg_verts[:, 1])
     table[0::2, 1] = np.maximum(seg_verts[:, 0], seg_verts[:, 1])
     table[1::2, 0], table[1::2, 1] = seg_ends[:, 0], seg_ends[:, 1]
     arrays.region_table = table
-    region_table_start = (len(arrays.ngon_corners) + TEXELS_PER_SEGMENT * edge_start[:-1]).astype(np.int32)
+    region_table_start = np.multiply(edge_start[:-1], TEXELS_PER_SEGMENT, dtype=np.int32)
+    if len(arrays.ngon_corners):
+        region_table_start += len(arrays.ngon_corners)
 
     # Each quad's two rows in one 64-bit write (row 2i the low half), looked
     # up by its block's segment count, its split and its hidden edges
     # (_listed_quad_rows), written in place: no million-row temporaries.
     at = _hidden_pattern(drawn, corner_edge, face_count, corner_drawn)
     at |= flip.view(np.uint8) << np.uint8(4)
-    at |= np.repeat((per_region << 5).astype(np.uint32), region_faces)
+    at |= np.left_shift(per_region, 5, dtype=np.uint32, casting="unsafe").repeat(region_faces)
     flags = arrays.edge_flags
     if flags.dtype == np.int32 and flags.flags.c_contiguous:
-        np.take(_LISTED_QUAD_ROWS, at, out=flags.view(np.uint64), mode="clip")
+        _LISTED_QUAD_ROWS.take(at, out=flags.view(np.uint64), mode="clip")
     else:
         flags[:] = np.take(_LISTED_QUAD_ROWS, at).view(np.int32)
-    face_table_start = np.repeat(region_table_start, region_faces)
-    if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one (2, 4) block
-        arrays.triangles.reshape(face_count, 2, 4)[:, :, 3] = face_table_start[:, None]
+    face_table_start = region_table_start.repeat(region_faces)
+    if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one row of 8: two column writes
+        quads = arrays.triangles.reshape(face_count, 8)
+        quads[:, 3] = face_table_start
+        quads[:, 7] = face_table_start
     else:
         arrays.triangles[:, 3] = np.repeat(face_table_start, 2)
-    arrays.triangle_regions = np.repeat(label.astype(np.float32), 2 * region_faces)
+    label_texel = label.astype(np.float32)  # as the tables hold it
+    arrays.triangle_regions = label_texel.repeat(2 * region_faces)
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
     stats.segments = len(edges)
-    _known_region_lines(arrays, verts, ends, table, seg_ends, seg_owner, edges, stats)
+    if chain_edges > 1 and _chain_region_lines(
+        arrays, table, firsts, label_texel.repeat(per_region // chain_edges), chain_edges, stats
+    ):
+        return stats
+    _known_region_lines(arrays, verts, ends, table, seg_ends, np.repeat(label, per_region), edges, stats)
     return stats
+
+
+def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: int, stats) -> bool:
+    """_known_region_lines for regions listed in whole chains
+    (KnownRegions.chain_edges; ``firsts``: the first edge of each listed
+    chain, ``owners``: its region as a float32 texel), done per chain: a
+    chain's edges are listed together by the same regions, so they are
+    consecutive entries with its first edge's regions, and their texels
+    are consecutive block rows. Consecutive chains with different ends
+    make the runs whole chains cut into pieces of the run length, with no
+    search. False (nothing written) where an edge bounds more than two
+    regions or two consecutive chains have the same ends."""
+    counts = np.bincount(firsts)
+    if counts.max() > 2:
+        return False
+    chain = counts.nonzero()[0]
+    listing = np.arange(len(firsts))
+    first = np.empty(len(counts), np.intp)
+    first[firsts[::-1]] = listing[::-1]  # the last write is the first listing's
+    last = np.empty(len(counts), np.intp)
+    last[firsts] = listing
+    first, last = first.take(chain), last.take(chain)
+    # A listed chain's block rows are one row of the table seen as (chains, n * texels).
+    lines = table.reshape(len(firsts), -1).take(first, axis=0).reshape(len(chain), chain_edges, -1)
+    # Two consecutive chains with the same ends (texels 4 and 5 of a
+    # chain's first entry, compared as one 64-bit word: equal ids always
+    # are) could join into one run: left to _known_region_lines.
+    chain_ends = lines.reshape(len(chain), -1).view(np.int64)[:, 2]
+    if (chain_ends[1:] == chain_ends[:-1]).any():
+        return False
+    lines[:, :, 3] = owners.take(first)[:, None]
+    lines[:, :, 6] = np.where(first != last, owners.take(last), np.float32(NO_REGION))[:, None]
+    arrays.region_lines = lines.reshape(-1, 4)
+    # _line_runs of groups of chain_edges entries each.
+    count, length = len(chain) * chain_edges, _run_length(chain_edges)
+    if chain_edges % length == 0:  # (a subdivision's 2**L: always)
+        runs = np.zeros((count // length, 4), np.float32)
+        runs[:, 0] = np.arange(0, count, length)
+        runs[:, 1] = length
+    else:
+        within = np.arange(0, chain_edges, length)
+        runs = np.zeros((len(chain), len(within), 4), np.float32)
+        runs[:, :, 0] = np.arange(0, count, chain_edges)[:, None] + within
+        runs[:, :, 1] = np.minimum(length, chain_edges - within)
+    arrays.region_line_runs, arrays.region_run_segments = runs.reshape(-1, 4), length
+    stats.region_lines = count
+    return True
 
 
 def _known_region_lines(arrays: MeshArrays, verts, ends, table, seg_ends, seg_owner, edges, stats) -> None:
@@ -787,15 +883,22 @@ def _line_runs(chain_ends: np.ndarray, style: np.ndarray, region: np.ndarray, pa
     # The group size at which half of the entries are in groups no larger.
     sizes = np.sort(group_size)
     typical = sizes[np.searchsorted(np.cumsum(sizes), count / 2.0)]
-    length = 1
-    while length < min(typical, RUN_SEGMENTS):
-        length *= 2
+    length = _run_length(typical)
     rank = np.arange(count) - np.repeat(group_start, group_size)
     first = np.flatnonzero(rank % length == 0)
     runs = np.zeros((len(first), 4), np.float32)
     runs[:, 0] = first
     runs[:, 1] = np.diff(np.append(first, count))
     return runs, length
+
+
+def _run_length(typical: int) -> int:
+    """The entries a run holds for chains of ``typical`` entries: the
+    power of two that holds them, up to RUN_SEGMENTS (see _line_runs)."""
+    length = 1
+    while length < min(typical, RUN_SEGMENTS):
+        length *= 2
+    return length
 
 
 def _mark_own_edges(
@@ -812,7 +915,7 @@ def _mark_own_edges(
     quad's edges to its 4th corner and an n-gon's outline slots."""
     if drawn.all():
         return
-    if _mark_quad_rows(arrays, drawn, corner_vert, sizes, corner_edge):
+    if _mark_quad_rows(arrays, drawn, corner_vert, offsets, corner_edge):
         return
     vertex_count = np.int64(max(arrays.vertex_count, int(verts.max()) + 1))
     sorted_keys = []  # the hidden edges' vertex-pair keys, sorted on first use
@@ -874,7 +977,7 @@ def _mark_own_edges(
 
 
 def _mark_quad_rows(
-    arrays: MeshArrays, drawn: np.ndarray, corner_vert: np.ndarray, sizes: np.ndarray, corner_edge: np.ndarray
+    arrays: MeshArrays, drawn: np.ndarray, corner_vert: np.ndarray, offsets: np.ndarray, corner_edge: np.ndarray
 ) -> bool:
     """_mark_own_edges for a mesh of quads only (what a subdivision makes)
     whose triangle rows are those extract.build_arrays_fast writes: quad i
@@ -882,13 +985,13 @@ def _mark_quad_rows(
     the quad is split along its other diagonal. Each row's edges are then
     its quad's corner edges in a known order: a few column picks instead of
     finding every row's corners. False (nothing done) for any other mesh."""
-    flip = _quad_row_flip(arrays, corner_vert, sizes)
+    flip = _quad_row_flip(arrays, corner_vert, offsets)
     if flip is None:
         return False
     flags = arrays.edge_flags
     # Which of its quad's edges are hidden, one bit per corner, and then per
     # row a lookup of that pattern turned to the row's first corner.
-    pattern = _hidden_pattern(drawn, corner_edge, len(sizes)).astype(np.intp)
+    pattern = _hidden_pattern(drawn, corner_edge, len(flip)).astype(np.intp)
     clear_of, marks_of = _quad_row_marks()
     # A row starting at corner r: its edges 0, 1 and its quad edges 3, 4
     # leave corners r, r + 1, r + 2, r + 3.
@@ -898,16 +1001,22 @@ def _mark_quad_rows(
     return True
 
 
-def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, sizes: np.ndarray) -> np.ndarray | None:
-    """(F,) bool for a mesh of quads only whose triangle rows are those
-    extract.build_arrays_fast writes (see _mark_quad_rows): True where the
-    quad is split along its other diagonal. None for any other mesh."""
-    face_count = len(sizes)
-    if face_count == 0 or arrays.triangle_count != 2 * face_count or sizes.min() != 4 or sizes.max() != 4:
+def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, offsets: np.ndarray) -> np.ndarray | None:
+    """(F,) bool for a mesh of quads only (``offsets``: its F + 1 face
+    offsets) whose triangle rows are those extract.build_arrays_fast writes
+    (see _mark_quad_rows): True where the quad is split along its other
+    diagonal. None for any other mesh."""
+    face_count = len(offsets) - 1
+    if face_count <= 0 or arrays.triangle_count != 2 * face_count:
         return None
     known = arrays.quad_flip
     if known is not None and len(known) == face_count:
-        return known  # the rows build_arrays_fast wrote for a mesh of quads only, as it says
+        # build_arrays_fast keeps a split per quad for a mesh without
+        # n-gons: one per face is a mesh of quads only, its rows as it says.
+        return known
+    sizes = np.diff(offsets)
+    if sizes.min() != 4 or sizes.max() != 4:
+        return None
     tri, flags = arrays.triangles, arrays.edge_flags
     quad = np.asarray(corner_vert).reshape(face_count, 4)
     even, odd = tri[0::2], tri[1::2]
@@ -928,11 +1037,19 @@ def _quad_row_flip(arrays: MeshArrays, corner_vert: np.ndarray, sizes: np.ndarra
     return flip
 
 
-def _corner_drawn(drawn: np.ndarray, corner_edge: np.ndarray) -> np.ndarray:
-    """(L,) bool, a fresh array: whether each corner's edge is drawn."""
-    drawn = np.asarray(drawn, bool)
+def _drawn_prefix(drawn: np.ndarray) -> tuple[int, bool]:
+    """(how many edges are drawn, whether they are the first ones: a
+    subdivision's cage children)."""
     count = int(np.count_nonzero(drawn))
-    if drawn[:count].all():  # the drawn edges come first (a subdivision's cage children): a compare, no gather
+    return count, bool(drawn[:count].all())
+
+
+def _corner_drawn(drawn: np.ndarray, corner_edge: np.ndarray, prefix: tuple[int, bool] | None = None) -> np.ndarray:
+    """(L,) bool, a fresh array: whether each corner's edge is drawn.
+    ``prefix``: _drawn_prefix's answer when the caller has it."""
+    drawn = np.asarray(drawn, bool)
+    count, first = _drawn_prefix(drawn) if prefix is None else prefix
+    if first:  # the drawn edges come first: a compare, no gather
         return np.asarray(corner_edge) < count
     return np.take(drawn, corner_edge)
 

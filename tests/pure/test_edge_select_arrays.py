@@ -230,7 +230,8 @@ def test_known_regions_give_the_general_path_arrays(monkeypatch):
 
 def test_known_regions_that_do_not_fit_the_mesh_are_found_instead(monkeypatch):
     """A list that does not cover the faces, names an edge that is not
-    drawn or has a region of one face: the general path decides."""
+    drawn, has a region of one face or names an edge twice: the general
+    path decides."""
 
     def short(index, drawn, verts):
         known = _known_strip_regions(index, drawn, verts, 3)
@@ -244,6 +245,11 @@ def test_known_regions_that_do_not_fit_the_mesh_are_found_instead(monkeypatch):
     def single_faces(index, drawn, verts):
         return edge_select.KnownRegions(np.arange(7), np.arange(7), np.flatnonzero(drawn)[:6])
 
-    for regions_for in (short, hidden_edge, single_faces):
+    def repeated_edge(index, drawn, verts):  # (a corrupt cage face names one edge twice)
+        known = _known_strip_regions(index, drawn, verts, 3)
+        known.region_edges[1] = known.region_edges[0]
+        return known
+
+    for regions_for in (short, hidden_edge, single_faces, repeated_edge):
         assert not _select_both(6, regions_for, monkeypatch)[1]
         monkeypatch.undo()
