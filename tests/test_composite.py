@@ -161,7 +161,7 @@ def test_composite_goes_through_the_scene_colour_management(tmp_path, transparen
 def test_beauty_is_the_compositor_output_when_the_scene_composites():
     scene = occlusion_scene()
     cycles_tiny(scene)
-    if not hasattr(scene, "compositing_node_group"):
+    if not compat.has_compositor_node_group(scene):
         pytest.skip("Blender before 5.0: compositor node tree API differs")
     plain = composite.render_layers(scene, "CYCLES")
     tree = bpy.data.node_groups.new("Invert", "CompositorNodeTree")
@@ -171,7 +171,7 @@ def test_beauty_is_the_compositor_output_when_the_scene_composites():
     output = tree.nodes.new("NodeGroupOutput")
     tree.links.new(layers_node.outputs["Image"], invert.inputs["Color"])
     tree.links.new(invert.outputs[0], output.inputs[0])
-    scene.compositing_node_group = tree
+    compat.set_compositor_node_group(scene, tree)
     scene.render.use_compositing = True
     inverted = composite.render_layers(scene, "CYCLES")
     np.testing.assert_allclose(inverted.beauty[..., :3], 1.0 - plain.beauty[..., :3], atol=1e-4)

@@ -26,7 +26,7 @@ import bpy
 import numpy as np
 from bpy.app.handlers import persistent
 
-from ..core import exr, matcaps, shaders
+from ..core import compat, exr, matcaps, shaders
 from . import runtime
 
 SUBFOLDER = "studiolights/matcap"
@@ -51,7 +51,7 @@ def _passes_through_compositor(image, outputs) -> dict:
         node = tree.nodes.new("CompositorNodeImage")
         node.image = image
         out = tree.nodes.new("NodeGroupOutput")
-        scene.compositing_node_group = tree
+        compat.set_compositor_node_group(scene, tree)
         scene.render.use_compositing = True
         scene.render.film_transparent = True
         scene.render.engine = "BLENDER_WORKBENCH"

@@ -13,6 +13,11 @@ Known differences:
   is lost.
 * ``ImageFormatSettings.media_type`` (the image/video/multilayer family that
   must be chosen before ``file_format``) is new in Blender 5.0.
+* A scene's compositor node group: ``Scene.compositing_node_group`` from
+  5.0; from 5.3 a scene holds a list of compositor effects, each with its
+  node group (``Scene.compositor_effects``), and the old property, which
+  now reads and sets the active effect's group, is deprecated (to be
+  removed in 6.0).
 """
 
 from __future__ import annotations
@@ -34,3 +39,20 @@ def set_media_type(image_settings, media_type: str) -> bool:
         return False
     image_settings.media_type = media_type
     return True
+
+
+def has_compositor_node_group(scene) -> bool:
+    """Whether ``scene`` takes a compositor node group (Blender 5.0 on)."""
+    return hasattr(scene, "compositor_effects") or hasattr(scene, "compositing_node_group")
+
+
+def set_compositor_node_group(scene, tree) -> None:
+    """Composite ``scene`` with node group ``tree``: as its active compositor
+    effect where scenes have effects (made if it has none), else as its
+    compositor node group."""
+    effects = getattr(scene, "compositor_effects", None)
+    if effects is None:
+        scene.compositing_node_group = tree
+        return
+    effect = effects.active or effects.new(name=tree.name)
+    effect.node_group = tree
