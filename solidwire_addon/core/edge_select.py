@@ -686,6 +686,23 @@ def _select_known_regions(
     return stats
 
 
+def _first_and_last_listing(ids: np.ndarray):
+    """(the listed ids ascending, the position of each one's first listing
+    in ``ids``, of its last) where no id is listed more than twice (a
+    manifold cage: an edge bounds at most two regions), found by two
+    scatters instead of a sort; else None."""
+    counts = np.bincount(ids)
+    if counts.max() > 2:
+        return None
+    listed = counts.nonzero()[0]
+    listing = np.arange(len(ids))
+    first = np.empty(len(counts), np.intp)
+    first[ids[::-1]] = listing[::-1]  # the last write is the first listing's
+    last = np.empty(len(counts), np.intp)
+    last[ids] = listing
+    return listed, first.take(listed), last.take(listed)
+
+
 def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: int, stats) -> bool:
     """_known_region_lines for regions listed in whole chains
     (KnownRegions.chain_edges; ``firsts``: the first edge of each listed
@@ -696,16 +713,10 @@ def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: 
     make the runs whole chains cut into pieces of the run length, with no
     search. False (nothing written) where an edge bounds more than two
     regions or two consecutive chains have the same ends."""
-    counts = np.bincount(firsts)
-    if counts.max() > 2:
+    listings = _first_and_last_listing(firsts)
+    if listings is None:
         return False
-    chain = counts.nonzero()[0]
-    listing = np.arange(len(firsts))
-    first = np.empty(len(counts), np.intp)
-    first[firsts[::-1]] = listing[::-1]  # the last write is the first listing's
-    last = np.empty(len(counts), np.intp)
-    last[firsts] = listing
-    first, last = first.take(chain), last.take(chain)
+    chain, first, last = listings
     # A listed chain's block rows are one row of the table seen as (chains, n * texels).
     lines = table.reshape(len(firsts), -1).take(first, axis=0).reshape(len(chain), chain_edges, -1)
     # Two consecutive chains with the same ends (texels 4 and 5 of a
@@ -740,17 +751,11 @@ def _known_region_lines(arrays: MeshArrays, verts, ends, table, seg_ends, seg_ow
     the one that lists it first and its partner the one that lists it last:
     found by two scatters instead of a sort, and its texels are its first
     listing's block texels with the regions filled in."""
-    counts = np.bincount(edges)
-    if counts.max() > 2:
+    listings = _first_and_last_listing(edges)
+    if listings is None:
         _region_line_table(arrays, verts, None, ends, np.stack([seg_owner, edges], axis=1), stats)
         return
-    edge = np.flatnonzero(counts)
-    listing = np.arange(len(edges))
-    first = np.empty(len(counts), np.intp)
-    first[edges[::-1]] = listing[::-1]  # the last write is the first listing's
-    last = np.empty(len(counts), np.intp)
-    last[edges] = listing
-    first, last = np.take(first, edge), np.take(last, edge)
+    edge, first, last = listings
     region = np.take(seg_owner, first)
     partner = np.where(first != last, np.take(seg_owner, last), -1)
     lines = np.take(table.reshape(-1, TEXELS_PER_SEGMENT * 4), first, axis=0)
