@@ -8,8 +8,8 @@ search by vertex pair. On real evaluated meshes: Suzanne's cage at levels
 subdivision, the regions read from the evaluated mesh's own layout (a
 modifier before the subdivision, Edit Mode), and meshes where a shortcut
 must refuse (triangles and n-gons under the edge angle, a subdivision whose
-quads a modifier triangulated, a cage face past the walk limit, a layout
-that does not hold)."""
+quads a modifier triangulated, an Array with caps, a layout that does not
+hold); cage faces past the walk limit take blocks of their own edges."""
 
 from __future__ import annotations
 
@@ -231,18 +231,27 @@ def test_concave_quads_split_along_their_other_diagonal(monkeypatch):
     _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
 
 
-def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
+@pytest.mark.parametrize(("segments", "level"), [(24, 3), (5, 5)])
+def test_cage_faces_past_the_walk_limit(segments, level, monkeypatch):
     """A cage face whose region is past WALK_LIMIT (a 24-gon at level 3:
-    192 drawn edges), from the object's own mesh or behind a modifier, and
-    an Array with caps take the regions found from the mesh."""
+    192 drawn edges; a pentagon at level 5: 160), from the object's own
+    mesh or behind a modifier: its faces get blocks of their own drawn
+    edges, as the general path gives them, beside the side quads' region
+    blocks."""
+    assert segments * 2**level > edge_select.WALK_LIMIT
     scene = scenes.empty_scene()
-    cylinder = _cylinder(scene, segments=24)
-    _subdivide(cylinder, 3)
-    _assert_same_as_general(cylinder, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
-    behind = _cylinder(scene, segments=24)
+    cylinder = _cylinder(scene, segments=segments)
+    _subdivide(cylinder, level)
+    _assert_same_as_general(cylinder, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+    behind = _cylinder(scene, segments=segments)
     behind.modifiers.new("Mirror", "MIRROR").use_mirror_merge = False
-    _subdivide(behind, 3)
-    _assert_same_as_general(behind, CAGE, monkeypatch, rows_expected=True, regions_expected=False)
+    _subdivide(behind, level)
+    _assert_same_as_general(behind, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+
+
+def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
+    """An Array with caps takes the regions found from the mesh."""
+    scene = scenes.empty_scene()
     capped = scenes.monkey(scene)
     _subdivide(capped, 1)
     array = capped.modifiers.new("Array", "ARRAY")

@@ -586,15 +586,17 @@ def _select_known_regions(
     written per region and per quad instead of found from every corner, or
     None (nothing written) where the shortcut does not apply: faces other
     than extract.build_arrays_fast's quad rows, a region of one face, a
-    region past WALK_LIMIT (walked face by face), a region list that does
-    not cover the faces or names an edge that is not drawn.
+    region list that does not cover the faces or names an edge that is not
+    drawn.
 
-    Every face is then in a multi-face region, so every face is listed, its
-    block is its region's (id = the region's first face) and its lines come
-    from the region-lines pass; each block holds its region's drawn edges,
-    ascending, one segment each (no class, no n-gon diagonal). Regions
-    listed in whole chains (KnownRegions.chain_edges) have their list
-    order checked and their region lines written per chain."""
+    Every face is then in a multi-face region, so every face is listed and
+    its lines come from the region-lines pass. Its block is its region's
+    (id = the region's first face), holding the region's drawn edges,
+    ascending, one segment each (no class, no n-gon diagonal); in a region
+    past WALK_LIMIT it is the face's own, holding the face's own drawn
+    edges (_face_blocks_past_walk_limit). Regions listed in whole chains
+    (KnownRegions.chain_edges) have their list order checked and their
+    region lines written per chain."""
     regions, drawn = inputs.regions, inputs.drawn
     if drawn is None or inputs.chain_ends is None:
         return None
@@ -625,7 +627,6 @@ def _select_known_regions(
         or edge_start[0] != 0
         or edge_start[-1] != len(edges)
         or per_region.min() < 1
-        or per_region.max() > WALK_LIMIT
         or firsts.min() < 0
         or firsts.max() + chain_edges > (prefix[0] if prefix[1] else len(verts))
         or not (prefix[1] or drawn[edges].all())  # (drawn edges first: all below their count)
@@ -645,28 +646,33 @@ def _select_known_regions(
     ends = np.asarray(inputs.chain_ends)
     # (take gathers rows several times faster than fancy indexing; the
     # methods, here and below, skip numpy's function wrappers.)
-    seg_verts, seg_ends = verts.take(edges, axis=0), ends.take(edges, axis=0)
-    table = np.zeros((TEXELS_PER_SEGMENT * len(edges), 4), dtype=np.float32)
-    table[0::2, 0] = np.minimum(seg_verts[:, 0], seg_verts[:, 1])
-    table[0::2, 1] = np.maximum(seg_verts[:, 0], seg_verts[:, 1])
-    table[1::2, 0], table[1::2, 1] = seg_ends[:, 0], seg_ends[:, 1]
-    arrays.region_table = table
-    region_table_start = np.multiply(edge_start[:-1], TEXELS_PER_SEGMENT, dtype=np.int32)
+    seg_ends = ends.take(edges, axis=0)
+    table = _segment_rows(verts, seg_ends, edges)  # every region's list, as its region lines read it
+    at = _hidden_pattern(drawn, corner_edge, face_count, corner_drawn)
+    big = per_region > WALK_LIMIT
+    if big.any():
+        blocks = _face_blocks_past_walk_limit(table, per_region, region_faces, big, at, corner_edge, verts, ends)
+        if blocks is None:
+            return None
+        arrays.region_table, face_segments, face_table_start = blocks
+    else:
+        arrays.region_table = table
+        face_segments = per_region.repeat(region_faces)
+        face_table_start = np.multiply(edge_start[:-1], TEXELS_PER_SEGMENT, dtype=np.int32).repeat(region_faces)
     if len(arrays.ngon_corners):
-        region_table_start += len(arrays.ngon_corners)
+        face_table_start += len(arrays.ngon_corners)
+    stats.segments = len(arrays.region_table) // TEXELS_PER_SEGMENT
 
     # Each quad's two rows in one 64-bit write (row 2i the low half), looked
     # up by its block's segment count, its split and its hidden edges
     # (_listed_quad_rows), written in place: no million-row temporaries.
-    at = _hidden_pattern(drawn, corner_edge, face_count, corner_drawn)
     at |= flip.view(np.uint8) << np.uint8(4)
-    at |= np.left_shift(per_region, 5, dtype=np.uint32, casting="unsafe").repeat(region_faces)
+    at |= np.left_shift(face_segments, 5, dtype=np.uint32, casting="unsafe")
     flags = arrays.edge_flags
     if flags.dtype == np.int32 and flags.flags.c_contiguous:
         _LISTED_QUAD_ROWS.take(at, out=flags.view(np.uint64), mode="clip")
     else:
         flags[:] = np.take(_LISTED_QUAD_ROWS, at).view(np.int32)
-    face_table_start = region_table_start.repeat(region_faces)
     if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one row of 8: two column writes
         quads = arrays.triangles.reshape(face_count, 8)
         quads[:, 3] = face_table_start
@@ -677,13 +683,67 @@ def _select_known_regions(
     arrays.triangle_regions = label_texel.repeat(2 * region_faces)
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
-    stats.segments = len(edges)
     if chain_edges > 1 and _chain_region_lines(
         arrays, table, firsts, label_texel.repeat(per_region // chain_edges), chain_edges, stats
     ):
         return stats
     _known_region_lines(arrays, verts, ends, table, seg_ends, np.repeat(label, per_region), edges, stats)
     return stats
+
+
+def _segment_rows(verts: np.ndarray, seg_ends: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Region-table rows (TEXELS_PER_SEGMENT texels each, no class) of the
+    drawn ``edges`` in order, ``seg_ends`` their chain ends."""
+    seg_verts = verts.take(edges, axis=0)
+    table = np.zeros((TEXELS_PER_SEGMENT * len(edges), 4), dtype=np.float32)
+    table[0::2, 0] = np.minimum(seg_verts[:, 0], seg_verts[:, 1])
+    table[0::2, 1] = np.maximum(seg_verts[:, 0], seg_verts[:, 1])
+    table[1::2, 0], table[1::2, 1] = seg_ends[:, 0], seg_ends[:, 1]
+    return table
+
+
+# Whether each corner's edge is drawn, for each of _hidden_pattern's 16 patterns.
+_DRAWN_CORNERS = (np.arange(16)[:, None] >> np.arange(4)) & 1 == 0
+
+
+def _face_blocks_past_walk_limit(table, per_region, region_faces, big, hidden, corner_edge, verts, ends):
+    """The blocks of _select_known_regions where some regions (``big``) are
+    past WALK_LIMIT, as the general path lays them out: the other regions'
+    blocks (their rows of ``table``, the regions' lists in order), then one
+    block per face of a big region, in face order, holding that quad's own
+    drawn edges ascending (``hidden``: _hidden_pattern's bits). Returns
+    (region table, each face's segment count, each face's first texel),
+    or None where a quad names one drawn edge twice (the general path
+    would list it once). A face with no drawn edge of its own starts at
+    texel 0, as the general path gives a block without segments."""
+    small_segments = np.where(big, 0, per_region)
+    faces = np.flatnonzero(big.repeat(region_faces))
+    pattern = hidden.take(faces)
+    # The drawn corners of those faces, as (face, edge) keys sorted once:
+    # most faces inside a big region have none (a sort per face of four
+    # corners costs many times more).
+    at = np.flatnonzero(_DRAWN_CORNERS.take(pattern, axis=0))
+    local_face = at >> 2
+    edge_count = np.int64(len(verts))
+    edges = np.asarray(corner_edge).reshape(-1, 4).take(faces, axis=0).reshape(-1).take(at)
+    keys = local_face * edge_count + edges
+    keys.sort()
+    if len(keys) > 1 and (keys[1:] == keys[:-1]).any():
+        return None
+    own_edges = keys % edge_count
+    own_count = np.bincount(local_face, minlength=len(faces))
+    blocks = np.concatenate(
+        [
+            table.reshape(-1, 4 * TEXELS_PER_SEGMENT).compress(~big.repeat(per_region), axis=0).reshape(-1, 4),
+            _segment_rows(verts, ends.take(own_edges, axis=0), own_edges),
+        ]
+    )
+    first = (np.cumsum(small_segments) - small_segments).repeat(region_faces)
+    own_first = int(small_segments.sum()) + np.cumsum(own_count) - own_count
+    first[faces] = np.where(own_count > 0, own_first, 0)
+    segments = per_region.repeat(region_faces)
+    segments[faces] = own_count
+    return blocks, segments, np.multiply(first, TEXELS_PER_SEGMENT, dtype=np.int32)
 
 
 def _first_and_last_listing(ids: np.ndarray):
