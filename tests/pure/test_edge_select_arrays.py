@@ -253,3 +253,44 @@ def test_known_regions_that_do_not_fit_the_mesh_are_found_instead(monkeypatch):
     for regions_for in (short, hidden_edge, single_faces, repeated_edge):
         assert not _select_both(6, regions_for, monkeypatch)[1]
         monkeypatch.undo()
+
+
+def test_known_regions_past_the_walk_limit_give_the_general_path_arrays(monkeypatch):
+    """A known region past WALK_LIMIT drawn edges beside one under it: its
+    faces get blocks of their own drawn edges, after the small region's
+    block, as the general path lays them out; its lines are still every
+    drawn edge of the region."""
+    columns = edge_select.WALK_LIMIT + 4
+    top = columns + 1
+    taken = []
+    real = edge_select._select_known_regions
+    monkeypatch.setattr(edge_select, "_select_known_regions", lambda *args: taken.append(real(*args)) or taken[-1])
+    results = []
+    for known in (True, False):
+        arrays, corner_vert, offsets, corner_edge, verts, index = _strip(columns)
+        drawn = np.ones(len(verts), bool)
+        drawn[index[(1, top + 1)]] = False  # quads 0 and 1: a small region
+        for x in range(3, columns):
+            drawn[index[(x, top + x)]] = False  # quads 2 on: one region of 2 * columns - 2 drawn edges
+        regions = None
+        if known:
+            face_edges = corner_edge.reshape(-1, 4)
+            small = sorted({e for e in face_edges[:2].reshape(-1) if drawn[e]})
+            large = sorted({e for e in face_edges[2:].reshape(-1) if drawn[e]})
+            assert len(large) > edge_select.WALK_LIMIT >= len(small)
+            regions = edge_select.KnownRegions(
+                np.array([0, 2, columns]), np.array([0, len(small), len(small) + len(large)]), np.array(small + large)
+            )
+        inputs = edge_select.EdgeInputs(verts, drawn, chain_ends=verts.copy(), regions=regions)
+        results.append((arrays, edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, inputs)))
+    (fast, fast_stats), (general, general_stats) = results
+    assert taken[0] is not None
+    assert fast_stats == general_stats
+    for field in ("triangles", "edge_flags", "region_table", "region_lines", "region_line_runs", "triangle_regions"):
+        a, b = getattr(fast, field), getattr(general, field)
+        assert a.dtype == b.dtype and np.array_equal(a, b), field
+    # The small region's quads walk its six drawn edges; the large
+    # region's quads their own: two, three at either end of it.
+    segments = (fast.edge_flags >> extract.NGON_SHIFT)[0::2]
+    assert segments.tolist() == [6, 6, 3] + [2] * (columns - 4) + [3]
+    assert len(fast.region_lines) // 2 == 2 * columns + 3  # every drawn edge once: sides, 3 verticals
