@@ -332,8 +332,9 @@ def test_a_single_image_format_says_that_passes_are_dropped(tmp_path, capsys):
     blend = _multilayer_blend(tmp_path)
     code, _stdout, err = command(capsys, blend, "-o", tmp_path / "shot_####.png", "-f", 1)
     assert code == 0
+    depth = bpy.types.ViewLayer.bl_rna.properties["use_pass_z"].name  # Blender's UI name: "Z" before 4.5
     assert err == [
-        ("solidwire: note: '.png' holds one image: the scene's passes Depth are not written; -o NAME.exr keeps them")
+        f"solidwire: note: '.png' holds one image: the scene's passes {depth} are not written; -o NAME.exr keeps them"
     ], err
     assert_complete_png(tmp_path / "shot_0001.png", (48, 36))
 
@@ -359,7 +360,9 @@ def test_a_video_scene_without_o_is_refused_before_rendering(tmp_path, capsys):
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     from solidwire_addon.core import compat
 
-    compat.set_media_type(bpy.context.scene.render.image_settings, "VIDEO")
+    image_settings = bpy.context.scene.render.image_settings
+    if not compat.set_media_type(image_settings, "VIDEO"):
+        image_settings.file_format = "FFMPEG"  # Blender 4.x: the format is the family
     bpy.ops.wm.save_mainfile()
     code, _stdout, err = command(capsys, blend, "-a")
     assert code == 2 and len(err) == 1 and "video" in err[0], err

@@ -331,8 +331,10 @@ def test_nothing_to_draw_leaves_the_viewport_untouched():
     viewport.depth_pass(depsgraph, view, objects)
 
     def depth():
-        buffer = viewport.depth.read()
-        return np.array(buffer.to_list(), dtype=np.float64)
+        values = np.array(viewport.depth.read().to_list(), dtype=np.float64)
+        if values.max() > 1.0:  # Blender 4.2 reads depth-stencil packed: 24-bit depth, 8-bit stencil
+            values = np.floor(values / 256.0) / (2**24 - 1)
+        return values
 
     before_depth, before_rgba = depth(), viewport.rgba()
     assert (before_depth < 1.0).any()

@@ -30,14 +30,22 @@ def hair(
             ).astype(np.float32)
             data.attributes.new("radius", "FLOAT", "POINT").data.foreach_set("value", values)
         kinds = [POLY] * len(curves) if types is None else list(types)
-        # (set_types: a foreach_set on the INT8 attribute overruns its buffer.)
-        for kind, type_name in ((CATMULL_ROM, "CATMULL_ROM"), (POLY, "POLY"), (BEZIER, "BEZIER")):
-            indices = [i for i, k in enumerate(kinds) if k == kind]
-            if indices:
-                data.set_types(type=type_name, indices=indices)
+        # Before Blender 4.3 (no set_types; writing the curve_type attribute
+        # leaves Blender's type counts stale and evaluation aborts) the types
+        # and handles are set by a geometry-nodes modifier (_typed_curves).
+        by_modifier = not hasattr(data, "set_types")
+        if by_modifier:
+            data.attributes.new(_TYPE, "INT", "CURVE").data.foreach_set("value", kinds)
+        else:
+            # (set_types: a foreach_set on the INT8 attribute overruns its buffer.)
+            for kind, type_name in ((CATMULL_ROM, "CATMULL_ROM"), (POLY, "POLY"), (BEZIER, "BEZIER")):
+                indices = [i for i, k in enumerate(kinds) if k == kind]
+                if indices:
+                    data.set_types(type=type_name, indices=indices)
         if handles is not None:
             for attribute, values in zip(("handle_left", "handle_right"), handles):
-                data.attributes.new(attribute, "FLOAT_VECTOR", "POINT").data.foreach_set(
+                name = _HANDLE[attribute] if by_modifier else attribute
+                data.attributes.new(name, "FLOAT_VECTOR", "POINT").data.foreach_set(
                     "vector", np.asarray(values, dtype=np.float32).ravel()
                 )
         if resolution is not None:
@@ -46,7 +54,48 @@ def hair(
     obj.location = location
     obj.scale = scale
     scene.collection.objects.link(obj)
+    if sizes and not hasattr(data, "set_types"):
+        obj.modifiers.new("Types", "NODES").node_group = _typed_curves(handles is not None)
     return obj
+
+
+_TYPE = "test_curve_type"
+_HANDLE = {"handle_left": "test_handle_left", "handle_right": "test_handle_right"}
+
+
+def _typed_curves(handles: bool):
+    """Geometry nodes giving each curve the type in its _TYPE attribute and,
+    with ``handles``, the Bezier handles in the _HANDLE attributes."""
+    group = bpy.data.node_groups.new("TypedCurves", "GeometryNodeTree")
+    group.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    group.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    nodes, links = group.nodes, group.links
+    geometry = nodes.new("NodeGroupInput").outputs[0]
+    kind = nodes.new("GeometryNodeInputNamedAttribute")
+    kind.data_type = "INT"
+    kind.inputs["Name"].default_value = _TYPE
+    for value, type_name in ((CATMULL_ROM, "CATMULL_ROM"), (POLY, "POLY"), (BEZIER, "BEZIER")):
+        is_type = nodes.new("FunctionNodeCompare")
+        is_type.data_type, is_type.operation = "INT", "EQUAL"
+        links.new(kind.outputs["Attribute"], is_type.inputs[2])
+        is_type.inputs[3].default_value = value
+        set_type = nodes.new("GeometryNodeCurveSplineType")
+        set_type.spline_type = type_name
+        links.new(geometry, set_type.inputs["Curve"])
+        links.new(is_type.outputs[0], set_type.inputs["Selection"])
+        geometry = set_type.outputs[0]
+    if handles:
+        for side in ("LEFT", "RIGHT"):
+            position = nodes.new("GeometryNodeInputNamedAttribute")
+            position.data_type = "FLOAT_VECTOR"
+            position.inputs["Name"].default_value = _HANDLE[f"handle_{side.lower()}"]
+            set_handles = nodes.new("GeometryNodeSetCurveHandlePositions")
+            set_handles.mode = side
+            links.new(geometry, set_handles.inputs["Curve"])
+            links.new(position.outputs["Attribute"], set_handles.inputs["Position"])
+            geometry = set_handles.outputs[0]
+    links.new(geometry, nodes.new("NodeGroupOutput").inputs[0])
+    return group
 
 
 def _points_group(radius: float):
