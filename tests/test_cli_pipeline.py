@@ -424,8 +424,8 @@ def test_the_wrapper_sees_the_presets_saved_in_blender(tmp_path):
     "options", [pytest.param((), id="animation-render"), pytest.param(("--no-overwrite",), id="frame-by-frame")]
 )
 def test_braces_in_the_output_path_are_written_as_they_are(tmp_path, capsys, options):
-    """Blender 5 reads "{name}" in an output path as a template variable; the
-    path given with -o is a plain path."""
+    """Blender (from 4.5) reads "{name}" in an output path as a template
+    variable; the path given with -o is a plain path."""
     out = tmp_path / "shot {v2}"
     code, _stdout, err = command(capsys, _blend(tmp_path), "-o", out / "f_#.png", "-s", 1, "-e", 2, *options)
     assert code == 0, err

@@ -866,11 +866,11 @@ TEMP_SUFFIX = ".solidwire-tmp"
 
 
 def blender_path(path: Path) -> str:
-    """``path`` as Blender must read it to write exactly there: Blender 5
-    reads "{name}" in an output path as a template variable (and fails on
-    unknown ones), so literal braces are doubled."""
+    """``path`` as Blender must read it to write exactly there: from 4.5
+    (path templates) Blender reads "{name}" in an output path as a template
+    variable (and fails on unknown ones), so literal braces are doubled."""
     text = str(path)
-    if bpy.app.version >= (5, 0, 0):
+    if bpy.app.version >= (4, 5, 0):
         text = text.replace("{", "{{").replace("}", "}}")
     return text
 
