@@ -249,6 +249,34 @@ def test_cage_faces_past_the_walk_limit(segments, level, monkeypatch):
     _assert_same_as_general(behind, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
 
 
+ALL_CLASSES = edge_select.Selection(classes=tuple(edge_select.EDGE_CLASSES), use_cage=True)
+
+
+@pytest.mark.parametrize(
+    ("shape", "marked", "taken"),
+    [("sphere", False, True), ("sphere", True, False), ("Suzanne", False, False)],
+)
+def test_edge_classes_that_give_no_edge_a_class_keep_the_cage_regions(shape, marked, taken, monkeypatch):
+    """Every edge class on (the Edge Classes preset) over a closed, unmarked
+    subdivision: no edge has a class, so the cage's regions apply. A seam
+    mark, or Suzanne's boundary edges (its eye holes), give edges a class
+    (drawn and styled): the regions are found from the mesh."""
+    scene = scenes.empty_scene()
+    if shape == "sphere":
+        obj = scenes.mesh_object(
+            scene,
+            "Sphere",
+            lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=12, v_segments=8, radius=1.0),
+        )
+    else:
+        obj = scenes.monkey(scene)
+    if marked:
+        for edge in obj.data.edges[:12]:
+            edge.use_seam = True
+    _subdivide(obj, 2)
+    _assert_same_as_general(obj, ALL_CLASSES, monkeypatch, rows_expected=True, regions_expected=taken)
+
+
 def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
     """An Array with caps takes the regions found from the mesh."""
     scene = scenes.empty_scene()
@@ -334,7 +362,8 @@ def _layout_inputs(obj):
     import bpy
 
     mesh = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
-    drawn, _chain, _ends, layout, _verts = cage.cage_edges(obj, mesh, render=False, regions=True)
+    drawn, _chain, _ends, known_regions, _verts = cage.cage_edges(obj, mesh, render=False, regions=True)
+    layout = known_regions()
     assert isinstance(layout, edge_select.SubdivisionLayout)
     verts, corner_edge = mesh_reading.read_edge_topology(mesh)
     corner_vert = mesh_reading.read_corner_verts(mesh)

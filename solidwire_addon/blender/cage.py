@@ -43,6 +43,8 @@ What the evaluated mesh is (read in Blender 5.0's source):
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ..core import edge_select
@@ -452,15 +454,17 @@ def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
     ids, as the ends say which edges are pieces of one), or None: the
     children of one cage edge share their chain's ends, so the density
     fade measures the whole cage edge, not its pieces (an edge that is no
-    cage child is its own chain, its own ends). ``regions``: also the
-    regions of that mask as the layout gives them, or the layout to read
-    them from (_known_regions; None where it cannot tell), else None."""
+    cage child is its own chain, its own ends). ``regions``: also a
+    function giving the regions of that mask as the layout gives them, or
+    the layout to read them from (_known_regions; None where it cannot
+    tell), else None. It runs on first use: the caller asks only where they
+    apply (mesh_reading.apply_edge_selection: no edge has a class)."""
     if layout is None:
         layout = _cage_layout(obj, mesh, render=render)
     if layout is None:
         return None
     children, per_edge, cage, steps, _cage_mesh, edges = layout
-    known = _known_regions(obj, mesh, layout) if regions else None
+    known = functools.partial(_known_regions, obj, mesh, layout) if regions else None
     size = _subdivided_edge_count(steps, len(edges))
     mask = np.zeros(size, bool)
     mask[:children] = True

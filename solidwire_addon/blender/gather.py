@@ -608,8 +608,9 @@ def _mesh_for(
                 if outline:
                     cage_edges = outlines.outline_mask(source_mesh, face_offsets)
                 elif edges.use_cage:
-                    # The cage alone decides the regions unless the angle or a class hides or shows more.
-                    alone = not edges.edge_angle > 0.0 and not edges.classes
+                    # The cage's regions, unless the angle hides more edges; select_edges
+                    # takes them only where no edge has an enabled class (a class shows more).
+                    alone = not edges.edge_angle > 0.0
                     cage_edges = cage.cage_edges(obj.original, source_mesh, render=render, regions=alone)
                 mesh_reading.apply_edge_selection(
                     arrays,

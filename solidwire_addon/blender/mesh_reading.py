@@ -340,9 +340,10 @@ def apply_edge_selection(
     evaluated edges from the cage detection (blender/cage.py) or an outline
     mask (blender/outlines.py), or None (no subdivision, or cage edges
     off). The regions (KnownRegions, or the SubdivisionLayout
-    core/edge_select.py reads them from) are those of the mask alone: used
-    only where nothing else hides an edge. (select_edges copies the mask
-    where it changes it.)"""
+    core/edge_select.py reads them from, or a function giving either) are
+    those of the mask alone: used only where nothing else hides an edge and
+    no edge has an enabled class (a function is called only then).
+    (select_edges copies the mask where it changes it.)"""
     verts = cage[4] if cage is not None and len(cage) > 4 else None
     if verts is None:
         verts, corner_edge = read_edge_topology(mesh)
@@ -367,8 +368,12 @@ def apply_edge_selection(
         "boundary" in selection.classes,
         chain,
         chain_ends,
-        regions,
+        # The boundary class and the regions' check both need it: counted once.
+        corner_uses=np.bincount(corner_edge, minlength=len(verts)) if "boundary" in selection.classes else None,
     )
     if not inputs.selects_anything:
         return SelectionStats()
+    if callable(regions):  # found on first use: only where no edge has a class
+        regions = regions() if edge_select.classes_style_no_edge(inputs, corner_edge) else None
+    inputs.regions = regions
     return edge_select.select_edges(arrays, corner_vert, face_offsets, corner_edge, inputs)

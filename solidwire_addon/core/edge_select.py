@@ -162,6 +162,9 @@ class EdgeInputs:
     # was made (a subdivision's cage faces), or the layout they are read
     # from; None: found here.
     regions: KnownRegions | SubdivisionLayout | None = None
+    # (E,) how many face corners each edge has, when the caller has counted
+    # them (np.bincount of the corner edges): counted once per mesh.
+    corner_uses: np.ndarray | None = None
 
     @property
     def selects_anything(self) -> bool:
@@ -261,12 +264,33 @@ def _chain_ends(verts: np.ndarray, chain: np.ndarray | None) -> np.ndarray:
     return ends
 
 
+def classes_style_no_edge(inputs: EdgeInputs, corner_edge: np.ndarray) -> bool:
+    """Whether the enabled edge classes give no edge of the mesh a class (no
+    edge carries a mark, and with the boundary class none has one face):
+    the selection is then the drawn mask's alone, bit for bit, and regions
+    known for that mask hold (the Edge Classes and Portfolio presets on a
+    closed, unmarked subdivision)."""
+    if inputs.classes is not None and np.asarray(inputs.classes).any():
+        return False
+    if not inputs.boundary_class:
+        return True
+    return not (_corner_uses(inputs, corner_edge, len(np.asarray(inputs.verts).reshape(-1, 2))) == 1).any()
+
+
+def _corner_uses(inputs: EdgeInputs, corner_edge: np.ndarray, edge_count: int) -> np.ndarray:
+    """(E,) face corners per edge: the caller's count where it has one."""
+    uses = inputs.corner_uses
+    if uses is not None and len(uses) == edge_count:
+        return uses
+    return np.bincount(np.asarray(corner_edge), minlength=edge_count)
+
+
 def select_edges(
     arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray, inputs: EdgeInputs
 ) -> SelectionStats:
     """Apply ``inputs`` to ``arrays`` in place (edge flags, column 3 of
     listed triangles, ``region_table``) and say what it did."""
-    if inputs.regions is not None and inputs.classes is None and not inputs.boundary_class:
+    if inputs.regions is not None and classes_style_no_edge(inputs, corner_edge):
         known = _select_known_regions(arrays, corner_vert, face_offsets, corner_edge, inputs)
         if known is not None:
             return known
@@ -280,7 +304,7 @@ def select_edges(
     if edge_count == 0 or face_count == 0 or arrays.triangle_count == 0:
         return stats
     corner_face = _face_of_corner(sizes)
-    uses = np.bincount(corner_edge, minlength=edge_count)
+    uses = _corner_uses(inputs, corner_edge, edge_count)
 
     drawn = np.ones(edge_count, bool) if inputs.drawn is None else np.asarray(inputs.drawn, bool).copy()
     classes = np.zeros(edge_count, np.int64) if inputs.classes is None else np.asarray(inputs.classes, np.int64).copy()
