@@ -195,9 +195,11 @@ def _known_strip_regions(index, drawn, verts, pairs_of_quads: int):
     return edge_select.KnownRegions(face_start, np.array(edge_start), np.array(edges))
 
 
-def _select_both(columns, regions_for, monkeypatch):
+def _select_both(columns, regions_for, monkeypatch, hidden=None):
     """The arrays through the known regions (the same as the general
-    path's) and whether the known regions were taken."""
+    path's) and whether the known regions were taken. ``hidden``: the x of
+    each vertical edge that is not drawn (default: every odd one, so that
+    quads 2k and 2k + 1 form region k)."""
     taken = []
     real = edge_select._select_known_regions
     monkeypatch.setattr(edge_select, "_select_known_regions", lambda *args: taken.append(real(*args)) or taken[-1])
@@ -206,8 +208,8 @@ def _select_both(columns, regions_for, monkeypatch):
         arrays, corner_vert, offsets, corner_edge, verts, index = _strip(columns)
         drawn = np.ones(len(verts), bool)
         top = columns + 1
-        for x in range(1, columns, 2):
-            drawn[index[(x, top + x)]] = False  # quads 2k and 2k + 1 form a region
+        for x in range(1, columns, 2) if hidden is None else hidden:
+            drawn[index[(x, top + x)]] = False
         ends = verts.copy()
         regions = regions_for(index, drawn, verts) if known else None
         inputs = edge_select.EdgeInputs(verts, drawn, chain_ends=ends, regions=regions)
@@ -262,33 +264,27 @@ def test_known_regions_past_the_walk_limit_give_the_general_path_arrays(monkeypa
     drawn edge of the region."""
     columns = edge_select.WALK_LIMIT + 4
     top = columns + 1
-    taken = []
-    real = edge_select._select_known_regions
-    monkeypatch.setattr(edge_select, "_select_known_regions", lambda *args: taken.append(real(*args)) or taken[-1])
-    results = []
-    for known in (True, False):
-        arrays, corner_vert, offsets, corner_edge, verts, index = _strip(columns)
-        drawn = np.ones(len(verts), bool)
-        drawn[index[(1, top + 1)]] = False  # quads 0 and 1: a small region
-        for x in range(3, columns):
-            drawn[index[(x, top + x)]] = False  # quads 2 on: one region of 2 * columns - 2 drawn edges
-        regions = None
-        if known:
-            face_edges = corner_edge.reshape(-1, 4)
-            small = sorted({e for e in face_edges[:2].reshape(-1) if drawn[e]})
-            large = sorted({e for e in face_edges[2:].reshape(-1) if drawn[e]})
-            assert len(large) > edge_select.WALK_LIMIT >= len(small)
-            regions = edge_select.KnownRegions(
-                np.array([0, 2, columns]), np.array([0, len(small), len(small) + len(large)]), np.array(small + large)
+
+    def regions_for(index, drawn, verts):
+        def drawn_edges(faces):
+            return sorted(
+                {
+                    index[key]
+                    for x in faces
+                    for key in ((x, x + 1), (top + x, top + x + 1), (x, top + x), (x + 1, top + x + 1))
+                    if drawn[index[key]]
+                }
             )
-        inputs = edge_select.EdgeInputs(verts, drawn, chain_ends=verts.copy(), regions=regions)
-        results.append((arrays, edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, inputs)))
-    (fast, fast_stats), (general, general_stats) = results
-    assert taken[0] is not None
-    assert fast_stats == general_stats
-    for field in ("triangles", "edge_flags", "region_table", "region_lines", "region_line_runs", "triangle_regions"):
-        a, b = getattr(fast, field), getattr(general, field)
-        assert a.dtype == b.dtype and np.array_equal(a, b), field
+
+        small, large = drawn_edges(range(2)), drawn_edges(range(2, columns))
+        assert len(large) > edge_select.WALK_LIMIT >= len(small)
+        return edge_select.KnownRegions(
+            np.array([0, 2, columns]), np.array([0, len(small), len(small) + len(large)]), np.array(small + large)
+        )
+
+    # Quads 0 and 1: a small region; quads 2 on: one of 2 * columns - 2 drawn edges.
+    fast, taken = _select_both(columns, regions_for, monkeypatch, hidden=[1, *range(3, columns)])
+    assert taken
     # The small region's quads walk its six drawn edges; the large
     # region's quads their own: two, three at either end of it.
     segments = (fast.edge_flags >> extract.NGON_SHIFT)[0::2]
