@@ -17,6 +17,10 @@ def hair(
     point (Bezier curves)."""
     data = bpy.data.hair_curves.new(name)
     sizes = [len(c) for c in curves]
+    # Before Blender 4.3 (no set_types; writing the curve_type attribute
+    # leaves Blender's type counts stale and evaluation aborts) the types
+    # and handles are set by a geometry-nodes modifier (_typed_curves).
+    by_modifier = bool(sizes) and not hasattr(data, "set_types")
     if sizes:
         data.add_curves(sizes)
         positions = np.concatenate([np.asarray(c, dtype=np.float32) for c in curves])
@@ -30,10 +34,6 @@ def hair(
             ).astype(np.float32)
             data.attributes.new("radius", "FLOAT", "POINT").data.foreach_set("value", values)
         kinds = [POLY] * len(curves) if types is None else list(types)
-        # Before Blender 4.3 (no set_types; writing the curve_type attribute
-        # leaves Blender's type counts stale and evaluation aborts) the types
-        # and handles are set by a geometry-nodes modifier (_typed_curves).
-        by_modifier = not hasattr(data, "set_types")
         if by_modifier:
             data.attributes.new(_TYPE, "INT", "CURVE").data.foreach_set("value", kinds)
         else:
@@ -54,7 +54,7 @@ def hair(
     obj.location = location
     obj.scale = scale
     scene.collection.objects.link(obj)
-    if sizes and not hasattr(data, "set_types"):
+    if by_modifier:
         obj.modifiers.new("Types", "NODES").node_group = _typed_curves(handles is not None)
     return obj
 
