@@ -154,22 +154,29 @@ def compare(scene, monkey, size, looks, repeats: int, viewport: Viewport | None)
     return best
 
 
-# (name, shape, modifier types before the subdivision, Edit Mode)
+# Every edge class on, as the Edge Classes preset (build_scene marks 80
+# of Suzanne's edges seam or sharp; its eye holes are boundary edges).
+EVERY_CLASS = dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True, use_crease_edges=True)
+
+# (name, shape, modifier types before the subdivision, Edit Mode, look
+# beside the cage or every edge)
 STACKS = (
-    ("own mesh", "Suzanne", (), False),
-    ("Mirror, Subdivision", "Suzanne", ("MIRROR",), False),
-    ("Bevel, Subdivision", "Suzanne", ("BEVEL",), False),
-    ("Solidify, Subdivision", "Suzanne", ("SOLIDIFY",), False),
-    ("Edit Mode", "Suzanne", (), True),
-    ("Edit Mode, Mirror, Subdivision", "Suzanne", ("MIRROR",), True),
+    ("own mesh", "Suzanne", (), False, {}),
+    ("Mirror, Subdivision", "Suzanne", ("MIRROR",), False, {}),
+    ("Bevel, Subdivision", "Suzanne", ("BEVEL",), False, {}),
+    ("Solidify, Subdivision", "Suzanne", ("SOLIDIFY",), False, {}),
+    ("Edit Mode", "Suzanne", (), True, {}),
+    ("Edit Mode, Mirror, Subdivision", "Suzanne", ("MIRROR",), True, {}),
     # Its caps' regions pass WALK_LIMIT from level 3: blocks of their faces' own edges.
-    ("Cylinder, 32-gon caps", "Cylinder", (), False),
+    ("Cylinder, 32-gon caps", "Cylinder", (), False, {}),
+    ("own mesh, every edge class on", "Suzanne", (), False, EVERY_CLASS),
 )
 
 
 def stack_table(size, levels, repeats: int, names=()) -> None:
-    """First extraction of the cage look against every edge for STACKS
-    (those whose name contains one of ``names``, when given),
+    """First extraction of the cage look against every edge (each with the
+    stack's look beside it) for STACKS (those whose name contains one of
+    ``names``, when given),
     with the regions the cage layout gives and with the regions found from
     the mesh (the layout's shortcut switched off), rounds alternating."""
     print(
@@ -185,7 +192,7 @@ def stack_table(size, levels, repeats: int, names=()) -> None:
         taken.append(result is not None)
         return result
 
-    for name, shape, before, edit in STACKS:
+    for name, shape, before, edit, look_extra in STACKS:
         if names and not any(part in name for part in names):
             continue
         for level in levels:
@@ -203,7 +210,7 @@ def stack_table(size, levels, repeats: int, names=()) -> None:
             try:
                 for round_ in range(repeats + 1):  # the first round warms up
                     for look, (use_cage, select) in looks.items():
-                        apply(scene, dict(use_cage_edges=use_cage))
+                        apply(scene, dict(look_extra, use_cage_edges=use_cage))
                         edge_select._select_known_regions = select
                         taken.clear()
                         ms = first_extract_ms(scene, size)

@@ -86,7 +86,7 @@ def _select(obj, selection, path, monkeypatch, *, cage_edges_of=None):
                 lambda *args: per_chain.append(real_chains(*args)) or per_chain[-1],
             )
         stats = mesh_reading.apply_edge_selection(arrays, mesh, corner_vert, offsets, selection, cage_edges)
-    return arrays, stats, any(applied), any(per_chain)
+    return arrays, stats, any(applied), any(lines is not None for lines in per_chain)
 
 
 def _assert_same_as_general(
@@ -118,6 +118,7 @@ def _assert_same_as_general(
                 assert a.dtype == b.dtype and np.array_equal(a, b), (path, field)
         assert other.region_run_segments == general.region_run_segments, path
     assert general.region_lines is not None and len(general.region_lines)
+    return general
 
 
 def _subdivide(obj, level):
@@ -252,15 +253,29 @@ def test_cage_faces_past_the_walk_limit(segments, level, monkeypatch):
 ALL_CLASSES = edge_select.Selection(classes=tuple(edge_select.EDGE_CLASSES), use_cage=True)
 
 
-@pytest.mark.parametrize(
-    ("shape", "marked", "taken"),
-    [("sphere", False, True), ("sphere", True, False), ("Suzanne", False, False)],
-)
-def test_edge_classes_that_give_no_edge_a_class_keep_the_cage_regions(shape, marked, taken, monkeypatch):
-    """Every edge class on (the Edge Classes preset) over a closed, unmarked
-    subdivision: no edge has a class, so the cage's regions apply. A seam
-    mark, or Suzanne's boundary edges (its eye holes), give edges a class
-    (drawn and styled): the regions are found from the mesh."""
+# The line styles of the classes _mark_classes marks, and of the boundary class.
+_STYLES = {1.0 + edge_select.EDGE_CLASSES.index(name) for name in ("seam", "sharp", "crease")}
+_BOUNDARY = 1.0 + edge_select.EDGE_CLASSES.index("boundary")
+
+
+def _mark_classes(obj, count):
+    """Seam, sharp and crease marks on the first ``count`` cage edges, a
+    third of them in two classes at once (two segments and two line
+    entries each)."""
+    for edge in obj.data.edges[:count]:
+        edge.use_seam = edge.index % 3 != 1
+        edge.use_edge_sharp = edge.index % 3 != 0
+    crease = obj.data.attributes.new("crease_edge", "FLOAT", "EDGE")
+    crease.data.foreach_set("value", [1.0 if index % 4 == 0 else 0.0 for index in range(len(obj.data.edges))])
+
+
+@pytest.mark.parametrize(("shape", "marked"), [("sphere", False), ("sphere", True), ("Suzanne", True)])
+def test_edge_classes_beside_the_cage_keep_its_regions(shape, marked, monkeypatch):
+    """Every edge class on (the Edge Classes preset) beside the cage: marks
+    live on cage edges, and a subdivision's boundary edges (Suzanne's eye
+    holes) are cage children, so the classes only style edges the cage
+    draws. The cage's regions apply, the classed edges' segments and line
+    entries one per class, as the general path lays them out."""
     scene = scenes.empty_scene()
     if shape == "sphere":
         obj = scenes.mesh_object(
@@ -271,10 +286,23 @@ def test_edge_classes_that_give_no_edge_a_class_keep_the_cage_regions(shape, mar
     else:
         obj = scenes.monkey(scene)
     if marked:
-        for edge in obj.data.edges[:12]:
-            edge.use_seam = True
+        _mark_classes(obj, 40)
     _subdivide(obj, 2)
-    _assert_same_as_general(obj, ALL_CLASSES, monkeypatch, rows_expected=True, regions_expected=taken)
+    general = _assert_same_as_general(obj, ALL_CLASSES, monkeypatch, rows_expected=True, regions_expected=True)
+    styles = set(general.region_lines[0::2, 2].tolist())
+    assert styles == ({0.0, *_STYLES} if marked else {0.0}) | ({_BOUNDARY} if shape == "Suzanne" else set())
+
+
+def test_edge_classes_on_cage_faces_past_the_walk_limit(monkeypatch):
+    """Classed edges around a 24-gon cap at level 3 (a region past
+    WALK_LIMIT, whose faces get blocks of their own edges) and on the side
+    quads' regions: the general path's blocks, one segment per class."""
+    scene = scenes.empty_scene()
+    cylinder = _cylinder(scene, segments=24)
+    _mark_classes(cylinder, len(cylinder.data.edges) // 2)
+    _subdivide(cylinder, 3)
+    general = _assert_same_as_general(cylinder, ALL_CLASSES, monkeypatch, rows_expected=True, regions_expected=True)
+    assert set(general.region_table[0::2, 2].tolist()) >= {0.0, *_STYLES}
 
 
 def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):

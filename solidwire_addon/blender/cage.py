@@ -457,8 +457,9 @@ def cage_edges(obj, mesh, *, render: bool, layout=None, regions: bool = False):
     cage child is its own chain, its own ends). ``regions``: also a
     function giving the regions of that mask as the layout gives them, or
     the layout to read them from (_known_regions; None where it cannot
-    tell), else None. It runs on first use: the caller asks only where they
-    apply (mesh_reading.apply_edge_selection: no edge has a class)."""
+    tell), else None. It runs on first use: asked only where they apply
+    (core/edge_select.py's select_edges: no class names an edge the mask
+    hides)."""
     if layout is None:
         layout = _cage_layout(obj, mesh, render=render)
     if layout is None:

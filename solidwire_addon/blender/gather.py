@@ -110,8 +110,8 @@ def _is_plain(obj_orig) -> bool:
 
 
 def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute_colors: bool = False):
-    """(fingerprint, (positions, corner_vert, corner inputs)) of a mesh's
-    drawn geometry.
+    """(fingerprint, (positions, corner_vert, corner inputs, edge class
+    bits)) of a mesh's drawn geometry.
 
     Counts plus CRC32 of the vertex positions and corner vertices (~4 GB/s),
     read with the same bulk reads extraction needs, which then reuses them.
@@ -122,7 +122,8 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute
     (extract.normals_follow_geometry), so they are neither read nor
     checksummed here (None in the context: read when the mesh is extracted
     or moved). With ``edge_classes``, the edge data of those classes
-    (marking a seam moves nothing either); with ``attribute_colors``, the
+    (marking a seam moves nothing either; the bits read are handed on,
+    mesh_reading.UNREAD without classes); with ``attribute_colors``, the
     active colour attribute (painting moves nothing).
 
     The fingerprint is ``(topology, shape)`` (see MeshCache.get_validated):
@@ -136,8 +137,11 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute
         len(corner_vert),
         len(mesh.polygons),
         _crc(corner_vert),
-        *_edge_class_checksums(mesh, edge_classes),
     )
+    class_bits = mesh_reading.UNREAD
+    if edge_classes:
+        class_bits = mesh_reading.read_edge_classes(mesh, edge_classes)
+        topology += (0,) if class_bits is None else (_crc(class_bits),)
     shape = (_crc(positions),)
     if attribute_colors:
         topology += mesh_reading.attribute_colors_checksum(mesh)
@@ -150,18 +154,11 @@ def fingerprint(mesh, corners: bool = False, edge_classes: tuple = (), attribute
             normals = mesh_reading.read_normals(mesh, domain)
             shape += (_crc(normals),)
         corner_inputs = (normals, materials, domain)
-    return (topology, shape), (positions, corner_vert, corner_inputs)
+    return (topology, shape), (positions, corner_vert, corner_inputs, class_bits)
 
 
 def _crc(array: np.ndarray) -> int:
     return zlib.crc32(memoryview(np.ascontiguousarray(array)).cast("B"))
-
-
-def _edge_class_checksums(mesh, edge_classes: tuple) -> tuple:
-    if not edge_classes:
-        return ()
-    bits = mesh_reading.read_edge_classes(mesh, edge_classes)
-    return (0,) if bits is None else (_crc(bits),)
 
 
 def item_source(obj) -> ItemSource:
@@ -591,7 +588,7 @@ def _mesh_for(
         return source[0]
 
     def make_arrays(context):
-        positions, corner_vert, corner_inputs = context
+        positions, corner_vert, corner_inputs, class_bits = context
         try:
             source_mesh = get_source()
             # Edge selection reads the face offsets too: once for both.
@@ -609,7 +606,7 @@ def _mesh_for(
                     cage_edges = outlines.outline_mask(source_mesh, face_offsets)
                 elif edges.use_cage:
                     # The cage's regions, unless the angle hides more edges; select_edges
-                    # takes them only where no edge has an enabled class (a class shows more).
+                    # takes them only where the enabled classes style drawn edges alone.
                     alone = not edges.edge_angle > 0.0
                     cage_edges = cage.cage_edges(obj.original, source_mesh, render=render, regions=alone)
                 mesh_reading.apply_edge_selection(
@@ -619,6 +616,7 @@ def _mesh_for(
                     face_offsets,
                     edges,
                     cage_edges,
+                    class_bits,
                 )
             read_colors = mesh_reading.read_attribute_colors(source_mesh) if attribute_colors else None
             if read_colors is not None:
@@ -646,7 +644,7 @@ def _mesh_for(
         return arrays
 
     def reposition(entry, context):
-        positions, corner_vert, corner_inputs = context
+        positions, corner_vert, corner_inputs, _class_bits = context
         source_mesh = get_source()
         if edges.follows_positions and (outline or not _edge_angle_holds(entry, source_mesh)):
             # An edge crossed the angle: other drawn edges and regions. (An

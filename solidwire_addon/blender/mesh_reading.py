@@ -252,6 +252,10 @@ _CLASS_ATTRIBUTES = {
 }
 
 
+# What a caller passes for edge class bits it has not read (None: read, no data).
+UNREAD = object()
+
+
 def read_edge_classes(mesh, enabled) -> np.ndarray | None:
     """(E,) class bits of ``mesh``'s edges for the enabled classes (other
     than boundary, which is topology), read from Blender's edge attributes;
@@ -333,6 +337,7 @@ def apply_edge_selection(
     face_offsets: np.ndarray,
     selection: Selection,
     cage: tuple | None = None,
+    class_bits=UNREAD,
 ) -> SelectionStats:
     """Read ``mesh``'s edges and apply ``selection`` to ``arrays``
     (core.edge_select.select_edges). ``cage``: (drawn mask, chain ids or
@@ -342,8 +347,11 @@ def apply_edge_selection(
     off). The regions (KnownRegions, or the SubdivisionLayout
     core/edge_select.py reads them from, or a function giving either) are
     those of the mask alone: used only where nothing else hides an edge and
-    no edge has an enabled class (a function is called only then).
-    (select_edges copies the mask where it changes it.)"""
+    the enabled classes only style edges the mask draws (a function is
+    called only then, by select_edges).
+    (select_edges copies the mask where it changes it.) ``class_bits``:
+    read_edge_classes of the selection's classes where the caller has read
+    them (the fingerprint checksums them)."""
     verts = cage[4] if cage is not None and len(cage) > 4 else None
     if verts is None:
         verts, corner_edge = read_edge_topology(mesh)
@@ -364,7 +372,7 @@ def apply_edge_selection(
     inputs = EdgeInputs(
         verts,
         drawn,
-        read_edge_classes(mesh, others) if others else None,
+        (read_edge_classes(mesh, others) if class_bits is UNREAD else class_bits) if others else None,
         "boundary" in selection.classes,
         chain,
         chain_ends,
@@ -373,7 +381,5 @@ def apply_edge_selection(
     )
     if not inputs.selects_anything:
         return SelectionStats()
-    if callable(regions):  # found on first use: only where no edge has a class
-        regions = regions() if edge_select.classes_style_no_edge(inputs, corner_edge) else None
-    inputs.regions = regions
+    inputs.regions = regions  # a function is called only where they apply (select_edges)
     return edge_select.select_edges(arrays, corner_vert, face_offsets, corner_edge, inputs)

@@ -29,6 +29,7 @@ Plain numpy on arrays; no Blender.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -160,8 +161,9 @@ class EdgeInputs:
     chain_ends: np.ndarray | None = None
     # The regions of ``drawn`` when the caller knows them from how the mesh
     # was made (a subdivision's cage faces), or the layout they are read
-    # from; None: found here.
-    regions: KnownRegions | SubdivisionLayout | None = None
+    # from, or a function giving either (or None), called only where they
+    # apply; None: found here.
+    regions: KnownRegions | SubdivisionLayout | Callable[[], KnownRegions | SubdivisionLayout | None] | None = None
     # (E,) how many face corners each edge has, when the caller has counted
     # them (np.bincount of the corner edges): counted once per mesh.
     corner_uses: np.ndarray | None = None
@@ -264,17 +266,27 @@ def _chain_ends(verts: np.ndarray, chain: np.ndarray | None) -> np.ndarray:
     return ends
 
 
-def classes_style_no_edge(inputs: EdgeInputs, corner_edge: np.ndarray) -> bool:
-    """Whether the enabled edge classes give no edge of the mesh a class (no
-    edge carries a mark, and with the boundary class none has one face):
-    the selection is then the drawn mask's alone, bit for bit, and regions
-    known for that mask hold (the Edge Classes and Portfolio presets on a
-    closed, unmarked subdivision)."""
-    if inputs.classes is not None and np.asarray(inputs.classes).any():
-        return False
-    if not inputs.boundary_class:
-        return True
-    return not (_corner_uses(inputs, corner_edge, len(np.asarray(inputs.verts).reshape(-1, 2))) == 1).any()
+def edge_classes(inputs: EdgeInputs, corner_edge: np.ndarray) -> np.ndarray | None:
+    """(E,) int64 class bits of every edge: the marks the caller read, and
+    the boundary class from the topology (an edge with one face corner);
+    None where no edge has a class."""
+    edge_count = len(np.asarray(inputs.verts).reshape(-1, 2))
+    marks = inputs.classes
+    has_marks = marks is not None and np.asarray(marks).any()
+    if not (has_marks or inputs.boundary_class):
+        return None
+    classes = np.asarray(marks, np.int64).copy() if has_marks else np.zeros(edge_count, np.int64)
+    if inputs.boundary_class:
+        classes[_corner_uses(inputs, corner_edge, edge_count) == 1] |= CLASS_BIT["boundary"]
+    return classes if classes.any() else None
+
+
+def _classes_style_drawn_edges(classes: np.ndarray | None, drawn) -> bool:
+    """Whether the edge classes only give edges that are drawn anyway a
+    style, hiding or showing nothing: the regions of the drawn mask then
+    hold. So on a subdivision's cage: marks live on the cage's edges, whose
+    children are all drawn, and its boundary edges are cage children."""
+    return classes is None or drawn is None or not np.logical_and(classes, ~np.asarray(drawn, bool)).any()
 
 
 def _corner_uses(inputs: EdgeInputs, corner_edge: np.ndarray, edge_count: int) -> np.ndarray:
@@ -290,8 +302,16 @@ def select_edges(
 ) -> SelectionStats:
     """Apply ``inputs`` to ``arrays`` in place (edge flags, column 3 of
     listed triangles, ``region_table``) and say what it did."""
-    if inputs.regions is not None and classes_style_no_edge(inputs, corner_edge):
-        known = _select_known_regions(arrays, corner_vert, face_offsets, corner_edge, inputs)
+    classes = edge_classes(inputs, corner_edge)
+    regions = inputs.regions
+    if regions is not None and _classes_style_drawn_edges(classes, inputs.drawn):
+        if callable(regions):  # found on first use (blender/cage.py): only here, where they apply
+            regions = inputs.regions = regions()
+        known = (
+            None
+            if regions is None
+            else _select_known_regions(arrays, corner_vert, face_offsets, corner_edge, inputs, classes)
+        )
         if known is not None:
             return known
     stats = SelectionStats()
@@ -307,10 +327,9 @@ def select_edges(
     uses = _corner_uses(inputs, corner_edge, edge_count)
 
     drawn = np.ones(edge_count, bool) if inputs.drawn is None else np.asarray(inputs.drawn, bool).copy()
-    classes = np.zeros(edge_count, np.int64) if inputs.classes is None else np.asarray(inputs.classes, np.int64).copy()
-    if inputs.boundary_class:
-        classes[uses == 1] |= CLASS_BIT["boundary"]
-    has_classes = (inputs.classes is not None or inputs.boundary_class) and bool(classes.any())
+    has_classes = classes is not None
+    if classes is None:
+        classes = np.zeros(edge_count, np.int64)
     # Boundary and non-manifold edges are always drawn, and so is an edge of
     # an enabled class (asking for sharp edges shows them even where the
     # angle or the cage would not).
@@ -602,25 +621,31 @@ def copied_regions(
 
 
 def _select_known_regions(
-    arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray, inputs: EdgeInputs
+    arrays: MeshArrays,
+    corner_vert: np.ndarray,
+    face_offsets: np.ndarray,
+    corner_edge: np.ndarray,
+    inputs: EdgeInputs,
+    classes: np.ndarray | None = None,
 ) -> SelectionStats | None:
     """select_edges for regions the caller knows (``inputs.regions``, or
-    read from the layout it gives: regions_from_layout; no classes) on a
-    mesh of quads only: the same arrays as the general path,
-    written per region and per quad instead of found from every corner, or
-    None (nothing written) where the shortcut does not apply: faces other
-    than extract.build_arrays_fast's quad rows, a region of one face, a
-    region list that does not cover the faces or names an edge that is not
-    drawn.
+    read from the layout it gives: regions_from_layout) on a mesh of quads
+    only: the same arrays as the general path, written per region and per
+    quad instead of found from every corner, or None (nothing written)
+    where the shortcut does not apply: faces other than
+    extract.build_arrays_fast's quad rows, a region of one face, a region
+    list that does not cover the faces or names an edge that is not drawn.
+    ``classes``: edge_classes, which the caller has checked style only
+    drawn edges (_classes_style_drawn_edges).
 
     Every face is then in a multi-face region, so every face is listed and
     its lines come from the region-lines pass. Its block is its region's
     (id = the region's first face), holding the region's drawn edges,
-    ascending, one segment each (no class, no n-gon diagonal); in a region
-    past WALK_LIMIT it is the face's own, holding the face's own drawn
-    edges (_face_blocks_past_walk_limit). Regions listed in whole chains
-    (KnownRegions.chain_edges) have their list order checked and their
-    region lines written per chain."""
+    ascending, one segment per class of each (one where it has none; no
+    n-gon diagonal); in a region past WALK_LIMIT it is the face's own,
+    holding the face's own drawn edges (_face_blocks_past_walk_limit).
+    Regions listed in whole chains (KnownRegions.chain_edges) have their
+    list order checked and their region lines written per chain."""
     regions, drawn = inputs.regions, inputs.drawn
     if drawn is None or inputs.chain_ends is None:
         return None
@@ -672,17 +697,38 @@ def _select_known_regions(
     # methods, here and below, skip numpy's function wrappers.)
     seg_ends = ends.take(edges, axis=0)
     table = _segment_rows(verts, seg_ends, edges)  # every region's list, as its region lines read it
+    big = per_region > WALK_LIMIT  # (in drawn edges, as the general path counts)
+    blocks, listing_segments = _class_segments(table, classes, edges)
+    if listing_segments is None:
+        region_segments, segment_start = per_region, edge_start
+    else:
+        segment_start = np.zeros(len(edge_start), np.int64)
+        np.cumsum(np.add.reduceat(listing_segments, edge_start[:-1]), out=segment_start[1:])
+        region_segments = segment_start[1:] - segment_start[:-1]
+        if (region_segments[~big] > _MOST_BLOCK_SEGMENTS).any():
+            return None  # (classes that are not EDGE_CLASSES: more than the quad rows' lookup holds)
     at = _hidden_pattern(drawn, corner_edge, face_count, corner_drawn)
-    big = per_region > WALK_LIMIT
     if big.any():
-        blocks = _face_blocks_past_walk_limit(table, per_region, region_faces, big, at, corner_edge, verts, ends)
+        blocks = _face_blocks_past_walk_limit(
+            blocks,
+            listing_segments,
+            region_segments,
+            per_region,
+            region_faces,
+            big,
+            at,
+            corner_edge,
+            verts,
+            ends,
+            classes,
+        )
         if blocks is None:
             return None
         arrays.region_table, face_segments, face_table_start = blocks
     else:
-        arrays.region_table = table
-        face_segments = per_region.repeat(region_faces)
-        face_table_start = np.multiply(edge_start[:-1], TEXELS_PER_SEGMENT, dtype=np.int32).repeat(region_faces)
+        arrays.region_table = blocks
+        face_segments = region_segments.repeat(region_faces)
+        face_table_start = np.multiply(segment_start[:-1], TEXELS_PER_SEGMENT, dtype=np.int32).repeat(region_faces)
     if len(arrays.ngon_corners):
         face_table_start += len(arrays.ngon_corners)
     stats.segments = len(arrays.region_table) // TEXELS_PER_SEGMENT
@@ -707,11 +753,17 @@ def _select_known_regions(
     arrays.triangle_regions = label_texel.repeat(2 * region_faces)
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
-    if chain_edges > 1 and _chain_region_lines(
-        arrays, table, firsts, label_texel.repeat(per_region // chain_edges), chain_edges, stats
-    ):
-        return stats
-    _known_region_lines(arrays, verts, ends, table, seg_ends, np.repeat(label, per_region), edges, stats)
+    line_edges = None
+    if chain_edges > 1:
+        line_edges = _chain_region_lines(
+            arrays, table, firsts, label_texel.repeat(per_region // chain_edges), chain_edges, stats
+        )
+    if line_edges is None:
+        line_edges = _known_region_lines(
+            arrays, verts, ends, table, seg_ends, np.repeat(label, per_region), edges, stats, classes
+        )
+    if classes is not None and line_edges is not None:
+        _style_region_lines(arrays, classes, line_edges, ends, stats)
     return stats
 
 
@@ -730,17 +782,40 @@ def _segment_rows(verts: np.ndarray, seg_ends: np.ndarray, edges: np.ndarray) ->
 _DRAWN_CORNERS = (np.arange(16)[:, None] >> np.arange(4)) & 1 == 0
 
 
-def _face_blocks_past_walk_limit(table, per_region, region_faces, big, hidden, corner_edge, verts, ends):
+def _class_segments(table: np.ndarray, classes: np.ndarray | None, edges: np.ndarray):
+    """(block rows, segments per edge) of ``table`` (_segment_rows of
+    ``edges``) with one segment per class of each edge, its style k + 1 for
+    class k, in place of the edge's one (as the general path's
+    _one_per_class; None: one each). Where no edge has two classes the
+    styles are written into ``table`` itself (the region lines read from it
+    set their own: _style_region_lines)."""
+    bits = None if classes is None else classes.take(edges)
+    if bits is None or not bits.any():
+        return table, None
+    style, row, per_edge = _class_rows(bits)
+    if row is None:
+        table[0::TEXELS_PER_SEGMENT, 2] = style
+        return table, None
+    rows = table.reshape(len(edges), -1).take(row, axis=0)
+    rows[:, 2] = style
+    return rows.reshape(-1, 4), per_edge
+
+
+def _face_blocks_past_walk_limit(
+    blocks, listing_segments, region_segments, per_region, region_faces, big, hidden, corner_edge, verts, ends, classes
+):
     """The blocks of _select_known_regions where some regions (``big``) are
     past WALK_LIMIT, as the general path lays them out: the other regions'
-    blocks (their rows of ``table``, the regions' lists in order), then one
-    block per face of a big region, in face order, holding that quad's own
-    drawn edges ascending (``hidden``: _hidden_pattern's bits). Returns
-    (region table, each face's segment count, each face's first texel),
-    or None where a quad names one drawn edge twice (the general path
-    would list it once). A face with no drawn edge of its own starts at
-    texel 0, as the general path gives a block without segments."""
-    small_segments = np.where(big, 0, per_region)
+    blocks (their rows of ``blocks``, the regions' lists in order, one
+    segment per class of each listed edge: ``listing_segments``, None for
+    one each), then one block per face of a big region, in face order,
+    holding that quad's own drawn edges ascending (``hidden``:
+    _hidden_pattern's bits), each once per class. Returns (region table,
+    each face's segment count, each face's first texel), or None where a
+    quad names one drawn edge twice (the general path would list it once).
+    A face with no drawn edge of its own starts at texel 0, as the general
+    path gives a block without segments."""
+    small_segments = np.where(big, 0, region_segments)
     faces = np.flatnonzero(big.repeat(region_faces))
     pattern = hidden.take(faces)
     # The drawn corners of those faces, as (face, edge) keys sorted once:
@@ -755,17 +830,20 @@ def _face_blocks_past_walk_limit(table, per_region, region_faces, big, hidden, c
     if len(keys) > 1 and (keys[1:] == keys[:-1]).any():
         return None
     own_edges = keys % edge_count
-    own_count = np.bincount(local_face, minlength=len(faces))
+    own_rows, own_segments = _class_segments(
+        _segment_rows(verts, ends.take(own_edges, axis=0), own_edges), classes, own_edges
+    )
+    own_count = np.bincount(keys // edge_count, weights=own_segments, minlength=len(faces)).astype(np.int64)
+    kept = ~big.repeat(per_region)
+    if listing_segments is not None:
+        kept = kept.repeat(listing_segments)
     blocks = np.concatenate(
-        [
-            table.reshape(-1, 4 * TEXELS_PER_SEGMENT).compress(~big.repeat(per_region), axis=0).reshape(-1, 4),
-            _segment_rows(verts, ends.take(own_edges, axis=0), own_edges),
-        ]
+        [blocks.reshape(-1, 4 * TEXELS_PER_SEGMENT).compress(kept, axis=0).reshape(-1, 4), own_rows]
     )
     first = (np.cumsum(small_segments) - small_segments).repeat(region_faces)
     own_first = int(small_segments.sum()) + np.cumsum(own_count) - own_count
     first[faces] = np.where(own_count > 0, own_first, 0)
-    segments = per_region.repeat(region_faces)
+    segments = region_segments.repeat(region_faces)
     segments[faces] = own_count
     return blocks, segments, np.multiply(first, TEXELS_PER_SEGMENT, dtype=np.int32)
 
@@ -787,7 +865,7 @@ def _first_and_last_listing(ids: np.ndarray):
     return listed, first.take(listed), last.take(listed)
 
 
-def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: int, stats) -> bool:
+def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: int, stats) -> np.ndarray | None:
     """_known_region_lines for regions listed in whole chains
     (KnownRegions.chain_edges; ``firsts``: the first edge of each listed
     chain, ``owners``: its region as a float32 texel), done per chain: a
@@ -795,11 +873,12 @@ def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: 
     consecutive entries with its first edge's regions, and their texels
     are consecutive block rows. Consecutive chains with different ends
     make the runs whole chains cut into pieces of the run length, with no
-    search. False (nothing written) where an edge bounds more than two
-    regions or two consecutive chains have the same ends."""
+    search. Returns the entries' edges, or None (nothing written) where an
+    edge bounds more than two regions or two consecutive chains have the
+    same ends."""
     listings = _first_and_last_listing(firsts)
     if listings is None:
-        return False
+        return None
     chain, first, last = listings
     # A listed chain's block rows are one row of the table seen as (chains, n * texels).
     lines = table.reshape(len(firsts), -1).take(first, axis=0).reshape(len(chain), chain_edges, -1)
@@ -808,7 +887,7 @@ def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: 
     # are) could join into one run: left to _known_region_lines.
     chain_ends = lines.reshape(len(chain), -1).view(np.int64)[:, 2]
     if (chain_ends[1:] == chain_ends[:-1]).any():
-        return False
+        return None
     lines[:, :, 3] = owners.take(first)[:, None]
     lines[:, :, 6] = np.where(first != last, owners.take(last), np.float32(NO_REGION))[:, None]
     arrays.region_lines = lines.reshape(-1, 4)
@@ -825,20 +904,24 @@ def _chain_region_lines(arrays: MeshArrays, table, firsts, owners, chain_edges: 
         runs[:, :, 1] = np.minimum(length, chain_edges - within)
     arrays.region_line_runs, arrays.region_run_segments = runs.reshape(-1, 4), length
     stats.region_lines = count
-    return True
+    return whole_chains(chain, chain_edges)
 
 
-def _known_region_lines(arrays: MeshArrays, verts, ends, table, seg_ends, seg_owner, edges, stats) -> None:
+def _known_region_lines(
+    arrays: MeshArrays, verts, ends, table, seg_ends, seg_owner, edges, stats, classes=None
+) -> np.ndarray | None:
     """_region_line_table for the blocks of _select_known_regions (``table``
-    its block rows, owners ascending, no class). Where no edge bounds more
-    than two regions (a manifold cage) each edge is one entry, its region
-    the one that lists it first and its partner the one that lists it last:
-    found by two scatters instead of a sort, and its texels are its first
-    listing's block texels with the regions filled in."""
+    its block rows without classes, owners ascending). Where no edge bounds
+    more than two regions (a manifold cage) each edge is one entry, its
+    region the one that lists it first and its partner the one that lists
+    it last: found by two scatters instead of a sort, and its texels are
+    its first listing's block texels with the regions filled in; returns
+    the entries' edges, for _style_region_lines. Else the general table,
+    ``classes`` and all, and None."""
     listings = _first_and_last_listing(edges)
     if listings is None:
-        _region_line_table(arrays, verts, None, ends, np.stack([seg_owner, edges], axis=1), stats)
-        return
+        _region_line_table(arrays, verts, classes, ends, np.stack([seg_owner, edges], axis=1), stats)
+        return None
     edge, first, last = listings
     region = np.take(seg_owner, first)
     partner = np.where(first != last, np.take(seg_owner, last), -1)
@@ -850,10 +933,32 @@ def _known_region_lines(arrays: MeshArrays, verts, ends, table, seg_ends, seg_ow
     runs = _line_runs(np.take(seg_ends, first, axis=0), style, region, partner)
     arrays.region_line_runs, arrays.region_run_segments = runs
     stats.region_lines = len(edge)
+    return edge
+
+
+def _style_region_lines(arrays: MeshArrays, classes: np.ndarray, edge: np.ndarray, ends: np.ndarray, stats) -> None:
+    """The region lines of _select_known_regions (one unstyled entry per
+    ``edge``, ascending) with classes, as _region_line_table lays them out:
+    one entry per class of each edge (style k + 1 for class k, style 0
+    where it has none), by style, then edge; the runs found again."""
+    bits = classes.take(edge)
+    if not bits.any():
+        return
+    style, row, _per_edge = _class_rows(bits)
+    if row is None:
+        row = np.arange(len(edge))
+    order = np.argsort(style.astype(np.uint8), kind="stable")  # (a radix sort on bytes)
+    style, row = style.take(order), row.take(order)
+    lines = arrays.region_lines.reshape(len(edge), -1).take(row, axis=0)
+    lines[:, 2] = style
+    arrays.region_lines = lines.reshape(-1, 4)
+    chain_ends = np.asarray(ends).take(edge.take(row), axis=0)
+    arrays.region_line_runs, arrays.region_run_segments = _line_runs(chain_ends, style, lines[:, 3], lines[:, 6])
+    stats.region_lines = len(row)
 
 
 def _listed_quad_rows() -> np.ndarray:
-    """(32 * (WALK_LIMIT + 1),) uint64 indexed by 32 * block segments + 16 *
+    """(32 * (_MOST_BLOCK_SEGMENTS + 1),) uint64 indexed by 32 * block segments + 16 *
     split + hidden-edge pattern (see _mark_quad_rows): a listed quad's two
     rows' flags, row 2i in the low 32 bits: the row marks of
     _quad_row_marks applied to a quad row's flags, less what a listed face
@@ -866,26 +971,43 @@ def _listed_quad_rows() -> np.ndarray:
     # Not split: rows from corners 0 and 2; split: from corners 3 and 1.
     even = np.concatenate([row[pattern], row[48 + pattern]]).astype(np.uint64)
     odd = np.concatenate([row[32 + pattern], row[16 + pattern]]).astype(np.uint64)
-    segments = np.arange(WALK_LIMIT + 1, dtype=np.uint64)
+    segments = np.arange(_MOST_BLOCK_SEGMENTS + 1, dtype=np.uint64)
     block = (segments << np.uint64(NGON_SHIFT)) | np.uint64(IN_REGION | REGION_LINES)
     both = np.uint64(1 | 1 << 32)
     return ((even | (odd << np.uint64(32)))[None, :] | (block * both)[:, None]).reshape(-1)
 
 
+# Per combination of class bits: how many classes, and the style of the
+# lowest (k + 1 for class k; 0 for none).
+_CLASS_COUNT = np.array([b.bit_count() for b in range(1 << len(EDGE_CLASSES))], np.int64)
+_LOWEST_STYLE = np.array([(b & -b).bit_length() for b in range(1 << len(EDGE_CLASSES))], np.int64)
+
+
+def _class_rows(bits: np.ndarray):
+    """(style, row, rows per input) for one row per class bit set in
+    ``bits`` (its style k + 1 for class k, ascending), one row of style 0
+    where no bit is set: ``row`` the input each comes from, or (style,
+    None, None) where every input is one row (at most one class each: a
+    lookup, no repeat)."""
+    per_input = _CLASS_COUNT.take(bits)
+    most = int(per_input.max(initial=0))
+    if most <= 1:
+        return _LOWEST_STYLE.take(bits), None, None
+    np.maximum(per_input, 1, out=per_input)
+    row = np.repeat(np.arange(len(bits)), per_input)
+    rank = np.arange(len(row)) - np.repeat(np.cumsum(per_input) - per_input, per_input)
+    left = bits.take(row)
+    for dropped in range(most - 1):  # the rank-th class: the lowest once `rank` lower ones are cleared
+        np.copyto(left, left & (left - 1), where=rank > dropped)
+    return _LOWEST_STYLE.take(left), row, per_input
+
+
 def _one_per_class(bits: np.ndarray, *columns: np.ndarray):
-    """(style, columns repeated): one row per class bit set in ``bits`` (its
-    style k + 1 for class k), one row of style 0 where no bit is set."""
-    if not bits.any():  # one ordinary row each: nothing to repeat
-        return np.zeros(len(bits), np.int64), columns
-    popcount = np.array([b.bit_count() for b in range(1 << len(EDGE_CLASSES))])
-    per_row = np.maximum(popcount[bits], 1)
-    bits = np.repeat(bits, per_row)
-    rank = np.arange(len(bits)) - np.repeat(np.cumsum(per_row) - per_row, per_row)
-    style = np.zeros(len(bits), np.int64)
-    for k in range(len(EDGE_CLASSES)):  # the rank-th set bit of each row's classes
-        below = popcount[bits & ((1 << k) - 1)]
-        style = np.where(((bits >> k) & 1 == 1) & (below == rank), k + 1, style)
-    return style, tuple(np.repeat(column, per_row) for column in columns)
+    """(style, columns repeated) as _class_rows lays the rows out."""
+    style, row, _per_input = _class_rows(bits)
+    if row is None:
+        return style, columns
+    return style, tuple(column.take(row, axis=0) for column in columns)
 
 
 def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, pairs, stats: SelectionStats) -> None:
@@ -1175,6 +1297,9 @@ def _quad_row_marks():
     return clear.astype(np.int32), marks.astype(np.int32)
 
 
+# The most segments a region's block holds: WALK_LIMIT drawn edges (a larger
+# region's faces get blocks of their own), each once per class.
+_MOST_BLOCK_SEGMENTS = WALK_LIMIT * len(EDGE_CLASSES)
 # Computed once: the lookup _select_known_regions writes quad rows from.
 _LISTED_QUAD_ROWS = _listed_quad_rows()
 

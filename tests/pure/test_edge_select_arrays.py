@@ -195,11 +195,12 @@ def _known_strip_regions(index, drawn, verts, pairs_of_quads: int):
     return edge_select.KnownRegions(face_start, np.array(edge_start), np.array(edges))
 
 
-def _select_both(columns, regions_for, monkeypatch, hidden=None):
+def _select_both(columns, regions_for, monkeypatch, hidden=None, classes_for=None):
     """The arrays through the known regions (the same as the general
     path's) and whether the known regions were taken. ``hidden``: the x of
     each vertical edge that is not drawn (default: every odd one, so that
-    quads 2k and 2k + 1 form region k)."""
+    quads 2k and 2k + 1 form region k). ``classes_for(index, drawn)``: the
+    edges' class bits."""
     taken = []
     real = edge_select._select_known_regions
     monkeypatch.setattr(edge_select, "_select_known_regions", lambda *args: taken.append(real(*args)) or taken[-1])
@@ -212,14 +213,15 @@ def _select_both(columns, regions_for, monkeypatch, hidden=None):
             drawn[index[(x, top + x)]] = False
         ends = verts.copy()
         regions = regions_for(index, drawn, verts) if known else None
-        inputs = edge_select.EdgeInputs(verts, drawn, chain_ends=ends, regions=regions)
+        classes = None if classes_for is None else classes_for(index, drawn)
+        inputs = edge_select.EdgeInputs(verts, drawn, classes, chain_ends=ends, regions=regions)
         results.append((arrays, edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, inputs)))
     (fast, fast_stats), (general, general_stats) = results
     assert fast_stats == general_stats
     for field in ("triangles", "edge_flags", "region_table", "region_lines", "region_line_runs", "triangle_regions"):
         a, b = getattr(fast, field), getattr(general, field)
         assert (a is None) == (b is None) and (a is None or (a.dtype == b.dtype and np.array_equal(a, b))), field
-    return fast, taken[0] is not None
+    return fast, bool(taken) and taken[0] is not None
 
 
 def test_known_regions_give_the_general_path_arrays(monkeypatch):
@@ -290,3 +292,68 @@ def test_known_regions_past_the_walk_limit_give_the_general_path_arrays(monkeypa
     segments = (fast.edge_flags >> extract.NGON_SHIFT)[0::2]
     assert segments.tolist() == [6, 6, 3] + [2] * (columns - 4) + [3]
     assert len(fast.region_lines) // 2 == 2 * columns + 3  # every drawn edge once: sides, 3 verticals
+
+
+def _strip_classes(pick):
+    """classes_for for _select_both: sharp on every drawn edge ``pick``
+    takes, seam too on every other one of them."""
+    sharp, seam = edge_select.CLASS_BIT["sharp"], edge_select.CLASS_BIT["seam"]
+
+    def classes_for(index, drawn):
+        classes = np.zeros(len(drawn), np.int64)
+        for k, edge in enumerate(pick(index, drawn)):
+            classes[edge] = sharp | (seam if k % 2 else 0)
+        return classes
+
+    return classes_for
+
+
+def test_known_regions_with_classed_edges_give_the_general_path_arrays(monkeypatch):
+    """Classes on drawn edges only style them: the known regions hold, each
+    classed edge one segment and one line entry per class, in the general
+    path's order; also where a region is past WALK_LIMIT."""
+    regions_for = lambda index, drawn, verts: _known_strip_regions(index, drawn, verts, 3)
+    some_drawn = _strip_classes(lambda index, drawn: np.flatnonzero(drawn)[::3])
+    fast, taken = _select_both(6, regions_for, monkeypatch, classes_for=some_drawn)
+    assert taken
+    assert len(fast.region_lines) // 2 > np.count_nonzero(fast.region_lines[0::2, 2] == 0) > 0
+    monkeypatch.undo()
+
+    columns = edge_select.WALK_LIMIT + 4
+
+    def one_large_region(index, drawn, verts):
+        edges = np.flatnonzero(drawn)
+        return edge_select.KnownRegions(np.array([0, columns]), np.array([0, len(edges)]), edges)
+
+    fast, taken = _select_both(columns, one_large_region, monkeypatch, hidden=range(1, columns), classes_for=some_drawn)
+    assert taken
+    assert (fast.region_table[0::2, 2] > 0).any()
+
+
+def test_known_regions_refuse_classes_that_change_them(monkeypatch):
+    """A class on an edge the mask hides shows it: the regions change, and
+    the general path decides."""
+    regions_for = lambda index, drawn, verts: _known_strip_regions(index, drawn, verts, 3)
+    on_hidden = _strip_classes(lambda index, drawn: np.flatnonzero(~drawn)[:1])
+    assert not _select_both(6, regions_for, monkeypatch, classes_for=on_hidden)[1]
+
+
+def test_known_regions_whose_classes_lengthen_a_block_past_the_walk_limit(monkeypatch):
+    """A region of WALK_LIMIT drawn edges or fewer keeps its one block when
+    classes double its segments past WALK_LIMIT, as the general path does
+    (the limit is on drawn edges)."""
+    columns = 40  # one region of 2 * 40 + 2 drawn edges: under WALK_LIMIT, not once classed twice
+
+    def one_region(index, drawn, verts):
+        edges = np.flatnonzero(drawn)
+        assert len(edges) <= edge_select.WALK_LIMIT < 2 * len(edges)
+        return edge_select.KnownRegions(np.array([0, columns]), np.array([0, len(edges)]), edges)
+
+    def every_drawn_twice(index, drawn):
+        return np.where(drawn, edge_select.CLASS_BIT["sharp"] | edge_select.CLASS_BIT["seam"], 0)
+
+    fast, taken = _select_both(
+        columns, one_region, monkeypatch, hidden=range(1, columns), classes_for=every_drawn_twice
+    )
+    assert taken
+    assert ((fast.edge_flags >> extract.NGON_SHIFT) == 2 * (2 * columns + 2)).all()
