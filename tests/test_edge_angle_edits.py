@@ -213,3 +213,30 @@ def test_the_overlay_repositions_an_edit_and_draws_what_a_fresh_frame_draws():
     stats, fresh = redraw()
     assert stats["meshes_extracted"] == 1
     assert np.array_equal(edited, fresh)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_still_flat_among_candidates_answers_as_the_full_test_on_them(seed):
+    """Beside a mask (the cage look) only the mask's edges are tested: the
+    state's flat edges are the full test's among them, and a move is
+    answered as the full test answers it on them alone."""
+    rng = np.random.default_rng(seed)
+    corner_edge, offsets, edge_count, quads = _grid_topology(24)
+    candidates = rng.random(edge_count) < 0.3
+    normals = rng.normal(0.0, 0.15, (len(quads), 3)).astype(np.float32)
+    normals[:, 2] = 1.0
+    state = edge_select.EdgeAngleState(corner_edge, offsets, normals, edge_count, ANGLE, candidates=candidates)
+    full = edge_select.flat_edges(corner_edge, offsets, normals, edge_count, ANGLE)
+    assert np.array_equal(state.flat, full & candidates)
+    assert 0 < state.flat.sum() < (full.sum())
+    for _ in range(20):
+        moved = normals.copy()
+        turned = rng.choice(len(quads), size=rng.integers(1, 12), replace=False)
+        moved[turned] += rng.normal(0.0, rng.choice([1e-4, 0.05, 0.3]), (len(turned), 3)).astype(np.float32)
+        now = edge_select.flat_edges(corner_edge, offsets, moved, edge_count, ANGLE) & candidates
+        before = state.flat.copy()
+        kept = state.still_flat(moved)
+        assert kept == np.array_equal(now, before)
+        normals = moved
+        if not kept:
+            state = edge_select.EdgeAngleState(corner_edge, offsets, moved, edge_count, ANGLE, candidates=candidates)

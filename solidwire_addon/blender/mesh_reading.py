@@ -363,8 +363,9 @@ def apply_edge_selection(
         chain_ends = cage[2] if len(cage) > 2 else None
         regions = cage[3] if len(cage) > 3 and not selection.edge_angle > 0.0 else None
     if selection.edge_angle > 0.0:
+        # Beside a mask only its edges can be hidden by the angle: only they are tested.
         state = edge_select.EdgeAngleState(
-            corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle
+            corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle, candidates=drawn
         )
         arrays.edge_angle_state = state  # a move of vertices is checked against it
         drawn = ~state.flat if drawn is None else drawn & ~state.flat

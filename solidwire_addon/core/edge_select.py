@@ -1349,16 +1349,29 @@ def flat_edges(
     return flat
 
 
-def _face_pairs(corner_edge: np.ndarray, face_offsets: np.ndarray, edge_count: int):
+def _face_pairs(corner_edge: np.ndarray, face_offsets: np.ndarray, edge_count: int, candidates=None):
     """(edge ids, first face, second face) of every edge with exactly two
-    face corners, in the order of their corners."""
+    face corners (among ``candidates``, an (E,) mask, where given), in the
+    order of their corners. Only the corners of those edges are looked at:
+    beside a cage mask, a fraction of the mesh's."""
     corner_edge = np.asarray(corner_edge, np.int64)
-    corner_face = _face_of_corner(np.diff(np.asarray(face_offsets, np.int64)))
-    uses = np.bincount(corner_edge, minlength=edge_count)
-    corners = np.flatnonzero(uses[corner_edge] == 2)
-    corners = corners[np.argsort(corner_edge[corners], kind="stable")]
-    first, second = corners[0::2], corners[1::2]
-    return corner_edge[first], corner_face[first], corner_face[second]
+    offsets = np.asarray(face_offsets, np.int64)
+    at = None if candidates is None else np.flatnonzero(_corner_drawn(candidates, corner_edge))
+    edge_of = corner_edge if at is None else corner_edge.take(at)
+    uses = np.bincount(edge_of, minlength=edge_count)  # all of a candidate's corners are candidates
+    two = np.flatnonzero(uses.take(edge_of) == 2)
+    two = two.take(np.argsort(edge_of.take(two), kind="stable"))
+    corners = two if at is None else at.take(two)
+    face_count = len(offsets) - 1
+    if (
+        face_count > 0
+        and offsets[-1] == 4 * face_count
+        and np.array_equal(offsets[1:] - offsets[:-1], np.full(face_count, 4))
+    ):
+        faces = corners >> 2  # quads only (a subdivision): no search
+    else:
+        faces = np.searchsorted(offsets, corners, side="right") - 1
+    return corner_edge.take(corners[0::2]), faces[0::2], faces[1::2]
 
 
 def _pairs_flat(face_normals: np.ndarray, f1: np.ndarray, f2: np.ndarray, angle: float) -> np.ndarray:
@@ -1375,11 +1388,13 @@ class EdgeAngleState:
     tested edge, the face normals it saw and the flat edges it found.
     :meth:`still_flat` recomputes only the edges next to a face whose
     normal changed, with the same arithmetic as :func:`flat_edges`, so its
-    answer is the full test's."""
+    answer is the full test's. ``candidates``: the only edges whose
+    flatness counts (the cage look's drawn edges: the angle can hide no
+    other), where given; the others are neither tested nor flat."""
 
-    def __init__(self, corner_edge, face_offsets, face_normals, edge_count: int, angle: float):
+    def __init__(self, corner_edge, face_offsets, face_normals, edge_count: int, angle: float, candidates=None):
         self.angle = float(angle)
-        pairs = _face_pairs(corner_edge, face_offsets, edge_count)
+        pairs = _face_pairs(corner_edge, face_offsets, edge_count, candidates)
         self.tested, self.first, self.second = (ids.astype(np.int32) for ids in pairs)  # kept per mesh: half the memory
         self.normals = np.array(face_normals, np.float32)
         self.flat = np.zeros(edge_count, bool)
