@@ -170,6 +170,9 @@ STACKS = (
     # Its caps' regions pass WALK_LIMIT from level 3: blocks of their faces' own edges.
     ("Cylinder, 32-gon caps", "Cylinder", (), False, {}),
     ("own mesh, every edge class on", "Suzanne", (), False, EVERY_CLASS),
+    # Cage faces meeting at under 30 degrees join into one region (join_regions).
+    ("own mesh, edge angle 30°", "Suzanne", (), False, dict(edge_angle=math.radians(30.0))),
+    ("Mirror, Subdivision, edge angle 30°", "Suzanne", ("MIRROR",), False, dict(edge_angle=math.radians(30.0))),
 )
 
 

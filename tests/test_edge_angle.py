@@ -54,6 +54,28 @@ def test_flat_edges_are_not_drawn_on_a_subdivided_mesh(mode, output_dir):
     accuracy.assert_accurate(report)
 
 
+@pytest.mark.parametrize(("level", "degrees"), [(2, 5.0), (3, 3.0)])
+def test_the_angle_beside_the_cage_hides_flat_cage_edges(level, degrees, output_dir):
+    """Cage edges and the angle together: a cage edge whose pieces meet at
+    less than the angle is hidden piece by piece, and the cage faces on
+    either side draw their lines from their joined region; against the
+    reference, which finds the regions from the mesh itself. Sharp edges
+    show through the angle."""
+    scene = scenes.empty_scene(
+        200, 150, use_cage_edges=True, edge_angle=math.radians(degrees), use_sharp_edges=True, thickness=1.5
+    )
+    monkey = scenes.monkey(scene, subdivisions=level, rotation=(0.2, 0.0, 0.5))
+    for edge in monkey.data.edges[:60]:
+        edge.use_edge_sharp = edge.index % 3 == 0
+    scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0, 0, 0))
+    report = accuracy.measure(scene, f"edge_angle_cage_level{level}", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    ref_cage = reference.render_reference(scene, settings=reference.SettingsWith(scene.solidwire, edge_angle=0.0))
+    # The angle hides about a third of the cage's pieces (not all of them).
+    assert 0.3 * ref_cage.intensity.sum() < ref.intensity.sum() < 0.9 * ref_cage.intensity.sum()
+
+
 def test_ngon_outlines_and_quad_corners_follow_the_angle(output_dir):
     scene = scenes.empty_scene(220, 160, edge_angle=math.radians(5.0), diagonal_mode="SOLID", thickness=2.0)
     _coplanar_ngons(scene)

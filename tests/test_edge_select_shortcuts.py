@@ -305,6 +305,42 @@ def test_edge_classes_on_cage_faces_past_the_walk_limit(monkeypatch):
     assert set(general.region_table[0::2, 2].tolist()) >= {0.0, *_STYLES}
 
 
+@pytest.mark.parametrize(
+    ("shape", "before", "degrees", "classes"),
+    [
+        ("Suzanne", None, 20.0, ()),
+        ("Suzanne", None, 40.0, tuple(edge_select.EDGE_CLASSES)),
+        ("Suzanne", "MIRROR", 30.0, ()),
+        ("Cylinder", None, 20.0, ()),
+    ],
+)
+def test_the_edge_angle_beside_the_cage_joins_its_regions(shape, before, degrees, classes, monkeypatch):
+    """The edge angle beside the cage look hides cage edges between faces
+    that meet at less than the angle: the cage faces on either side form
+    one region (join_regions), from the object's own mesh or from the
+    layout behind a modifier, with classes, and with a 24-gon cap whose
+    region is past the walk limit: the general path's arrays."""
+    scene = scenes.empty_scene()
+    obj = scenes.monkey(scene) if shape == "Suzanne" else _cylinder(scene, segments=24)
+    if classes:
+        _mark_classes(obj, 40)
+    if before:
+        _modifier_before(obj, before)
+    _subdivide(obj, 2 if shape == "Suzanne" else 3)
+    selection = edge_select.Selection(edge_angle=math.radians(degrees), classes=classes, use_cage=True)
+    joins = []
+    real_join = edge_select.join_regions
+    monkeypatch.setattr(edge_select, "join_regions", lambda *args: joins.append(real_join(*args)) or joins[-1])
+    general = _assert_same_as_general(
+        obj, selection, monkeypatch, rows_expected=True, regions_expected=True, chains_expected=False
+    )
+    joined = [regions for regions in joins if regions is not None and regions.piece_region is not None]
+    assert joined, "some cage faces are joined"
+    merged = joined[-1]
+    assert len(merged.edge_start) - 1 < len(merged.face_start) - 1  # fewer regions than cage faces
+    assert len(set(general.triangle_regions.tolist())) == len(merged.edge_start) - 1
+
+
 def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
     """An Array with caps takes the regions found from the mesh."""
     scene = scenes.empty_scene()

@@ -605,10 +605,9 @@ def _mesh_for(
                 if outline:
                     cage_edges = outlines.outline_mask(source_mesh, face_offsets)
                 elif edges.use_cage:
-                    # The cage's regions, unless the angle hides more edges; select_edges
+                    # The cage's regions (joined across what the angle hides); select_edges
                     # takes them only where the enabled classes style drawn edges alone.
-                    alone = not edges.edge_angle > 0.0
-                    cage_edges = cage.cage_edges(obj.original, source_mesh, render=render, regions=alone)
+                    cage_edges = cage.cage_edges(obj.original, source_mesh, render=render, regions=True)
                 mesh_reading.apply_edge_selection(
                     arrays,
                     source_mesh,

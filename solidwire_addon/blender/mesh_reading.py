@@ -346,9 +346,9 @@ def apply_edge_selection(
     mask (blender/outlines.py), or None (no subdivision, or cage edges
     off). The regions (KnownRegions, or the SubdivisionLayout
     core/edge_select.py reads them from, or a function giving either) are
-    those of the mask alone: used only where nothing else hides an edge and
-    the enabled classes only style edges the mask draws (a function is
-    called only then, by select_edges).
+    those of the mask alone: joined across the edges the edge angle hides,
+    and used only where the enabled classes only style edges that are
+    drawn (a function is called only then, by select_edges).
     (select_edges copies the mask where it changes it.) ``class_bits``:
     read_edge_classes of the selection's classes where the caller has read
     them (the fingerprint checksums them)."""
@@ -361,7 +361,8 @@ def apply_edge_selection(
     if cage is not None:
         drawn, chain = np.asarray(cage[0], bool), cage[1]
         chain_ends = cage[2] if len(cage) > 2 else None
-        regions = cage[3] if len(cage) > 3 and not selection.edge_angle > 0.0 else None
+        regions = cage[3] if len(cage) > 3 else None
+    joined = None
     if selection.edge_angle > 0.0:
         # Beside a mask only its edges can be hidden by the angle: only they are tested.
         state = edge_select.EdgeAngleState(
@@ -369,6 +370,7 @@ def apply_edge_selection(
         )
         arrays.edge_angle_state = state  # a move of vertices is checked against it
         drawn = ~state.flat if drawn is None else drawn & ~state.flat
+        joined = state.flat  # the mask's regions join across these (edge_select.join_regions)
     others = tuple(c for c in selection.classes if c != "boundary")
     inputs = EdgeInputs(
         verts,
@@ -383,4 +385,5 @@ def apply_edge_selection(
     if not inputs.selects_anything:
         return SelectionStats()
     inputs.regions = regions  # a function is called only where they apply (select_edges)
+    inputs.joined = joined
     return edge_select.select_edges(arrays, corner_vert, face_offsets, corner_edge, inputs)

@@ -30,7 +30,7 @@ Plain numpy on arrays; no Blender.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -112,6 +112,10 @@ class KnownRegions:
     edge_start: np.ndarray  # (R + 1,) offsets into ``region_edges``
     region_edges: np.ndarray  # (S,) edge ids
     chain_edges: int = 1
+    # Regions of several runs of faces (join_regions): ``face_start`` then
+    # bounds P runs ("pieces", each a joined patch), piece p lies in region
+    # ``piece_region[p]``, and regions are numbered by their first piece.
+    piece_region: np.ndarray | None = None
 
 
 @dataclass
@@ -167,6 +171,10 @@ class EdgeInputs:
     # (E,) how many face corners each edge has, when the caller has counted
     # them (np.bincount of the corner edges): counted once per mesh.
     corner_uses: np.ndarray | None = None
+    # (E,) edges ``drawn`` leaves out beyond the mask the regions are of (the
+    # edge angle beside the cage look): the regions join across them
+    # (join_regions). None: the regions are of ``drawn`` itself.
+    joined: np.ndarray | None = None
 
     @property
     def selects_anything(self) -> bool:
@@ -304,6 +312,12 @@ def select_edges(
     listed triangles, ``region_table``) and say what it did."""
     classes = edge_classes(inputs, corner_edge)
     regions = inputs.regions
+    if regions is not None and inputs.joined is not None and classes is not None and inputs.drawn is not None:
+        # An edge of an enabled class shows though the angle would hide it
+        # (as below): the regions join across the others alone.
+        shown = np.logical_and(inputs.joined, classes)
+        if shown.any():
+            inputs = replace(inputs, drawn=inputs.drawn | shown, joined=inputs.joined & ~shown)
     if regions is not None and _classes_style_drawn_edges(classes, inputs.drawn):
         if callable(regions):  # found on first use (blender/cage.py): only here, where they apply
             regions = inputs.regions = regions()
@@ -588,6 +602,43 @@ def regions_from_layout(
     return copied_regions(known, layout.copies, faces, edges_num, face_count, len(drawn))
 
 
+def join_regions(regions: KnownRegions, joined: np.ndarray) -> KnownRegions | None:
+    """``regions`` (of a mask) joined across the ``joined`` edges the mask
+    drew but the selection hides (the edge angle beside the cage look): two
+    regions that list a joined edge become one. Each becomes a piece of
+    the result (KnownRegions.piece_region), whose regions, numbered by
+    their first piece, list their pieces' drawn edges once each,
+    ascending. None where an edge is listed by more than two regions or a
+    list is not ascending, which the result's lists rely on."""
+    face_start = np.asarray(regions.face_start, np.int64)
+    edge_start = np.asarray(regions.edge_start, np.int64)
+    edges = np.asarray(regions.region_edges, np.int64)
+    pieces = len(face_start) - 1
+    if regions.piece_region is not None or pieces < 1 or len(edges) == 0 or edge_start[-1] != len(edges):
+        return None
+    hidden_listing = joined.take(edges)
+    if not hidden_listing.any():
+        return regions
+    piece_of_listing = np.repeat(np.arange(pieces, dtype=np.int64), edge_start[1:] - edge_start[:-1])
+    listings = _first_and_last_listing(edges)
+    if listings is None:
+        return None
+    edge, first, last = listings
+    across = joined.take(edge)
+    piece_label = _components(pieces, piece_of_listing.take(first[across]), piece_of_listing.take(last[across]))
+    # Each component's label is its smallest piece: regions numbered by it.
+    is_first = piece_label == np.arange(pieces)
+    piece_region = (np.cumsum(is_first) - 1).take(piece_label)
+    edge_count = np.int64(int(edges.max()) + 1)
+    drawn_listing = ~hidden_listing
+    keys = piece_region.take(piece_of_listing[drawn_listing]) * edge_count + edges[drawn_listing]
+    region, edge = np.divmod(np.unique(keys), edge_count)
+    region_count = int(is_first.sum())
+    joined_start = np.zeros(region_count + 1, np.int64)
+    np.cumsum(np.bincount(region, minlength=region_count), out=joined_start[1:])
+    return KnownRegions(face_start, joined_start, edge, 1, piece_region)
+
+
 def whole_chains(firsts: np.ndarray, chain_edges: int) -> np.ndarray:
     """(len(firsts) * chain_edges,) int64: each chain's consecutive edges
     ``first, first + 1, ...`` (KnownRegions.chain_edges), chain by chain."""
@@ -645,7 +696,9 @@ def _select_known_regions(
     n-gon diagonal); in a region past WALK_LIMIT it is the face's own,
     holding the face's own drawn edges (_face_blocks_past_walk_limit).
     Regions listed in whole chains (KnownRegions.chain_edges) have their
-    list order checked and their region lines written per chain."""
+    list order checked and their region lines written per chain. Regions
+    known for a mask that ``inputs.joined`` thins are joined across it
+    first (join_regions)."""
     regions, drawn = inputs.regions, inputs.drawn
     if drawn is None or inputs.chain_ends is None:
         return None
@@ -655,16 +708,53 @@ def _select_known_regions(
     drawn = np.asarray(drawn, bool)
     prefix = _drawn_prefix(drawn)
     corner_drawn = _corner_drawn(drawn, corner_edge, prefix)  # shared with _hidden_pattern, which consumes it
+    joined = None if inputs.joined is None else np.asarray(inputs.joined, bool)
+    if joined is not None and (len(joined) != len(drawn) or (joined & drawn).any()):
+        return None
     if isinstance(regions, SubdivisionLayout):
-        regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn, face_count, corner_drawn)
+        if joined is None:
+            regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn, face_count, corner_drawn)
+        else:  # the layout's regions are of the mask before the join
+            regions = regions_from_layout(regions, corner_vert, corner_edge, verts, drawn | joined, face_count)
+        if regions is None:
+            return None
+    if joined is not None:
+        regions = join_regions(regions, joined)
         if regions is None:
             return None
     face_start = np.asarray(regions.face_start, np.int64)
     edge_start = np.asarray(regions.edge_start, np.int64)
     edges = np.asarray(regions.region_edges, np.int64)
-    if face_count <= 0 or len(face_start) < 2 or len(edge_start) != len(face_start) or len(drawn) != len(verts):
+    piece_faces = face_start[1:] - face_start[:-1]
+    piece_region = regions.piece_region
+    region_count = len(piece_faces) if piece_region is None else int(piece_region.max(initial=-1)) + 1
+    if (
+        face_count <= 0
+        or len(face_start) < 2
+        or len(edge_start) != region_count + 1
+        or len(drawn) != len(verts)
+        or (piece_region is not None and (len(piece_region) != len(piece_faces) or piece_region.min() < 0))
+    ):
         return None
-    region_faces, per_region = face_start[1:] - face_start[:-1], edge_start[1:] - edge_start[:-1]
+    per_region = edge_start[1:] - edge_start[:-1]
+    if piece_region is None:
+        region_faces, label = piece_faces, face_start[:-1]
+
+        def per_face(values):
+            return values.repeat(piece_faces)
+    else:
+        region_faces = np.bincount(piece_region, weights=piece_faces, minlength=region_count).astype(np.int64)
+        # Regions are numbered by their first piece: where the running maximum rises.
+        rises = np.empty(len(piece_region), bool)
+        rises[0] = True
+        np.greater(piece_region[1:], np.maximum.accumulate(piece_region)[:-1], out=rises[1:])
+        label = face_start.take(np.flatnonzero(rises))
+        if len(label) != region_count:
+            return None
+
+        def per_face(values):
+            return values.take(piece_region).repeat(piece_faces)
+
     # Whole chains of consecutive edges (KnownRegions.chain_edges): their
     # first edges bound the ids and ascend where the list does.
     chain_edges = max(1, int(regions.chain_edges))
@@ -691,7 +781,6 @@ def _select_known_regions(
     stats = SelectionStats(hidden_edges=len(drawn) - prefix[0])
 
     # The blocks: region k's drawn edges from table row first[k], in region order.
-    label = face_start[:-1]
     ends = np.asarray(inputs.chain_ends)
     # (take gathers rows several times faster than fancy indexing; the
     # methods, here and below, skip numpy's function wrappers.)
@@ -714,7 +803,7 @@ def _select_known_regions(
             listing_segments,
             region_segments,
             per_region,
-            region_faces,
+            per_face,
             big,
             at,
             corner_edge,
@@ -727,8 +816,8 @@ def _select_known_regions(
         arrays.region_table, face_segments, face_table_start = blocks
     else:
         arrays.region_table = blocks
-        face_segments = region_segments.repeat(region_faces)
-        face_table_start = np.multiply(segment_start[:-1], TEXELS_PER_SEGMENT, dtype=np.int32).repeat(region_faces)
+        face_segments = per_face(region_segments)
+        face_table_start = per_face(np.multiply(segment_start[:-1], TEXELS_PER_SEGMENT, dtype=np.int32))
     if len(arrays.ngon_corners):
         face_table_start += len(arrays.ngon_corners)
     stats.segments = len(arrays.region_table) // TEXELS_PER_SEGMENT
@@ -750,7 +839,10 @@ def _select_known_regions(
     else:
         arrays.triangles[:, 3] = np.repeat(face_table_start, 2)
     label_texel = label.astype(np.float32)  # as the tables hold it
-    arrays.triangle_regions = label_texel.repeat(2 * region_faces)
+    if piece_region is None:
+        arrays.triangle_regions = label_texel.repeat(2 * region_faces)
+    else:
+        arrays.triangle_regions = per_face(label_texel).repeat(2)
     stats.regions = len(label)
     stats.listed_triangles = arrays.triangle_count
     line_edges = None
@@ -802,7 +894,7 @@ def _class_segments(table: np.ndarray, classes: np.ndarray | None, edges: np.nda
 
 
 def _face_blocks_past_walk_limit(
-    blocks, listing_segments, region_segments, per_region, region_faces, big, hidden, corner_edge, verts, ends, classes
+    blocks, listing_segments, region_segments, per_region, per_face, big, hidden, corner_edge, verts, ends, classes
 ):
     """The blocks of _select_known_regions where some regions (``big``) are
     past WALK_LIMIT, as the general path lays them out: the other regions'
@@ -814,9 +906,10 @@ def _face_blocks_past_walk_limit(
     each face's segment count, each face's first texel), or None where a
     quad names one drawn edge twice (the general path would list it once).
     A face with no drawn edge of its own starts at texel 0, as the general
-    path gives a block without segments."""
+    path gives a block without segments. ``per_face``: a value per region
+    to one per face."""
     small_segments = np.where(big, 0, region_segments)
-    faces = np.flatnonzero(big.repeat(region_faces))
+    faces = np.flatnonzero(per_face(big))
     pattern = hidden.take(faces)
     # The drawn corners of those faces, as (face, edge) keys sorted once:
     # most faces inside a big region have none (a sort per face of four
@@ -840,10 +933,10 @@ def _face_blocks_past_walk_limit(
     blocks = np.concatenate(
         [blocks.reshape(-1, 4 * TEXELS_PER_SEGMENT).compress(kept, axis=0).reshape(-1, 4), own_rows]
     )
-    first = (np.cumsum(small_segments) - small_segments).repeat(region_faces)
+    first = per_face(np.cumsum(small_segments) - small_segments)
     own_first = int(small_segments.sum()) + np.cumsum(own_count) - own_count
     first[faces] = np.where(own_count > 0, own_first, 0)
-    segments = region_segments.repeat(region_faces)
+    segments = per_face(region_segments)
     segments[faces] = own_count
     return blocks, segments, np.multiply(first, TEXELS_PER_SEGMENT, dtype=np.int32)
 

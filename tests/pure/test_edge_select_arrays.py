@@ -195,12 +195,13 @@ def _known_strip_regions(index, drawn, verts, pairs_of_quads: int):
     return edge_select.KnownRegions(face_start, np.array(edge_start), np.array(edges))
 
 
-def _select_both(columns, regions_for, monkeypatch, hidden=None, classes_for=None):
+def _select_both(columns, regions_for, monkeypatch, hidden=None, classes_for=None, joined_x=()):
     """The arrays through the known regions (the same as the general
     path's) and whether the known regions were taken. ``hidden``: the x of
     each vertical edge that is not drawn (default: every odd one, so that
     quads 2k and 2k + 1 form region k). ``classes_for(index, drawn)``: the
-    edges' class bits."""
+    edges' class bits. ``joined_x``: the x of vertical edges the regions'
+    mask draws but the selection hides (EdgeInputs.joined)."""
     taken = []
     real = edge_select._select_known_regions
     monkeypatch.setattr(edge_select, "_select_known_regions", lambda *args: taken.append(real(*args)) or taken[-1])
@@ -213,8 +214,14 @@ def _select_both(columns, regions_for, monkeypatch, hidden=None, classes_for=Non
             drawn[index[(x, top + x)]] = False
         ends = verts.copy()
         regions = regions_for(index, drawn, verts) if known else None
+        joined = np.zeros(len(verts), bool)
+        for x in joined_x:
+            joined[index[(x, top + x)]] = True
+        drawn &= ~joined
         classes = None if classes_for is None else classes_for(index, drawn)
-        inputs = edge_select.EdgeInputs(verts, drawn, classes, chain_ends=ends, regions=regions)
+        inputs = edge_select.EdgeInputs(
+            verts, drawn, classes, chain_ends=ends, regions=regions, joined=joined if known else None
+        )
         results.append((arrays, edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, inputs)))
     (fast, fast_stats), (general, general_stats) = results
     assert fast_stats == general_stats
@@ -357,3 +364,24 @@ def test_known_regions_whose_classes_lengthen_a_block_past_the_walk_limit(monkey
     )
     assert taken
     assert ((fast.edge_flags >> extract.NGON_SHIFT) == 2 * (2 * columns + 2)).all()
+
+
+def test_known_regions_joined_across_hidden_edges_give_the_general_path_arrays(monkeypatch):
+    """Regions known for a mask, with some of its edges hidden beyond it
+    (the edge angle beside the cage): the regions on either side become
+    one (join_regions), its edges listed once; as the general path finds
+    them."""
+    regions_for = lambda index, drawn, verts: _known_strip_regions(index, drawn, verts, 4)
+    joins = []
+    real_join = edge_select.join_regions
+    monkeypatch.setattr(edge_select, "join_regions", lambda *args: joins.append(real_join(*args)) or joins[-1])
+    fast, taken = _select_both(8, regions_for, monkeypatch, joined_x=[2, 6])
+    assert taken
+    # Quads 0-3 and 4-7: two regions of two pieces each.
+    assert sorted(set(fast.triangle_regions.tolist())) == [0.0, 4.0]
+    assert joins[0].piece_region.tolist() == [0, 0, 1, 1]
+    monkeypatch.undo()
+
+    # One join in the middle: regions 1 and 2 (quads 2-5) become one.
+    fast, taken = _select_both(8, regions_for, monkeypatch, joined_x=[4])
+    assert taken and sorted(set(fast.triangle_regions.tolist())) == [0.0, 2.0, 6.0]
