@@ -143,7 +143,8 @@ def test_what_is_kept_between_redraws():
     Blender's buffer; the next redraw that changes nothing resolves the
     kept record into an image it keeps, and the ones after only composite
     that image. An edit (vertices moved) keeps its image, for the next edit
-    of a drag. Every frame equals a fresh one."""
+    of a drag. Every frame equals a fresh one (after edits, up to the
+    rounding of the centre they kept)."""
     scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
     front, _back = objects
 
@@ -189,7 +190,10 @@ def test_what_is_kept_between_redraws():
     assert path == "surface_straight" and not np.array_equal(dragged, moved)
     runtime.mesh_cache.clear()
     fresh, path = frame()
-    assert path == "surface_straight" and np.array_equal(moved, fresh)
+    # The edits above kept the mesh's centre (extract.reposition) where a
+    # fresh extraction centres it again: the same image up to float32
+    # rounding, which can move a pixel by one step of the 8-bit encoding.
+    assert path == "surface_straight" and np.abs(moved - fresh).max() <= 1.0 / 255.0 + 1e-9
     scene.camera.location.z += 0.5
     other_view, path = frame()
     assert path == "surface_straight" and not np.array_equal(moved, other_view)
