@@ -356,22 +356,28 @@ def select_edges(
     # corner belongs to).
     hidden_edges = np.flatnonzero(~drawn)
     stats.hidden_edges = len(hidden_edges)
-    first_face = np.empty(edge_count, np.int64)
-    first_face[corner_edge[::-1]] = corner_face[::-1]  # the last write is the first corner's
-    last_face = np.empty(edge_count, np.int64)
-    last_face[corner_edge] = corner_face
-    label = _region_labels(face_count, first_face[hidden_edges], last_face[hidden_edges])
+    if len(hidden_edges):
+        first_face = np.empty(edge_count, np.int64)
+        first_face[corner_edge[::-1]] = corner_face[::-1]  # the last write is the first corner's
+        last_face = np.empty(edge_count, np.int64)
+        last_face[corner_edge] = corner_face
+        label = _region_labels(face_count, first_face[hidden_edges], last_face[hidden_edges])
+    else:  # every edge drawn (classes on a plain look): every face its own region
+        label = np.arange(face_count, dtype=np.int64)
     region_size = np.bincount(label, minlength=face_count)
-
-    # Drawn edges of each region (unique (label, edge) pairs, as one key).
-    drawn_corner = drawn[corner_edge]
-    keys = np.unique(label[corner_face[drawn_corner]] * edge_count + corner_edge[drawn_corner])
-    pairs = np.stack([keys // edge_count, keys % edge_count], axis=1)
     walked_region = region_size > 1
     styled_face = np.zeros(face_count, bool)
     if has_classes:
-        styled_face = np.bincount(corner_face, weights=(classes[corner_edge] != 0), minlength=face_count) > 0
+        styled_face[corner_face[classes.take(corner_edge) != 0]] = True
     walked = walked_region[label]
+
+    # Drawn edges of each region whose lines are listed (unique (label,
+    # edge) pairs, as one key, so sorted by region): those of multi-face
+    # regions and of faces with a classed edge; a plain face needs none.
+    drawn_corner = drawn[corner_edge]
+    lines_corner = drawn_corner & (walked | styled_face)[corner_face]
+    keys = np.unique(label[corner_face[lines_corner]] * edge_count + corner_edge[lines_corner])
+    pairs = np.stack(np.divmod(keys, edge_count), axis=1)
     ngon_face = sizes > 4
     # A region too large to walk (see WALK_LIMIT): its faces' blocks hold
     # their own drawn edges (the walk is then face by face); the region-lines
@@ -393,7 +399,7 @@ def select_edges(
         return stats
 
     # Segments of each block.
-    by_label = pairs[np.argsort(pairs[:, 0], kind="stable")] if len(pairs) else pairs.reshape(0, 2)
+    by_label = pairs  # (sorted by region already)
     # The distinct owners, ascending: marked in a bitmap over [0, 2 F), no sort.
     owned = np.zeros(2 * face_count, bool)
     owned[owner[listed_face]] = True
@@ -414,7 +420,9 @@ def select_edges(
         face_owned = np.zeros(face_count, bool)
         face_owned[block_face[~from_region]] = True
         own_corner = face_owned[corner_face] & drawn_corner
-        own = np.unique(np.stack([face_count + corner_face[own_corner], corner_edge[own_corner]], axis=1), axis=0)
+        # Unique (owner, edge) pairs, as one key: sorted by owner, then edge.
+        own_keys = np.unique((face_count + corner_face[own_corner]) * edge_count + corner_edge[own_corner])
+        own = np.stack(np.divmod(own_keys, edge_count), axis=1)
     seg_owner = np.concatenate([seg_owner, own[:, 0]])
     seg_edge = np.concatenate([seg_edge, own[:, 1]])
     # One segment per class of the edge (an edge with no class: one
@@ -1444,27 +1452,37 @@ def flat_edges(
 
 def _face_pairs(corner_edge: np.ndarray, face_offsets: np.ndarray, edge_count: int, candidates=None):
     """(edge ids, first face, second face) of every edge with exactly two
-    face corners (among ``candidates``, an (E,) mask, where given), in the
-    order of their corners. Only the corners of those edges are looked at:
-    beside a cage mask, a fraction of the mesh's."""
+    face corners (among ``candidates``, an (E,) mask, where given), by
+    edge; the first face is its lower corner's. Only the corners of those
+    edges are looked at: beside a cage mask, a fraction of the mesh's."""
     corner_edge = np.asarray(corner_edge, np.int64)
     offsets = np.asarray(face_offsets, np.int64)
     at = None if candidates is None else np.flatnonzero(_corner_drawn(candidates, corner_edge))
     edge_of = corner_edge if at is None else corner_edge.take(at)
     uses = np.bincount(edge_of, minlength=edge_count)  # all of a candidate's corners are candidates
-    two = np.flatnonzero(uses.take(edge_of) == 2)
-    two = two.take(np.argsort(edge_of.take(two), kind="stable"))
-    corners = two if at is None else at.take(two)
+    edges = np.flatnonzero(uses == 2)
+    # Each edge's lower and higher corner by two scatters (the last write
+    # wins: written backwards, it is the lower one's), no sort.
+    listing = np.arange(len(edge_of), dtype=np.int64)
+    lower = np.empty(edge_count, np.int64)
+    lower[edge_of[::-1]] = listing[::-1]
+    higher = np.empty(edge_count, np.int64)
+    higher[edge_of] = listing
+    first, second = lower.take(edges), higher.take(edges)
+    if at is not None:
+        first, second = at.take(first), at.take(second)
     face_count = len(offsets) - 1
-    if (
-        face_count > 0
-        and offsets[-1] == 4 * face_count
-        and np.array_equal(offsets[1:] - offsets[:-1], np.full(face_count, 4))
-    ):
-        faces = corners >> 2  # quads only (a subdivision): no search
-    else:
-        faces = np.searchsorted(offsets, corners, side="right") - 1
-    return corner_edge.take(corners[0::2]), faces[0::2], faces[1::2]
+    sizes = offsets[1:] - offsets[:-1]
+    if face_count > 0 and offsets[-1] == 4 * face_count and (sizes == 4).all():
+        return edges, first >> 2, second >> 2  # quads only (a subdivision): no search
+    if 8 * len(edges) < len(corner_edge):  # few corners: a search each
+        return (
+            edges,
+            np.searchsorted(offsets, first, side="right") - 1,
+            np.searchsorted(offsets, second, side="right") - 1,
+        )
+    corner_face = _face_of_corner(sizes)
+    return edges, corner_face.take(first), corner_face.take(second)
 
 
 def _pairs_flat(face_normals: np.ndarray, f1: np.ndarray, f2: np.ndarray, angle: float) -> np.ndarray:
