@@ -89,6 +89,15 @@ def _select(obj, selection, path, monkeypatch, *, cage_edges_of=None):
     return arrays, stats, any(applied), any(lines is not None for lines in per_chain)
 
 
+def _assert_same_arrays(other, general, path="") -> None:
+    for field in ARRAY_FIELDS:
+        a, b = getattr(other, field), getattr(general, field)
+        assert (a is None) == (b is None), (path, field)
+        if a is not None:
+            assert a.dtype == b.dtype and np.array_equal(a, b), (path, field)
+    assert other.region_run_segments == general.region_run_segments, path
+
+
 def _assert_same_as_general(
     obj,
     selection,
@@ -111,12 +120,7 @@ def _assert_same_as_general(
         if path == "regions":
             assert per_chain == chains_expected
         assert stats == general_stats, path
-        for field in ARRAY_FIELDS:
-            a, b = getattr(other, field), getattr(general, field)
-            assert (a is None) == (b is None), (path, field)
-            if a is not None:
-                assert a.dtype == b.dtype and np.array_equal(a, b), (path, field)
-        assert other.region_run_segments == general.region_run_segments, path
+        _assert_same_arrays(other, general, path)
     assert general.region_lines is not None and len(general.region_lines)
     return general
 
@@ -490,3 +494,39 @@ def test_multires_cage(monkeypatch):
         for _ in range(2):
             bpy.ops.object.multires_subdivide(modifier=modifier.name, mode="CATMULL_CLARK")
     _assert_same_as_general(obj, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+
+
+@pytest.mark.parametrize("seed", range(16))
+def test_random_marks_angles_and_stacks_give_the_general_path_arrays(seed, monkeypatch):
+    """Seeded random cases of what the known regions take: Suzanne, a
+    cylinder with n-gon caps or a UV sphere, random seam and sharp marks,
+    a modifier before the subdivision or none, levels 1-3, an edge angle
+    from none to 20 degrees and a random set of classes beside the cage:
+    the general path's arrays, whether the regions were taken or not."""
+    rng = np.random.default_rng(seed)
+    scene = scenes.empty_scene()
+    shape = ("Suzanne", "cylinder", "sphere")[seed % 3]
+    if shape == "Suzanne":
+        obj = scenes.monkey(scene)
+    elif shape == "cylinder":
+        obj = _cylinder(scene, segments=int(rng.integers(5, 30)))
+    else:
+        obj = scenes.mesh_object(
+            scene, "Sphere", lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=10, v_segments=7, radius=1.0)
+        )
+    for edge in obj.data.edges:
+        draw = rng.random()
+        edge.use_seam = draw < 0.15
+        edge.use_edge_sharp = 0.1 < draw < 0.2
+    if rng.random() < 0.4:
+        _modifier_before(obj, str(rng.choice(["MIRROR", "BEVEL", "SOLIDIFY"])))
+    _subdivide(obj, int(rng.integers(1, 4)))
+    selection = edge_select.Selection(
+        edge_angle=math.radians(float(rng.choice([0.0, 2.0, 5.0, 10.0, 20.0]))),
+        classes=tuple(name for name in edge_select.EDGE_CLASSES if rng.random() < 0.5),
+        use_cage=True,
+    )
+    general, general_stats, _, _ = _select(obj, selection, "general", monkeypatch)
+    other, stats, _applied, _per_chain = _select(obj, selection, "regions", monkeypatch)
+    assert stats == general_stats
+    _assert_same_arrays(other, general)
