@@ -616,13 +616,20 @@ def join_regions(regions: KnownRegions, joined: np.ndarray) -> KnownRegions | No
     regions that list a joined edge become one. Each becomes a piece of
     the result (KnownRegions.piece_region), whose regions, numbered by
     their first piece, list their pieces' drawn edges once each,
-    ascending. None where an edge is listed by more than two regions or a
-    list is not ascending, which the result's lists rely on."""
+    ascending. None where the lists name no edge or a negative one, or an
+    edge is listed by more than two regions (a manifold cage lists each
+    edge at most twice)."""
     face_start = np.asarray(regions.face_start, np.int64)
     edge_start = np.asarray(regions.edge_start, np.int64)
     edges = np.asarray(regions.region_edges, np.int64)
     pieces = len(face_start) - 1
-    if regions.piece_region is not None or pieces < 1 or len(edges) == 0 or edge_start[-1] != len(edges):
+    if (
+        regions.piece_region is not None
+        or pieces < 1
+        or len(edges) == 0
+        or edges.min() < 0
+        or edge_start[-1] != len(edges)
+    ):
         return None
     hidden_listing = joined.take(edges)
     if not hidden_listing.any():
