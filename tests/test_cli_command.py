@@ -9,6 +9,7 @@ scripts/render.py wrapper is tested both ways in test_cli.py.
 from __future__ import annotations
 
 import json
+import threading
 from pathlib import Path
 
 import bpy
@@ -133,6 +134,18 @@ def test_bad_options_are_one_line_and_exit_2(tmp_path, capsys, args, expected):
     assert code == 2, err
     assert len(lines) == 1 and lines[0].startswith("solidwire: error: ") and expected in lines[0], lines
     assert not (tmp_path / "bad.png").exists()
+
+
+def test_a_run_leaves_no_thread_behind(tmp_path, capsys):
+    # The signal watcher must be gone when the command returns, whether it
+    # rendered or refused: a thread alive at interpreter exit keeps the bpy
+    # 4.5 module from shutting Blender down, and the process hangs there.
+    blend = _animated_blend(tmp_path)
+    before = set(threading.enumerate())
+    for extra in ((), ("--thickness", 5000)):
+        code, _out, err = run(capsys, "render", blend, "-o", tmp_path / "still.png", "-f", 1, *extra)
+        assert code == (2 if extra else 0), err
+        assert set(threading.enumerate()) <= before, [t.name for t in set(threading.enumerate()) - before]
 
 
 def test_no_output_path_anywhere_is_an_error(tmp_path, capsys):

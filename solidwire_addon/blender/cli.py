@@ -770,6 +770,7 @@ class Interrupts:
         self._previous: dict = {}
         self._pipe: tuple | None = None
         self._previous_fd = -1
+        self._watcher: threading.Thread | None = None
 
     def install(self) -> bool:
         if threading.current_thread() is not threading.main_thread():
@@ -790,7 +791,10 @@ class Interrupts:
             os.close(write_fd)
         self._previous = {sig: signal.signal(sig, self._on_signal) for sig in self.SIGNALS}
         if self._pipe is not None:
-            threading.Thread(target=self._watch, args=(self._pipe[0],), name="solidwire-signals", daemon=True).start()
+            self._watcher = threading.Thread(
+                target=self._watch, args=(self._pipe[0],), name="solidwire-signals", daemon=True
+            )
+            self._watcher.start()
         return True
 
     def uninstall(self) -> None:
@@ -803,6 +807,13 @@ class Interrupts:
         read_fd, write_fd = self._pipe
         self._pipe = None
         os.close(write_fd)  # ends the watcher's read
+        # The watcher is gone before the run returns: a thread still alive at
+        # interpreter exit keeps the bpy 4.5 module from shutting Blender down,
+        # and the process then hangs in a static destructor (Blender's audio
+        # thread is never stopped).
+        if self._watcher is not None:
+            self._watcher.join(timeout=5.0)
+            self._watcher = None
         os.close(read_fd)
 
     def _on_signal(self, signum, frame):
