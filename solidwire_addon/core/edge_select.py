@@ -234,18 +234,21 @@ def _components(count: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     long chain of nodes."""
     label = np.arange(count, dtype=np.int64)
     while True:
-        l1, l2 = label[a], label[b]  # roots: every label points at one
+        l1, l2 = label.take(a), label.take(b)  # roots: every label points at one
         differ = l1 != l2
         if not differ.any():
             return label
-        l1, l2 = l1[differ], l2[differ]
+        # A pair joins what its two roots join: the next round looks at the
+        # roots of the pairs still apart, and no longer at pairs already in
+        # one component.
+        a, b = l1[differ], l2[differ]
         # Hook each larger root under a smaller one. Where one root gets
         # several, the last write wins: any of them is a valid hook, and the
         # others are joined in a later round (a plain write is far cheaper
         # than np.minimum.at).
-        label[np.maximum(l1, l2)] = np.minimum(l1, l2)
+        label[np.maximum(a, b)] = np.minimum(a, b)
         while True:
-            jumped = label[label]
+            jumped = label.take(label)
             if np.array_equal(jumped, label):
                 break
             label = jumped
@@ -452,12 +455,12 @@ def select_edges(
     )
     owners, first, count = np.unique(seg_owner, return_index=True, return_counts=True)
     if not np.array_equal(owners, block_owner):  # a block with no segment at all
-        missing = np.setdiff1d(block_owner, owners)
-        owners = np.concatenate([owners, missing])
-        first = np.concatenate([first, np.zeros(len(missing), first.dtype)])
-        count = np.concatenate([count, np.zeros(len(missing), count.dtype)])
-        order = np.argsort(owners)
-        owners, first, count = owners[order], first[order], count[order]
+        # Every owner is a block's and both are sorted: the blocks without
+        # a segment get none, starting at 0.
+        at = np.searchsorted(block_owner, owners)
+        every_first, every_count = np.zeros(len(block_owner), first.dtype), np.zeros(len(block_owner), count.dtype)
+        every_first[at], every_count[at] = first, count
+        owners, first, count = block_owner, every_first, every_count
     table = np.zeros((TEXELS_PER_SEGMENT * len(seg_a), 4), dtype=np.float32)
     table[0::2, 0], table[0::2, 1], table[0::2, 2] = seg_a, seg_b, seg_style
     table[1::2, 0], table[1::2, 1] = chain_a, chain_b
@@ -1267,10 +1270,12 @@ def _mark_own_edges(
     walks = (size <= 4) & (first >= 0) & (corner_vert[corner(1)] == tri[:, 1]) & (corner_vert[corner(2)] == tri[:, 2])
     by_key = np.flatnonzero(~walks)
 
+    hidden_corner = ~drawn[corner_edge]  # per polygon corner: its leaving edge is not drawn
+
     def hidden(k, i, j):
         """Whether the polygon edge leaving the triangle's corner k (the
         vertex pair i, j) is not drawn."""
-        out = walks & ~drawn[corner_edge[corner(k)]]
+        out = walks & hidden_corner[corner(k)]
         if len(by_key):
             out[by_key] = hidden_by_key(tri[by_key, i], tri[by_key, j])
         return out
@@ -1494,10 +1499,45 @@ def _face_pairs(corner_edge: np.ndarray, face_offsets: np.ndarray, edge_count: i
 
 def _pairs_flat(face_normals: np.ndarray, f1: np.ndarray, f2: np.ndarray, angle: float) -> np.ndarray:
     """Whether the faces of each pair are distinct and their normals differ
-    by less than ``angle`` radians."""
-    n1, n2 = face_normals[f1].astype(np.float64), face_normals[f2].astype(np.float64)
-    cosine = np.einsum("ij,ij->i", n1, n2) / np.maximum(np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1), 1e-300)
-    return (np.arccos(np.clip(cosine, -1.0, 1.0)) < angle) & (f1 != f2)
+    by less than ``angle`` radians, in float64.
+
+    The angle between two normals is under ``angle`` exactly where the
+    cosine of the angle is above cos(angle) (for angles up to pi; every
+    angle is under a larger one), so no arccos is taken. The cosine is the
+    dot product of unit normals. Where the pairs outnumber the faces, each
+    face's normal is made unit length once; for a few pairs (an edit's
+    rows) only their faces are read. Both give the same bits (the same
+    element-wise arithmetic), so an edit's answer is the full test's. Each
+    component is gathered as its own 1-D array: a fancy index into (F, 3)
+    rows costs several times more. A zero normal has cosine 0 with
+    anything (90 degrees)."""
+    face_normals = np.asarray(face_normals)
+    f1, f2 = np.asarray(f1, np.int64), np.asarray(f2, np.int64)
+    cosine = np.zeros(len(f1))
+    if len(f1) > len(face_normals):
+        for column in _unit_components(face_normals):
+            cosine += column.take(f1) * column.take(f2)
+    else:
+        for first, second in zip(_unit_components(face_normals, f1), _unit_components(face_normals, f2)):
+            cosine += first * second
+    threshold = np.cos(angle) if angle <= np.pi else -np.inf
+    # Parallel normals are 0 degrees apart, under any positive angle, also
+    # one so small (under about 1e-7 radians) that its cosine is within the
+    # few units of rounding of a float64 cosine of parallel unit vectors.
+    parallel = cosine >= 1.0 - 4 * np.finfo(np.float64).eps
+    return ((cosine > threshold) | (parallel & (angle > 0.0))) & (f1 != f2)
+
+
+def _unit_components(face_normals: np.ndarray, faces: np.ndarray | None = None) -> list:
+    """The x, y and z of the unit normals (float64) of every face, or of
+    ``faces`` only: the same values either way."""
+    columns = [
+        (face_normals[:, k] if faces is None else face_normals[:, k].take(faces)).astype(np.float64) for k in range(3)
+    ]
+    length = np.maximum(np.sqrt(columns[0] * columns[0] + columns[1] * columns[1] + columns[2] * columns[2]), 1e-300)
+    for column in columns:
+        column /= length
+    return columns
 
 
 class EdgeAngleState:

@@ -385,3 +385,39 @@ def test_known_regions_joined_across_hidden_edges_give_the_general_path_arrays(m
     # One join in the middle: regions 1 and 2 (quads 2-5) become one.
     fast, taken = _select_both(8, regions_for, monkeypatch, joined_x=[4])
     assert taken and sorted(set(fast.triangle_regions.tolist())) == [0.0, 2.0, 6.0]
+
+
+def test_the_angle_between_normals_is_the_arccos_angle_whichever_way_it_is_gathered():
+    # The edge angle compares cosines instead of taking arccos, and gathers
+    # unit normals per face (many pairs) or per pair (an edit's few rows).
+    # Both ways must give the same bits, and the same answer as the angle
+    # itself wherever the angle is not within rounding of the threshold.
+    rng = np.random.default_rng(7)
+    normals = rng.normal(size=(400, 3)).astype(np.float32)
+    normals[:5] *= 1e-20  # tiny but not zero: unit length all the same
+    normals[5] = 0.0  # a zero normal is 90 degrees from anything
+    f1, f2 = rng.integers(0, 400, 1000), rng.integers(0, 400, 1000)
+    f2[:10] = f1[:10]  # a face with itself is never flat
+    n1, n2 = normals[f1].astype(np.float64), normals[f2].astype(np.float64)
+    cosine = np.einsum("ij,ij->i", n1, n2) / np.maximum(np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1), 1e-300)
+    between = np.arccos(np.clip(cosine, -1.0, 1.0))
+    for angle in (1e-3, 0.3, np.pi / 2, 2.0, np.pi, 4.0):
+        many = edge_select._pairs_flat(normals, f1, f2, angle)  # more pairs than faces
+        few = np.concatenate(
+            [edge_select._pairs_flat(normals, f1[i : i + 100], f2[i : i + 100], angle) for i in range(0, 1000, 100)]
+        )
+        assert np.array_equal(many, few)
+        clear = np.abs(between - angle) > 1e-9
+        assert np.array_equal(many[clear], ((between < angle) & (f1 != f2))[clear])
+        assert not many[:10].any()
+        assert many[f1 == 5].sum() == (angle > np.pi / 2) * (f2[f1 == 5] != 5).sum()
+    # Below about 1e-8 radians cos(angle) rounds to 1: the angle between
+    # two normals is then either 0 (the cosine rounds to 1 or above) or
+    # past the threshold, and the cosine test must still say which.
+    same = np.repeat(normals[6:7], 50, axis=0) * np.exp2(rng.integers(-3, 4, (50, 1))).astype(np.float32)
+    first, pairs = np.zeros(49, np.int64), np.arange(1, 50)
+    n1, n2 = same[first].astype(np.float64), same[pairs].astype(np.float64)
+    cosine = np.einsum("ij,ij->i", n1, n2) / (np.linalg.norm(n1, axis=1) * np.linalg.norm(n2, axis=1))
+    for angle in (1e-12, 1e-9):
+        expected = np.arccos(np.clip(cosine, -1.0, 1.0)) < angle
+        assert np.array_equal(edge_select._pairs_flat(same, first, pairs, angle), expected)
