@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.view import View
+from ..core.view import View, affine_inverse
 
 
 class NoCameraError(ValueError):
@@ -71,7 +71,7 @@ def camera_view(scene, depsgraph, size: tuple[int, int] | None = None) -> View:
     if not (np.isfinite(camera_to_world).all() and (axis_length > 0.0).all()):
         raise NoCameraError(f"camera '{camera.name}' has a zero or non-finite scale or transform")
     camera_to_world[:3, :3] /= axis_length
-    return View(np.linalg.inv(camera_to_world), np.array(projection, dtype=np.float64), (0, 0, width, height))
+    return View(affine_inverse(camera_to_world), np.array(projection, dtype=np.float64), (0, 0, width, height))
 
 
 def region_view(region, region_3d) -> View:

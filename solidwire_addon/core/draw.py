@@ -23,6 +23,8 @@ from .view import (
     DrawStats,
     View,
     box_pixels,
+    determinant3,
+    inverse_transpose3,
     outside_frustum_many,
     translation,
     wholly_in_front,
@@ -368,10 +370,9 @@ def normal_to_view(object_to_view: np.ndarray) -> np.ndarray:
     space), as a 4x4 with zeros elsewhere; non-invertible -> zeros."""
     linear = object_to_view[..., :3, :3]
     out = np.zeros(linear.shape[:-2] + (4, 4))
-    with np.errstate(all="ignore"):
-        ok = np.abs(np.linalg.det(linear)) > 1e-300
-        safe = np.where(ok[..., None, None], linear, np.eye(3))
-        out[..., :3, :3] = np.swapaxes(np.linalg.inv(safe), -1, -2) * ok[..., None, None]
+    inverse_t, det = inverse_transpose3(linear)
+    ok = np.abs(det) > 1e-300
+    out[..., :3, :3] = np.where(ok[..., None, None], inverse_t, 0.0)
     return out
 
 
@@ -458,7 +459,7 @@ def draw(
     gpu.state.depth_mask_set(depth_write)
     # Window-space winding flips with a mirroring view or a projection that
     # mirrors x or y (the z flip of a GL projection does not change winding).
-    flip = np.linalg.det(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
+    flip = determinant3(view.view_matrix[:3, :3]) * view.projection[0, 0] * view.projection[1, 1] < 0.0
     groups = list(_groups(items, view, cull, stats, pass_indices=target.aovs))
     try:
         call = _DrawCall(
@@ -812,7 +813,7 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
     instanced: list[InstancedDraw] = []
     single: list[SingleDraw] = []
     for group in groups:
-        mirrored_all = (np.linalg.det(group.world[:, :3, :3]) < 0.0) != call.flip
+        mirrored_all = (determinant3(group.world[:, :3, :3]) < 0.0) != call.flip
         info_all = np.zeros((len(group.world), 4))
         if bases is not None and len(bases):
             info_all[:, 0] = bases[group.indices]
@@ -1002,9 +1003,8 @@ def _set_object_block(shader, block, world: np.ndarray, mirrored: bool, pass_ind
     the normal matrix (inverse transpose of the object's 3x3), negated for a
     mirrored object so that gl_FrontFacing says which side the camera sees,
     and the object's pass index. One block, updated per object."""
-    try:
-        normal_matrix = np.linalg.inv(world[:3, :3]).T
-    except np.linalg.LinAlgError:
+    normal_matrix, det = inverse_transpose3(world[:3, :3])
+    if not (det != 0.0 and np.isfinite(det)):
         normal_matrix = np.zeros((3, 3))
     if mirrored:
         normal_matrix = -normal_matrix

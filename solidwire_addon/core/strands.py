@@ -35,7 +35,7 @@ from .draw import DrawTarget, bind_display_transform, clip_space_planes, quad_ba
 from .log import one_line, warn_once
 from .settings import pack_params
 from .targets import read_texture
-from .view import outside_frustum_many, translation
+from .view import determinant3, outside_frustum_many, translation
 
 CURVES, POINTS = "curves", "points"
 
@@ -346,7 +346,7 @@ def release() -> None:
 def _radius_scale(matrix: np.ndarray) -> float:
     """Scene units per object unit of a radius: the cube root of the
     object's volume scale (a uniform scale exactly)."""
-    det = abs(float(np.linalg.det(matrix[:3, :3])))
+    det = abs(float(determinant3(matrix[:3, :3])))
     return det ** (1.0 / 3.0) if np.isfinite(det) else 0.0
 
 
