@@ -92,8 +92,13 @@ def translation(offset) -> np.ndarray:
 
 
 def determinant3(linear: np.ndarray) -> np.ndarray:
-    """(...,): the determinants of (..., 3, 3) matrices."""
-    return inverse_transpose3(linear)[1]
+    """(...,): the determinants of (..., 3, 3) matrices, expanded along the
+    first row exactly as inverse_transpose3 does (the same bits)."""
+    m = np.asarray(linear, dtype=np.float64)
+    a, b, c = m[..., 0, 0], m[..., 0, 1], m[..., 0, 2]
+    d, e, f = m[..., 1, 0], m[..., 1, 1], m[..., 1, 2]
+    g, h, i = m[..., 2, 0], m[..., 2, 1], m[..., 2, 2]
+    return a * (e * i - f * h) + b * (f * g - d * i) + c * (d * h - e * g)
 
 
 def inverse_transpose3(linear: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
