@@ -1,9 +1,9 @@
 """Edge selection's shortcuts for a subdivision's layout give the general
 path's arrays bit for bit (core/edge_select.py): the regions the cage
 layout gives (blender/cage.py) written per region, region labels found over
-runs of consecutive joined faces, and a quad-only mesh's hidden-edge marks
-by row lookup, each against the components of the faces themselves and the
-search by vertex pair. On real evaluated meshes: Suzanne's cage at levels
+runs of consecutive joined faces, and the hidden-edge marks of a mesh of
+quads, or of triangles and quads, by row lookup, each against the
+components of the faces themselves and the search by vertex pair. On real evaluated meshes: Suzanne's cage at levels
 1-5, an n-gon cage, Multiresolution, Mirror and Array copies after the
 subdivision, the regions read from the evaluated mesh's own layout (a
 modifier before the subdivision, Edit Mode), and meshes where a shortcut
@@ -66,6 +66,7 @@ def _select(obj, selection, path, monkeypatch, *, cage_edges_of=None):
     with monkeypatch.context() as patch:
         if path == "general":
             patch.setattr(edge_select, "_mark_quad_rows", lambda *args: False)
+            patch.setattr(edge_select, "_mark_tri_and_quad_rows", lambda *args: False)
             patch.setattr(edge_select, "_region_labels", _general_labels)
         else:
             spied = "_select_known_regions" if path == "regions" else "_mark_quad_rows"
@@ -211,6 +212,37 @@ def test_a_subdivision_triangulated_afterwards_takes_the_general_marks(monkeypat
     obj.modifiers.new("Triangulate", "TRIANGULATE")
     angle = edge_select.Selection(edge_angle=math.radians(10.0))
     _assert_same_as_general(obj, angle, monkeypatch, rows_expected=False)
+
+
+@pytest.mark.parametrize("stack", ["own mesh", "triangulated subdivision", "UV sphere"])
+def test_triangles_and_quads_take_the_row_lookup(stack, monkeypatch):
+    """A mesh of triangles and quads (Suzanne's own, a subdivision
+    triangulated afterwards, a UV sphere's fans) under the edge angle and
+    the classes marks its rows by the lookup per row: the general path's
+    arrays."""
+    scene = scenes.empty_scene()
+    if stack == "UV sphere":
+        obj = scenes.mesh_object(
+            scene, "Sphere", lambda bm: bmesh.ops.create_uvsphere(bm, u_segments=12, v_segments=8, radius=1.0)
+        )
+    else:
+        obj = scenes.monkey(scene)
+    if stack == "triangulated subdivision":
+        _subdivide(obj, 1)
+        obj.modifiers.new("Triangulate", "TRIANGULATE")
+    for edge in obj.data.edges:
+        edge.use_seam = edge.index % 7 == 0
+    selection = edge_select.Selection(edge_angle=math.radians(15.0), classes=("seam",))
+    general, general_stats, _, _ = _select(obj, selection, "general", monkeypatch)
+    taken = []
+    real = edge_select._mark_tri_and_quad_rows
+    monkeypatch.setattr(edge_select, "_mark_tri_and_quad_rows", lambda *args: taken.append(real(*args)) or taken[-1])
+    other, stats, _, _ = _select(obj, selection, "regions", monkeypatch)
+    assert taken == [True]
+    assert stats == general_stats
+    _assert_same_arrays(other, general)
+    hidden = general.edge_flags & (edge_select.EDGE0_HIDDEN | edge_select.EDGE3_HIDDEN)
+    assert hidden.any()
 
 
 def test_concave_quads_split_along_their_other_diagonal(monkeypatch):

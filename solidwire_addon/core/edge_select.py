@@ -1137,22 +1137,31 @@ def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, p
 
 def _region_line_table(arrays: MeshArrays, verts, classes, ends, pairs, stats: SelectionStats) -> None:
     """``region_lines`` and its runs from the (region, drawn edge) pairs of
-    the regions whose lines the region-lines pass draws (see _region_lines).
-    ``classes`` None: no edge has a class."""
+    the regions whose lines the region-lines pass draws (see _region_lines),
+    sorted by region. ``classes`` None: no edge has a class."""
     if not len(pairs):
         arrays.region_lines = arrays.region_line_runs = None
         return
-    pairs = pairs[np.lexsort((pairs[:, 0], pairs[:, 1]))]  # by edge, then region
-    edge, region = pairs[:, 1], pairs[:, 0]
-    start = np.ones(len(edge), bool)
-    start[1:] = edge[1:] != edge[:-1]
-    first = np.flatnonzero(start)
-    rank = np.arange(len(edge)) - np.repeat(first, np.diff(np.append(first, len(edge))))
-    # Ranks 0 and 1 of an edge share an entry, then 2 and 3, ...
-    head = rank % 2 == 0
-    has_partner = np.append(~start[1:], False) & head
-    partner = np.where(has_partner, np.append(region[1:], -1), -1)
-    edge, region, partner = edge[head], region[head], partner[head]
+    listings = _first_and_last_listing(pairs[:, 1])
+    if listings is not None:
+        # No edge bounds more than two regions (a manifold mesh): its entry
+        # names the region that lists it first (the lower, as the pairs are
+        # by region) and the one that lists it last. Two scatters, no sort.
+        edge, first, last = listings
+        region = pairs[:, 0].take(first)
+        partner = np.where(first != last, pairs[:, 0].take(last), -1)
+    else:
+        pairs = pairs[np.lexsort((pairs[:, 0], pairs[:, 1]))]  # by edge, then region
+        edge, region = pairs[:, 1], pairs[:, 0]
+        start = np.ones(len(edge), bool)
+        start[1:] = edge[1:] != edge[:-1]
+        first = np.flatnonzero(start)
+        rank = np.arange(len(edge)) - np.repeat(first, np.diff(np.append(first, len(edge))))
+        # Ranks 0 and 1 of an edge share an entry, then 2 and 3, ...
+        head = rank % 2 == 0
+        has_partner = np.append(~start[1:], False) & head
+        partner = np.where(has_partner, np.append(region[1:], -1), -1)
+        edge, region, partner = edge[head], region[head], partner[head]
     # One entry per class of the edge (an edge with no class: one entry).
     bits = np.zeros(len(edge), np.int64) if classes is None else classes[edge]
     style, (edge, region, partner) = _one_per_class(bits, edge, region, partner)
@@ -1239,6 +1248,8 @@ def _mark_own_edges(
         return
     if _mark_quad_rows(arrays, drawn, corner_vert, offsets, corner_edge):
         return
+    if _mark_tri_and_quad_rows(arrays, drawn, offsets, sizes, corner_edge):
+        return
     vertex_count = np.int64(max(arrays.vertex_count, int(verts.max()) + 1))
     sorted_keys = []  # the hidden edges' vertex-pair keys, sorted on first use
 
@@ -1316,12 +1327,62 @@ def _mark_quad_rows(
     # Which of its quad's edges are hidden, one bit per corner, and then per
     # row a lookup of that pattern turned to the row's first corner.
     pattern = _hidden_pattern(drawn, corner_edge, len(flip)).astype(np.intp)
-    clear_of, marks_of = _quad_row_marks()
+    clear_of, marks_of = _ROW_MARKS
     # A row starting at corner r: its edges 0, 1 and its quad edges 3, 4
     # leave corners r, r + 1, r + 2, r + 3.
     for rows, plain, flipped in ((slice(0, None, 2), 0, 3), (slice(1, None, 2), 2, 1)):
         at = np.where(flip, 16 * flipped, 16 * plain) + pattern
         flags[rows] = (flags[rows] & ~clear_of[at]) | marks_of[at]
+    return True
+
+
+def _mark_tri_and_quad_rows(
+    arrays: MeshArrays, drawn: np.ndarray, offsets: np.ndarray, sizes: np.ndarray, corner_edge: np.ndarray
+) -> bool:
+    """_mark_own_edges for a mesh of triangles and quads (no n-gon) whose
+    rows are those extract.build_arrays_fast writes, which it says by
+    keeping a split per quad (``quad_flip``): a triangle as its row from
+    corner 0, a quad as its two rows (see _mark_quad_rows). Each row's
+    edges are then its face's corner edges in a known order, so one
+    lookup per row of its face's hidden edges turned to its first corner
+    marks it, where the general path finds every row's corners among its
+    face's. False (nothing done) for any other mesh."""
+    flip = arrays.quad_flip
+    face_count = len(sizes)
+    if (
+        flip is None
+        or face_count == 0
+        or len(arrays.ngon_corners)
+        or arrays.triangle_count != int(offsets[-1]) - 2 * face_count
+        or sizes.min() < 3
+        or sizes.max() > 4
+    ):
+        return False
+    quad_faces = np.flatnonzero(sizes == 4)
+    if len(quad_faces) != len(flip):
+        return False
+    # Which of its face's edges are hidden, one bit per corner (the edge
+    # leaving it): every face has corners 0-2, a quad corner 3 too.
+    hidden_corner = np.take(drawn, corner_edge)
+    np.logical_not(hidden_corner, out=hidden_corner)
+    hidden_corner = hidden_corner.view(np.uint8)
+    start = offsets[:-1]
+    pattern = hidden_corner.take(start)
+    pattern |= hidden_corner.take(start + 1) << np.uint8(1)
+    pattern |= hidden_corner.take(start + 2) << np.uint8(2)
+    pattern[quad_faces] |= hidden_corner.take(start.take(quad_faces) + 3) << np.uint8(3)
+    # Each row's entry of the lookup: 16 * its first corner for a quad's
+    # rows (corners 0 and 2, or 3 and 1 where split the other way),
+    # TRIANGLE_ROWS for a triangle's; plus its face's pattern.
+    row_base = np.full(arrays.triangle_count, _TRIANGLE_ROWS, np.uint8)
+    quad_row = start.take(quad_faces) - 2 * quad_faces  # a face's first row (build_arrays_fast)
+    row_base[quad_row] = np.where(flip, np.uint8(48), np.uint8(0))
+    row_base[quad_row + 1] = np.where(flip, np.uint8(16), np.uint8(32))
+    row_base += pattern.take(arrays.triangle_polygons)
+    clear_of, marks_of = _ROW_MARKS
+    flags = arrays.edge_flags
+    flags &= ~clear_of.take(row_base)
+    flags |= marks_of.take(row_base)
     return True
 
 
@@ -1400,14 +1461,26 @@ def _hidden_pattern(
 
 
 def _quad_row_marks():
-    """(clear, marks), each (64,) int32 indexed by 16 * r + p: the flag bits
-    _mark_quad_rows clears and sets on a row starting at its quad's corner
-    r whose quad has the hidden edges p (bit c: the edge leaving corner c)."""
+    """(clear, marks), each (64 + 8,) int32 indexed by 16 * r + p: the flag
+    bits _mark_quad_rows clears and sets on a row starting at its quad's
+    corner r whose quad has the hidden edges p (bit c: the edge leaving
+    corner c); from _TRIANGLE_ROWS on, indexed by _TRIANGLE_ROWS + p, those
+    of a triangle's row (which starts at its corner 0) with the hidden
+    edges p."""
     r, p = np.divmod(np.arange(64), 16)
     h = [(p >> ((r + k) % 4)) & 1 for k in range(4)]
     clear = h[0] * EDGE0_REAL | h[1] * EDGE1_REAL
     marks = h[0] * EDGE0_HIDDEN | h[1] * (EDGE0_HIDDEN << 1) | h[2] * EDGE3_HIDDEN | h[3] * EDGE4_HIDDEN
-    return clear.astype(np.int32), marks.astype(np.int32)
+    t = [(np.arange(8) >> k) & 1 for k in range(3)]
+    tri_clear = t[0] * EDGE0_REAL | t[1] * EDGE1_REAL | t[2] * EDGE2_REAL
+    tri_marks = t[0] * EDGE0_HIDDEN | t[1] * (EDGE0_HIDDEN << 1) | t[2] * (EDGE0_HIDDEN << 2)
+    return (
+        np.concatenate([clear, tri_clear]).astype(np.int32),
+        np.concatenate([marks, tri_marks]).astype(np.int32),
+    )
+
+
+_TRIANGLE_ROWS = 64  # where _quad_row_marks' entries for a triangle's row start
 
 
 # The most segments a region's block holds: WALK_LIMIT drawn edges (a larger
@@ -1415,6 +1488,7 @@ def _quad_row_marks():
 _MOST_BLOCK_SEGMENTS = WALK_LIMIT * len(EDGE_CLASSES)
 # Computed once: the lookup _select_known_regions writes quad rows from.
 _LISTED_QUAD_ROWS = _listed_quad_rows()
+_ROW_MARKS = _quad_row_marks()
 
 
 def _corner_in_polygon(vertex, start, size, corner_vert) -> np.ndarray:

@@ -421,3 +421,66 @@ def test_the_angle_between_normals_is_the_arccos_angle_whichever_way_it_is_gathe
     for angle in (1e-12, 1e-9):
         expected = np.arccos(np.clip(cosine, -1.0, 1.0)) < angle
         assert np.array_equal(edge_select._pairs_flat(same, first, pairs, angle), expected)
+
+
+def _grid_of_triangles_and_quads(rng, size: int):
+    """A ``size`` x ``size`` grid whose cells are a quad or two triangles
+    (split along either diagonal), each face's corners starting at a random
+    one of them, the vertices jittered so far that some quads are concave
+    and split along their other diagonal: positions, corner ids, offsets, corner
+    edges and edge vertex pairs."""
+    row = size + 1
+    positions = np.array([[x, y, 0] for y in range(row) for x in range(row)], np.float32)
+    positions += rng.uniform(-0.45, 0.45, positions.shape).astype(np.float32)
+    faces = []
+    for y in range(size):
+        for x in range(size):
+            a, b, c, d = y * row + x, y * row + x + 1, (y + 1) * row + x + 1, (y + 1) * row + x
+            cell = ([(a, b, c, d)], [(a, b, c), (a, c, d)], [(a, b, d), (b, c, d)])[rng.integers(3)]
+            for face in cell:
+                turn = int(rng.integers(len(face)))
+                faces.append(face[turn:] + face[:turn])
+    corner_vert = np.array([v for f in faces for v in f], np.int32)
+    offsets = np.concatenate([[0], np.cumsum([len(f) for f in faces])]).astype(np.int32)
+    index: dict = {}
+    corner_edge = [
+        index.setdefault(tuple(sorted((f[k], f[(k + 1) % len(f)]))), len(index)) for f in faces for k in range(len(f))
+    ]
+    return positions, corner_vert, offsets, np.array(corner_edge), np.array(list(index), np.int64)
+
+
+def test_rows_of_triangles_and_quads_are_marked_as_the_general_path_marks_them(monkeypatch):
+    """A mesh of triangles and quads marks its rows' hidden edges by a
+    lookup per row (build_arrays_fast's layout); the arrays are the general
+    path's bit for bit, which finds each row's corners in its face."""
+    rng = np.random.default_rng(7)
+    taken = []
+    real = edge_select._mark_tri_and_quad_rows
+    monkeypatch.setattr(edge_select, "_mark_tri_and_quad_rows", lambda *args: taken.append(real(*args)) or taken[-1])
+    trials = 12
+    flips = []
+    for trial in range(trials):
+        positions, corner_vert, offsets, corner_edge, verts = _grid_of_triangles_and_quads(rng, int(rng.integers(3, 9)))
+        drawn = rng.random(len(verts)) < rng.uniform(0.2, 0.9)
+        classes = (
+            np.where(rng.random(len(verts)) < 0.1, 1 << rng.integers(3, size=len(verts)), 0) if trial % 2 else None
+        )
+        results = []
+        for shortcut in (True, False):
+            arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
+            assert arrays.quad_flip is not None
+            flips.append(arrays.quad_flip.mean())
+            if not shortcut:
+                arrays.quad_flip = None  # the general path: each row's corners found in its face
+            inputs = edge_select.EdgeInputs(verts, drawn.copy(), classes)
+            results.append((arrays, edge_select.select_edges(arrays, corner_vert, offsets, corner_edge, inputs)))
+        (fast, fast_stats), (general, general_stats) = results
+        assert fast_stats == general_stats
+        for field in ("triangles", "edge_flags", "region_table", "region_lines", "triangle_regions"):
+            a, b = getattr(fast, field), getattr(general, field)
+            assert (a is None) == (b is None) and (a is None or np.array_equal(a, b)), (trial, field)
+        hidden_bits = extract.EDGE0_HIDDEN | extract.EDGE0_HIDDEN << 1 | extract.EDGE0_HIDDEN << 2
+        hidden = (fast.edge_flags & hidden_bits) != 0
+        assert hidden.any() and not hidden.all()
+    assert taken == [True, False] * trials
+    assert 0 < np.mean(flips) < 0.5  # quads split along either diagonal
