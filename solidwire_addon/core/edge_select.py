@@ -256,10 +256,11 @@ def _components(count: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _chain_ends(verts: np.ndarray, chain: np.ndarray | None) -> np.ndarray:
     """(E, 2) the two ends of each edge's chain (its own ends when the chain
-    is not a simple open path)."""
-    ends = verts.astype(np.int64).copy()
+    is not a simple open path); without chains, ``verts`` itself (read,
+    never written)."""
     if chain is None or len(verts) == 0:
-        return ends
+        return np.asarray(verts, np.int64)
+    ends = verts.astype(np.int64)  # (a copy: written below)
     chain = chain.astype(np.int64)
     vertex_count = int(verts.max()) + 1
     keys = np.repeat(chain, 2) * vertex_count + verts.astype(np.int64).reshape(-1)
