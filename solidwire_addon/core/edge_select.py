@@ -1374,7 +1374,7 @@ def _mark_tri_and_quad_rows(
     pattern[quad_faces] |= hidden_corner.take(start.take(quad_faces) + 3) << np.uint8(3)
     # Each row's entry of the lookup: 16 * its first corner for a quad's
     # rows (corners 0 and 2, or 3 and 1 where split the other way),
-    # TRIANGLE_ROWS for a triangle's; plus its face's pattern.
+    # _TRIANGLE_ROWS for a triangle's; plus its face's pattern.
     row_base = np.full(arrays.triangle_count, _TRIANGLE_ROWS, np.uint8)
     quad_row = start.take(quad_faces) - 2 * quad_faces  # a face's first row (build_arrays_fast)
     row_base[quad_row] = np.where(flip, np.uint8(48), np.uint8(0))
