@@ -91,13 +91,16 @@ def translation(offset) -> np.ndarray:
 # load.
 
 
+def _entries3(linear: np.ndarray):
+    """The nine entries of (..., 3, 3) matrices in float64, row by row."""
+    m = np.asarray(linear, dtype=np.float64)
+    return tuple(m[..., row, column] for row in range(3) for column in range(3))
+
+
 def determinant3(linear: np.ndarray) -> np.ndarray:
     """(...,): the determinants of (..., 3, 3) matrices, expanded along the
     first row exactly as inverse_transpose3 does (the same bits)."""
-    m = np.asarray(linear, dtype=np.float64)
-    a, b, c = m[..., 0, 0], m[..., 0, 1], m[..., 0, 2]
-    d, e, f = m[..., 1, 0], m[..., 1, 1], m[..., 1, 2]
-    g, h, i = m[..., 2, 0], m[..., 2, 1], m[..., 2, 2]
+    a, b, c, d, e, f, g, h, i = _entries3(linear)
     return a * (e * i - f * h) + b * (f * g - d * i) + c * (d * h - e * g)
 
 
@@ -108,11 +111,8 @@ def inverse_transpose3(linear: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     transpose is the cofactor matrix itself over it). Element-wise
     arithmetic only: no LAPACK, no temporary per matrix. Where the
     determinant is 0 the result is not finite: the caller decides."""
-    m = np.asarray(linear, dtype=np.float64)
-    a, b, c = m[..., 0, 0], m[..., 0, 1], m[..., 0, 2]
-    d, e, f = m[..., 1, 0], m[..., 1, 1], m[..., 1, 2]
-    g, h, i = m[..., 2, 0], m[..., 2, 1], m[..., 2, 2]
-    cofactors = np.empty(m.shape)
+    a, b, c, d, e, f, g, h, i = _entries3(linear)
+    cofactors = np.empty(np.shape(a) + (3, 3))
     cofactors[..., 0, 0], cofactors[..., 0, 1], cofactors[..., 0, 2] = e * i - f * h, f * g - d * i, d * h - e * g
     cofactors[..., 1, 0], cofactors[..., 1, 1], cofactors[..., 1, 2] = c * h - b * i, a * i - c * g, b * g - a * h
     cofactors[..., 2, 0], cofactors[..., 2, 1], cofactors[..., 2, 2] = b * f - c * e, c * d - a * f, a * e - b * d
