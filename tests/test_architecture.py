@@ -622,14 +622,26 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "aovs": (True, lambda v: v.write_aovs),
         "lines": (draw.HIDDEN_LINES, lambda v: v.hidden_pass),
     }
-    state_or_input = {"depth_test", "depth_write", "visibility", "triangle_ids_by_vertex", "record_depth"}
+    state_or_input = {
+        "depth_test",
+        "depth_write",
+        "visibility",
+        "triangle_ids_by_vertex",
+        "record_depth",
+        "lines_window",  # which region-lines runs a partial redraw draws
+    }
     names = {f.name for f in fields(draw.DrawTarget)}
     assert names == set(selects_code) | state_or_input, "classify every DrawTarget field here"
     for name, (value, says) in selects_code.items():
         variant = draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value}))
         assert variant != plain and says(variant), name
     for name in state_or_input - {"triangle_ids_by_vertex", "record_depth"}:
-        value = {"depth_test": "GREATER", "depth_write": False, "visibility": object()}[name]
+        value = {
+            "depth_test": "GREATER",
+            "depth_write": False,
+            "visibility": object(),
+            "lines_window": (0, 0, 8, 8, 3.0),
+        }[name]
         assert draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value})) == plain, name
     # The visibility stage's numbering is compiled code of that stage only.
     record = draw.DrawTarget(stage=draw.VISIBILITY, linear_depth=True)

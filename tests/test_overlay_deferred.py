@@ -299,6 +299,44 @@ def test_an_edit_redraws_up_to_the_lines_reach(look):
         frame()  # kept from now on
 
 
+def test_a_partial_redraw_draws_the_region_lines_that_reach_it():
+    """A dense subdivided grid, one vertex dragged near a corner: the
+    partial redraw draws again only the region-lines runs that can reach its
+    rectangle (their segments' window box widened by the lines' reach), and
+    equals a fresh frame: lines of edges just outside the rectangle that
+    reach into it included (the grid's cells are narrower than the reach)."""
+    scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=2.0, use_cage_edges=True)
+    scenes.add_camera(scene, location=(0.0, -10.0, 0.0))
+    plane = scenes.grid(scene, "Grid", x_segments=40, y_segments=30, size=2.0, rotation=(1.5708, 0, 0))
+    plane.modifiers.new("Subdivision", "SUBSURF").levels = 1
+    vertices = plane.data.vertices
+    corners = sorted(vertices, key=lambda v: (v.co.x, v.co.y))
+    corners[0].co.z, corners[-1].co.z = 0.3, -0.3  # the bounds the drag stays within
+    moved = min(vertices, key=lambda v: (v.co.x + 1.2) ** 2 + (v.co.y - 0.9) ** 2)
+    plane.data.update()
+    frame_stats = []
+
+    def frame():
+        rgba, stats = _draw(scene, [plane])
+        frame_stats.append(stats)
+        return rgba, _path(stats)
+
+    frame()
+    frame()
+    for _step in range(2):
+        moved.co.x += 0.02
+        moved.co.z += 0.05
+        plane.data.update()
+        edited, path = frame()
+        assert path == "surface_partial"
+        # Runs of two entries (a cage edge cut once): most stay out.
+        runs = frame_stats[-1]["region_line_entries"] // 2
+        assert frame_stats[-1].get("region_runs_left_out", 0) > 0.8 * runs
+    runtime.mesh_cache.clear()
+    fresh, _path_fresh = frame()
+    assert np.array_equal(edited, fresh), np.abs(edited - fresh).max()
+
+
 def test_cage_look_alike_on_every_path():
     """The cage look (multi-face regions: their lines drawn over the record,
     docs/image_model.md §2.6), Suzanne-like dense: resolved straight, resolved

@@ -142,6 +142,7 @@ class GPUMesh:
         )
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
+        self._run_vertices = None  # run_points(), made on first use
         # The set-up pre-pass's output for big meshes (draw._run_setup), made
         # on first use, and what it was set up for (draw._setup_key): kept
         # while the mesh, its matrix and the viewport stay the same.
@@ -228,6 +229,26 @@ class GPUMesh:
             self._region_tables = (table_texture(lines), table_texture(regions))
             self.gpu_bytes += sum(t.width * t.height * 16 for t in self._region_tables)
         return self._region_tables
+
+    def run_points(self):
+        """(points, corners): the mesh-space position of every vertex at
+        which a segment of a region-lines run ends, and each run's
+        segment ends as rows of ``points``, transposed: (2 L, R) (L: the
+        most segments a run holds; a shorter run repeats its last
+        segment's). Which vertices
+        is made on first use and kept (a move keeps the runs); their
+        positions are read now. What a partial redraw reads to leave out
+        the runs that cannot reach its rectangle (draw.runs_reaching)."""
+        if self._run_vertices is None:
+            runs = self._region_line_runs_cpu
+            first, count = runs[:, 0].astype(np.int64), runs[:, 1].astype(np.int64)
+            slot = np.minimum(np.arange(self.region_run_segments), count[:, None] - 1)
+            rows = TEXELS_PER_REGION_LINE * (first[:, None] + slot)
+            ends = self._region_lines_cpu[rows.ravel(), :2].astype(np.int64)
+            vertices, corners = np.unique(ends.ravel(), return_inverse=True)
+            self._run_vertices = (vertices, np.ascontiguousarray(corners.reshape(len(runs), -1).T))
+        vertices, corners = self._run_vertices
+        return self._local_positions[vertices], corners
 
     def visibility_batch(self, by_vertex: bool = False):
         """An indexed triangle batch (the triangle table as index buffer)

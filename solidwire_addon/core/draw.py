@@ -72,7 +72,11 @@ class DrawTarget:
     depth in a second colour target, the render passes' targets (``aovs``),
     and which ``lines`` the colour shows (WIRE_LINES, NO_LINES,
     HIDDEN_LINES). ``triangle_ids_by_vertex``: how the VISIBILITY stage
-    numbers triangles (options.DrawOptions)."""
+    numbers triangles (options.DrawOptions). ``lines_window`` (x, y,
+    width, height, reach; LINES only): the caller draws inside that window
+    rectangle alone (a scissor) and no line reaches farther than ``reach``
+    px from its segment, so the runs whose lines cannot reach the
+    rectangle are left out of the draw (a partial redraw's lines)."""
 
     depth_test: str = "LESS_EQUAL"
     depth_write: bool = True
@@ -88,6 +92,7 @@ class DrawTarget:
     aovs: bool = False
     lines: str = WIRE_LINES
     triangle_ids_by_vertex: bool = False
+    lines_window: tuple | None = None
 
     def hidden(self) -> DrawTarget:
         """The hidden-line layer over this target (image model §5.4): every
@@ -473,13 +478,17 @@ def draw(
             # Both deferred stages must split and number the draws alike:
             # instancing does not depend on the stage's variant.
             instancing=program.supports_instancing and not target.aovs,
-            numbering=_DrawNumbers(stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view),
+            numbering=_DrawNumbers(
+                stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view, lines_window=target.lines_window
+            ),
         )
         parts = _parts(groups, program, stage, view)
         # One variant per part; parts in a fixed order (both deferred stages
         # must draw, and so number, alike).
         for part in sorted(parts):
             _draw_groups(parts[part], part.variant(variant), call)
+        if call.numbering.runs_left_out:
+            stats.extra["region_runs_left_out"] = call.numbering.runs_left_out
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
@@ -662,10 +671,12 @@ class _DrawNumbers:
     rectangle over the draw's window box. A direct draw (stage None) just
     draws the batch."""
 
-    def __init__(self, stage, extras, by_vertex: bool = False, view: View | None = None):
+    def __init__(self, stage, extras, by_vertex: bool = False, view: View | None = None, lines_window=None):
         self.stage, self.extras, self.count = stage, extras, 0
         self.by_vertex = by_vertex  # the visibility batch's numbering (ShaderVariant.triangle_ids_by_vertex)
         self.view = view
+        self.lines_window = lines_window  # DrawTarget.lines_window
+        self.runs_left_out = 0  # region-lines runs that lines_window left out
 
     @property
     def viewport(self):
@@ -700,17 +711,22 @@ class _DrawNumbers:
         self.count += 1
         if self.stage == LINES:
             count = mesh.region_run_count
-            if count:
+            picked = None
+            if count and self.lines_window is not None and not instance_count:
+                picked = runs_reaching(mesh, object_to_clip, self.view.viewport, self.lines_window)
+                self.runs_left_out += count - (count if picked is None else len(picked))
+            if count and (picked is None or len(picked)):
                 shader.uniform_int("draw_number", self.count)
                 lines, regions = mesh.region_tables()
                 shader.uniform_sampler("region_lines", lines)
                 shader.uniform_sampler("triangle_regions", regions)
                 shader.uniform_int("line_count", count)
-                batch = indexed_quad_batch(count)
                 if instance_count:
-                    batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
+                    indexed_quad_batch(count).draw_instanced(shader, instance_start=0, instance_count=instance_count)
+                elif picked is None:
+                    indexed_quad_batch(count).draw_range(shader, elem_start=0, elem_count=6 * count)
                 else:
-                    batch.draw_range(shader, elem_start=0, elem_count=6 * count)
+                    picked_quad_batch(picked, count).draw(shader)
             return
         shader.uniform_int("draw_number", self.count)
         if self.stage == VISIBILITY:
@@ -725,7 +741,8 @@ class _DrawNumbers:
         _rectangle().draw(shader)
 
 
-_quad_batches: dict[tuple[int, int], object] = {}  # (quads, corners per quad): batch
+# (quads, corners per quad): batch; (quads, corners per quad, "corners"): its vertex buffer
+_quad_batches: dict[tuple, object] = {}
 
 
 def quad_batch(count: int):
@@ -747,22 +764,86 @@ def indexed_quad_batch(count: int):
 
 
 def _shared_quads(count: int, *, indexed: bool):
-    size = 1 << max(int(count - 1).bit_length(), 6)
+    size = _size_class(count)
     corners = 4 if indexed else 6
     batch = _quad_batches.get((size, corners))
     if batch is None:
-        fmt = gpu.types.GPUVertFormat()
-        fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
-        vbo = gpu.types.GPUVertBuf(fmt, corners * size)
-        vbo.attr_fill("quad_corner", np.tile(np.arange(corners, dtype=np.int32), size))
+        vbo = _quad_corners(size, corners)
         if indexed:
-            first = 4 * np.arange(size, dtype=np.int32)[:, None]
-            indices = (first + np.array([0, 1, 2, 0, 2, 3], dtype=np.int32)).reshape(-1, 3)
-            batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=indices))
+            batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=_quad_indices(np.arange(size, dtype=np.int32)))
         else:
             batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
         _quad_batches[(size, corners)] = batch
     return batch
+
+
+def _size_class(count: int) -> int:
+    """The quads a shared batch for ``count`` holds: the next power of two
+    (at least 64)."""
+    return 1 << max(int(count - 1).bit_length(), 6)
+
+
+def picked_quad_batch(picked: np.ndarray, count: int):
+    """indexed_quad_batch(count)'s corners with the triangles of the quads
+    ``picked`` alone: a draw of some of ``count`` quads in which
+    gl_VertexID / 4 is still each quad's number. Made per draw (its index
+    buffer is as long as the pick)."""
+    return gpu.types.GPUBatch(type="TRIS", buf=_quad_corners(_size_class(count), 4), elem=_quad_indices(picked))
+
+
+def runs_reaching(mesh, object_to_clip: np.ndarray, viewport, window) -> np.ndarray | None:
+    """The runs of ``mesh``'s region lines (cache.GPUMesh.run_points)
+    whose lines can reach the window rectangle of ``window`` (x, y, width,
+    height, reach: DrawTarget.lines_window), in order; None where that is
+    every run. A run's segments lie in the window box of their ends where
+    every end is in front of the camera (a segment there projects to the
+    segment between its ends' projections; the near plane only shortens
+    it), and its lines within ``reach`` px of them. A run with an end at or
+    behind the camera plane is kept. This rounds in float32 as the
+    drawing does, not in the same order: the reach has pixels to spare
+    (passes._line_reach_px)."""
+    points, corners = mesh.run_points()
+    to_clip = object_to_clip.astype(np.float32)
+    x, y, z, w = to_clip[:, :3] @ points.T + to_clip[:, 3:]
+    ahead = w > 1e-6 * (np.abs(x) + np.abs(y) + np.abs(z) + 1.0)
+    safe_w = np.where(ahead, w, np.float32(1.0))
+    left, bottom, width, height = viewport
+    x = left + (x / safe_w + 1.0) * (0.5 * width)
+    y = bottom + (y / safe_w + 1.0) * (0.5 * height)
+    # (corners is (2 L, R): each reduction runs along whole rows.)
+    run_x, run_y = x[corners], y[corners]
+    rect_x, rect_y, rect_width, rect_height, reach = window
+    reaching = (
+        (run_x.min(axis=0) < rect_x + rect_width + reach)
+        & (run_x.max(axis=0) > rect_x - reach)
+        & (run_y.min(axis=0) < rect_y + rect_height + reach)
+        & (run_y.max(axis=0) > rect_y - reach)
+    ) | ~ahead[corners].all(axis=0)
+    picked = np.flatnonzero(reaching)
+    return None if len(picked) == corners.shape[1] else picked
+
+
+# Each quad's two triangles over its four corners.
+_QUAD_TRIANGLES = np.array([0, 1, 2, 0, 2, 3], dtype=np.int32)
+
+
+def _quad_indices(quads: np.ndarray):
+    return gpu.types.GPUIndexBuf(
+        type="TRIS", seq=(4 * quads.astype(np.int32)[:, None] + _QUAD_TRIANGLES).reshape(-1, 3)
+    )
+
+
+def _quad_corners(size: int, corners: int):
+    """The vertex buffer of ``size`` quads' corners (``quad_corner`` 0 to
+    ``corners`` - 1 each), shared as _shared_quads's batches are."""
+    vbo = _quad_batches.get((size, corners, "corners"))
+    if vbo is None:
+        fmt = gpu.types.GPUVertFormat()
+        fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
+        vbo = gpu.types.GPUVertBuf(fmt, corners * size)
+        vbo.attr_fill("quad_corner", np.tile(np.arange(corners, dtype=np.int32), size))
+        _quad_batches[(size, corners, "corners")] = vbo
+    return vbo
 
 
 _rectangles: list = []

@@ -555,13 +555,23 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
     line per pixel into ``targets.lines``, which it returns; ``scissor``
     as _record_visibility's."""
     framebuffer = targets.region_lines_framebuffer()
+    # Inside a scissor only the runs whose lines reach it are drawn (the
+    # scissor comes from _redraw_rect, which measures the lines' reach).
+    reach = None if scissor is None else _line_reach_px(settings, items)
     with framebuffer.bind(), _scissored(scissor):
         _clear(framebuffer, view.width, view.height)
-        lines = replace(target, stage=draw_mod.LINES, visibility=targets.visible)
-        draw_mod.draw(items, view, settings, target=lines, cull=cull)
+        lines = replace(
+            target,
+            stage=draw_mod.LINES,
+            visibility=targets.visible,
+            lines_window=None if reach is None else (*scissor, reach),
+        )
+        drawn = draw_mod.draw(items, view, settings, target=lines, cull=cull)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
+    if "region_runs_left_out" in drawn.extra:
+        stats.extra["region_runs_left_out"] = drawn.extra["region_runs_left_out"]
     return targets.lines
 
 
