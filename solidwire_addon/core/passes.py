@@ -555,9 +555,11 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
     line per pixel into ``targets.lines``, which it returns; ``scissor``
     as _record_visibility's."""
     framebuffer = targets.region_lines_framebuffer()
-    # Inside a scissor only the runs whose lines reach it are drawn (the
-    # scissor comes from _redraw_rect, which measures the lines' reach).
-    reach = None if scissor is None else _line_reach_px(settings, items)
+    # Inside a scissor a software rasteriser draws only the runs whose
+    # lines reach it (the scissor comes from _redraw_rect, which measures the
+    # lines' reach): it would set up every run's quad before the scissor
+    # drops it, where a GPU drops them for less than picking them costs.
+    reach = None if scissor is None or not shaders.software_rasteriser() else _line_reach_px(settings, items)
     with framebuffer.bind(), _scissored(scissor):
         _clear(framebuffer, view.width, view.height)
         lines = replace(

@@ -512,6 +512,16 @@ def _region_lines_create_info(variant: ShaderVariant):
     return info
 
 
+def software_rasteriser() -> bool:
+    """Whether the GPU module draws through a software rasteriser (Mesa's
+    llvmpipe, the machines without a GPU), which runs the vertex stage and
+    sets up every triangle on the CPU, even those the scissor then drops."""
+    try:
+        return gpu.platform.device_type_get() == "SOFTWARE"
+    except (AttributeError, RuntimeError):
+        return False
+
+
 def triangle_ids_by_vertex() -> bool:
     """Whether the visibility pass numbers triangles by their provoking
     vertex rather than with gl_PrimitiveID: on a software rasteriser under
@@ -522,7 +532,7 @@ def triangle_ids_by_vertex() -> bool:
     Blender keeps (see _provoking_corners). options.DrawOptions can
     choose either (tests compare the two)."""
     try:
-        return gpu.platform.backend_type_get() == "OPENGL" and gpu.platform.device_type_get() == "SOFTWARE"
+        return gpu.platform.backend_type_get() == "OPENGL" and software_rasteriser()
     except (AttributeError, RuntimeError):
         return False
 
