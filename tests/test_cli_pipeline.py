@@ -82,10 +82,18 @@ def _start(*args, env=None) -> subprocess.Popen:
 
 def _wait_for_first_frame(proc: subprocess.Popen) -> dict:
     """Read progress until one frame is reported written; then the run is
-    between or inside frames, the state a signal is tested in."""
-    for line in proc.stdout:
-        if line.startswith("{"):
+    between or inside frames, the state a signal is tested in. The pipe is
+    read a byte at a time: a buffered read can take the next frame's record
+    along (a loaded machine writes two before the test reads), and
+    communicate(), which reads the pipe itself, would never see it."""
+    fd, line = proc.stdout.fileno(), b""
+    while byte := os.read(fd, 1):
+        if byte != b"\n":
+            line += byte
+        elif line.startswith(b"{"):
             return json.loads(line)
+        else:
+            line = b""
     raise AssertionError(f"no frame was reported; exit {proc.wait()}: {proc.stderr.read()}")
 
 
