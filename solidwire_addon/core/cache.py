@@ -232,13 +232,13 @@ class GPUMesh:
 
     def run_points(self):
         """(points, corners): the mesh-space position of every vertex at
-        which a segment of a region-lines run ends, and each run's
-        segment ends as rows of ``points``, transposed: (2 L, R) (L: the
-        most segments a run holds; a shorter run repeats its last
-        segment's). Which vertices
-        is made on first use and kept (a move keeps the runs); their
-        positions are read now. What a partial redraw reads to leave out
-        the runs that cannot reach its rectangle (draw.runs_reaching)."""
+        which a segment of a region-lines run ends, and each run's segment
+        ends as rows of ``points``, transposed: (2 L, R) (L: the most
+        segments a run holds; a shorter run repeats its last segment's).
+        Which vertices is found on first use and kept (a move keeps the
+        runs); their positions are read now. What a partial redraw reads to
+        leave out the runs that cannot reach its rectangle
+        (draw.runs_reaching)."""
         if self._run_vertices is None:
             runs = self._region_line_runs_cpu
             first, count = runs[:, 0].astype(np.int64), runs[:, 1].astype(np.int64)
