@@ -741,8 +741,8 @@ class _DrawNumbers:
         _rectangle().draw(shader)
 
 
-# (quads, corners per quad): batch; (quads, corners per quad, "corners"): its vertex buffer
-_quad_batches: dict[tuple, object] = {}
+_quad_batches: dict[tuple[int, int], object] = {}  # (quads, corners per quad): batch
+_quad_corner_buffers: dict[tuple[int, int], object] = {}  # (quads, corners per quad): their vertex buffer
 
 
 def quad_batch(count: int):
@@ -836,13 +836,13 @@ def _quad_indices(quads: np.ndarray):
 def _quad_corners(size: int, corners: int):
     """The vertex buffer of ``size`` quads' corners (``quad_corner`` 0 to
     ``corners`` - 1 each), shared as _shared_quads's batches are."""
-    vbo = _quad_batches.get((size, corners, "corners"))
+    vbo = _quad_corner_buffers.get((size, corners))
     if vbo is None:
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
         vbo = gpu.types.GPUVertBuf(fmt, corners * size)
         vbo.attr_fill("quad_corner", np.tile(np.arange(corners, dtype=np.int32), size))
-        _quad_batches[(size, corners, "corners")] = vbo
+        _quad_corner_buffers[(size, corners)] = vbo
     return vbo
 
 
@@ -873,6 +873,7 @@ def release_rectangle() -> None:
     unregister frees every GPU object)."""
     _rectangles.clear()
     _quad_batches.clear()
+    _quad_corner_buffers.clear()
 
 
 def _draw_groups(groups, variant, call: _DrawCall) -> None:
