@@ -53,3 +53,42 @@ float chain_length(int chain_texel, vec2 own_span)
   return own_span.y - own_span.x;
 }
 #endif
+
+/* The region-lines image (docs/image_model.md §2.6) keeps the strongest line
+ * per pixel in a depth buffer alone, one value per pixel for its intensity
+ * and style: a LESS test then keeps the larger intensity and, of two equal
+ * ones, the lower style. The intensity keeps LINE_LEVELS steps (2^-19, far
+ * below one step of a 16-bit image); the value is a whole multiple of 2^-22
+ * below 1.0, which a 32-bit float depth buffer stores exactly, and the
+ * cleared 1.0 means no line. Without a colour target the pass writes a
+ * third of the bytes per pixel it wrote with (intensity, style) beside its
+ * depth, which a software rasteriser pays at every covered pixel. */
+#define LINE_STYLE_SLOTS 8
+#define LINE_LEVELS 524288.0      /* 2^19 */
+#define LINE_CODE_SCALE 4194304.0 /* LINE_LEVELS * LINE_STYLE_SLOTS */
+#if CLASS_STYLE_COUNT >= LINE_STYLE_SLOTS
+#  error "more line styles than the region-lines image packs"
+#endif
+
+/* The depth that keeps `intensity` (0 to 1) of line style `style`: 1.0 (no
+ * line) where it rounds to no step. */
+float line_code(float intensity, int style)
+{
+  float levels = floor(min(intensity, 1.0) * LINE_LEVELS + 0.5);
+  if (levels < 1.0) {
+    return 1.0;
+  }
+  return ((LINE_LEVELS - levels) * float(LINE_STYLE_SLOTS) + float(style)) / LINE_CODE_SCALE;
+}
+
+/* (intensity, style) of a texel of the region-lines image (0 intensity:
+ * no line). Exact: every step is a product by a power of two. */
+vec2 line_of_code(float code)
+{
+  if (code >= 1.0) {
+    return vec2(0.0);
+  }
+  float whole = code * LINE_CODE_SCALE;
+  float rank = floor(whole * (1.0 / float(LINE_STYLE_SLOTS)));
+  return vec2((LINE_LEVELS - rank) * (1.0 / LINE_LEVELS), whole - rank * float(LINE_STYLE_SLOTS));
+}

@@ -2,16 +2,13 @@
  * visible triangle (the deferred surface's visibility record) lies in one
  * of this run's regions, the strongest of the run's lines P(d) m(t) g(l) at
  * the exact window distance of each segment, kept per pixel as the strongest
- * of all lines: written as colour and as depth (1 - intensity, LESS test),
- * since Blender's gpu module has no MAX blend. The resolve pass then reads
- * it in place of walking the region's edges. The run's segments share
+ * of all lines: written as depth alone (line_code, edge_styles.glsl: the
+ * intensity and style packed so that a LESS test keeps the strongest, since
+ * Blender's gpu module has no MAX blend). The resolve pass then reads it in
+ * place of walking the region's edges. The run's segments share
  * style, regions and chain; for a solid style the profile falls with d, so
  * the strongest of them is the profile at the nearest one (the same bits
  * as one quad per segment, each kept by the depth test). */
-/* A tie between styles goes to the lower style number (image model §3.6):
- * a nudge far below one 16-bit step of intensity. */
-#define STYLE_NUDGE 1.0e-6
-
 /* The squared distance from the pixel p to one segment of the run ((line,
  * span start), span end; unused slots are NO_SEGMENT, far away) and its
  * position along the line, from the segment's own lower-id end. */
@@ -120,6 +117,7 @@ void main()
   if (intensity <= 0.0) {
     discard;
   }
-  frag_line = vec2(intensity, float(line_style));
-  gl_FragDepth = clamp(1.0 - intensity + STYLE_NUDGE * float(line_style), 0.0, 1.0);
+  /* A tie between styles goes to the lower style number (image model
+   * §3.6): line_code orders equal intensities by style. */
+  gl_FragDepth = line_code(intensity, line_style);
 }

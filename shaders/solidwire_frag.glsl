@@ -418,7 +418,7 @@ float visible_intensity(vec2 p, float half_thickness, NearLines found, int style
   }
 #  ifdef REGION_LINE_IMAGE
   if (lines_from_image) {
-    vec2 line = texelFetch(region_line_image, ivec2(gl_FragCoord.xy), 0).xy;
+    vec2 line = line_of_code(texelFetch(region_line_image, ivec2(gl_FragCoord.xy), 0).r);
     if (line.x > intensity) {
       intensity = line.x;
       winner = int(line.y);

@@ -218,13 +218,16 @@ def test_an_ngon_inside_a_region_keeps_its_own_diagonals(diagonals, output_dir):
 def test_edge_classes_on_large_regions(case, output_dir):
     """Edge classes with their own width, colour and pattern on regions of
     more than a hundred edges: the strongest line per pixel decides the
-    style, with each class's pattern running along its own edges."""
+    style, with each class's pattern running along its own edges, and the
+    pixel takes that style's colour."""
     look = dict(
         use_sharp_edges=True,
         sharp_thickness=3.0,
         sharp_pattern="DASHED",
+        sharp_color=(0.0, 1.0, 0.0, 1.0),
         use_boundary_edges=True,
         boundary_thickness=2.5,
+        boundary_color=(1.0, 0.0, 0.0, 1.0),
         thickness=1.0,
     )
     if case == "cage":
@@ -244,6 +247,15 @@ def test_edge_classes_on_large_regions(case, output_dir):
     report = accuracy.measure(scene, f"regions_classes_{case}", output_dir)
     accuracy.assert_accurate(report)
     _assert_region_lines_drawn()
+    # Each solid sample has the colour of the style the reference picks
+    # (but where two styles tie at full strength, which a rounding step
+    # decides): the region lines carry the style beside the intensity.
+    rgba = scenes.load_png(output_dir / f"regions_classes_{case}.png")
+    ref = reference.render_reference(scene)
+    solid = (rgba[..., 3] > 0.99) & ~ref.on_silhouette & np.isfinite(ref.wire).all(axis=-1)
+    wrong = np.abs(rgba[..., :3] - reference.srgb_encode(ref.wire)).max(axis=-1) > 0.02
+    green = solid & (rgba[..., 1] > 0.9) & (rgba[..., 0] < 0.1)
+    assert green.sum() > 50 and (wrong & solid).sum() <= 0.005 * solid.sum()
 
 
 def test_the_edge_distance_pass_walks_regions_whole(output_dir):

@@ -381,7 +381,7 @@ def render_passes(
     return frame.rgba, frame.depth, frame.stats, extra
 
 
-def _clear(framebuffer, width: int, height: int, depth: bool = True) -> None:
+def _clear(framebuffer, width: int, height: int, depth: bool = True, color: bool = True) -> None:
     # A clear honours the depth write mask, and GPU state lives per GL
     # context: a previous frame drawn in this context may have left depth
     # writes off, which left the old depth in place (wrong occlusion in the
@@ -389,7 +389,9 @@ def _clear(framebuffer, width: int, height: int, depth: bool = True) -> None:
     gpu.state.depth_mask_set(depth)
     gpu.state.color_mask_set(True, True, True, True)
     gpu.state.blend_set("NONE")
-    if depth:
+    if not color:
+        framebuffer.clear(depth=1.0)
+    elif depth:
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
     else:
         framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0))
@@ -561,7 +563,7 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
     # drops it, where a GPU drops them for less than picking them costs.
     reach = None if scissor is None or not shaders.software_rasteriser() else _line_reach_px(settings, items)
     with framebuffer.bind(), _scissored(scissor):
-        _clear(framebuffer, view.width, view.height)
+        _clear(framebuffer, view.width, view.height, color=False)  # the lines are the depth alone
         lines = replace(
             target,
             stage=draw_mod.LINES,

@@ -243,7 +243,7 @@ SAMPLERS = {
     "setup_table": (9, "FLOAT_2D"),
     "visibility": (10, "FLOAT_2D"),
     "triangle_flag_table": (11, "FLOAT_2D"),
-    "region_line_image": (12, "FLOAT_2D"),
+    "region_line_image": (12, "DEPTH_2D"),
     "attribute_colors": (13, "FLOAT_2D"),
     "record_depth": (14, "DEPTH_2D"),
     "surface_image": (15, "FLOAT_2D"),
@@ -491,7 +491,7 @@ def _region_lines_create_info(variant: ShaderVariant):
         )
     info.vertex_in(0, "INT", "quad_corner")
     info.vertex_out(iface)
-    info.fragment_out(0, "VEC2", "frag_line")
+    # No colour output: the line is its depth (edge_styles.glsl line_code).
     compat.depth_write(info, "ANY")
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     info.define("RUN_SEGMENTS", str(variant.run_segments))

@@ -43,7 +43,7 @@ class Targets:
         self.view_depth = gpu.types.GPUTexture((width, height), format="R32F")
         self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
         self.outer = self.outer_depth = None  # silhouette targets, made on first use
-        self.lines = None  # the region lines' (intensity, style), made on first use
+        self.lines = None  # the region lines' strongest line per pixel, made on first use
         self.lines_key = None  # what the overlay's lines were drawn for (passes._overlay_lines_key)
         self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
         self.visible = None  # the deferred surface's visibility record, made on first use
@@ -111,27 +111,23 @@ class Targets:
         return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.color,))
 
     def silhouette_framebuffer(self):
-        """Outer-half intensity (R32F) with its own depth buffer, created on
-        first use (see silhouettes.py)."""
+        """Outer-half intensity (R32F) with its own depth buffer, in which
+        the silhouettes keep their per-pixel maximum, created on first use
+        (see silhouettes.py)."""
         if self.outer is None:
             self.outer = gpu.types.GPUTexture(self.size, format="R32F")
-        return gpu.types.GPUFrameBuffer(depth_slot=self._pass_depth(), color_slots=(self.outer,))
-
-    def _pass_depth(self):
-        # The silhouettes and the region lines each keep a per-pixel maximum
-        # in a depth buffer of their own; they run one after the other, each
-        # clearing it, so they share one.
-        if self.outer_depth is None:
             self.outer_depth = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
-        return self.outer_depth
+        return gpu.types.GPUFrameBuffer(depth_slot=self.outer_depth, color_slots=(self.outer,))
 
     def region_lines_framebuffer(self):
-        """The region lines' strongest line per pixel (RG32F: intensity,
-        style) with its own depth buffer (1 - intensity), created on first
-        use (docs/image_model.md §2.6; passes._draw_region_lines)."""
+        """The region lines' strongest line per pixel: a depth buffer alone
+        whose value packs intensity and style (shaders/edge_styles.glsl
+        line_code), created on first use (docs/image_model.md §2.6;
+        passes._draw_region_lines). Its own, not the silhouettes': the
+        overlay keeps it across redraws."""
         if self.lines is None:
-            self.lines = gpu.types.GPUTexture(self.size, format="RG32F")
-        return gpu.types.GPUFrameBuffer(depth_slot=self._pass_depth(), color_slots=(self.lines,))
+            self.lines = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
+        return gpu.types.GPUFrameBuffer(depth_slot=self.lines)
 
     def clear_view_depth(self) -> None:
         """The view-depth target to BACKGROUND_DEPTH: where no surface is
