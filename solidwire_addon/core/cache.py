@@ -244,9 +244,16 @@ class GPUMesh:
             first, count = runs[:, 0].astype(np.int64), runs[:, 1].astype(np.int64)
             slot = np.minimum(np.arange(self.region_run_segments), count[:, None] - 1)
             rows = TEXELS_PER_REGION_LINE * (first[:, None] + slot)
-            ends = self._region_lines_cpu[rows.ravel(), :2].astype(np.int64)
-            vertices, corners = np.unique(ends.ravel(), return_inverse=True)
-            self._run_vertices = (vertices, np.ascontiguousarray(corners.reshape(len(runs), -1).T))
+            ends = self._region_lines_cpu[rows.ravel(), :2].astype(np.intp).ravel()
+            # The distinct ends by a scatter over the vertices, not a sort
+            # (np.unique): this runs at the first edit after an extraction.
+            used = np.zeros(len(self._local_positions), bool)
+            used[ends] = True
+            vertices = np.flatnonzero(used)
+            row_of = np.empty(len(used), np.intp)  # read only where used
+            row_of[vertices] = np.arange(len(vertices))
+            corners = row_of.take(ends).reshape(len(runs), -1)
+            self._run_vertices = (vertices, np.ascontiguousarray(corners.T))
         vertices, corners = self._run_vertices
         return self._local_positions[vertices], corners
 
