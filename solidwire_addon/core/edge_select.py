@@ -1226,9 +1226,15 @@ def _line_runs(chain_ends: np.ndarray, style: np.ndarray, region: np.ndarray, pa
 
 def _run_length(typical: int) -> int:
     """The entries a run holds for chains of ``typical`` entries: the
-    power of two that holds them, up to RUN_SEGMENTS (see _line_runs)."""
+    power of two that holds half a chain (a chain of two: both), up to
+    RUN_SEGMENTS (see _line_runs). A chain is a curve, and the quad of a
+    whole one is a box around its bend: at subdivision levels 2 and 3 the
+    two quads of its halves cover fewer pixels than that box by more than
+    a second quad costs (F12 on llvmpipe: 5 % and 2 % faster), and from
+    level 4 on a run holds no more than half a chain anyway."""
+    half = max(min(typical, 2), typical // 2)
     length = 1
-    while length < min(typical, RUN_SEGMENTS):
+    while length < min(half, RUN_SEGMENTS):
         length *= 2
     return length
 
