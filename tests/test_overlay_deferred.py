@@ -361,6 +361,42 @@ def test_cage_look_alike_on_every_path():
     _assert_matches_reference(scene, images[0][..., 3])
 
 
+def test_cage_look_with_classes_takes_each_lines_colour():
+    """Edge classes on the cage look's regions in the viewport: the region
+    lines carry each pixel's style beside its intensity (one packed depth
+    value, shaders/edge_styles.glsl), so every solid sample takes the
+    colour of the style the reference picks, drawn straight and from the
+    kept image alike."""
+    scene = scenes.empty_scene(
+        WIDTH,
+        HEIGHT,
+        use_cage_edges=True,
+        thickness=1.5,
+        use_sharp_edges=True,
+        sharp_thickness=3.0,
+        sharp_color=(0.0, 1.0, 0.0, 1.0),
+    )
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    for edge in cube.data.edges[:4]:
+        edge.use_edge_sharp = True
+    modifier = cube.modifiers.new("Subdivision", "SUBSURF")
+    modifier.levels = modifier.render_levels = 3
+    straight, stats = _draw(scene, [cube])
+    assert _path(stats) == "surface_straight" and stats.get("region_line_entries", 0) > 0
+    kept, stats = _draw(scene, [cube])
+    assert np.array_equal(straight, kept)
+    _assert_matches_reference(scene, straight[..., 3])
+    plan = overlay_state.plan_overlay(SOLID)
+    settings = overlay_state.draw_settings(plan, scene.solidwire.snapshot())
+    ref = reference.render_reference(scene, size=(WIDTH, HEIGHT), settings=settings)
+    solid = (straight[..., 3] > 0.99) & ~ref.on_silhouette & (ref.intensity > 0.99)
+    wrong = np.abs(straight[..., :3] - reference.srgb_encode(ref.wire)).max(axis=-1) > 0.02
+    green = solid & (straight[..., 1] > 0.9) & (straight[..., 0] < 0.1)
+    assert green.sum() > 30 and (solid & ~green).sum() > 30, (green.sum(), solid.sum())
+    assert (wrong & solid).sum() <= 0.005 * solid.sum(), (wrong & solid).sum()
+
+
 def test_clipping_region_and_hidden_lines_stay_direct(monkeypatch):
     """Passes the record cannot serve (a clipping region, hidden lines)
     keep the direct pass."""
