@@ -107,10 +107,12 @@ class GPUMesh:
         # there are no n-gons: where the region-lines pass measures the
         # lines, no triangle walks anything (the draw needs no block code).
         flags = arrays.edge_flags
-        self.blocks_only_for_region_lines = (
-            arrays.region_lines is not None
-            and len(arrays.ngon_corners) == 0
-            and not np.any((flags & IN_REGION != 0) & (flags & REGION_LINES == 0))
+        region_pass_only = arrays.region_lines is not None and len(arrays.ngon_corners) == 0
+        # Every triangle flagged REGION_LINES (a cage look): one reduction
+        # answers both questions below.
+        every_triangle_region_lines = region_pass_only and bool(np.bitwise_and.reduce(flags) & REGION_LINES)
+        self.blocks_only_for_region_lines = region_pass_only and (
+            every_triangle_region_lines or not np.any((flags & IN_REGION != 0) & (flags & REGION_LINES == 0))
         )
         # Shading normals and material indices, a texel per vertex, triangle
         # or triangle corner (normal_domain); only for a shaded or
@@ -137,9 +139,7 @@ class GPUMesh:
         # Every triangle takes its lines from the region-lines pass and
         # there is no n-gon (a cage look): a resolve that reads the pass's
         # image sets up no triangle edge (ShaderVariant.no_edge_setup).
-        self.lines_only_from_region_pass = (
-            arrays.region_lines is not None and len(arrays.ngon_corners) == 0 and bool(np.all(flags & REGION_LINES))
-        )
+        self.lines_only_from_region_pass = every_triangle_region_lines
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
         self._run_vertices = None  # run_points(), made on first use
@@ -152,6 +152,7 @@ class GPUMesh:
         self._visibility_batch = None  # visibility_batch(), made on first use
         self._visibility_layout = None  # (by_vertex, bytes) of that batch
         self._visibility_index = None  # (by_vertex, index buffer, copied vertices, numbers), kept across moves
+        self._position_rows = positions  # (N, 4), w 0: as uploaded (run_points gathers whole rows)
         self._local_positions = positions[:, :3]  # for visibility_batch()
         # What reposition() needs to tell a move of vertices from a new shape.
         self.vertex_count = arrays.vertex_count
@@ -231,7 +232,7 @@ class GPUMesh:
         return self._region_tables
 
     def run_points(self):
-        """(points, corners): the mesh-space position of every vertex at
+        """(points, corners): the mesh-space position (x, y, z, 0) of every vertex at
         which a segment of a region-lines run ends, and each run's segment
         ends as rows of ``points``, transposed: (2 L, R) (L: the most
         segments a run holds; a shorter run repeats its last segment's).
@@ -255,7 +256,9 @@ class GPUMesh:
             corners = row_of.take(ends).reshape(len(runs), -1)
             self._run_vertices = (vertices, np.ascontiguousarray(corners.T))
         vertices, corners = self._run_vertices
-        return self._local_positions[vertices], corners
+        # (A gather of whole contiguous rows: several times faster than one
+        # of the strided (N, 3) view.)
+        return self._position_rows.take(vertices, axis=0), corners
 
     def visibility_batch(self, by_vertex: bool = False):
         """An indexed triangle batch (the triangle table as index buffer)
@@ -339,6 +342,7 @@ class GPUMesh:
         self._before_move = (self._local_positions, self.centre, self.mesh_bounds, self._corner_rows_uploaded)
         self._moved_box = None
         self._corner_rows_uploaded = corners
+        self._position_rows = positions
         self._local_positions = positions[:, :3]
         self.centre = centre
         self.bounds_min = bounds_min - centre

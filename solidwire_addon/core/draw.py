@@ -802,9 +802,9 @@ def runs_reaching(mesh, object_to_clip: np.ndarray, viewport, window) -> np.ndar
     behind the camera plane is kept. This rounds in float32 as the
     drawing does, not in the same order: the reach has pixels to spare
     (passes._line_reach_px)."""
-    points, corners = mesh.run_points()
+    points, corners = mesh.run_points()  # (w 0: the matrix's last column is added apart)
     to_clip = object_to_clip.astype(np.float32)
-    x, y, z, w = to_clip[:, :3] @ points.T + to_clip[:, 3:]
+    x, y, z, w = to_clip @ points.T + to_clip[:, 3:]
     ahead = w > 1e-6 * (np.abs(x) + np.abs(y) + np.abs(z) + 1.0)
     safe_w = np.where(ahead, w, np.float32(1.0))
     left, bottom, width, height = viewport
