@@ -152,8 +152,7 @@ class GPUMesh:
         self._visibility_batch = None  # visibility_batch(), made on first use
         self._visibility_layout = None  # (by_vertex, bytes) of that batch
         self._visibility_index = None  # (by_vertex, index buffer, copied vertices, numbers), kept across moves
-        self._position_rows = positions  # (N, 4), w 0: as uploaded (run_points gathers whole rows)
-        self._local_positions = positions[:, :3]  # for visibility_batch()
+        self._position_rows = positions  # (N, 4), w 0: as uploaded (_local_positions, run_points)
         # What reposition() needs to tell a move of vertices from a new shape.
         self.vertex_count = arrays.vertex_count
         self.quads = arrays.quads
@@ -230,6 +229,11 @@ class GPUMesh:
             self._region_tables = (table_texture(lines), table_texture(regions))
             self.gpu_bytes += sum(t.width * t.height * 16 for t in self._region_tables)
         return self._region_tables
+
+    @property
+    def _local_positions(self) -> np.ndarray:
+        """(N, 3) mesh-space positions as uploaded (a view)."""
+        return self._position_rows[:, :3]
 
     def run_points(self):
         """(points, corners): the mesh-space position (x, y, z, 0) of every vertex at
@@ -343,7 +347,6 @@ class GPUMesh:
         self._moved_box = None
         self._corner_rows_uploaded = corners
         self._position_rows = positions
-        self._local_positions = positions[:, :3]
         self.centre = centre
         self.bounds_min = bounds_min - centre
         self.bounds_max = bounds_max - centre
