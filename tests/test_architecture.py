@@ -628,7 +628,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "visibility",
         "triangle_ids_by_vertex",
         "record_depth",
-        "lines_window",  # which region-lines runs a partial redraw draws
+        "scissor_window",  # what a partial redraw leaves out (region-lines runs, record blocks)
     }
     names = {f.name for f in fields(draw.DrawTarget)}
     assert names == set(selects_code) | state_or_input, "classify every DrawTarget field here"
@@ -640,7 +640,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
             "depth_test": "GREATER",
             "depth_write": False,
             "visibility": object(),
-            "lines_window": (0, 0, 8, 8, 3.0),
+            "scissor_window": (0, 0, 8, 8, 3.0),
         }[name]
         assert draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value})) == plain, name
     # The visibility stage's numbering is compiled code of that stage only.

@@ -299,6 +299,20 @@ def test_an_edit_redraws_up_to_the_lines_reach(look):
         frame()  # kept from now on
 
 
+def _frames(scene, obj):
+    """(frame, stats): ``frame()`` draws one overlay frame of ``obj`` and
+    returns (rgba, how it drew its surface: _path); its stats go to the list
+    ``stats``."""
+    frame_stats = []
+
+    def frame():
+        rgba, stats = _draw(scene, [obj])
+        frame_stats.append(stats)
+        return rgba, _path(stats)
+
+    return frame, frame_stats
+
+
 @pytest.mark.parametrize("software", [True, False])
 def test_a_partial_redraw_draws_the_region_lines_that_reach_it(monkeypatch, software):
     """A dense subdivided grid, one vertex dragged near a corner: on a
@@ -318,13 +332,7 @@ def test_a_partial_redraw_draws_the_region_lines_that_reach_it(monkeypatch, soft
     corners[0].co.z, corners[-1].co.z = 0.3, -0.3  # the bounds the drag stays within
     moved = min(vertices, key=lambda v: (v.co.x + 1.2) ** 2 + (v.co.y - 0.9) ** 2)
     plane.data.update()
-    frame_stats = []
-
-    def frame():
-        rgba, stats = _draw(scene, [plane])
-        frame_stats.append(stats)
-        return rgba, _path(stats)
-
+    frame, frame_stats = _frames(scene, plane)
     frame()
     frame()
     for _step in range(2):
@@ -337,6 +345,58 @@ def test_a_partial_redraw_draws_the_region_lines_that_reach_it(monkeypatch, soft
         runs = frame_stats[-1]["region_line_entries"] // 2
         left_out = frame_stats[-1].get("region_runs_left_out", 0)
         assert left_out > 0.8 * runs if software else left_out == 0
+    runtime.mesh_cache.clear()
+    fresh, _path_fresh = frame()
+    assert np.array_equal(edited, fresh), np.abs(edited - fresh).max()
+
+
+@pytest.mark.parametrize("software", [True, False])
+def test_a_partial_redraw_records_the_triangles_that_can_cover_it(monkeypatch, software):
+    """A dense grid whose triangles run row by row, every edge drawn: on a
+    software rasteriser a partial redraw records again only the blocks of
+    triangles whose boxes reach its rectangle, elsewhere every triangle
+    (the scissor drops the rest), and either equals a fresh frame. The
+    boxes follow the moves: a small quad listed first (in the first block,
+    with the grid's bottom rows) is dragged from the bottom to the top, and
+    an edit beside where it went must record that block (a box left where
+    the quad was would leave it out)."""
+    monkeypatch.setattr(passes.shaders, "software_rasteriser", lambda: software)
+    scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=1.5)
+    scenes.add_camera(scene, location=(0.0, -10.0, 0.0))
+    columns, rows = 60, 40
+    quad = [(-0.8, -0.9, 0.1), (-0.7, -0.9, 0.1), (-0.7, -0.8, 0.1), (-0.8, -0.8, 0.1)]
+    xs, ys = np.meshgrid(np.linspace(-1.0, 1.0, columns + 1), np.linspace(-1.0, 1.0, rows + 1))
+    grid = [(x, y, 0.0) for x, y in zip(xs.ravel(), ys.ravel())]
+    first = len(quad)
+    faces = [(0, 1, 2, 3)] + [
+        (
+            first + r * (columns + 1) + c,
+            first + r * (columns + 1) + c + 1,
+            first + (r + 1) * (columns + 1) + c + 1,
+            first + (r + 1) * (columns + 1) + c,
+        )
+        for r in range(rows)
+        for c in range(columns)
+    ]
+    plane = scenes.from_pydata(scene, "Grid", quad + grid, faces, rotation_euler=(1.5708, 0, 0))
+    vertices = plane.data.vertices
+    frame, frame_stats = _frames(scene, plane)
+    frame()
+    frame()
+    triangles = frame_stats[-1]["triangles_drawn"]
+    for _step in range(4):  # bottom to top, each step an edit of a drag
+        for k in range(4):
+            vertices[k].co.y += 0.42
+        plane.data.update()
+        edited, path = frame()
+        assert path == "surface_partial"
+    beside = min(vertices[first:], key=lambda v: (v.co.x + 0.6) ** 2 + (v.co.y - 0.85) ** 2)
+    beside.co.z += 0.05
+    plane.data.update()
+    edited, path = frame()
+    assert path == "surface_partial"
+    left_out = frame_stats[-1].get("record_triangles_left_out", 0)
+    assert left_out > 0.5 * triangles if software else left_out == 0
     runtime.mesh_cache.clear()
     fresh, _path_fresh = frame()
     assert np.array_equal(edited, fresh), np.abs(edited - fresh).max()

@@ -21,6 +21,14 @@ from .extract import IN_REGION, NORMALS_BY_TRIANGLE, NORMALS_BY_VERTEX, REGION_L
 
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
+# Consecutive triangles per box of GPUMesh.triangle_block_corners: what a
+# partial redraw's record leaves out at a time (draw.triangle_ranges_reaching).
+# A subdivision lists each cage corner's children together (4**(L-1) quads,
+# 512 triangles at level 5), so blocks this size stay small on screen; a
+# level-5 Suzanne has ~2000 of them, whose corners a redraw projects in
+# well under a millisecond.
+RECORD_BLOCK_TRIANGLES = 512
+
 
 def table_shape(count: int) -> tuple[int, int]:
     """(width, height) of a table of ``count`` texels: TABLE_WIDTH texels a
@@ -143,6 +151,10 @@ class GPUMesh:
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
         self._run_vertices = None  # run_points(), made on first use
+        self._block_boxes = None  # (version, low, high) of triangle_block_corners(), made on first use
+        self._moved_triangles = None  # (version, which triangles the move to it moved): _change_box
+        self._corner_vertex_rows = None  # _corner_vertices(), made at the first move
+        self._faces_in_order = None  # whether the triangles are numbered face by face (_triangles_of_faces)
         # The set-up pre-pass's output for big meshes (draw._run_setup), made
         # on first use, and what it was set up for (draw._setup_key): kept
         # while the mesh, its matrix and the viewport stay the same.
@@ -264,6 +276,84 @@ class GPUMesh:
         # of the strided (N, 3) view.)
         return self._position_rows.take(vertices, axis=0), corners
 
+    def prepare_partial_redraws(self) -> None:
+        """Make now what a software rasteriser's partial redraw reads to
+        leave out what cannot reach its rectangle and is kept across moves:
+        the boxes of the triangle blocks (measure_triangle_blocks) and which
+        vertices end the region-lines runs (run_points)."""
+        self.measure_triangle_blocks()
+        if self.region_run_count:
+            self.run_points()
+
+    def triangle_block_corners(self) -> np.ndarray:
+        """(8 K, 4): the corners (x, y, z, 0: mesh space as uploaded, as
+        run_points) of the box around each block of RECORD_BLOCK_TRIANGLES
+        consecutive triangles (the last block may hold fewer), corner c of
+        every block before corner c + 1 of any. What a partial redraw reads
+        to leave out of its record the triangles that cannot cover its
+        rectangle (draw.triangle_ranges_reaching)."""
+        low, high = self.measure_triangle_blocks()
+        corners = np.zeros((8, len(low), 4), np.float32)
+        for corner in range(8):
+            for axis in range(3):
+                corners[corner, :, axis] = (high if corner >> axis & 1 else low)[:, axis]
+        return corners.reshape(-1, 4)
+
+    def measure_triangle_blocks(self):
+        """(low, high) (K, 3) of the boxes of triangle_block_corners, made
+        on first use and kept with the positions: after a move that
+        _change_box has measured only the blocks with a moved triangle are
+        measured again (a drag moves a few), after any other every block
+        (about 12 ms for a level-4 Suzanne on a 2-core machine, ten times a
+        drag's)."""
+        boxes = self._block_boxes
+        if boxes is None or boxes[0] != self.version:
+            moved = self._moved_triangles
+            if boxes is not None and boxes[0] == self.version - 1 and moved is not None and moved[0] == self.version:
+                low, high = boxes[1], boxes[2]
+                self._measure_blocks_again(moved[1], low, high)
+            else:
+                low, high = self._measure_blocks()
+            boxes = self._block_boxes = (self.version, low, high)
+        return boxes[1], boxes[2]
+
+    def _measure_blocks(self):
+        """(low, high) (K, 3) of every block of triangle_block_corners."""
+        # (The corner rows of a mesh that has moved, else made for this
+        # measure alone: a mesh that is only looked at keeps no copy.)
+        corner_vertices = self._corner_vertex_rows
+        if corner_vertices is None:
+            corner_vertices = _corner_vertex_rows(self.triangles_cpu)
+        starts = np.arange(0, self.triangle_count, RECORD_BLOCK_TRIANGLES)
+        low = np.empty((len(starts), 3), np.float32)
+        high = np.empty((len(starts), 3), np.float32)
+        for axis in range(3 if len(starts) else 0):
+            # (Gathers from a contiguous copy of the column: numpy would
+            # copy the strided column for every gather anyway.)
+            column = np.ascontiguousarray(self._position_rows[:, axis])
+            values = [column.take(vertices) for vertices in corner_vertices]
+            low[:, axis] = np.minimum.reduce([np.minimum.reduceat(v, starts) for v in values])
+            high[:, axis] = np.maximum.reduce([np.maximum.reduceat(v, starts) for v in values])
+        return low, high
+
+    def _measure_blocks_again(self, moved: np.ndarray, low: np.ndarray, high: np.ndarray) -> None:
+        """Measure again, in place, the blocks of ``low`` / ``high`` that
+        hold a triangle of the (T,) bool mask ``moved``."""
+        blocks = np.flatnonzero(np.logical_or.reduceat(moved, np.arange(0, len(moved), RECORD_BLOCK_TRIANGLES)))
+        if not len(blocks):
+            return
+        # Every block as RECORD_BLOCK_TRIANGLES rows: the last one's missing
+        # rows repeat its last triangle, which changes no bound.
+        rows = blocks[:, None] * RECORD_BLOCK_TRIANGLES + np.arange(RECORD_BLOCK_TRIANGLES)
+        np.minimum(rows, self.triangle_count - 1, out=rows)
+        corners = self.triangles_cpu.take(rows.reshape(-1), axis=0)[:, :3].reshape(-1)
+        # (Few rows: gathered whole, which copies no column.)
+        points = self._position_rows.take(corners, axis=0)
+        for axis in range(3):
+            values = points[:, axis].reshape(len(blocks), -1)
+            low[blocks, axis] = values.min(axis=1)
+            high[blocks, axis] = values.max(axis=1)
+
     def visibility_batch(self, by_vertex: bool = False):
         """An indexed triangle batch (the triangle table as index buffer)
         for the deferred surface's visibility pass: each vertex is
@@ -343,7 +433,7 @@ class GPUMesh:
         self._drop_visibility_batch()  # made again from the new positions on first use
         self.version += 1
         # The shape before, for last_move(): asked of a viewport overlay only.
-        self._before_move = (self._local_positions, self.centre, self.mesh_bounds, self._corner_rows_uploaded)
+        self._before_move = (self._position_rows, self.centre, self.mesh_bounds, self._corner_rows_uploaded)
         self._moved_box = None
         self._corner_rows_uploaded = corners
         self._position_rows = positions
@@ -373,9 +463,9 @@ class GPUMesh:
         return box if box is None else (self.version, box[0])
 
     def _change_box(self, old, old_centre, old_bounds, old_corners):
-        local, corners = self._local_positions, self._corner_rows_uploaded
+        rows, corners = self._position_rows, self._corner_rows_uploaded
         if (
-            old.shape != local.shape
+            old.shape != rows.shape
             or not np.array_equal(np.asarray(old_centre), np.asarray(self.centre))
             or not (
                 np.array_equal(old_bounds[0], self.mesh_bounds[0])
@@ -383,45 +473,77 @@ class GPUMesh:
             )
         ):
             return None
-        # Column-wise ORs and whole-row compares: numpy reduces the short
-        # axis of an (N, 3) array slowly.
-        differs = (local != old).view(np.uint8)
-        vertex_moved = (differs[:, 0] | differs[:, 1] | differs[:, 2]).view(bool)
-        triangles = self.triangles_cpu
-        corner_vertices = [triangles[:, k] for k in range(3)]
+        vertex_moved = _rows_differ(old, rows)
+        corner_vertices = self._corner_vertices()
 
         def touching(vertex_mask):
             return vertex_mask[corner_vertices[0]] | vertex_mask[corner_vertices[1]] | vertex_mask[corner_vertices[2]]
 
         triangle_changed = touching(vertex_moved)
+        # Which triangles moved: the blocks of triangle_block_corners to measure again.
+        self._moved_triangles = (self.version, triangle_changed.copy())
         if corners is not None:
             if old_corners is None or old_corners.shape != corners.shape:
                 return None
-            # (A row is 16 bytes: one complex128 compare per row; a NaN
-            # compares unequal, which only redraws more.)
-            rows = np.flatnonzero(_row_view(old_corners) != _row_view(corners))
+            changed_rows = np.flatnonzero(_rows_differ(old_corners, corners))
             if self.normal_domain == NORMALS_BY_VERTEX:
-                vertex_moved[rows] = True
+                vertex_moved[changed_rows] = True
                 triangle_changed = touching(vertex_moved)
             elif self.normal_domain == NORMALS_BY_TRIANGLE:
-                triangle_changed[rows] = True
+                triangle_changed[changed_rows] = True
             else:
-                triangle_changed[rows // 3] = True
+                triangle_changed[changed_rows // 3] = True
         # A face's triangles set up its outline together (a quad's fourth
         # corner, an n-gon's corners): a changed face redraws every one.
-        polygons = np.asarray(self.triangle_polygons_cpu)
-        touched = np.zeros(int(polygons.max(initial=-1)) + 1, dtype=bool)
-        touched[polygons[triangle_changed]] = True
-        vertices = np.unique(triangles[touched[polygons], :3])
-        if not len(vertices):
+        triangles = self._triangles_of_faces(np.flatnonzero(triangle_changed))
+        if not len(triangles):
             return (None,)
-        points = np.concatenate([old[vertices], local[vertices]]).astype(np.float64) + np.asarray(self.centre)
+        vertices = np.unique(corner_vertices[:, triangles])
+        points = np.concatenate([old[vertices, :3], rows[vertices, :3]]).astype(np.float64) + np.asarray(self.centre)
         return ((points.min(axis=0), points.max(axis=0)),)
 
+    def _corner_vertices(self) -> np.ndarray:
+        """(3, T) intp: each triangle's corner vertices, a contiguous row per
+        corner, in numpy's own index type (gathers by the columns of the
+        (T, 4) int32 triangle table cost two to three times more: each
+        copies and widens its indices first). Made at the first move and
+        kept: the triangles do not change when vertices move."""
+        if self._corner_vertex_rows is None:
+            self._corner_vertex_rows = _corner_vertex_rows(self.triangles_cpu)
+        return self._corner_vertex_rows
 
-def _row_view(table: np.ndarray) -> np.ndarray:
-    """An (N, 4) float32 table as N complex128 values, one per row."""
-    return np.ascontiguousarray(table, dtype=np.float32).view(np.complex128).reshape(-1)
+    def _triangles_of_faces(self, triangles: np.ndarray) -> np.ndarray:
+        """Every triangle of the faces of ``triangles`` (ascending): where the
+        triangles are numbered face by face, as the extraction numbers them,
+        found by a search around the few faces instead of a pass over every
+        triangle."""
+        polygons = np.asarray(self.triangle_polygons_cpu)
+        if self._faces_in_order is None:
+            self._faces_in_order = bool(np.all(polygons[1:] >= polygons[:-1]))
+        if not self._faces_in_order:
+            touched = np.zeros(int(polygons.max(initial=-1)) + 1, dtype=bool)
+            touched[polygons[triangles]] = True
+            return np.flatnonzero(touched[polygons])
+        faces = np.unique(polygons[triangles])
+        first = np.searchsorted(polygons, faces, side="left")
+        count = np.searchsorted(polygons, faces, side="right") - first
+        # first[k], first[k] + 1, ... for count[k] each, face after face.
+        return np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+
+
+def _corner_vertex_rows(triangles: np.ndarray) -> np.ndarray:
+    """(3, T) intp: column k of the (T, 4) triangle table as row k."""
+    return np.ascontiguousarray(triangles[:, :3].T, dtype=np.intp)
+
+
+def _rows_differ(before: np.ndarray, after: np.ndarray) -> np.ndarray:
+    """(N,) bool: which rows of two (N, 4) float32 tables differ, bit for
+    bit (two 64-bit compares a row: -0.0 against 0.0 differs, which only
+    redraws more)."""
+    before = np.ascontiguousarray(before, dtype=np.float32).view(np.int64)
+    after = np.ascontiguousarray(after, dtype=np.float32).view(np.int64)
+    differs = before != after
+    return differs[:, 0] | differs[:, 1]
 
 
 class MeshCache:

@@ -15,7 +15,7 @@ import gpu
 import numpy as np
 
 from . import colors, matcaps, shaders
-from .cache import table_texture
+from .cache import RECORD_BLOCK_TRIANGLES, table_texture
 from .edge_select import EDGE_CLASSES
 from .log import warn_once
 from .settings import pack_params
@@ -72,11 +72,14 @@ class DrawTarget:
     depth in a second colour target, the render passes' targets (``aovs``),
     and which ``lines`` the colour shows (WIRE_LINES, NO_LINES,
     HIDDEN_LINES). ``triangle_ids_by_vertex``: how the VISIBILITY stage
-    numbers triangles (options.DrawOptions). ``lines_window`` (x, y,
-    width, height, reach; LINES only): the caller draws inside that window
-    rectangle alone (a scissor) and no line reaches farther than ``reach``
-    px from its segment, so the runs whose lines cannot reach the
-    rectangle are left out of the draw (a partial redraw's lines)."""
+    numbers triangles (options.DrawOptions). ``scissor_window`` (x, y,
+    width, height, reach; LINES and VISIBILITY): the caller draws inside
+    that window rectangle alone (a scissor) and nothing drawn reaches
+    farther than ``reach`` px from its geometry's window box, so what
+    cannot reach the rectangle is left out of the draw (a partial redraw
+    on a software rasteriser): the runs of LINES whose lines cannot reach
+    it, the blocks of triangles of VISIBILITY that lie outside it (numbered
+    by vertex only: gl_PrimitiveID would start again at each range)."""
 
     depth_test: str = "LESS_EQUAL"
     depth_write: bool = True
@@ -92,7 +95,7 @@ class DrawTarget:
     aovs: bool = False
     lines: str = WIRE_LINES
     triangle_ids_by_vertex: bool = False
-    lines_window: tuple | None = None
+    scissor_window: tuple | None = None
 
     def hidden(self) -> DrawTarget:
         """The hidden-line layer over this target (image model §5.4): every
@@ -479,7 +482,7 @@ def draw(
             # instancing does not depend on the stage's variant.
             instancing=program.supports_instancing and not target.aovs,
             numbering=_DrawNumbers(
-                stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view, lines_window=target.lines_window
+                stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view, window=target.scissor_window
             ),
         )
         parts = _parts(groups, program, stage, view)
@@ -489,6 +492,8 @@ def draw(
             _draw_groups(parts[part], part.variant(variant), call)
         if call.numbering.runs_left_out:
             stats.extra["region_runs_left_out"] = call.numbering.runs_left_out
+        if call.numbering.triangles_left_out:
+            stats.extra["record_triangles_left_out"] = call.numbering.triangles_left_out
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
@@ -671,12 +676,13 @@ class _DrawNumbers:
     rectangle over the draw's window box. A direct draw (stage None) just
     draws the batch."""
 
-    def __init__(self, stage, extras, by_vertex: bool = False, view: View | None = None, lines_window=None):
+    def __init__(self, stage, extras, by_vertex: bool = False, view: View | None = None, window=None):
         self.stage, self.extras, self.count = stage, extras, 0
         self.by_vertex = by_vertex  # the visibility batch's numbering (ShaderVariant.triangle_ids_by_vertex)
         self.view = view
-        self.lines_window = lines_window  # DrawTarget.lines_window
-        self.runs_left_out = 0  # region-lines runs that lines_window left out
+        self.window = window  # DrawTarget.scissor_window
+        self.runs_left_out = 0  # region-lines runs that the window left out
+        self.triangles_left_out = 0  # recorded triangles that the window left out
 
     @property
     def viewport(self):
@@ -712,8 +718,8 @@ class _DrawNumbers:
         if self.stage == LINES:
             count = mesh.region_run_count
             picked = None
-            if count and self.lines_window is not None and not instance_count:
-                picked = runs_reaching(mesh, object_to_clip, self.view.viewport, self.lines_window)
+            if count and self.window is not None and not instance_count:
+                picked = runs_reaching(mesh, object_to_clip, self.view.viewport, self.window)
                 self.runs_left_out += count - (count if picked is None else len(picked))
             if count and (picked is None or len(picked)):
                 shader.uniform_int("draw_number", self.count)
@@ -731,10 +737,18 @@ class _DrawNumbers:
         shader.uniform_int("draw_number", self.count)
         if self.stage == VISIBILITY:
             batch = mesh.visibility_batch(by_vertex=self.by_vertex)
+            ranges = None
+            if self.window is not None and self.by_vertex and not instance_count:
+                ranges = triangle_ranges_reaching(mesh, object_to_clip, self.view.viewport, self.window)
             if instance_count:
                 batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
-            else:
+            elif ranges is None:
                 batch.draw(shader)
+            else:
+                first, count = ranges
+                for start, size in zip((3 * first).tolist(), (3 * count).tolist()):
+                    batch.draw_range(shader, elem_start=start, elem_count=size)  # (size > 0: 0 would draw to the end)
+                self.triangles_left_out += mesh.triangle_count - int(count.sum())
             return
         shader.uniform_float("resolve_rect", window_rect(object_to_clip, mesh.bounds_min, mesh.bounds_max))
         shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
@@ -794,33 +808,66 @@ def picked_quad_batch(picked: np.ndarray, count: int):
 def runs_reaching(mesh, object_to_clip: np.ndarray, viewport, window) -> np.ndarray | None:
     """The runs of ``mesh``'s region lines (cache.GPUMesh.run_points)
     whose lines can reach the window rectangle of ``window`` (x, y, width,
-    height, reach: DrawTarget.lines_window), in order; None where that is
+    height, reach: DrawTarget.scissor_window), in order; None where that is
     every run. A run's segments lie in the window box of their ends where
     every end is in front of the camera (a segment there projects to the
     segment between its ends' projections; the near plane only shortens
-    it), and its lines within ``reach`` px of them. A run with an end at or
-    behind the camera plane is kept. This rounds in float32 as the
-    drawing does, not in the same order: the reach has pixels to spare
-    (passes._line_reach_px)."""
-    points, corners = mesh.run_points()  # (w 0: the matrix's last column is added apart)
+    it), and its lines within ``reach`` px of them. This rounds in float32
+    as the drawing does, not in the same order: the reach has pixels to
+    spare (passes._line_reach_px)."""
+    points, corners = mesh.run_points()
+    x, y, ahead = _window_points(points, object_to_clip, viewport)
+    # (corners is (2 L, R): each reduction runs along whole rows.)
+    picked = np.flatnonzero(_boxes_reaching(x[corners], y[corners], ahead[corners], window))
+    return None if len(picked) == corners.shape[1] else picked
+
+
+def triangle_ranges_reaching(mesh, object_to_clip: np.ndarray, viewport, window):
+    """(first triangle, triangle count) (int64 arrays) of each range of
+    consecutive triangles of ``mesh`` that may cover a pixel of the window
+    rectangle of ``window`` (DrawTarget.scissor_window), in order, or None
+    where that is every triangle: the blocks of
+    cache.GPUMesh.triangle_block_corners whose box projects within
+    ``reach`` px of the rectangle, neighbours joined. A box wholly in front
+    of the camera projects inside the window box of its corners, so every
+    triangle it holds does."""
+    points = mesh.triangle_block_corners()
+    x, y, ahead = _window_points(points, object_to_clip, viewport)
+    kept = _boxes_reaching(x.reshape(8, -1), y.reshape(8, -1), ahead.reshape(8, -1), window)
+    if kept.all():
+        return None
+    # Where kept blocks start and stop: the rises and falls of the padded mask.
+    steps = np.diff(np.concatenate(([0], kept.view(np.int8), [0])))
+    first = np.flatnonzero(steps == 1) * RECORD_BLOCK_TRIANGLES
+    end = np.minimum(np.flatnonzero(steps == -1) * RECORD_BLOCK_TRIANGLES, mesh.triangle_count)
+    return first, end - first
+
+
+def _window_points(points: np.ndarray, object_to_clip: np.ndarray, viewport):
+    """(x, y, ahead): the window position of mesh-space ``points`` ((N, 4),
+    w 0: the matrix's last column is added apart) under ``object_to_clip``
+    in ``viewport`` (x, y, width, height), and whether each lies in front
+    of the camera plane (where not, its x and y mean nothing)."""
     to_clip = object_to_clip.astype(np.float32)
     x, y, z, w = to_clip @ points.T + to_clip[:, 3:]
     ahead = w > 1e-6 * (np.abs(x) + np.abs(y) + np.abs(z) + 1.0)
     safe_w = np.where(ahead, w, np.float32(1.0))
     left, bottom, width, height = viewport
-    x = left + (x / safe_w + 1.0) * (0.5 * width)
-    y = bottom + (y / safe_w + 1.0) * (0.5 * height)
-    # (corners is (2 L, R): each reduction runs along whole rows.)
-    run_x, run_y = x[corners], y[corners]
+    return left + (x / safe_w + 1.0) * (0.5 * width), bottom + (y / safe_w + 1.0) * (0.5 * height), ahead
+
+
+def _boxes_reaching(x: np.ndarray, y: np.ndarray, ahead: np.ndarray, window) -> np.ndarray:
+    """(K,) bool: whether the window box of each column of points ((P, K)
+    window ``x``, ``y`` and ``ahead`` of _window_points) comes within the
+    reach of ``window`` (DrawTarget.scissor_window). A column with a point
+    at or behind the camera plane is kept."""
     rect_x, rect_y, rect_width, rect_height, reach = window
-    reaching = (
-        (run_x.min(axis=0) < rect_x + rect_width + reach)
-        & (run_x.max(axis=0) > rect_x - reach)
-        & (run_y.min(axis=0) < rect_y + rect_height + reach)
-        & (run_y.max(axis=0) > rect_y - reach)
-    ) | ~ahead[corners].all(axis=0)
-    picked = np.flatnonzero(reaching)
-    return None if len(picked) == corners.shape[1] else picked
+    return (
+        (x.min(axis=0) < rect_x + rect_width + reach)
+        & (x.max(axis=0) > rect_x - reach)
+        & (y.min(axis=0) < rect_y + rect_height + reach)
+        & (y.max(axis=0) > rect_y - reach)
+    ) | ~ahead.all(axis=0)
 
 
 # Each quad's two triangles over its four corners.

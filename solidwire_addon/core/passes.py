@@ -514,12 +514,22 @@ def _record_visibility(
     ``clear_record`` False leaves the last record where nothing is drawn
     now (for a reader that tests depth first). Returns the DrawStats."""
     framebuffer = targets.visibility_framebuffer()
+    # Inside a scissor a software rasteriser records only the blocks of
+    # triangles that can cover it (as the region lines' runs below): it
+    # would transform and set up every triangle before the scissor drops
+    # it. The reach is a pixel of rounding to spare.
+    window = None if scissor is None or not shaders.software_rasteriser() else (*scissor, 1.0)
     with framebuffer.bind(), _scissored(scissor):
         if clear_record or not keep_depth:
             _clear(framebuffer, view.width, view.height, depth=not keep_depth)
         else:
             _no_clear(view.width, view.height)
-        record = replace(target, stage=draw_mod.VISIBILITY, triangle_ids_by_vertex=_triangle_ids_by_vertex(options))
+        record = replace(
+            target,
+            stage=draw_mod.VISIBILITY,
+            triangle_ids_by_vertex=_triangle_ids_by_vertex(options),
+            scissor_window=window,
+        )
         stats = draw_mod.draw(items, view, settings, target=record, cull=cull)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
@@ -568,7 +578,7 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
             target,
             stage=draw_mod.LINES,
             visibility=targets.visible,
-            lines_window=None if reach is None else (*scissor, reach),
+            scissor_window=None if reach is None else (*scissor, reach),
         )
         drawn = draw_mod.draw(items, view, settings, target=lines, cull=cull)
         gpu.state.depth_test_set("NONE")
@@ -749,7 +759,9 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame) -> Over
         # record, lines and colour depend on what covers it alone).
         record_stats.extra["surface_partial"] = 1
         if scissor:
-            _record_visibility(targets, items, view, settings, DrawTarget(), frame.options, scissor=scissor)
+            recorded = _record_visibility(targets, items, view, settings, DrawTarget(), frame.options, scissor=scissor)
+            if "record_triangles_left_out" in recorded.extra:
+                record_stats.extra["record_triangles_left_out"] = recorded.extra["record_triangles_left_out"]
             if line_count:
                 _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats, scissor=scissor)
         elif line_count:
@@ -762,6 +774,7 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame) -> Over
     elif edited:
         targets.lines_key = targets.surface_key = None
         _record_visibility(targets, items, view, settings, DrawTarget(), frame.options)
+        _ready_for_partial_redraws(items)
         if line_count:
             lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats)
         targets.lines_key = key
@@ -769,6 +782,7 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame) -> Over
     else:
         targets.lines_key = targets.surface_key = None
         _record_visibility(targets, items, view, settings, DrawTarget(), frame.options)
+        _ready_for_partial_redraws(items)
         if line_count:
             lines = _draw_region_lines(targets, items, view, settings, DrawTarget(), True, record_stats)
         # (One key for the record, its lines and the resolved image: the
@@ -792,6 +806,18 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame) -> Over
     targets.surface_counts = (record_stats.objects_drawn, record_stats.objects_culled, record_stats.triangles_drawn)
     frame.line_stats.add(record_stats)
     return OverlaySurface(targets, items, lines, kept=True)
+
+
+def _ready_for_partial_redraws(items) -> None:
+    """After a whole record on a software rasteriser: make what a partial
+    redraw reads to leave out the triangle blocks and region-lines runs
+    that cannot reach its rectangle (cache.GPUMesh.prepare_partial_redraws)
+    now, with the whole record's cost, so that an edit, the redraw that has
+    to be quick, measures only the blocks it moved. Kept with each mesh: a
+    view change, which records whole again, makes nothing."""
+    if shaders.software_rasteriser():
+        for item in items:
+            item.mesh.prepare_partial_redraws()
 
 
 def _moved_items(before_key, key, items):
