@@ -1,8 +1,9 @@
 /* Visibility pass of the deferred surface (docs/image_model.md §2.5): the
  * rasteriser only decides which triangle each pixel shows. An indexed batch
- * (cache.GPUMesh.visibility_batch): each vertex is transformed once, with
- * the exact path's own expression (so the same coverage and depth), and
- * hands on nothing but the view depth (and its instance); gl_PrimitiveID
+ * (cache.GPUMesh.visibility_batch): each vertex is transformed once, read
+ * from the position table and transformed with the exact path's own
+ * expression (so the same coverage and depth; a move re-uploads that table
+ * alone), and hands on nothing but the view depth (and its instance); gl_PrimitiveID
  * numbers the triangle, or on a software rasteriser the provoking vertex
  * does (SW_TRIANGLE_BY_VERTEX, shaders.triangle_ids_by_vertex). The per-triangle edge set-up, which dominates a
  * dense mesh's frame on a software rasteriser, moves to the resolve pass
@@ -10,6 +11,7 @@
 
 void main()
 {
+  vec3 position = fetch_texel(vertex_positions, source_vertex).xyz;
   view_depth = -dot(object_to_view_z, vec4(position, 1.0));
 #ifdef SW_TRIANGLE_BY_VERTEX
   /* Only the provoking (last) corner's value reaches the fragments: the

@@ -61,7 +61,7 @@ def _provoking_triangle_numbers(vertex_count: int, triangles: np.ndarray):
     gets a copy of it, appended after the original vertices in the order of
     ``copied vertices``. Corners keep their order, so each triangle is
     rasterised exactly as before. Depends on the triangles alone, so a mesh
-    that only moves keeps it (the positions are appended again)."""
+    that only moves keeps it."""
     count = len(triangles)
     last = np.ascontiguousarray(triangles[:, 2])
     rows = np.arange(count, dtype=np.int32)
@@ -161,9 +161,7 @@ class GPUMesh:
         self.setup_table = None
         self.setup_key = None
         self._flag_table = None  # flag_table(), made on first use
-        self._visibility_batch = None  # visibility_batch(), made on first use
-        self._visibility_layout = None  # (by_vertex, bytes) of that batch
-        self._visibility_index = None  # (by_vertex, index buffer, copied vertices, numbers), kept across moves
+        self._visibility = None  # (by_vertex, visibility_batch(), its bytes), made on first use, kept across moves
         self._position_rows = positions  # (N, 4), w 0: as uploaded (_local_positions, run_points)
         # What reposition() needs to tell a move of vertices from a new shape.
         self.vertex_count = arrays.vertex_count
@@ -357,58 +355,46 @@ class GPUMesh:
     def visibility_batch(self, by_vertex: bool = False):
         """An indexed triangle batch (the triangle table as index buffer)
         for the deferred surface's visibility pass: each vertex is
-        transformed once, not once per corner. Made on first use.
+        transformed once, not once per corner. Its vertices hold which row
+        of the position table each stands for ("source_vertex"), which the
+        pass reads as the exact path does: the batch depends on the
+        triangles alone, so a mesh that moves keeps it (a move uploads the
+        position table and nothing else). Made on first use.
 
         The pass numbers the triangles as the triangle table does, either
-        with gl_PrimitiveID (the batch holds the positions alone) or, with
-        ``by_vertex``, with a "triangle" attribute that each triangle's last
-        corner (OpenGL's provoking vertex, whose value a flat output takes)
-        carries for it. A vertex can carry that for one triangle only, so
-        every other triangle ending at it gets a copy of the vertex as its
-        last corner: same position, so the same coverage and depth. This
-        costs ~16 bytes per triangle and saves a software rasteriser its
-        primitive-ID bookkeeping (shaders.triangle_ids_by_vertex)."""
-        if self._visibility_batch is not None and self._visibility_layout[0] != by_vertex:
+        with gl_PrimitiveID or, with ``by_vertex``, with a "triangle"
+        attribute that each triangle's last corner (OpenGL's provoking
+        vertex, whose value a flat output takes) carries for it. A vertex
+        can carry that for one triangle only, so every other triangle ending
+        at it gets a copy of the vertex as its last corner: the same row of
+        the position table, so the same coverage and depth. This costs ~12
+        bytes per triangle and saves a software rasteriser its primitive-ID
+        bookkeeping (shaders.triangle_ids_by_vertex)."""
+        if self._visibility is not None and self._visibility[0] != by_vertex:
             self._drop_visibility_batch()
-        if self._visibility_batch is None:
-            index = self._visibility_index
-            if index is None or index[0] != by_vertex:
-                # The index buffer (and by vertex, which vertices are copied)
-                # depends on the triangles alone: kept when the mesh moves.
-                triangles = np.ascontiguousarray(self.triangles_cpu[:, :3], dtype=np.int32)
-                copied = numbers = None
-                if by_vertex:
-                    copied, numbers, triangles = _provoking_triangle_numbers(len(self._local_positions), triangles)
-                if index is not None:
-                    self.gpu_bytes -= self.triangle_count * 12  # the other numbering's index buffer
-                index = self._visibility_index = (
-                    by_vertex,
-                    gpu.types.GPUIndexBuf(type="TRIS", seq=triangles),
-                    copied,
-                    numbers,
-                )
-                self.gpu_bytes += self.triangle_count * 12
-            _by_vertex, ibo, copied, numbers = index
-            positions = self._local_positions
+        if self._visibility is None:
+            triangles = np.ascontiguousarray(self.triangles_cpu[:, :3], dtype=np.int32)
+            sources = np.arange(self.vertex_count, dtype=np.int32)
             fmt = gpu.types.GPUVertFormat()
-            fmt.attr_add(id="position", comp_type="F32", len=3, fetch_mode="FLOAT")
+            fmt.attr_add(id="source_vertex", comp_type="I32", len=1, fetch_mode="INT")
             if by_vertex:
+                copied, numbers, triangles = _provoking_triangle_numbers(self.vertex_count, triangles)
+                sources = np.concatenate([sources, copied.astype(np.int32)])
                 fmt.attr_add(id="triangle", comp_type="F32", len=1, fetch_mode="FLOAT")
-                positions = np.concatenate([positions, positions[copied]])
-            vbo = gpu.types.GPUVertBuf(fmt, len(positions))
-            vbo.attr_fill("position", positions)
+            vbo = gpu.types.GPUVertBuf(fmt, len(sources))
+            vbo.attr_fill("source_vertex", sources)
             if by_vertex:
                 vbo.attr_fill("triangle", numbers)
-            self._visibility_batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=ibo)
-            size = len(positions) * (16 if by_vertex else 12)  # the vertex buffer; the index buffer is counted above
-            self._visibility_layout = (by_vertex, size)
+            batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=gpu.types.GPUIndexBuf(type="TRIS", seq=triangles))
+            size = self.triangle_count * 12 + len(sources) * (8 if by_vertex else 4)
+            self._visibility = (by_vertex, batch, size)
             self.gpu_bytes += size
-        return self._visibility_batch
+        return self._visibility[1]
 
     def _drop_visibility_batch(self) -> None:
-        if self._visibility_batch is not None:
-            self.gpu_bytes -= self._visibility_layout[1]
-            self._visibility_batch = self._visibility_layout = None
+        if self._visibility is not None:
+            self.gpu_bytes -= self._visibility[2]
+            self._visibility = None
 
     def replace_positions(
         self,
@@ -422,15 +408,14 @@ class GPUMesh:
         """New vertex positions, same faces and triangles: only the position
         table is uploaded again, and the corner table when ``corners`` (the
         corner normals follow a deformation). The triangle and outline
-        tables, the edge-flag batch and the silhouette edges depend on the
-        faces and the edge selection alone; the set-up table is set up again
+        tables, the edge-flag and visibility batches and the silhouette edges
+        depend on the faces and the edge selection alone; the set-up table is set up again
         from the new positions (its key holds ``version``)."""
         positions = np.zeros((len(local), 4), dtype=np.float32)
         positions[:, :3] = local
         self.positions = table_texture(positions)
         if corners is not None and self.corners is not None:
             self.corners = table_texture(corners)
-        self._drop_visibility_batch()  # made again from the new positions on first use
         self.version += 1
         # The shape before, for last_move(): asked of a viewport overlay only.
         self._before_move = (self._position_rows, self.centre, self.mesh_bounds, self._corner_rows_uploaded)

@@ -655,9 +655,9 @@ def bind_display_transform(shader, display) -> None:
 
 
 def _bind_mesh(shader, variant, mesh) -> None:
-    if variant.visibility:
-        return  # its batch holds what it reads (cache.GPUMesh.visibility_batch)
     shader.uniform_sampler("vertex_positions", mesh.positions)
+    if variant.visibility:
+        return  # its batch holds the rest (cache.GPUMesh.visibility_batch)
     shader.uniform_sampler("triangle_vertices", mesh.triangles)
     if variant.ngons:
         shader.uniform_sampler("ngon_corners", mesh.ngon_corners)

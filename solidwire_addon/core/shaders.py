@@ -418,8 +418,9 @@ def _create_info(variant: ShaderVariant):
 
 def _visibility_create_info(variant: ShaderVariant):
     """The visibility pass (visibility_vert.glsl): positions pulled as the
-    exact path pulls them, depth as it writes it, and per pixel the
-    triangle, instance and draw that won the depth test."""
+    exact path pulls them (from the position table, by each vertex's
+    "source_vertex"), depth as it writes it, and per pixel the triangle,
+    instance and draw that won the depth test."""
     iface = gpu.types.GPUStageInterfaceInfo("solidwire_visibility_iface")
     iface.smooth("FLOAT", "view_depth")
     info = pulling_info(push_matrices=not variant.instanced)
@@ -432,7 +433,7 @@ def _visibility_create_info(variant: ShaderVariant):
         iface.flat("FLOAT", "visible_instance")
         info.push_constant("INT", "instance_base")
         add_sampler(info, "instance_table")
-    info.vertex_in(0, "VEC3", "position")
+    info.vertex_in(0, "INT", "source_vertex")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_visible")
     if variant.linear_depth:
@@ -440,16 +441,15 @@ def _visibility_create_info(variant: ShaderVariant):
         # overlay's record, whose resolve hands it to Blender's depth test.)
         info.define("LINEAR_DEPTH", "1")
         compat.depth_write(info, "ANY")
+    # (edge_geometry.glsl: fetch_texel, as the exact path reads positions.)
+    prologue = read_source("common.glsl") + read_source("edge_geometry.glsl")
     if variant.instanced:
         info.define("SW_INSTANCED", "1")
         prologue = (
             f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n"
             + read_source("instancing.glsl")
-            + read_source("common.glsl")
-            + read_source("edge_geometry.glsl")
+            + prologue
         )
-    else:
-        prologue = ""
     info.vertex_source(prologue + read_source("visibility_vert.glsl"))
     info.fragment_source(read_source("visibility_frag.glsl"))
     return info
