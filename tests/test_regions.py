@@ -280,6 +280,28 @@ def test_the_edge_distance_pass_walks_regions_whole(output_dir):
     assert "region_line_entries" not in solidwire_addon.stats()
 
 
+def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
+    """A cage look's resolve takes every line from the region-lines image
+    and reads no triangle's edge flags: their table (8 bytes a triangle) is
+    made only when a pass walks the regions, here the Edge Distance pass,
+    on the mesh already extracted."""
+    from solidwire_addon.core import cache
+
+    scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    _subdivided(cube, 3)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    bpy.ops.render.render(scene=scene.name)
+    plain = solidwire_addon.stats()
+    _assert_region_lines_drawn()
+    scene.view_layers[0].solidwire.use_pass_edge_distance = True
+    scenes.render_multilayer_exr(scene, output_dir / "regions_flags_made.exr")
+    walked = solidwire_addon.stats()
+    assert walked["meshes_extracted"] == 0
+    width, height = cache.table_shape(plain["triangles_drawn"])
+    assert walked["gpu_bytes"] - plain["gpu_bytes"] == 8 * width * height
+
+
 @pytest.mark.parametrize(
     "look",
     [dict(), dict(use_sharp_edges=True, sharp_pattern="DASHED", sharp_thickness=3.0), dict(use_hidden_lines=True)],

@@ -43,14 +43,31 @@ def table_shape(count: int) -> tuple[int, int]:
 
 def table_texture(rows4: np.ndarray):
     """(N, 4) float32 -> RGBA32F texture laid out by table_shape."""
-    width, height = table_shape(len(rows4))
-    buf = gpu.types.Buffer("FLOAT", width * height * 4)
+    return _table(rows4, 4, "RGBA32F")
+
+
+def value_table_texture(values: np.ndarray):
+    """(N,) float32 -> R32F texture laid out by table_shape: a value per
+    texel, a quarter of an RGBA table's memory (a shader reads it as
+    .x of the texel)."""
+    return _table(values, 1, "R32F")
+
+
+def _table(rows: np.ndarray, channels: int, texture_format: str):
+    width, height = table_shape(len(rows))
+    buf = gpu.types.Buffer("FLOAT", width * height * channels)
     # Fill through numpy's view of the buffer: one memcpy instead of a
     # per-element Python sequence copy.
     view = np.asarray(buf)
-    view[: rows4.size] = rows4.reshape(-1)
-    view[rows4.size :] = 0.0
-    return gpu.types.GPUTexture((width, height), format="RGBA32F", data=buf)
+    view[: rows.size] = rows.reshape(-1)
+    view[rows.size :] = 0.0
+    return gpu.types.GPUTexture((width, height), format=texture_format, data=buf)
+
+
+def texture_bytes(texture) -> int:
+    """The GPU memory of a table made here (float32 channels)."""
+    channels = {"RGBA32F": 4, "RG32F": 2, "R32F": 1}[texture.format]
+    return texture.width * texture.height * 4 * channels
 
 
 def _provoking_triangle_numbers(vertex_count: int, triangles: np.ndarray):
@@ -173,11 +190,10 @@ class GPUMesh:
         self.mesh_bounds = (arrays.bounds_min, arrays.bounds_max)  # mesh space
 
         self._batch = None  # batch, made on first use
-        self.gpu_bytes = (
-            self.positions.width * self.positions.height * 16
-            + self.triangles.width * self.triangles.height * 16
-            + self.ngon_corners.width * self.ngon_corners.height * 16
-            + (0 if self.corners is None else self.corners.width * self.corners.height * 16)
+        self.gpu_bytes = sum(
+            texture_bytes(table)
+            for table in (self.positions, self.triangles, self.ngon_corners, self.corners, self.attribute_colors)
+            if table is not None
         )
 
     @property
@@ -210,7 +226,7 @@ class GPUMesh:
             np.right_shift(flags, 12, out=view[: self.triangle_count, 1], casting="unsafe")
             view[self.triangle_count :] = 0.0
             self._flag_table = gpu.types.GPUTexture((width, height), format="RG32F", data=buf)
-            self.gpu_bytes += width * height * 8
+            self.gpu_bytes += texture_bytes(self._flag_table)
         return self._flag_table
 
     @property
@@ -231,13 +247,12 @@ class GPUMesh:
         runs (a texel each: the texel of the run's first entry, its
         entries), then the entries."""
         if self._region_tables is None:
-            regions = np.zeros((self.triangle_count, 4), np.float32)
-            regions[:, 0] = self._triangle_regions_cpu
             runs = self._region_line_runs_cpu.copy()
             runs[:, 0] = len(runs) + TEXELS_PER_REGION_LINE * runs[:, 0]
             lines = np.concatenate([runs, self._region_lines_cpu])
-            self._region_tables = (table_texture(lines), table_texture(regions))
-            self.gpu_bytes += sum(t.width * t.height * 16 for t in self._region_tables)
+            regions = np.asarray(self._triangle_regions_cpu, np.float32)
+            self._region_tables = (table_texture(lines), value_table_texture(regions))
+            self.gpu_bytes += sum(texture_bytes(t) for t in self._region_tables)
         return self._region_tables
 
     @property

@@ -15,7 +15,7 @@ import gpu
 import numpy as np
 
 from . import colors, matcaps, shaders
-from .cache import RECORD_BLOCK_TRIANGLES, table_texture
+from .cache import RECORD_BLOCK_TRIANGLES, table_texture, texture_bytes
 from .edge_select import EDGE_CLASSES
 from .log import warn_once
 from .settings import pack_params
@@ -659,6 +659,10 @@ def _bind_mesh(shader, variant, mesh) -> None:
     if variant.visibility:
         return  # its batch holds the rest (cache.GPUMesh.visibility_batch)
     shader.uniform_sampler("triangle_vertices", mesh.triangles)
+    if variant.resolve and not variant.no_edge_setup:
+        # (A resolve whose lines all come from the region-lines image reads
+        # no edge flags: the table is never made for it.)
+        shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
     if variant.ngons:
         shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
     if variant.uses_corners:
@@ -751,7 +755,6 @@ class _DrawNumbers:
                 self.triangles_left_out += mesh.triangle_count - int(count.sum())
             return
         shader.uniform_float("resolve_rect", window_rect(object_to_clip, mesh.bounds_min, mesh.bounds_max))
-        shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
         _rectangle().draw(shader)
 
 
@@ -1092,7 +1095,7 @@ def _run_setup(mesh, object_to_clip, block, in_front: bool = False, viewport=Non
         mesh.setup_table = gpu.types.GPUTexture(
             (shaders.SETUP_ROW_TRIANGLES * shaders.SETUP_TEXELS, rows), format="RGBA32F"
         )
-        mesh.gpu_bytes += mesh.setup_table.width * mesh.setup_table.height * 16
+        mesh.gpu_bytes += texture_bytes(mesh.setup_table)
     setup = shaders.get_setup(in_front)
     setup.bind()
     setup.uniform_block("params", block)

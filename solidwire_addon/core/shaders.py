@@ -359,7 +359,8 @@ def _create_info(variant: ShaderVariant):
         info.push_constant("INT", "draw_number")
         info.push_constant("VEC4", "resolve_rect")
         add_sampler(info, "visibility")
-        add_sampler(info, "triangle_flag_table")
+        if not variant.no_edge_setup:  # (NO_EDGE_SETUP reads no edge flags)
+            add_sampler(info, "triangle_flag_table")
         info.define("RESOLVE_PASS", "1")
         if variant.record_depth:
             if not variant.depth_bias:

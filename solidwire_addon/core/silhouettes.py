@@ -34,7 +34,7 @@ import gpu
 import numpy as np
 
 from . import shaders
-from .cache import table_texture
+from .cache import table_texture, texture_bytes
 from .draw import DrawTarget, bind_display_transform, quad_batch, shader_variant
 from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
 from .settings import pack_params
@@ -79,7 +79,7 @@ def edge_table(mesh):
     if mesh.silhouette_edges is None:
         rows = candidate_edges(mesh.triangles_cpu, mesh.edge_flags_cpu)
         mesh.silhouette_edges = (table_texture(rows), len(rows))
-        mesh.gpu_bytes += mesh.silhouette_edges[0].width * mesh.silhouette_edges[0].height * 16
+        mesh.gpu_bytes += texture_bytes(mesh.silhouette_edges[0])
     return mesh.silhouette_edges
 
 
