@@ -47,10 +47,11 @@ PLAIN = dict(
 )
 
 
-def build_scene(size, level: int, before=(), shape: str = "Suzanne"):
+def build_scene(size, level: int, before=(), shape: str = "Suzanne", capped_array: bool = False):
     """Suzanne (or a 32-sided cylinder with n-gon caps: ``shape``
     "Cylinder") under a Subdivision Surface at ``level``, the modifiers
-    ``before`` (types) ahead of it."""
+    ``before`` (types) ahead of it; ``capped_array``: a Mirror and an Array
+    of two with a cube at each end after it."""
     import bmesh  # (importable only once bpy is)
 
     scene = scenes.empty_scene(*size, transparent=False)
@@ -76,6 +77,12 @@ def build_scene(size, level: int, before=(), shape: str = "Suzanne"):
             modifier.thickness = 0.05
     modifier = monkey.modifiers.new("Subdivision", "SUBSURF")
     modifier.levels = modifier.render_levels = level
+    if capped_array:
+        array = scenes.add_mirror_and_array(monkey, count=2, offset=(1.2, 0.0, 0.0))
+        for end in ("start_cap", "end_cap"):
+            cap = scenes.cube(scene, end, size=0.3)
+            cap.hide_render = cap.hide_viewport = True
+            setattr(array, end, cap)
     scenes.add_camera(scene, location=(1.2, -3.4, 1.0), target=(0.0, 0.0, 0.0), lens=45.0)
     return scene, monkey
 
@@ -159,20 +166,22 @@ def compare(scene, monkey, size, looks, repeats: int, viewport: Viewport | None)
 EVERY_CLASS = dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True, use_crease_edges=True)
 
 # (name, shape, modifier types before the subdivision, Edit Mode, look
-# beside the cage or every edge)
+# beside the cage or every edge, a Mirror and a capped Array after it)
 STACKS = (
-    ("own mesh", "Suzanne", (), False, {}),
-    ("Mirror, Subdivision", "Suzanne", ("MIRROR",), False, {}),
-    ("Bevel, Subdivision", "Suzanne", ("BEVEL",), False, {}),
-    ("Solidify, Subdivision", "Suzanne", ("SOLIDIFY",), False, {}),
-    ("Edit Mode", "Suzanne", (), True, {}),
-    ("Edit Mode, Mirror, Subdivision", "Suzanne", ("MIRROR",), True, {}),
+    ("own mesh", "Suzanne", (), False, {}, False),
+    ("Mirror, Subdivision", "Suzanne", ("MIRROR",), False, {}, False),
+    ("Bevel, Subdivision", "Suzanne", ("BEVEL",), False, {}, False),
+    ("Solidify, Subdivision", "Suzanne", ("SOLIDIFY",), False, {}, False),
+    ("Edit Mode", "Suzanne", (), True, {}, False),
+    ("Edit Mode, Mirror, Subdivision", "Suzanne", ("MIRROR",), True, {}, False),
     # Its caps' regions pass WALK_LIMIT from level 3: blocks of their faces' own edges.
-    ("Cylinder, 32-gon caps", "Cylinder", (), False, {}),
-    ("own mesh, every edge class on", "Suzanne", (), False, EVERY_CLASS),
+    ("Cylinder, 32-gon caps", "Cylinder", (), False, {}, False),
+    ("own mesh, every edge class on", "Suzanne", (), False, EVERY_CLASS, False),
     # Cage faces meeting at under 30 degrees join into one region (join_regions).
-    ("own mesh, edge angle 30°", "Suzanne", (), False, dict(edge_angle=math.radians(30.0))),
-    ("Mirror, Subdivision, edge angle 30°", "Suzanne", ("MIRROR",), False, dict(edge_angle=math.radians(30.0))),
+    ("own mesh, edge angle 30°", "Suzanne", (), False, dict(edge_angle=math.radians(30.0)), False),
+    ("Mirror, Subdivision, edge angle 30°", "Suzanne", ("MIRROR",), False, dict(edge_angle=math.radians(30.0)), False),
+    # The caps follow the copies: faces past the listed regions.
+    ("Subdivision, Mirror, Array with caps", "Suzanne", (), False, {}, True),
 )
 
 
@@ -195,13 +204,13 @@ def stack_table(size, levels, repeats: int, names=()) -> None:
         taken.append(result is not None)
         return result
 
-    for name, shape, before, edit, look_extra in STACKS:
+    for name, shape, before, edit, look_extra, capped_array in STACKS:
         if names and not any(part in name for part in names):
             continue
         for level in levels:
             bpy.ops.wm.read_factory_settings(use_empty=True)
             solidwire_addon.register()
-            scene, monkey = build_scene(size, level, before, shape)
+            scene, monkey = build_scene(size, level, before, shape, capped_array)
             if edit:
                 bpy.context.view_layer.objects.active = monkey
                 monkey.select_set(True)

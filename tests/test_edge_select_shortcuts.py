@@ -5,11 +5,13 @@ runs of consecutive joined faces, and the hidden-edge marks of a mesh of
 quads, or of triangles and quads, by row lookup, each against the
 components of the faces themselves and the search by vertex pair. On real evaluated meshes: Suzanne's cage at levels
 1-5, an n-gon cage, Multiresolution, Mirror and Array copies after the
-subdivision, the regions read from the evaluated mesh's own layout (a
-modifier before the subdivision, Edit Mode), and meshes where a shortcut
-must refuse (triangles and n-gons under the edge angle, a subdivision whose
-quads a modifier triangulated, an Array with caps, a layout that does not
-hold); cage faces past the walk limit take blocks of their own edges."""
+subdivision (with an Array's caps past the regions), the regions read
+from the evaluated mesh's own layout (a modifier before the subdivision,
+Edit Mode), and meshes where a shortcut must refuse (triangles and n-gons
+under the edge angle, a subdivision whose quads a modifier triangulated,
+an Array cap with triangles, a hidden or a classed edge, a layout that
+does not hold); cage faces past the walk limit take blocks of their own
+edges."""
 
 from __future__ import annotations
 
@@ -377,8 +379,30 @@ def test_the_edge_angle_beside_the_cage_joins_its_regions(shape, before, degrees
     assert len(set(general.triangle_regions.tolist())) == len(merged.edge_start) - 1
 
 
+@pytest.mark.parametrize("caps", ["end", "both"])
+@pytest.mark.parametrize("level", [1, 3])
+def test_an_array_with_caps_keeps_the_cage_regions(caps, level, monkeypatch):
+    """The caps an Array adds after its copies (quads here) are plain faces
+    past the listed regions: the regions the layout gives still apply, with
+    the general path's arrays, the caps' triangles in no region."""
+    scene = scenes.empty_scene()
+    capped = scenes.monkey(scene)
+    _subdivide(capped, level)
+    array = scenes.add_mirror_and_array(capped, count=2, offset=(1.3, 0.0, 0.0))
+    array.end_cap = scenes.cube(scene, "End cap", size=0.4)
+    if caps == "both":
+        array.start_cap = scenes.cube(scene, "Start cap", size=0.3, location=(0.0, 2.0, 0.0))
+    general = _assert_same_as_general(capped, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+    cap_faces = 6 * (2 if caps == "both" else 1)
+    assert (general.triangle_regions[-2 * cap_faces :] == edge_select.NO_REGION).all()
+    assert (general.triangle_regions[: -2 * cap_faces] >= 0).all()
+
+
 def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
-    """An Array with caps takes the regions found from the mesh."""
+    """An Array whose cap has triangles (no quad rows), a hidden edge (the
+    edge angle beside the cage look hides a flat cap's inner edges) or an
+    edge of a drawn class (its border, of the boundary class) takes the
+    regions found from the mesh."""
     scene = scenes.empty_scene()
     capped = scenes.monkey(scene)
     _subdivide(capped, 1)
@@ -386,6 +410,16 @@ def test_the_cage_regions_refuse_what_they_cannot_tell(monkeypatch):
     array.use_merge_vertices = False
     array.end_cap = scenes.monkey(scene)  # its triangles: no quad rows either
     _assert_same_as_general(capped, CAGE, monkeypatch, rows_expected=False, regions_expected=False)
+    bpy = pytest.importorskip("bpy")
+    flat_cap = scenes.grid(scene, "Flat cap", x_segments=3, y_segments=3, size=0.5)
+    array.end_cap = flat_cap  # a flat grid: the angle hides its inner edges
+    angle = edge_select.Selection(use_cage=True, edge_angle=math.radians(10.0))
+    bpy.context.view_layer.update()
+    _assert_same_as_general(capped, angle, monkeypatch, rows_expected=True, regions_expected=False)
+    # Without the angle every edge of the flat cap is drawn, and its border
+    # is of the boundary class: a cap face with a classed edge is listed.
+    boundary = edge_select.Selection(use_cage=True, classes=("boundary",))
+    _assert_same_as_general(capped, boundary, monkeypatch, rows_expected=True, regions_expected=False)
 
 
 def _modifier_before(obj, kind):

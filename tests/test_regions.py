@@ -193,6 +193,24 @@ def test_cage_edges_through_a_mirror_and_an_array(merge, output_dir):
         assert ref.intensity.sum() < 0.5 * every_edge.intensity.sum()
 
 
+def test_cage_edges_through_an_array_with_caps(output_dir):
+    """An Array's caps follow its copies: the copies keep their cage
+    regions, each cap face is its own (every cap edge drawn, as Blender's
+    overlay shows a cap without marks), in one mesh."""
+    scene = scenes.empty_scene(220, 160, use_cage_edges=True, thickness=1.5)
+    obj = scenes.mesh_object(scene, "Half", _half_cube, rotation=(0.2, 0.1, 0.5))
+    _subdivided(obj, 3)
+    array = scenes.add_mirror_and_array(obj, count=2, offset=(0.0, 1.4, 0.0))
+    array.start_cap = scenes.cube(scene, "Start cap", size=0.5)
+    array.end_cap = scenes.cube(scene, "End cap", size=0.7)
+    for cap in (array.start_cap, array.end_cap):
+        cap.hide_render = True
+    scenes.add_camera(scene, location=(3.0, -7.5, 5.0), target=(0.3, 1.1, 0.0))
+    report = accuracy.measure(scene, "regions_array_caps", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+
+
 def _grid_with_ngon(bm):
     bmesh.ops.create_grid(bm, x_segments=8, y_segments=8, size=2.0)
     block = [f for f in bm.faces if all(abs(v.co.x) < 0.6 and abs(v.co.y) < 0.6 for v in f.verts)]

@@ -316,7 +316,8 @@ def _carried_copies(after, edges, verts_num: int, faces_num: int):
     mesh))`` where each step, in stack order, is ``(copies, vertices of its
     input, caps)``: ``copies`` copies of its input one after the other (its
     vertex numbers shifted by the input's vertex count for each), then each
-    cap's ``((E, 2) edges, vertex count, drawn mask)``. None where the
+    cap's ``((E, 2) edges, vertex count, drawn mask, face count)``
+    (_cap_layout). None where the
     marks are dropped or the counts do not fit (the caller checks the
     edges themselves)."""
     edges_num = len(edges)
@@ -354,7 +355,7 @@ def _carried_copies(after, edges, verts_num: int, faces_num: int):
             if count is None:
                 return None
             edges_num, verts_num, faces_num = edges_num // count, verts_num // count, faces_num // count
-            steps.append((count, verts_num, tuple((c[0], c[1], c[2]) for c in caps)))
+            steps.append((count, verts_num, tuple(caps)))
         # WELD: it kept its input only if nothing was welded, which the
         # caller's check of the whole layout tells.
     return steps[::-1], (edges_num, verts_num, faces_num)
@@ -408,7 +409,7 @@ def _copies_match(steps, edges, size: int) -> bool:
         if not np.array_equal(block[1:] - block[:1].astype(np.int64), np.broadcast_to(shift, block[1:].shape)):
             return False
         end, first_vertex = copies * size, copies * verts_in
-        for cap_edges, cap_verts, _cap_mask in caps:
+        for cap_edges, cap_verts, _cap_mask, _cap_faces in caps:
             if not np.array_equal(edges[end : end + len(cap_edges)], cap_edges + first_vertex):
                 return False
             end += len(cap_edges)
@@ -427,7 +428,7 @@ def _carry(steps, mask, ends):
         ends = (np.broadcast_to(ends, (copies, size, 2)) + (np.arange(copies) * verts_in)[:, None, None]).reshape(-1, 2)
         mask = np.tile(mask, copies)
         first_vertex = copies * verts_in
-        for cap_edges, cap_verts, cap_mask in caps:
+        for cap_edges, cap_verts, cap_mask, _cap_faces in caps:
             ends = np.concatenate([ends, cap_edges + first_vertex])
             mask = np.concatenate([mask, cap_mask])
             first_vertex += cap_verts
@@ -482,7 +483,10 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     else (a modifier before the subdivision made its input; Edit Mode, whose
     mesh datablock lags the edited one) the layout itself, for
     core/edge_select.py to read them from the evaluated mesh's corners
-    (``regions_from_layout``); None where an Array copy has caps.
+    (``regions_from_layout``); None where an Array copy has caps, unless
+    they are the last modifier's and the regions are read from the
+    object's own mesh: the caps' faces then follow every listed region
+    (KnownRegions: faces past the list), each cap face its own region.
 
     Blender's subdivision (``subdiv_foreach.cc``, ``subdiv_foreach_faces``)
     makes the children of each cage face one after another, in cage face
@@ -497,8 +501,9 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     cage mesh read here is checked to be the one the layout was peeled to
     (its vertex, face and corner counts and every edge)."""
     _children, per_edge, cage, steps, cage_mesh, _edges = layout
-    if any(caps for _copies, _verts, caps in steps):
-        return None
+    if any(caps for _copies, _verts, caps in steps[:-1]):
+        return None  # caps copied by a later step: faces of no region between listed ones
+    caps = steps[-1][2] if steps else ()
     verts_num, faces_num, sub_faces_num, own_input, sub_verts_num, sub_edges_num = cage_mesh
     original = getattr(obj, "original", None) or obj
     data = getattr(original, "data", None)
@@ -508,6 +513,8 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
         or data is None
         or getattr(original, "mode", "OBJECT") == "EDIT"
     ):
+        if caps:
+            return None  # (regions_from_layout reads every face as a child)
         return edge_select.SubdivisionLayout(
             level=per_edge.bit_length() - 1,
             coarse_verts=verts_num,
@@ -545,7 +552,12 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     edge_start = np.multiply(offsets, per_edge, dtype=np.int64)
     known = edge_select.KnownRegions(face_start, edge_start, edges, per_edge)
     copies = tuple(copies for copies, _verts, _caps in steps)
-    return edge_select.copied_regions(known, copies, sub_faces_num, sub_edges_num, len(mesh.polygons), len(mesh.edges))
+    # The caps' faces and edges come last (after every copy): past the regions.
+    cap_faces = sum(cap[3] for cap in caps)
+    cap_edges = sum(len(cap[0]) for cap in caps)
+    return edge_select.copied_regions(
+        known, copies, sub_faces_num, sub_edges_num, len(mesh.polygons) - cap_faces, len(mesh.edges) - cap_edges
+    )
 
 
 def _subdivided_edge_count(steps, edges_num: int) -> int:

@@ -100,6 +100,12 @@ class KnownRegions:
     rest of what its shortcut assumes and otherwise finds the regions
     itself.
 
+    Faces from ``face_start[-1]`` on, when there are any (the caps an Array
+    adds after its copies), are in no listed region: select_edges takes
+    them as plain faces (each its own region, drawn from its own edges)
+    where every edge they have is drawn and has no class, and otherwise
+    finds the regions itself.
+
     ``chain_edges`` > 1 (a subdivision at level L: 2**L) says more, which
     the caller vouches for too: the listed edges come in whole chains of
     that many consecutive edges (``region_edges`` in groups of
@@ -704,12 +710,14 @@ def _select_known_regions(
     quad instead of found from every corner, or None (nothing written)
     where the shortcut does not apply: faces other than
     extract.build_arrays_fast's quad rows, a region of one face, a region
-    list that does not cover the faces or names an edge that is not drawn.
+    list that names an edge that is not drawn, faces past the list
+    (KnownRegions) with an edge that is hidden or has a class.
     ``classes``: edge_classes, which the caller has checked style only
     drawn edges (_classes_style_drawn_edges).
 
-    Every face is then in a multi-face region, so every face is listed and
-    its lines come from the region-lines pass. Its block is its region's
+    Every face of the list is then in a multi-face region, so it is listed
+    and its lines come from the region-lines pass; the faces past it keep
+    their rows as extracted. Its block is its region's
     (id = the region's first face), holding the region's drawn edges,
     ascending, one segment per class of each (one where it has none; no
     n-gon diagonal); in a region past WALK_LIMIT it is the face's own,
@@ -778,9 +786,10 @@ def _select_known_regions(
     # first edges bound the ids and ascend where the list does.
     chain_edges = max(1, int(regions.chain_edges))
     firsts = edges[::chain_edges]
+    listed_faces = int(face_start[-1])  # the rest: plain faces (KnownRegions)
     if (
         face_start[0] != 0
-        or face_start[-1] != face_count
+        or not 0 < listed_faces <= face_count
         or region_faces.min() < 2
         or edge_start[0] != 0
         or edge_start[-1] != len(edges)
@@ -797,6 +806,12 @@ def _select_known_regions(
     flip = _quad_row_flip(arrays, corner_vert, offsets)
     if flip is None:
         return None
+    if listed_faces < face_count:
+        # Plain faces only where nothing joins them or lists them: every
+        # edge drawn and none with a class (all quads: 4 corners a face).
+        tail = slice(4 * listed_faces, None)
+        if not corner_drawn[tail].all() or (classes is not None and classes.take(corner_edge[tail]).any()):
+            return None
     stats = SelectionStats(hidden_edges=len(drawn) - prefix[0])
 
     # The blocks: region k's drawn edges from table row first[k], in region order.
@@ -841,29 +856,35 @@ def _select_known_regions(
         face_table_start += len(arrays.ngon_corners)
     stats.segments = len(arrays.region_table) // TEXELS_PER_SEGMENT
 
-    # Each quad's two rows in one 64-bit write (row 2i the low half), looked
-    # up by its block's segment count, its split and its hidden edges
+    # Each listed quad's two rows in one 64-bit write (row 2i the low half),
+    # looked up by its block's segment count, its split and its hidden edges
     # (_listed_quad_rows), written in place: no million-row temporaries.
+    if listed_faces < face_count:
+        at, flip = at[:listed_faces], flip[:listed_faces]
     at |= flip.view(np.uint8) << np.uint8(4)
     at |= np.left_shift(face_segments, 5, dtype=np.uint32, casting="unsafe")
     flags = arrays.edge_flags
     if flags.dtype == np.int32 and flags.flags.c_contiguous:
-        _LISTED_QUAD_ROWS.take(at, out=flags.view(np.uint64), mode="clip")
+        _LISTED_QUAD_ROWS.take(at, out=flags.view(np.uint64)[:listed_faces], mode="clip")
     else:
-        flags[:] = np.take(_LISTED_QUAD_ROWS, at).view(np.int32)
+        flags[: 2 * listed_faces] = np.take(_LISTED_QUAD_ROWS, at).view(np.int32)
     if arrays.triangles.flags.c_contiguous:  # a quad's two rows are one row of 8: two column writes
-        quads = arrays.triangles.reshape(face_count, 8)
+        quads = arrays.triangles.reshape(face_count, 8)[:listed_faces]
         quads[:, 3] = face_table_start
         quads[:, 7] = face_table_start
     else:
-        arrays.triangles[:, 3] = np.repeat(face_table_start, 2)
+        arrays.triangles[: 2 * listed_faces, 3] = np.repeat(face_table_start, 2)
     label_texel = label.astype(np.float32)  # as the tables hold it
     if piece_region is None:
-        arrays.triangle_regions = label_texel.repeat(2 * region_faces)
+        regions_of_triangles = label_texel.repeat(2 * region_faces)
     else:
-        arrays.triangle_regions = per_face(label_texel).repeat(2)
+        regions_of_triangles = per_face(label_texel).repeat(2)
+    if listed_faces < face_count:  # the plain faces' triangles: in no region
+        plain = np.full(2 * (face_count - listed_faces), NO_REGION, np.float32)
+        regions_of_triangles = np.concatenate([regions_of_triangles, plain])
+    arrays.triangle_regions = regions_of_triangles
     stats.regions = len(label)
-    stats.listed_triangles = arrays.triangle_count
+    stats.listed_triangles = 2 * listed_faces
     line_edges = None
     if chain_edges > 1:
         line_edges = _chain_region_lines(

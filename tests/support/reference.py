@@ -206,13 +206,16 @@ COPLANAR_ANGLE = 1.0e-3
 def _cage_masks(depsgraph, s) -> dict:
     """{object name: (drawn mask, chain id) per evaluated edge} for the
     meshes a subdivision modifier subdivides, found independently of the
-    add-on: a temporary boolean edge attribute on the original mesh is True
-    everywhere; Blender's subdivision carries it onto the child edges of
-    original edges only. Removed again before returning."""
+    add-on: a temporary integer edge attribute on the original mesh numbers
+    every edge from 1; Blender's subdivision carries it onto the child
+    edges of original edges only. An Array cap carries no Optimal Display
+    marks, so Blender's overlay shows every cap edge: the caps' meshes get
+    the attribute too, numbered past the object's edges, so each cap edge
+    is drawn and a chain of its own. Removed again before returning."""
     if s is None or not getattr(s, "use_cage_edges", False):
         return {}
     render = depsgraph.mode == "RENDER"
-    marked = []
+    marked, caps = [], []
     for obj in bpy.context.scene.objects:
         if obj.type != "MESH" or obj.mode == "EDIT":
             continue
@@ -229,6 +232,12 @@ def _cage_masks(depsgraph, s) -> dict:
             attribute = obj.data.attributes.new("__reference_cage", "INT", "EDGE")
             attribute.data.foreach_set("value", np.arange(1, len(obj.data.edges) + 1, dtype=np.int32))
             marked.append(obj)
+            for cap in _array_caps(obj, subdivides[-1], render):
+                if "__reference_cage" not in cap.data.attributes:
+                    first = _CAP_NUMBERS * (len(caps) + 1)
+                    attribute = cap.data.attributes.new("__reference_cage", "INT", "EDGE")
+                    attribute.data.foreach_set("value", np.arange(first, first + len(cap.data.edges), dtype=np.int32))
+                    caps.append(cap)
     masks = {}
     if not marked:
         return masks
@@ -245,10 +254,33 @@ def _cage_masks(depsgraph, s) -> dict:
             # edge attribute is copied to them); new inner edges get 0.
             masks[obj.name] = (values > 0, values - 1)
     finally:
-        for obj in marked:
+        for obj in marked + caps:
             obj.data.attributes.remove(obj.data.attributes["__reference_cage"])
         depsgraph.update()
     return masks
+
+
+# Where the caps' edge numbers start (cap k from (k + 1) times this): past
+# any test mesh's own edges.
+_CAP_NUMBERS = 1 << 24
+
+
+def _array_caps(obj, last_subdivision, render) -> list:
+    """The cap objects of the Array modifiers after ``obj``'s last
+    subdivision. A cap with modifiers of its own is not modelled (its marks
+    would come from its own evaluation)."""
+    enabled = [m for m in obj.modifiers if (m.show_render if render else m.show_viewport)]
+    caps = []
+    for m in enabled[enabled.index(last_subdivision) + 1 :]:
+        if m.type != "ARRAY":
+            continue
+        for cap in (m.start_cap, m.end_cap):
+            if cap is None:
+                continue
+            if cap.type != "MESH" or any(c.show_render or c.show_viewport for c in cap.modifiers):
+                raise NotImplementedError("the reference does not model Array caps with modifiers of their own")
+            caps.append(cap)
+    return caps
 
 
 # Modifiers after the last subdivision as Blender's overlay treats them
@@ -288,8 +320,6 @@ def _keeps_optimal_display(obj, subdivides, render, depsgraph) -> bool:
         elif m.type == "ARRAY":
             if m.use_merge_vertices:
                 return False
-            if m.start_cap is not None or m.end_cap is not None:
-                raise NotImplementedError("the reference does not model Array caps with cage edges")
         elif m.type == "WELD":
             merging.append((m, "show_render" if render else "show_viewport", False))
         elif m.type not in _REFERENCE_DEFORM:
