@@ -716,8 +716,8 @@ def _select_known_regions(
     drawn edges (_classes_style_drawn_edges).
 
     Every face of the list is then in a multi-face region, so it is listed
-    and its lines come from the region-lines pass; the faces past it keep
-    their rows as extracted. Its block is its region's
+    and its lines come from the region-lines pass (the faces past it keep
+    their rows as extracted). A listed face's block is its region's
     (id = the region's first face), holding the region's drawn edges,
     ascending, one segment per class of each (one where it has none; no
     n-gon diagonal); in a region past WALK_LIMIT it is the face's own,
