@@ -182,6 +182,7 @@ STACKS = (
     ("Mirror, Subdivision, edge angle 30°", "Suzanne", ("MIRROR",), False, dict(edge_angle=math.radians(30.0)), False),
     # The caps follow the copies: faces past the listed regions.
     ("Subdivision, Mirror, Array with caps", "Suzanne", (), False, {}, True),
+    ("Edit Mode, Subdivision, Mirror, Array with caps", "Suzanne", (), True, {}, True),
 )
 
 

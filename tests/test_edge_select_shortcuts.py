@@ -379,20 +379,36 @@ def test_the_edge_angle_beside_the_cage_joins_its_regions(shape, before, degrees
     assert len(set(general.triangle_regions.tolist())) == len(merged.edge_start) - 1
 
 
-@pytest.mark.parametrize("caps", ["end", "both"])
-@pytest.mark.parametrize("level", [1, 3])
-def test_an_array_with_caps_keeps_the_cage_regions(caps, level, monkeypatch):
+@pytest.mark.parametrize(
+    ("caps", "level", "stack"),
+    [("end", 1, "own mesh"), ("both", 3, "own mesh"), ("both", 2, "Mirror before"), ("end", 2, "Edit Mode")],
+)
+def test_an_array_with_caps_keeps_the_cage_regions(caps, level, stack, monkeypatch):
     """The caps an Array adds after its copies (quads here) are plain faces
     past the listed regions: the regions the layout gives still apply, with
-    the general path's arrays, the caps' triangles in no region."""
+    the general path's arrays, the caps' triangles in no region; read from
+    the object's own mesh, or from the evaluated mesh's layout (a modifier
+    before the subdivision, Edit Mode)."""
+    import bpy
+
     scene = scenes.empty_scene()
     capped = scenes.monkey(scene)
+    if stack == "Mirror before":
+        _modifier_before(capped, "MIRROR")
     _subdivide(capped, level)
     array = scenes.add_mirror_and_array(capped, count=2, offset=(1.3, 0.0, 0.0))
     array.end_cap = scenes.cube(scene, "End cap", size=0.4)
     if caps == "both":
         array.start_cap = scenes.cube(scene, "Start cap", size=0.3, location=(0.0, 2.0, 0.0))
-    general = _assert_same_as_general(capped, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+    if stack == "Edit Mode":
+        bpy.context.view_layer.objects.active = capped
+        capped.select_set(True)
+        bpy.ops.object.mode_set(mode="EDIT")
+    try:
+        general = _assert_same_as_general(capped, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+    finally:
+        if stack == "Edit Mode":
+            bpy.ops.object.mode_set(mode="OBJECT")
     cap_faces = 6 * (2 if caps == "both" else 1)
     assert (general.triangle_regions[-2 * cap_faces :] == edge_select.NO_REGION).all()
     assert (general.triangle_regions[: -2 * cap_faces] >= 0).all()

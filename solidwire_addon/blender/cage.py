@@ -483,10 +483,10 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     else (a modifier before the subdivision made its input; Edit Mode, whose
     mesh datablock lags the edited one) the layout itself, for
     core/edge_select.py to read them from the evaluated mesh's corners
-    (``regions_from_layout``); None where an Array copy has caps, unless
-    they are the last modifier's and the regions are read from the
-    object's own mesh: the caps' faces then follow every listed region
-    (KnownRegions: faces past the list), each cap face its own region.
+    (``regions_from_layout``); None where a step before the last has
+    caps. The last Array's caps follow every copy: their faces come after
+    every listed region (KnownRegions: faces past the list), each cap face
+    its own region.
 
     Blender's subdivision (``subdiv_foreach.cc``, ``subdiv_foreach_faces``)
     makes the children of each cage face one after another, in cage face
@@ -504,6 +504,9 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     if any(caps for _copies, _verts, caps in steps[:-1]):
         return None  # caps copied by a later step: faces of no region between listed ones
     caps = steps[-1][2] if steps else ()
+    # The caps' faces and edges come last (after every copy): past the regions.
+    cap_faces = sum(cap[3] for cap in caps)
+    cap_edges = sum(len(cap[0]) for cap in caps)
     verts_num, faces_num, sub_faces_num, own_input, sub_verts_num, sub_edges_num = cage_mesh
     original = getattr(obj, "original", None) or obj
     data = getattr(original, "data", None)
@@ -513,8 +516,6 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
         or data is None
         or getattr(original, "mode", "OBJECT") == "EDIT"
     ):
-        if caps:
-            return None  # (regions_from_layout reads every face as a child)
         return edge_select.SubdivisionLayout(
             level=per_edge.bit_length() - 1,
             coarse_verts=verts_num,
@@ -524,6 +525,8 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
             subdivided_edges=sub_edges_num,
             subdivided_faces=sub_faces_num,
             copies=tuple(copies for copies, _verts, _caps in steps),
+            cap_faces=cap_faces,
+            cap_edges=cap_edges,
         )
     children_per_corner = (per_edge // 2) ** 2  # 4**(L-1)
     if (
@@ -552,9 +555,6 @@ def _known_regions(obj, mesh, layout) -> edge_select.KnownRegions | edge_select.
     edge_start = np.multiply(offsets, per_edge, dtype=np.int64)
     known = edge_select.KnownRegions(face_start, edge_start, edges, per_edge)
     copies = tuple(copies for copies, _verts, _caps in steps)
-    # The caps' faces and edges come last (after every copy): past the regions.
-    cap_faces = sum(cap[3] for cap in caps)
-    cap_edges = sum(len(cap[0]) for cap in caps)
     return edge_select.copied_regions(
         known, copies, sub_faces_num, sub_edges_num, len(mesh.polygons) - cap_faces, len(mesh.edges) - cap_edges
     )

@@ -137,7 +137,9 @@ class SubdivisionLayout:
     edges, then each coarse face's own, face by face; its first
     ``coarse_edges * n`` edges are the drawn ones. ``copies``: how many
     copies each Mirror or Array step after the subdivision made, in stack
-    order (each copy's faces and edges follow its input's)."""
+    order (each copy's faces and edges follow its input's). ``cap_faces``,
+    ``cap_edges``: what the last Array's caps add after every copy (faces
+    past the regions: KnownRegions)."""
 
     level: int
     coarse_verts: int
@@ -147,6 +149,8 @@ class SubdivisionLayout:
     subdivided_edges: int
     subdivided_faces: int
     copies: tuple[int, ...] = ()
+    cap_faces: int = 0
+    cap_edges: int = 0
 
 
 @dataclass
@@ -617,7 +621,9 @@ def regions_from_layout(
         and np.array_equal(chains - chains[:, :1], np.broadcast_to(np.arange(n), chains.shape))
     )
     known = KnownRegions(face_start, edge_start, edge, n if whole else 1)
-    return copied_regions(known, layout.copies, faces, edges_num, face_count, len(drawn))
+    return copied_regions(
+        known, layout.copies, faces, edges_num, face_count - layout.cap_faces, len(drawn) - layout.cap_edges
+    )
 
 
 def join_regions(regions: KnownRegions, joined: np.ndarray) -> KnownRegions | None:
