@@ -48,6 +48,7 @@ from .extract import (
     NGON_SHIFT,
     REGION_LINES,
     MeshArrays,
+    distinct,
 )
 
 # Edge classes, in style order: style k + 1 is class k (style 0 is the
@@ -390,7 +391,7 @@ def select_edges(
     # regions and of faces with a classed edge; a plain face needs none.
     drawn_corner = drawn[corner_edge]
     lines_corner = drawn_corner & (walked | styled_face)[corner_face]
-    keys = np.unique(label[corner_face[lines_corner]] * edge_count + corner_edge[lines_corner])
+    keys = distinct(label[corner_face[lines_corner]] * edge_count + corner_edge[lines_corner])
     pairs = np.stack(np.divmod(keys, edge_count), axis=1)
     ngon_face = sizes > 4
     # A region too large to walk (see WALK_LIMIT): its faces' blocks hold
@@ -435,7 +436,7 @@ def select_edges(
         face_owned[block_face[~from_region]] = True
         own_corner = face_owned[corner_face] & drawn_corner
         # Unique (owner, edge) pairs, as one key: sorted by owner, then edge.
-        own_keys = np.unique((face_count + corner_face[own_corner]) * edge_count + corner_edge[own_corner])
+        own_keys = distinct((face_count + corner_face[own_corner]) * edge_count + corner_edge[own_corner])
         own = np.stack(np.divmod(own_keys, edge_count), axis=1)
     seg_owner = np.concatenate([seg_owner, own[:, 0]])
     seg_edge = np.concatenate([seg_edge, own[:, 1]])
@@ -608,7 +609,7 @@ def regions_from_layout(
     # Each run's drawn corners are one stretch of ``at``: R searches, not one per corner.
     per_run = np.diff(np.searchsorted(at, 4 * face_start))
     run = np.repeat(np.arange(len(first), dtype=np.int64), per_run)
-    region, edge = np.divmod(np.unique(run * drawn_count + np.take(corner_edge, at)), drawn_count)
+    region, edge = np.divmod(distinct(run * drawn_count + np.take(corner_edge, at)), drawn_count)
     edge_start = np.zeros(len(face_start), np.int64)
     np.cumsum(np.bincount(region, minlength=len(first)), out=edge_start[1:])
     # Whole chains (a coarse edge's n children, from a multiple of n), none
@@ -663,7 +664,7 @@ def join_regions(regions: KnownRegions, joined: np.ndarray) -> KnownRegions | No
     edge_count = np.int64(int(edges.max()) + 1)
     drawn_listing = ~hidden_listing
     keys = piece_region.take(piece_of_listing[drawn_listing]) * edge_count + edges[drawn_listing]
-    region, edge = np.divmod(np.unique(keys), edge_count)
+    region, edge = np.divmod(distinct(keys), edge_count)
     region_count = int(is_first.sum())
     joined_start = np.zeros(region_count + 1, np.int64)
     np.cumsum(np.bincount(region, minlength=region_count), out=joined_start[1:])

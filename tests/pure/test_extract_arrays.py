@@ -231,3 +231,22 @@ def test_infinite_vertices_of_both_signs_leave_their_faces_out_without_a_numpy_w
         arrays = extract.build_arrays_fast(positions, corner_vert, offsets)
     assert arrays.triangle_count == 2  # the first quad only
     assert set(np.unique(arrays.triangles[:, :3])) <= {0, 1, 2, 3}
+
+
+@pytest.mark.parametrize("shape", ["random", "grouped", "empty", "one"])
+def test_distinct_is_numpy_unique(shape):
+    """extract.distinct, the stable-sort unique the region keys use, gives
+    np.unique's answer: random keys with repeats, keys grouped by region
+    (ascending groups, shuffled within each, repeats across groups), none,
+    one."""
+    rng = np.random.default_rng(7)
+    if shape == "random":
+        keys = rng.integers(0, 500, 3000)
+    elif shape == "grouped":
+        groups = [1000 * g + rng.permutation(rng.integers(1, 60, 40)) for g in range(50)]
+        keys = np.concatenate(groups)
+    else:
+        keys = np.arange(0 if shape == "empty" else 1, dtype=np.int64) * 3
+    result = extract.distinct(keys)
+    assert result.dtype == keys.dtype
+    np.testing.assert_array_equal(result, np.unique(keys))
