@@ -328,3 +328,30 @@ def test_full_width_silhouettes_match_reference(case, output_dir):
     without = reference.render_reference(scene, settings=_Override(scene.solidwire, use_silhouettes=False))
     ref = reference.render_reference(scene)
     assert ((ref.intensity - without.intensity) > 0.5).sum() > 30  # outer halves really drawn
+
+
+def test_silhouette_candidates_are_every_real_edge_of_one_or_two_triangles():
+    """The silhouette pass's edge table (silhouettes.candidate_edges) on a
+    random triangle soup with random real edges: every real edge used by
+    one or two triangles, once, ascending by its vertex pair, with the
+    third vertex of each of its triangles in triangle order (-1 for a
+    boundary edge); an edge of three triangles is not a candidate."""
+    from solidwire_addon.core import extract, silhouettes
+
+    rng = np.random.default_rng(11)
+    triangles = np.zeros((400, 4), np.int32)
+    triangles[:, :3] = rng.integers(0, 40, (400, 3))
+    triangles = triangles[(triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2])]
+    triangles = triangles[triangles[:, 0] != triangles[:, 2]]
+    bits = (extract.EDGE0_REAL, extract.EDGE1_REAL, extract.EDGE2_REAL)
+    flags = (rng.random((len(triangles), 3)) < 0.8) @ np.array(bits, np.int32)
+    expected: dict = {}
+    for t, (row, flag) in enumerate(zip(triangles[:, :3].tolist(), flags.tolist())):
+        for k in range(3):
+            if flag & bits[k]:
+                a, b, o = row[k], row[(k + 1) % 3], row[(k + 2) % 3]
+                expected.setdefault((min(a, b), max(a, b)), []).append(o)
+    rows = [[a, b, o[0], o[1] if len(o) == 2 else -1] for (a, b), o in sorted(expected.items()) if len(o) <= 2]
+    assert any(len(o) > 2 for o in expected.values()) and any(len(o) == 1 for o in expected.values())
+    np.testing.assert_array_equal(silhouettes.candidate_edges(triangles, flags), np.array(rows, np.float32))
+    assert silhouettes.candidate_edges(triangles[:0], flags[:0]).shape == (0, 4)

@@ -966,7 +966,7 @@ def _face_blocks_past_walk_limit(
     edge_count = np.int64(len(verts))
     edges = np.asarray(corner_edge).reshape(-1, 4).take(faces, axis=0).reshape(-1).take(at)
     keys = local_face * edge_count + edges
-    keys.sort()
+    keys.sort(kind="stable")  # (timsort: the keys ascend face to face, as extract.distinct's)
     if len(keys) > 1 and (keys[1:] == keys[:-1]).any():
         return None
     own_edges = keys % edge_count
