@@ -42,7 +42,8 @@ def table_shape(count: int) -> tuple[int, int]:
 
 
 def table_texture(rows4: np.ndarray):
-    """(N, 4) float32 -> RGBA32F texture laid out by table_shape."""
+    """(N, 4) float32 (or integers float32 holds exactly) -> RGBA32F
+    texture laid out by table_shape."""
     return _table(rows4, 4, "RGBA32F")
 
 
@@ -116,7 +117,8 @@ class GPUMesh:
         positions = np.zeros((arrays.vertex_count, 4), dtype=np.float32)
         positions[:, :3] = arrays.positions
         self.positions = table_texture(positions)
-        self.triangles = table_texture(arrays.triangles.astype(np.float32))
+        # (Integer rows are converted as they are copied into the upload.)
+        self.triangles = table_texture(arrays.triangles)
         # One outline table: the n-gon blocks, then the segment blocks of the
         # triangles that walk their region (core/edge_select.py).
         region = arrays.region_table if arrays.region_table is not None else np.zeros((0, 4), np.float32)
