@@ -337,7 +337,7 @@ def test_provoking_vertex_numbering_keeps_every_triangle():
     rng = np.random.default_rng(3)
     positions = rng.random((50, 3)).astype(np.float32)
     triangles = rng.integers(0, 40, size=(300, 3)).astype(np.int32)  # vertices 40..49 end no triangle
-    copied, numbers, out_triangles = _provoking_triangle_numbers(len(positions), triangles)
+    copied, numbers, out_triangles = _provoking_triangle_numbers(len(positions), triangles.copy())  # (writes into it)
     out_positions = np.concatenate([positions, positions[copied]])
     np.testing.assert_array_equal(out_positions[:50], positions)
     np.testing.assert_array_equal(out_triangles[:, :2], triangles[:, :2])

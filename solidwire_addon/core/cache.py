@@ -79,7 +79,8 @@ def _provoking_triangle_numbers(vertex_count: int, triangles: np.ndarray):
     gets a copy of it, appended after the original vertices in the order of
     ``copied vertices``. Corners keep their order, so each triangle is
     rasterised exactly as before. Depends on the triangles alone, so a mesh
-    that only moves keeps it."""
+    that only moves keeps it. ``triangles`` ((T, 3) int32, the caller's own
+    copy) becomes the index triangles: the copies are written into it."""
     count = len(triangles)
     last = np.ascontiguousarray(triangles[:, 2])
     rows = np.arange(count, dtype=np.int32)
@@ -92,9 +93,8 @@ def _provoking_triangle_numbers(vertex_count: int, triangles: np.ndarray):
     # it ends no triangle: owner + 1 either way.
     np.add(owner, 1, out=numbers[:vertex_count], casting="unsafe")
     numbers[vertex_count:] = copied + 1
-    out_triangles = triangles.copy()
-    out_triangles[copied, 2] = vertex_count + np.arange(len(copied), dtype=np.int32)
-    return copied_vertices, numbers, out_triangles
+    triangles[copied, 2] = vertex_count + np.arange(len(copied), dtype=np.int32)
+    return copied_vertices, numbers, triangles
 
 
 _serials = itertools.count(1)
@@ -390,7 +390,7 @@ class GPUMesh:
         if self._visibility is not None and self._visibility[0] != by_vertex:
             self._drop_visibility_batch()
         if self._visibility is None:
-            triangles = np.ascontiguousarray(self.triangles_cpu[:, :3], dtype=np.int32)
+            triangles = np.array(self.triangles_cpu[:, :3], dtype=np.int32, order="C")  # (a copy: written into below)
             sources = np.arange(self.vertex_count, dtype=np.int32)
             fmt = gpu.types.GPUVertFormat()
             fmt.attr_add(id="source_vertex", comp_type="I32", len=1, fetch_mode="INT")
