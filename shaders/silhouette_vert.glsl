@@ -1,15 +1,17 @@
 /* SolidWire full-width silhouettes, vertex stage: one screen-space fin
- * (two triangles, six corners) per candidate edge, pulled from
- * `silhouette_edges` by gl_VertexID / 6. See solidwire_addon/silhouettes.py
- * for the definition. Fins of edges that are not silhouettes in this view
- * collapse to nothing here. */
+ * (two triangles over four shared corners, draw.indexed_quad_batch) per
+ * candidate edge, pulled from `silhouette_edges` by gl_VertexID / 4 (an
+ * indexed draw: gl_VertexID is the corner's index). See
+ * solidwire_addon/silhouettes.py for the definition. Fins of edges that are
+ * not silhouettes in this view collapse to nothing here: most fins, whose
+ * four corners a software rasteriser shades once each (not six). */
 
 /* Outside the clip volume: the rasteriser drops the triangle. */
 const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
 
 void main()
 {
-  int edge = gl_VertexID / 6;
+  int edge = gl_VertexID / 4;
   int corner = quad_corner;
   vec4 ids = fetch_texel(silhouette_edges, edge);
   vec4 a = vertex_clip(ids.x);
@@ -53,9 +55,9 @@ void main()
 #if THICKNESS_MODE == 1
   reach = max(reach, params.world_half_thickness_px / max(min(a_front.w, b_front.w), 1e-6) + 2.0 * params.softness + 1.0);
 #endif
-  /* corners 0..5: (a,-), (b,-), (b,+), (a,-), (b,+), (a,+) */
-  bool at_b = (corner == 1 || corner == 2 || corner == 4);
-  bool plus = (corner == 2 || corner == 4 || corner == 5);
+  /* corners 0..3: (a,-), (b,-), (b,+), (a,+) */
+  bool at_b = (corner == 1 || corner == 2);
+  bool plus = (corner >= 2);
   vec2 w = (at_b ? wb + dir * reach : wa - dir * reach) + normal * (plus ? reach : -reach);
   vec2 ndc = (w - params.viewport.xy) / params.viewport.zw * 2.0 - 1.0;
   gl_Position = vec4(ndc, 0.0, 1.0);

@@ -1,6 +1,7 @@
 /* SolidWire hair and point clouds, vertex stage: one screen-space quad (two
- * triangles, six corners) per strand segment or per point, pulled from the
- * tables by gl_VertexID / 6 (core/strands.py). The quad covers every pixel
+ * triangles over four shared corners, draw.indexed_quad_batch) per strand
+ * segment or per point, pulled from the tables by gl_VertexID / 4 (an indexed
+ * draw: gl_VertexID is the corner's index; core/strands.py). The quad covers every pixel
  * the fragment stage can give a non-zero value: the segment (or disc) widened
  * by its half-width, two softness widths and a pixel of slack. Primitives
  * wholly behind the near plane or with a non-finite position collapse to
@@ -18,7 +19,7 @@ float view_depth_of(vec3 p)
   return -dot(object_to_view_z, vec4(p, 1.0));
 }
 
-/* The quad corner `corner` (0..5: (a,-), (b,-), (b,+), (a,-), (b,+), (a,+))
+/* The quad corner `corner` (0..3: (a,-), (b,-), (b,+), (a,+))
  * around window points wa -> wb, `reach` px on every side. */
 vec4 quad_corner_position(vec2 wa, vec2 wb, float reach, int corner)
 {
@@ -26,8 +27,8 @@ vec4 quad_corner_position(vec2 wa, vec2 wb, float reach, int corner)
   float len = length(dir);
   dir = (len > 0.0) ? dir / len : vec2(1.0, 0.0);
   vec2 normal = vec2(-dir.y, dir.x);
-  bool at_b = (corner == 1 || corner == 2 || corner == 4);
-  bool plus = (corner == 2 || corner == 4 || corner == 5);
+  bool at_b = (corner == 1 || corner == 2);
+  bool plus = (corner >= 2);
   vec2 w = (at_b ? wb + dir * reach : wa - dir * reach) + normal * (plus ? reach : -reach);
   vec2 ndc = (w - params.viewport.xy) / params.viewport.zw * 2.0 - 1.0;
   return vec4(ndc, 0.0, 1.0);
@@ -61,7 +62,7 @@ vec2 joint_normal(float neighbour, vec2 win_a, vec2 win_b, bool clipped, bool at
 
 void main()
 {
-  int prim = gl_VertexID / 6;
+  int prim = gl_VertexID / 4;
   int corner = quad_corner;
 #ifdef STRAND_POINTS
   vec4 point = fetch_texel(vertex_positions, prim);

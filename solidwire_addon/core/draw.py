@@ -758,39 +758,25 @@ class _DrawNumbers:
         _rectangle().draw(shader)
 
 
-_quad_batches: dict[tuple[int, int], object] = {}  # (quads, corners per quad): batch
-_quad_corner_buffers: dict[tuple[int, int], object] = {}  # (quads, corners per quad): their vertex buffer
-
-
-def quad_batch(count: int):
-    """Six corners (two triangles, ``quad_corner`` 0..5) for each of at
-    least ``count`` screen-space quads whose shader pulls everything else:
-    the silhouette fins, hair segments and points. Shared
-    by every draw of the same size class (the next power of two)."""
-    return _shared_quads(count, indexed=False)
+_quad_batches: dict[int, object] = {}  # quads: batch
+_quad_corner_buffers: dict[int, object] = {}  # quads: their vertex buffer
 
 
 def indexed_quad_batch(count: int):
     """Four corners (``quad_corner`` 0..3) and six indices (two triangles)
-    for each of at least ``count`` screen-space quads, for a vertex stage
-    dear enough that sharing corners pays: the region lines' sets up every
-    segment of its run at each corner, and a software rasteriser shades
-    the vertices of an indexed draw once (4 invocations per quad, not 6).
-    Shared by every draw of the same size class (the next power of two)."""
-    return _shared_quads(count, indexed=True)
-
-
-def _shared_quads(count: int, *, indexed: bool):
+    for each of at least ``count`` screen-space quads whose shader pulls
+    everything else (gl_VertexID / 4 is the quad): the region lines' runs,
+    the silhouette fins, hair segments and points. Indexed, because a
+    software rasteriser shades the vertices of an indexed draw once (4
+    invocations per quad, not 6) and these vertex stages are dear: a
+    region-lines run sets up every segment at each corner, and most
+    silhouette fins are set up only to collapse. Shared by every draw of
+    the same size class (the next power of two)."""
     size = _size_class(count)
-    corners = 4 if indexed else 6
-    batch = _quad_batches.get((size, corners))
+    batch = _quad_batches.get(size)
     if batch is None:
-        vbo = _quad_corners(size, corners)
-        if indexed:
-            batch = gpu.types.GPUBatch(type="TRIS", buf=vbo, elem=_quad_indices(np.arange(size, dtype=np.int32)))
-        else:
-            batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
-        _quad_batches[(size, corners)] = batch
+        indices = _quad_indices(np.arange(size, dtype=np.int32))
+        batch = _quad_batches[size] = gpu.types.GPUBatch(type="TRIS", buf=_quad_corners(size), elem=indices)
     return batch
 
 
@@ -805,7 +791,7 @@ def picked_quad_batch(picked: np.ndarray, count: int):
     ``picked`` alone: a draw of some of ``count`` quads in which
     gl_VertexID / 4 is still each quad's number. Made per draw (its index
     buffer is as long as the pick)."""
-    return gpu.types.GPUBatch(type="TRIS", buf=_quad_corners(_size_class(count), 4), elem=_quad_indices(picked))
+    return gpu.types.GPUBatch(type="TRIS", buf=_quad_corners(_size_class(count)), elem=_quad_indices(picked))
 
 
 def runs_reaching(mesh, object_to_clip: np.ndarray, viewport, window) -> np.ndarray | None:
@@ -883,16 +869,16 @@ def _quad_indices(quads: np.ndarray):
     )
 
 
-def _quad_corners(size: int, corners: int):
-    """The vertex buffer of ``size`` quads' corners (``quad_corner`` 0 to
-    ``corners`` - 1 each), shared as _shared_quads's batches are."""
-    vbo = _quad_corner_buffers.get((size, corners))
+def _quad_corners(size: int):
+    """The vertex buffer of ``size`` quads' corners (``quad_corner`` 0 to 3
+    each), shared as indexed_quad_batch's batches are."""
+    vbo = _quad_corner_buffers.get(size)
     if vbo is None:
         fmt = gpu.types.GPUVertFormat()
         fmt.attr_add(id="quad_corner", comp_type="I32", len=1, fetch_mode="INT")
-        vbo = gpu.types.GPUVertBuf(fmt, corners * size)
-        vbo.attr_fill("quad_corner", np.tile(np.arange(corners, dtype=np.int32), size))
-        _quad_corner_buffers[(size, corners)] = vbo
+        vbo = gpu.types.GPUVertBuf(fmt, 4 * size)
+        vbo.attr_fill("quad_corner", np.tile(np.arange(4, dtype=np.int32), size))
+        _quad_corner_buffers[size] = vbo
     return vbo
 
 

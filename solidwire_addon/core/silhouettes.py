@@ -35,7 +35,7 @@ import numpy as np
 
 from . import shaders
 from .cache import table_texture, texture_bytes
-from .draw import DrawTarget, bind_display_transform, quad_batch, shader_variant
+from .draw import DrawTarget, bind_display_transform, indexed_quad_batch, shader_variant
 from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
 from .settings import pack_params
 from .view import translation
@@ -139,4 +139,4 @@ def draw_silhouettes(items, view, settings, target: DrawTarget, scene_depth_text
         shader.uniform_sampler("vertex_positions", mesh.positions)
         shader.uniform_sampler("silhouette_edges", table)
         shader.uniform_int("edge_count", count)
-        quad_batch(count).draw_range(shader, elem_start=0, elem_count=6 * count)
+        indexed_quad_batch(count).draw_range(shader, elem_start=0, elem_count=6 * count)

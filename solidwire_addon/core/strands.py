@@ -31,7 +31,7 @@ import numpy as np
 
 from . import colors, matcaps, shaders
 from .cache import table_texture
-from .draw import DrawTarget, bind_display_transform, clip_space_planes, quad_batch, shader_variant, styled
+from .draw import DrawTarget, bind_display_transform, clip_space_planes, indexed_quad_batch, shader_variant, styled
 from .log import one_line, warn_once
 from .settings import pack_params
 from .targets import read_texture
@@ -414,7 +414,7 @@ def _draw(items, view, settings, target: DrawTarget, scene_depth=None) -> int:
             shader.uniform_sampler("vertex_positions", point_table)
             if segment_table is not None:
                 shader.uniform_sampler("strand_segments", segment_table)
-            quad_batch(geometry.count).draw_range(shader, elem_start=0, elem_count=6 * geometry.count)
+            indexed_quad_batch(geometry.count).draw_range(shader, elem_start=0, elem_count=6 * geometry.count)
             drawn += 1
     return drawn
 
