@@ -232,6 +232,49 @@ def test_an_ngon_inside_a_region_keeps_its_own_diagonals(diagonals, output_dir):
     assert (ref.intensity > 0.5).sum() > 50  # the outline and the n-gon's diagonals
 
 
+def _ngon_shapes(scene):
+    """A 24-sided tube (n-gon caps), the grid with an n-gon inside and a
+    wobbly grid whose faces are dissolved into n-gons of up to a few dozen
+    corners: what a CAD import or a limited dissolve leaves."""
+    scenes.mesh_object(
+        scene,
+        "Tube",
+        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=24, radius1=0.7, radius2=0.7, depth=1.2),
+        location=(-1.4, 0.6, 0.0),
+        rotation=(0.5, 0.2, 0.0),
+    )
+    scenes.mesh_object(scene, "Holey", _grid_with_ngon, location=(1.2, 0.8, 0.0), rotation=(0.6, 0.0, 0.3))
+
+    def dissolved(bm):
+        bmesh.ops.create_grid(bm, x_segments=12, y_segments=12, size=1.0)
+        for v in bm.verts:
+            v.co.z = 0.08 * math.sin(3.0 * v.co.x) * math.cos(2.0 * v.co.y)
+        bmesh.ops.dissolve_limit(bm, angle_limit=math.radians(8.0), verts=bm.verts, edges=bm.edges)
+
+    scenes.mesh_object(scene, "Dissolved", dissolved, location=(0.0, -1.0, 0.0), rotation=(0.9, 0.0, 0.2))
+
+
+@pytest.mark.parametrize("diagonals", ["HIDDEN", "SOLID", "DASHED"])
+def test_ngons_are_regions_of_their_own(diagonals, output_dir):
+    """Every look draws an n-gon's outline with the region-lines pass (a
+    region of one face), so its triangles do not each walk the outline at
+    every pixel; its diagonals stay its own, walked where they show."""
+    scene = scenes.empty_scene(240, 180, thickness=1.5, diagonal_mode=diagonals)
+    _ngon_shapes(scene)
+    scenes.add_camera(scene, location=(0.5, -5.5, 4.0), target=(0.0, 0.0, 0.0))
+    assert max(len(face.vertices) for face in bpy.data.objects["Dissolved"].data.polygons) > 12
+    report = accuracy.measure(scene, f"regions_plain_ngons_{diagonals.lower()}", output_dir)
+    accuracy.assert_accurate(report)
+    stats = solidwire_addon.stats()
+    assert stats.get("region_line_entries", 0) > 0
+    # What the lines cover: the outlines alone, or the diagonals too.
+    ref = reference.render_reference(scene)
+    scene.solidwire.diagonal_mode = "HIDDEN"
+    hidden = reference.render_reference(scene)
+    extra = ((ref.intensity - hidden.intensity) > 0.5).sum()
+    assert extra == 0 if diagonals == "HIDDEN" else extra > 200
+
+
 @pytest.mark.parametrize("case", ["cage", "angle"])
 def test_edge_classes_on_large_regions(case, output_dir):
     """Edge classes with their own width, colour and pattern on regions of

@@ -592,7 +592,7 @@ def _mesh_for(
         try:
             source_mesh = get_source()
             # Edge selection reads the face offsets too: once for both.
-            face_offsets = mesh_reading.read_face_offsets(source_mesh) if edges.active else None
+            face_offsets = mesh_reading.read_face_offsets(source_mesh)
             arrays = mesh_reading.extract_mesh(
                 source_mesh,
                 positions=positions,
@@ -600,7 +600,9 @@ def _mesh_for(
                 corners=corner_inputs if corners else None,
                 face_offsets=face_offsets,
             )
-            if edges.active:
+            # Every look selects edges on a mesh with n-gons: each n-gon's
+            # outline is drawn by the region-lines pass (edge_select.select_edges).
+            if edges.active or arrays.has_ngons:
                 cage_edges = None
                 if outline:
                     cage_edges = outlines.outline_mask(source_mesh, face_offsets)

@@ -382,8 +382,8 @@ def apply_edge_selection(
         # The boundary class and the regions' check both need it: counted once.
         corner_uses=np.bincount(corner_edge, minlength=len(verts)) if "boundary" in selection.classes else None,
     )
-    if not inputs.selects_anything:
-        return SelectionStats()
+    if not inputs.selects_anything and not arrays.has_ngons:
+        return SelectionStats()  # (every edge drawn: only n-gons change, as regions of their own)
     inputs.regions = regions  # a function is called only where they apply (select_edges)
     inputs.joined = joined
     return edge_select.select_edges(arrays, corner_vert, face_offsets, corner_edge, inputs)

@@ -17,7 +17,7 @@ import gpu
 import numpy as np
 
 from .edge_select import TEXELS_PER_REGION_LINE
-from .extract import IN_REGION, NORMALS_BY_TRIANGLE, NORMALS_BY_VERTEX, REGION_LINES, MeshArrays
+from .extract import IN_REGION, IS_NGON, NORMALS_BY_TRIANGLE, NORMALS_BY_VERTEX, REGION_LINES, MeshArrays
 
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
@@ -130,11 +130,16 @@ class GPUMesh:
         ngon[len(arrays.ngon_corners) : outline_rows] = region
         self.ngon_corners = table_texture(ngon)
         self.has_ngons = outline_rows > 0
-        # Every triangle that walks a block lies in a multi-face region and
-        # there are no n-gons: where the region-lines pass measures the
-        # lines, no triangle walks anything (the draw needs no block code).
+        # Every triangle that walks a block lies in a region and no triangle
+        # walks an n-gon's own outline (edge selection lists every n-gon as a
+        # region: edge_select.select_edges): where the region-lines pass
+        # measures the lines, no triangle walks anything but a listed
+        # n-gon's diagonals, which only a shown diagonal needs
+        # (draw._Part.variant).
         flags = arrays.edge_flags
-        region_pass_only = arrays.region_lines is not None and len(arrays.ngon_corners) == 0
+        walks_ngon_outline = arrays.has_ngons and bool(np.any(flags & IS_NGON))
+        region_pass_only = arrays.region_lines is not None and not walks_ngon_outline
+        self.blocks_hold_ngon_diagonals = arrays.has_ngons
         # Every triangle flagged REGION_LINES (a cage look): one reduction
         # answers both questions below.
         every_triangle_region_lines = region_pass_only and bool(np.bitwise_and.reduce(flags) & REGION_LINES)

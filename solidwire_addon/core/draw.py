@@ -529,14 +529,16 @@ class _Part:
     in_front: bool  # every triangle lies in front of the near plane
     run_segments: int = 1  # the region-lines pass's segments per quad
     lines_from_image_only: bool = False  # every triangle's lines come from the region-lines pass
+    ngon_diagonals: bool = False  # blocks hold listed n-gons' diagonals (walked where a diagonal shows)
 
     def variant(self, variant):
         """``variant`` for this part. The visibility and region-lines passes
         read neither n-gon outlines nor the set-up table; a draw that reads
         the region lines needs no block code for a mesh whose blocks only
-        hold them."""
+        hold them (and n-gon diagonals, where no diagonal shows)."""
         plain_stage = variant.visibility or variant.region_lines_pass
-        lines_elsewhere = self.lines_only and variant.region_lines
+        diagonals_walked = self.ngon_diagonals and variant.diagonals != shaders.DIAGONALS_HIDDEN
+        lines_elsewhere = self.lines_only and variant.region_lines and not diagonals_walked
         part_variant = replace(
             variant,
             ngons=self.ngons and not plain_stage and not lines_elsewhere,
@@ -587,6 +589,7 @@ def _parts(groups, program, stage, view: View) -> dict:
             in_front=wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max),
             run_segments=getattr(mesh, "region_run_segments", 1),
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
+            ngon_diagonals=getattr(mesh, "blocks_hold_ngon_diagonals", False),
         )
         parts.setdefault(part, []).append(g)
     return parts

@@ -195,7 +195,7 @@ class EdgeInputs:
 @dataclass
 class SelectionStats:
     hidden_edges: int = 0
-    regions: int = 0  # regions of more than one face walked as a whole
+    regions: int = 0  # regions walked as a whole: of more than one face, or one n-gon
     listed_triangles: int = 0
     segments: int = 0
     region_lines: int = 0  # entries of the region-lines table
@@ -324,7 +324,9 @@ def select_edges(
     arrays: MeshArrays, corner_vert: np.ndarray, face_offsets: np.ndarray, corner_edge: np.ndarray, inputs: EdgeInputs
 ) -> SelectionStats:
     """Apply ``inputs`` to ``arrays`` in place (edge flags, column 3 of
-    listed triangles, ``region_table``) and say what it did."""
+    listed triangles, ``region_table``) and say what it did. A mesh with
+    n-gons is worth calling with no selection at all (every edge drawn):
+    its n-gons become regions of their own (see below)."""
     classes = edge_classes(inputs, corner_edge)
     regions = inputs.regions
     if regions is not None and inputs.joined is not None and classes is not None and inputs.drawn is not None:
@@ -380,7 +382,13 @@ def select_edges(
     else:  # every edge drawn (classes on a plain look): every face its own region
         label = np.arange(face_count, dtype=np.int64)
     region_size = np.bincount(label, minlength=face_count)
-    walked_region = region_size > 1
+    # The regions whose lines the region-lines pass draws: those of more than
+    # one face, and each n-gon on its own. An n-gon's triangles would
+    # otherwise each walk its whole outline and diagonals at every pixel, a
+    # cost that grows with its corners (five times a triangulated copy of
+    # a mesh of n-gons of up to 57 corners, on llvmpipe); the pass draws each
+    # outline edge once (image model §2.6).
+    walked_region = (region_size > 1) | ((region_size == 1) & (sizes > 4))
     styled_face = np.zeros(face_count, bool)
     if has_classes:
         styled_face[corner_face[classes.take(corner_edge) != 0]] = True

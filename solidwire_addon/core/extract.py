@@ -128,6 +128,12 @@ class MeshArrays:
         return int(self.positions.shape[0])
 
     @property
+    def has_ngons(self) -> bool:
+        """Whether the mesh has faces of more than four corners (their
+        outlines: ``ngon_corners``)."""
+        return len(self.ngon_corners) > 0
+
+    @property
     def nbytes(self) -> int:
         return sum(a.nbytes for a in (self.positions, self.triangles, self.edge_flags, self.triangle_polygons))
 
