@@ -225,15 +225,27 @@ def _pack_ngons(tri_ids, real, tri_polygons, loop_start, loop_total, corner_vert
     )
     ngon_corners[diag_slots] = np.repeat(corner_vert[loop_start[ngon_polys]], 2 * (sizes - 3))
     pairs = np.stack([tri_ids, np.roll(tri_ids, -1, axis=1)], axis=2)[~real]  # (D, 2)
-    pair_poly = np.repeat(tri_polygons, (~real).sum(axis=1))
-    diag = np.unique(np.column_stack([pair_poly, pairs.min(axis=1), pairs.max(axis=1)]), axis=0)
-    poly_rank = np.searchsorted(ngon_polys, diag[:, 0])
-    first_of_poly = np.searchsorted(diag[:, 0], diag[:, 0], side="left")
-    rank = np.arange(len(diag)) - first_of_poly
+    pair_poly = np.repeat(tri_polygons, (~real).sum(axis=1)).astype(np.int64)
+    # The distinct (polygon, lower id, upper id) diagonals in that order, each
+    # vertex pair as one key: a two-key lexsort, where np.unique of rows
+    # (axis=0) sorts structured rows several times slower (it was 85 % of this).
+    low = pairs.min(axis=1).astype(np.int64)
+    high = pairs.max(axis=1).astype(np.int64)
+    vertex_span = np.int64(int(high.max(initial=0)) + 1)
+    key = low * vertex_span + high
+    order = np.lexsort((key, pair_poly))
+    pair_poly, key = pair_poly[order], key[order]
+    first_of_kind = np.ones(len(key), bool)
+    first_of_kind[1:] = (key[1:] != key[:-1]) | (pair_poly[1:] != pair_poly[:-1])
+    diag_poly = pair_poly[first_of_kind]
+    diag_low, diag_high = np.divmod(key[first_of_kind], vertex_span)
+    poly_rank = np.searchsorted(ngon_polys, diag_poly)
+    first_of_poly = np.searchsorted(diag_poly, diag_poly, side="left")
+    rank = np.arange(len(diag_poly)) - first_of_poly
     ok = rank < sizes[poly_rank] - 3
     slot = offsets[poly_rank] + sizes[poly_rank] + 2 * rank
-    ngon_corners[slot[ok]] = diag[ok, 1]
-    ngon_corners[slot[ok] + 1] = diag[ok, 2]
+    ngon_corners[slot[ok]] = diag_low[ok]
+    ngon_corners[slot[ok] + 1] = diag_high[ok]
     return ngon_corners, offsets[np.searchsorted(ngon_polys, tri_polygons)]
 
 

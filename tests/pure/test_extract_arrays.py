@@ -250,3 +250,32 @@ def test_distinct_is_numpy_unique(shape):
     result = extract.distinct(keys)
     assert result.dtype == keys.dtype
     np.testing.assert_array_equal(result, np.unique(keys))
+
+
+def test_ngon_blocks_hold_the_outline_then_each_diagonal_once():
+    """extract._pack_ngons on random n-gons (5 to 40 corners, triangulated as
+    fans from a random corner, one n-gon given twice as many triangles as it
+    has): per n-gon, its outline's vertex ids in corner order, then its
+    n - 3 distinct diagonals as (lower, upper) pairs, ascending; each
+    triangle points at its n-gon's block."""
+    rng = np.random.default_rng(5)
+    sizes = rng.integers(5, 41, 60)
+    loop_start = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    corner_vert = rng.permutation(2 * int(sizes.sum()))[: int(sizes.sum())].astype(np.int32)
+    tris, polys, reals, expected = [], [], [], []
+    for face, (start, n) in enumerate(zip(loop_start.tolist(), sizes.tolist())):
+        turn = int(rng.integers(0, n))
+        ring = [int(corner_vert[start + (turn + k) % n]) for k in range(n)]
+        fan = [((ring[0], ring[k], ring[k + 1]), (k == 1, True, k == n - 2)) for k in range(1, n - 1)]
+        for (a, b, c), real in fan * (2 if face == 3 else 1):  # repeated triangles: diagonals listed twice
+            tris.append((a, b, c))
+            polys.append(face)
+            reals.append(real)
+        diagonals = sorted({(min(ring[0], ring[k]), max(ring[0], ring[k])) for k in range(2, n - 1)})
+        expected.append(corner_vert[start : start + n].tolist() + [v for pair in diagonals for v in pair])
+    ngon_corners, block_start = extract._pack_ngons(
+        np.array(tris, np.int32), np.array(reals, bool), np.array(polys, np.int64), loop_start, sizes, corner_vert
+    )
+    np.testing.assert_array_equal(ngon_corners, np.concatenate(expected))
+    starts = np.concatenate([[0], np.cumsum([len(block) for block in expected])[:-1]])
+    np.testing.assert_array_equal(block_start, starts[polys])
