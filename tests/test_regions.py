@@ -275,6 +275,28 @@ def test_ngons_are_regions_of_their_own(diagonals, output_dir):
     assert extra == 0 if diagonals == "HIDDEN" else extra > 200
 
 
+def test_many_objects_sharing_a_mesh_of_ngons_draw_it_instanced(output_dir):
+    """Copies of a tube with 20-sided caps, the plain look: the caps' outlines
+    come from the region-lines pass once per instance."""
+    scene = scenes.empty_scene(220, 160, thickness=1.5)
+    tube = scenes.mesh_object(
+        scene,
+        "Tube",
+        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=20, radius1=0.4, radius2=0.4, depth=0.6),
+    )
+    rng = np.random.default_rng(4)
+    for i in range(draw.INSTANCING_MIN + 2):
+        copy = bpy.data.objects.new(f"Tube{i}", tube.data)
+        scene.collection.objects.link(copy)
+        copy.location = (rng.uniform(-2.0, 2.0), rng.uniform(-1.0, 2.0), rng.uniform(-0.5, 0.5))
+        copy.rotation_euler = rng.uniform(-1.5, 1.5, 3)
+    scenes.add_camera(scene, location=(0.5, -5.0, 3.6), target=(0, 0.4, 0))
+    report = accuracy.measure(scene, "regions_instanced_ngons", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+    assert solidwire_addon.stats().get("instanced_draws", 0) > 0
+
+
 @pytest.mark.parametrize("case", ["cage", "angle"])
 def test_edge_classes_on_large_regions(case, output_dir):
     """Edge classes with their own width, colour and pattern on regions of
