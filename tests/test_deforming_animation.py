@@ -269,3 +269,40 @@ def test_normals_that_follow_the_positions_are_not_checksummed(monkeypatch, outp
     reads.clear()
     _image, stats = render(scene, output_dir / "derived_sharp.png")
     assert stats["meshes_extracted"] == 1 and extract.NORMALS_BY_CORNER in reads
+
+
+def test_a_mesh_of_ngons_moves_without_extraction_while_blender_splits_it_alike(output_dir):
+    """A tube with 16-sided caps: a move that keeps Blender's triangulation of
+    every n-gon uploads positions only and draws what the reference does; a
+    move that makes Blender split a cap another way (a corner pushed deep
+    inside it) is extracted again, and draws what the reference does too."""
+    scene = scenes.empty_scene(200, 150, thickness=1.5)
+    tube = scenes.mesh_object(
+        scene,
+        "Tube",
+        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=16, radius1=1.0, radius2=1.0, depth=1.0),
+        rotation=(0.9, 0.1, 0.3),
+    )
+    scenes.add_camera(scene, location=(0.0, -5.0, 3.0), target=(0.0, 0.0, 0.0))
+    cap = max(tube.data.polygons, key=lambda face: len(face.vertices))
+    corner = tube.data.vertices[cap.vertices[5]]
+
+    def cap_triangles():
+        tube.data.calc_loop_triangles()
+        return sorted(tuple(sorted(t.vertices)) for t in tube.data.loop_triangles if t.polygon_index == cap.index)
+
+    render(scene, output_dir / "deform_ngons.png")
+    before = cap_triangles()
+    corner.co.z += 0.2  # out of the cap's plane, same split
+    tube.data.update()
+    assert cap_triangles() == before
+    rgba, stats = render(scene, output_dir / "deform_ngons.png")
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (0, 1)
+    accuracy.assert_accurate(reference.error_report(rgba[..., 3], reference.render_reference(scene)))
+    corner.co.x *= 0.1  # deep inside the cap: a dart Blender splits another way
+    corner.co.y *= 0.1
+    tube.data.update()
+    assert cap_triangles() != before
+    rgba, stats = render(scene, output_dir / "deform_ngons.png")
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (1, 0)
+    accuracy.assert_accurate(reference.error_report(rgba[..., 3], reference.render_reference(scene)))

@@ -193,6 +193,7 @@ class GPUMesh:
         self.quad_flip = arrays.quad_flip
         self.face_offsets_crc = arrays.face_offsets_crc
         self.source_positions = arrays.source_positions
+        self.ngon_triangles = arrays.ngon_triangles
         self.edge_angle_state = arrays.edge_angle_state  # edge_select.EdgeAngleState
         self.mesh_bounds = (arrays.bounds_min, arrays.bounds_max)  # mesh space
 

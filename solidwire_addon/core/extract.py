@@ -110,6 +110,10 @@ class MeshArrays:
     quad_flip: np.ndarray | None = None
     face_offsets_crc: int | None = None
     source_positions: np.ndarray | None = None  # (V, 3) float32 as read, to find moved vertices
+    # With n-gons: the indices of their triangles in Blender's triangles and
+    # Blender's corners for each, as extracted: a move keeps the triangles
+    # only while Blender still splits every n-gon so.
+    ngon_triangles: tuple | None = None
     # The edge angle test's state (edge_select.EdgeAngleState) when it chose
     # the drawn edges: a move of vertices is checked against it.
     edge_angle_state: object | None = None
@@ -577,7 +581,9 @@ def build_arrays_fast(
         if len(ngon_faces):
             rows = _ngon_tri_rows(tri_start, sizes, ngon_faces)
             polys = tri_polygons[rows]
-            ngon_tris, real, is_quad = _triangles_from_loops(ask_blender(rows), polys, loop_start, sizes, corner_vert)
+            blender_ngon_tris = ask_blender(rows)
+            ngon_triangles = (rows, blender_ngon_tris)
+            ngon_tris, real, is_quad = _triangles_from_loops(blender_ngon_tris, polys, loop_start, sizes, corner_vert)
             ngon_flags = _edge_flags(real, is_quad)
             ngon_corners, block_start = _pack_ngons(ngon_tris[:, :3], real.T, polys, loop_start, sizes, corner_vert)
             ngon_tris[:, 3] = block_start
@@ -601,9 +607,10 @@ def build_arrays_fast(
         ngon_corners,
         degenerate_triangles=_degenerate_count(triangles),
     )
-    if not len(ngon_corners):
-        arrays.quads, arrays.quad_flip, arrays.source_positions = quads, flip, positions
-        arrays.face_offsets_crc = zlib.crc32(memoryview(np.ascontiguousarray(offsets)).cast("B"))
+    arrays.quads, arrays.quad_flip, arrays.source_positions = quads, flip, positions
+    arrays.face_offsets_crc = zlib.crc32(memoryview(np.ascontiguousarray(offsets)).cast("B"))
+    if len(ngon_corners):
+        arrays.ngon_triangles = ngon_triangles
     return arrays
 
 
@@ -616,15 +623,16 @@ def reposition(
 ):
     """(local positions, centre, bounds_min, bounds_max, source positions)
     for new vertex positions of a mesh whose faces are unchanged, or None when the new
-    positions change more than positions: a quad split differently, a
-    non-finite vertex, n-gons (their triangulation follows the positions),
-    other face sizes. A moved quad too close to call (a degenerate one
-    stays so in every frame) is settled by ``blender_tris`` as in
-    :func:`build_arrays_fast`; without it, None.
+    positions change more than positions: a quad split differently, an
+    n-gon that Blender now triangulates differently (asked of
+    ``blender_tris``; without it, a mesh with n-gons is refused), a
+    non-finite vertex, other face sizes. A moved quad too close to call (a
+    degenerate one stays so in every frame) is settled by ``blender_tris``
+    as in :func:`build_arrays_fast`; without it, None.
 
     ``previous`` is what the last extraction kept (``quads``, ``quad_flip``,
-    ``face_offsets_crc``, ``source_positions``, ``centre`` and
-    ``mesh_bounds``); the caller has checked that the
+    ``face_offsets_crc``, ``source_positions``, ``ngon_triangles``,
+    ``centre`` and ``mesh_bounds``); the caller has checked that the
     vertex, corner and face counts and the corner vertices are the same."""
     quads, flip = getattr(previous, "quads", None), getattr(previous, "quad_flip", None)
     if quads is None or flip is None or previous.face_offsets_crc is None:
@@ -672,6 +680,13 @@ def reposition(
                 new_flip[asked] = first[:, 2] == loop_start + 3
             if not np.array_equal(new_flip, flip if touched is None else flip[touched]):
                 return None
+    ngon_triangles = getattr(previous, "ngon_triangles", None)
+    if ngon_triangles is not None and moved_count:
+        # An n-gon's triangulation follows its corners' positions: the
+        # triangles hold while Blender splits every n-gon as before.
+        rows, corners = ngon_triangles
+        if blender_tris is None or not np.array_equal(np.asarray(blender_tris(rows)).reshape(-1, 3), corners):
+            return None
     # The centre stays where it was (any nearby centre keeps float32
     # precision); the bounds grow to take in the moved vertices, never
     # shrink (culling only needs them to enclose the mesh).

@@ -197,7 +197,7 @@ def test_reposition_refuses_what_changes_the_triangles():
     folded[q[1]] = 0.9 * positions[q[3]] + 0.1 * positions[q[0]]
     assert extract.reposition(arrays, folded, corner_vert, offsets) is None
     assert not np.array_equal(extract.build_arrays_fast(folded, corner_vert, offsets).triangles, arrays.triangles)
-    # A non-finite vertex, other face sizes, or n-gons: full extraction.
+    # A non-finite vertex or other face sizes: full extraction.
     broken = positions.copy()
     broken[3, 0] = np.nan
     assert extract.reposition(arrays, broken, corner_vert, offsets) is None
@@ -205,15 +205,37 @@ def test_reposition_refuses_what_changes_the_triangles():
     regrouped[1] -= 1
     regrouped[2] += 0
     assert extract.reposition(arrays, positions, corner_vert, regrouped) is None
-    hexagon = np.array([(np.cos(a), np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]], dtype=np.float32)
-    ngon = extract.build_arrays_fast(
-        hexagon,
-        np.arange(6, dtype=np.int32),
-        np.array([0, 6], dtype=np.int32),
-        blender_tris=lambda rows: np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]])[rows],
-    )
-    assert ngon.quads is None
-    assert extract.reposition(ngon, hexagon * 1.1, np.arange(6, dtype=np.int32), np.array([0, 6])) is None
+
+
+def test_reposition_of_ngons_holds_while_blender_splits_them_alike():
+    """A hexagon beside a quad: a move keeps the triangles while Blender
+    triangulates the hexagon as before (asked of Blender: without it, a
+    full extraction), and the result is a full extraction's; a move after
+    which Blender splits it another way is a full extraction."""
+    hexagon = [(np.cos(a), np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 7)[:-1]]
+    positions = np.array(hexagon + [(1.0, -1.0, 0.0), (2.0, -1.0, 0.0), (2.0, 0.0, 0.0)], dtype=np.float32)
+    corner_vert = np.array([0, 1, 2, 3, 4, 5, 6, 7, 8, 0], dtype=np.int32)
+    offsets = np.array([0, 6, 10], dtype=np.int32)
+    fan = np.array([[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]])
+    other_fan = np.array([[1, 2, 3], [1, 3, 4], [1, 4, 5], [1, 5, 0]])
+
+    def blender_tris(split):
+        return lambda rows: split[np.asarray(rows)]  # the hexagon's triangles are Blender's rows 0-3
+
+    arrays = extract.build_arrays_fast(positions, corner_vert, offsets, blender_tris=blender_tris(fan))
+    assert arrays.ngon_triangles is not None
+    moved = positions.copy()
+    moved[2] += (0.05, 0.1, 0.2)
+    moved[7, 2] -= 0.3
+    assert extract.reposition(arrays, moved, corner_vert, offsets) is None  # no one to ask
+    assert extract.reposition(arrays, moved, corner_vert, offsets, blender_tris(other_fan)) is None
+    result = extract.reposition(arrays, moved, corner_vert, offsets, blender_tris(fan))
+    assert result is not None
+    local, centre = result[:2]
+    full = extract.build_arrays_fast(moved, corner_vert, offsets, blender_tris=blender_tris(fan))
+    np.testing.assert_array_equal(full.triangles, arrays.triangles)
+    np.testing.assert_array_equal(full.ngon_corners, arrays.ngon_corners)
+    np.testing.assert_allclose(local + centre, full.positions + full.centre, atol=1e-5)
 
 
 def test_infinite_vertices_of_both_signs_leave_their_faces_out_without_a_numpy_warning():
