@@ -253,13 +253,16 @@ def test_a_drag_redraws_only_what_it_changes(look):
     assert path == "surface_straight" and np.array_equal(edited, fresh)
 
 
-@pytest.mark.parametrize("look", ["default", "cage"])
+@pytest.mark.parametrize("look", ["default", "cage", "ngon"])
 def test_an_edit_redraws_up_to_the_lines_reach(look):
     """A grid facing the camera, smooth-shaded: a vertex moved across and
     out of the plane changes its lines up to their reach past every vertex
     it moved, and the shading of faces that do not touch it (their corners'
-    normals turn). The partial redraw equals a fresh frame at every step."""
-    looks = {"default": {"diagonal_mode": "SOLID"}, "cage": {"use_cage_edges": True}}
+    normals turn). The partial redraw equals a fresh frame at every step;
+    also beside an n-gon (two faces next to the moved vertex's merged: a
+    corner of its own would make Blender split it anew), whose outline
+    comes from the region-lines pass and whose diagonals show."""
+    looks = {"default": {"diagonal_mode": "SOLID"}, "cage": {"use_cage_edges": True}, "ngon": {"diagonal_mode": "SOLID"}}
     scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=2.5, use_fill=True, fill_shading="STUDIO", **looks[look])
     scenes.add_camera(scene, location=(0.0, -10.0, 0.0))
     plane = scenes.grid(scene, "Grid", x_segments=6, y_segments=6, size=1.5, rotation=(1.5708, 0, 0))
@@ -272,6 +275,21 @@ def test_an_edit_redraws_up_to_the_lines_reach(look):
     corners = sorted(vertices, key=lambda v: (v.co.x, v.co.y))
     corners[0].co.z, corners[-1].co.z = 0.5, -0.5
     moved = min(vertices, key=lambda v: (v.co.x - 0.25) ** 2 + (v.co.y - 0.25) ** 2)
+    if look == "ngon":
+        import bmesh
+
+        bm = bmesh.new()
+        bm.from_mesh(plane.data)
+        bm.verts.ensure_lookup_table()
+        moved_index = moved.index
+        near = set(bm.verts[moved_index].link_faces)
+        beside = [f for f in bm.faces if f not in near and any(e in g.edges for g in near for e in f.edges)]
+        pair = next([f, g] for f in beside for g in beside if f is not g and set(f.edges) & set(g.edges))
+        merged = bmesh.ops.dissolve_faces(bm, faces=pair)["region"]
+        assert len(merged) == 1 and len(merged[0].verts) == 6
+        bm.to_mesh(plane.data)
+        bm.free()
+        moved = plane.data.vertices[moved_index]  # (the mesh's arrays were written anew)
     plane.data.update()
 
     def frame():
