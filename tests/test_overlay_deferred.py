@@ -262,7 +262,11 @@ def test_an_edit_redraws_up_to_the_lines_reach(look):
     also beside an n-gon (two faces next to the moved vertex's merged: a
     corner of its own would make Blender split it anew), whose outline
     comes from the region-lines pass and whose diagonals show."""
-    looks = {"default": {"diagonal_mode": "SOLID"}, "cage": {"use_cage_edges": True}, "ngon": {"diagonal_mode": "SOLID"}}
+    looks = {
+        "default": {"diagonal_mode": "SOLID"},
+        "cage": {"use_cage_edges": True},
+        "ngon": {"diagonal_mode": "SOLID"},
+    }
     scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=2.5, use_fill=True, fill_shading="STUDIO", **looks[look])
     scenes.add_camera(scene, location=(0.0, -10.0, 0.0))
     plane = scenes.grid(scene, "Grid", x_segments=6, y_segments=6, size=1.5, rotation=(1.5708, 0, 0))
