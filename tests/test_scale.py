@@ -62,8 +62,9 @@ def test_editing_one_mesh_of_ten_reextracts_one():
 
 def test_a_move_that_changes_the_triangles_reextracts():
     """Positions-only re-upload only when the triangles stay the same: a quad
-    folded over its diagonal splits the other way, and an n-gon's
-    triangulation follows its vertices; both go through full extraction."""
+    folded over its diagonal splits the other way, and an n-gon that Blender
+    triangulates anew after a move; both go through full extraction. A move
+    after which Blender splits the n-gon as before keeps the upload."""
     scene, _cubes = ten_cubes()
     quad = scenes.from_pydata(scene, "Quad", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [(0, 1, 2, 3)])
     hexagon = scenes.from_pydata(
@@ -78,8 +79,20 @@ def test_a_move_that_changes_the_triangles_reextracts():
     quad.data.update()
     stats = render(scene)
     assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (1, 0)
-    hexagon.data.vertices[0].co.x += 0.3
+
+    def split():
+        hexagon.data.calc_loop_triangles()
+        return sorted(tuple(sorted(t.vertices)) for t in hexagon.data.loop_triangles)
+
+    before = split()
+    hexagon.data.vertices[0].co.z += 0.3  # out of the plane: Blender splits it as before
     hexagon.data.update()
+    assert split() == before
+    stats = render(scene)
+    assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (0, 1)
+    hexagon.data.vertices[0].co.x = -0.8  # across the hexagon: a dart, split anew
+    hexagon.data.update()
+    assert split() != before
     stats = render(scene)
     assert (stats["meshes_extracted"], stats["meshes_repositioned"]) == (1, 0)
 
