@@ -110,9 +110,9 @@ class MeshArrays:
     quad_flip: np.ndarray | None = None
     face_offsets_crc: int | None = None
     source_positions: np.ndarray | None = None  # (V, 3) float32 as read, to find moved vertices
-    # With n-gons: the indices of their triangles in Blender's triangles and
-    # Blender's corners for each, as extracted: a move keeps the triangles
-    # only while Blender still splits every n-gon so.
+    # With n-gons: the indices of their triangles in Blender's triangles,
+    # Blender's corners for each and each one's face, as extracted: a move
+    # keeps the triangles only while Blender still splits every n-gon so.
     ngon_triangles: tuple | None = None
     # The edge angle test's state (edge_select.EdgeAngleState) when it chose
     # the drawn edges: a move of vertices is checked against it.
@@ -582,7 +582,7 @@ def build_arrays_fast(
             rows = _ngon_tri_rows(tri_start, sizes, ngon_faces)
             polys = tri_polygons[rows]
             blender_ngon_tris = ask_blender(rows)
-            ngon_triangles = (rows, blender_ngon_tris)
+            ngon_triangles = (rows, blender_ngon_tris, polys)
             ngon_tris, real, is_quad = _triangles_from_loops(blender_ngon_tris, polys, loop_start, sizes, corner_vert)
             ngon_flags = _edge_flags(real, is_quad)
             ngon_corners, block_start = _pack_ngons(ngon_tris[:, :3], real.T, polys, loop_start, sizes, corner_vert)
@@ -682,10 +682,19 @@ def reposition(
                 return None
     ngon_triangles = getattr(previous, "ngon_triangles", None)
     if ngon_triangles is not None and moved_count:
-        # An n-gon's triangulation follows its corners' positions: the
-        # triangles hold while Blender splits every n-gon as before.
-        rows, corners = ngon_triangles
-        if blender_tris is None or not np.array_equal(np.asarray(blender_tris(rows)).reshape(-1, 3), corners):
+        # An n-gon's triangulation follows its own corners' positions: the
+        # triangles hold while Blender splits every n-gon with a moved
+        # corner as before (asked for those alone: reading every triangle
+        # of a 116k-triangle mesh was half of a local edit's redraw).
+        rows, corners, faces = ngon_triangles
+        if not everything:
+            moved_corner = moved.take(np.asarray(corner_vert))
+            moved_face = np.logical_or.reduceat(moved_corner, offsets[:-1])
+            near = moved_face.take(faces)
+            rows, corners = rows[near], corners[near]
+        if len(rows) and (
+            blender_tris is None or not np.array_equal(np.asarray(blender_tris(rows)).reshape(-1, 3), corners)
+        ):
             return None
     # The centre stays where it was (any nearby centre keeps float32
     # precision); the bounds grow to take in the moved vertices, never

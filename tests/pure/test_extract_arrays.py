@@ -228,6 +228,9 @@ def test_reposition_of_ngons_holds_while_blender_splits_them_alike():
     moved[2] += (0.05, 0.1, 0.2)
     moved[7, 2] -= 0.3
     assert extract.reposition(arrays, moved, corner_vert, offsets) is None  # no one to ask
+    quad_moved = positions.copy()
+    quad_moved[7, 2] -= 0.3  # the quad alone: the hexagon's split is not asked
+    assert extract.reposition(arrays, quad_moved, corner_vert, offsets) is not None
     assert extract.reposition(arrays, moved, corner_vert, offsets, blender_tris(other_fan)) is None
     result = extract.reposition(arrays, moved, corner_vert, offsets, blender_tris(fan))
     assert result is not None
