@@ -556,6 +556,7 @@ def build_arrays_fast(
             rows_second[:, k] = np.where(flip, q[order_second[1][k]], q[order_second[0][k]])
 
     quad_flags = EDGE0_REAL | EDGE1_REAL | HAS_QUAD_CORNER
+    ngon_triangles = None  # (MeshArrays.ngon_triangles)
     if all_quads:
         pairs = triangles.reshape(face_count, 2, 4)
         fill_quad_rows(pairs[:, 0], pairs[:, 1])
@@ -581,9 +582,8 @@ def build_arrays_fast(
         if len(ngon_faces):
             rows = _ngon_tri_rows(tri_start, sizes, ngon_faces)
             polys = tri_polygons[rows]
-            blender_ngon_tris = ask_blender(rows)
-            ngon_triangles = (rows, blender_ngon_tris, polys)
-            ngon_tris, real, is_quad = _triangles_from_loops(blender_ngon_tris, polys, loop_start, sizes, corner_vert)
+            ngon_triangles = (rows, ask_blender(rows), polys)
+            ngon_tris, real, is_quad = _triangles_from_loops(ngon_triangles[1], polys, loop_start, sizes, corner_vert)
             ngon_flags = _edge_flags(real, is_quad)
             ngon_corners, block_start = _pack_ngons(ngon_tris[:, :3], real.T, polys, loop_start, sizes, corner_vert)
             ngon_tris[:, 3] = block_start
@@ -609,8 +609,7 @@ def build_arrays_fast(
     )
     arrays.quads, arrays.quad_flip, arrays.source_positions = quads, flip, positions
     arrays.face_offsets_crc = zlib.crc32(memoryview(np.ascontiguousarray(offsets)).cast("B"))
-    if len(ngon_corners):
-        arrays.ngon_triangles = ngon_triangles
+    arrays.ngon_triangles = ngon_triangles
     return arrays
 
 
