@@ -7,9 +7,11 @@ then the angle threshold and edge classes against a plain frame.
 whose cage regions are read from the evaluated mesh's layout (a modifier
 before the subdivision, Edit Mode) and for the object's own mesh, the cage
 look with those regions and with the regions found from the mesh, against
-every edge.
+every edge. ``--ngon-diagonals`` instead measures F12 of a tube with caps
+of 32 to 1,024 corners in each diagonal mode.
 
     .venv/bin/python -m scripts.bench_regions [--size 1280x720] [--repeats 3] [--levels 2 3 4 5] [--stacks [--stack NAME]]
+    .venv/bin/python -m scripts.bench_regions --ngon-diagonals
 
 Every ratio is taken within one process, rounds alternating between the two
 looks so that a change in machine load hits both alike; the table gives the
@@ -243,6 +245,36 @@ def stack_table(size, levels, repeats: int, names=()) -> None:
             )
 
 
+def ngon_diagonal_table(size, repeats: int, corners=(32, 256, 1024)) -> None:
+    """F12 of a tube whose caps are n-gons of ``corners`` corners, seen
+    from above at an angle, in each diagonal mode (best of ``repeats``):
+    what showing the diagonals of large n-gons costs."""
+    import bmesh  # (importable only once bpy is)
+
+    modes = ("HIDDEN", "SOLID", "DASHED")
+    print("| cap corners | " + " | ".join(f"{mode.lower()} diagonals (ms)" for mode in modes) + " |")
+    print("|---:|" + "---:|" * len(modes))
+    for count in corners:
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        solidwire_addon.register()
+        scene = scenes.empty_scene(*size, transparent=False)
+        scenes.mesh_object(
+            scene,
+            "Tube",
+            lambda bm, count=count: bmesh.ops.create_cone(
+                bm, cap_ends=True, segments=count, radius1=1.0, radius2=1.0, depth=2.0
+            ),
+            rotation=(0.6, 0.0, 0.5),
+        )
+        scenes.add_camera(scene, location=(0.0, -3.4, 2.0), target=(0.0, 0.0, 0.0), lens=45.0)
+        cells = []
+        for mode in modes:
+            apply(scene, dict(diagonal_mode=mode))
+            f12_ms(scene, size)  # compiles the variant
+            cells.append(f"{min(f12_ms(scene, size) for _ in range(repeats)):.0f}")
+        print(f"| {count} | " + " | ".join(cells) + " |", flush=True)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="1280x720")
@@ -250,11 +282,16 @@ def main(argv=None) -> int:
     parser.add_argument("--levels", type=int, nargs="+", default=[2, 3, 4, 5])
     parser.add_argument("--stacks", action="store_true", help="the first extraction behind other stacks only")
     parser.add_argument("--stack", action="append", default=[], help="with --stacks: only stacks whose name holds this")
+    parser.add_argument("--ngon-diagonals", action="store_true", help="F12 of large n-gons' diagonals only")
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.split("x"))
     solidwire_addon.register()
     try:
         ensure_gpu()
+        if args.ngon_diagonals:
+            print(f"{size[0]}x{size[1]}, F12, best of {args.repeats}\n")
+            ngon_diagonal_table(size, args.repeats)
+            return 0
         if args.stacks:
             print(f"{size[0]}x{size[1]}, first extraction, best of {args.repeats} alternating rounds\n")
             stack_table(size, args.levels, args.repeats, args.stack)

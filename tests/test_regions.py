@@ -258,7 +258,7 @@ def _ngon_shapes(scene):
 def test_ngons_are_regions_of_their_own(diagonals, output_dir):
     """Every look draws an n-gon's outline with the region-lines pass (a
     region of one face), so its triangles do not each walk the outline at
-    every pixel; its diagonals stay its own, walked where they show."""
+    every pixel; its diagonals stay its own."""
     scene = scenes.empty_scene(240, 180, thickness=1.5, diagonal_mode=diagonals)
     _ngon_shapes(scene)
     scenes.add_camera(scene, location=(0.5, -5.5, 4.0), target=(0.0, 0.0, 0.0))
@@ -273,6 +273,89 @@ def test_ngons_are_regions_of_their_own(diagonals, output_dir):
     hidden = reference.render_reference(scene)
     extra = ((ref.intensity - hidden.intensity) > 0.5).sum()
     assert extra == 0 if diagonals == "HIDDEN" else extra > 200
+
+
+@pytest.mark.parametrize("diagonals", ["SOLID", "DASHED"])
+@pytest.mark.parametrize("target", ["render", "overlay"])
+def test_diagonals_of_a_large_ngon(diagonals, target, output_dir):
+    """A tube with 160-sided caps seen from above, the caps' 157 diagonals
+    each shown: each pixel measures its own triangle's (draw._Part.variant
+    says why that is exact), and the image matches the float64 reference in
+    the render and the render in the overlay."""
+    from solidwire_addon.blender import engine
+    from solidwire_addon.blender.views import camera_view
+    from tests.test_overlay import FakeViewport, silhouette_mask
+
+    width, height = 200, 150
+    scene = scenes.empty_scene(width, height, thickness=1.0, diagonal_mode=diagonals)
+    tube = scenes.mesh_object(
+        scene,
+        "Tube",
+        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=160, radius1=1.0, radius2=1.0, depth=0.8),
+        rotation=(0.5, 0.0, 0.3),
+    )
+    scenes.add_camera(scene, location=(0.3, -2.6, 2.8), target=(0, 0, 0))
+    assert max(len(face.vertices) for face in tube.data.polygons) == 160
+    if target == "render":
+        report = accuracy.measure(scene, f"regions_large_ngon_{diagonals.lower()}_diagonals", output_dir)
+        accuracy.assert_accurate(report)
+        ref = reference.render_reference(scene)
+        assert (ref.intensity > 0.5).sum() > 1000  # the caps' diagonals show
+        return
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    rgba_engine, depth_engine = engine.render_scene(depsgraph, (width, height))
+    view = camera_view(scene, depsgraph, (width, height))
+    viewport = FakeViewport(width, height)
+    viewport.depth_pass(depsgraph, view, [tube])
+    viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
+    diff = np.abs(viewport.rgba()[..., 3] - rgba_engine[..., 3])
+    off = ~silhouette_mask(depth_engine)
+    assert rgba_engine[..., 3].max() > 0.9
+    assert np.percentile(diff[off], 99.9) <= 2.0 / 255.0 + 1e-9
+    assert diff[off].max() <= 0.1
+
+
+def _slotted_ngon(bm, filled: bool = False, seams: bool = False):
+    """One face: a square with a slot a pixel wide cut from its top edge
+    down past its middle, the slot's sides lined with short edges at
+    staggered heights, so the long diagonals of one arm end a pixel from
+    the other arm. ``filled``: a second, coplanar face fills the slot;
+    ``seams``: the slot's edges are UV seams."""
+    gap, steps = 0.006, 9
+    right = [(gap, 1.0 - 1.2 * (k + 0.5) / steps) for k in range(steps)]
+    left = [(-gap, 1.0 - 1.2 * (k + 1.0) / steps) for k in range(steps)][::-1]
+    slot = [(gap, 1.0), *right, (gap, -0.2), (-gap, -0.2), *left, (-gap, 1.0)]
+    verts = {xy: bm.verts.new((*xy, 0.0)) for xy in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), *slot, (-1.0, 1.0)]}
+    bm.faces.new([verts[xy] for xy in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), *slot, (-1.0, 1.0)]])
+    if filled:
+        bm.faces.new([verts[xy] for xy in slot[::-1]])
+    for a, b in zip(slot, slot[1:]):
+        bm.edges.get((verts[a], verts[b])).seam = seams
+
+
+@pytest.mark.parametrize(
+    "case, look",
+    [
+        ("faded", dict(use_density_fade=True, density_fade_length=40.0)),
+        ("filled", dict(edge_angle=math.radians(5.0))),
+        ("seams", dict(use_seam_edges=True, seam_thickness=0.3, seam_pattern="SOLID")),
+    ],
+)
+@pytest.mark.parametrize("diagonals", ["SOLID", "DASHED"])
+def test_lines_past_their_own_triangle_take_every_diagonal(case, look, diagonals, output_dir):
+    """Beside the slot of a concave n-gon a pixel's nearest diagonals can be
+    the other arm's, a pixel away, which its own triangle lacks; a slot
+    edge between them hides them only where it is a line as bright. With
+    the density fade the short slot edges fade out while the long
+    diagonals do not (each line keeps its own maximum, image model §3.7);
+    as UV seams of a thin class style they are thinner than the diagonals
+    (§3.6); with the slot filled and under the edge angle they are no lines
+    at all. Each walks its n-gon's diagonals."""
+    scene = scenes.empty_scene(200, 150, thickness=2.0, diagonal_mode=diagonals, **look)
+    scenes.mesh_object(scene, "Slotted", lambda bm: _slotted_ngon(bm, filled=case == "filled", seams=case == "seams"))
+    scenes.add_camera(scene, location=(0.0, -0.3, 3.4), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, f"regions_slotted_ngon_{case}_{diagonals.lower()}", output_dir)
+    accuracy.assert_accurate(report)
 
 
 def test_many_objects_sharing_a_mesh_of_ngons_draw_it_instanced(output_dir):

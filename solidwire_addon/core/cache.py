@@ -140,6 +140,7 @@ class GPUMesh:
         walks_ngon_outline = arrays.has_ngons and bool(np.any(flags & IS_NGON))
         region_pass_only = arrays.region_lines is not None and not walks_ngon_outline
         self.blocks_hold_ngon_diagonals = arrays.has_ngons
+        self.ngons_alone = arrays.ngons_alone
         # Every triangle flagged REGION_LINES (a cage look): one reduction
         # answers both questions below.
         every_triangle_region_lines = region_pass_only and bool(np.bitwise_and.reduce(flags) & REGION_LINES)

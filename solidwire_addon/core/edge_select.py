@@ -389,6 +389,7 @@ def select_edges(
     # a mesh of n-gons of up to 57 corners, on llvmpipe); the pass draws each
     # outline edge once (image model §2.6).
     walked_region = (region_size > 1) | ((region_size == 1) & (sizes > 4))
+    arrays.ngons_alone = bool((region_size[label[sizes > 4]] == 1).all())
     styled_face = np.zeros(face_count, bool)
     if has_classes:
         styled_face[corner_face[classes.take(corner_edge) != 0]] = True

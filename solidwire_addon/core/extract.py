@@ -90,6 +90,9 @@ class MeshArrays:
     # run holds (1, 2, 4 or 8).
     region_line_runs: np.ndarray = None
     region_run_segments: int = 1
+    # Every n-gon is a region of its own (edge_select.select_edges), so a
+    # triangle's own diagonals give its n-gon's (draw._Part.variant).
+    ngons_alone: bool = False
     # The ATTRIBUTE fill source: the active colour attribute as (R, 4)
     # float32 scene-linear RGBA rows, one per vertex (attribute_domain
     # NORMALS_BY_VERTEX) or per triangle corner (NORMALS_BY_CORNER); None:
