@@ -6,6 +6,7 @@ are compared with the float64 reference, which walks each region whole."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import bmesh
@@ -329,7 +330,7 @@ def _slotted_ngon(bm, filled: bool = False, seams: bool = False):
     bm.faces.new([verts[xy] for xy in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), *slot, (-1.0, 1.0)]])
     if filled:
         bm.faces.new([verts[xy] for xy in slot[::-1]])
-    for a, b in zip(slot, slot[1:]):
+    for a, b in itertools.pairwise(slot):
         bm.edges.get((verts[a], verts[b])).seam = seams
 
 
