@@ -54,16 +54,9 @@ def build_scene(size, level: int, before=(), shape: str = "Suzanne", capped_arra
     "Cylinder") under a Subdivision Surface at ``level``, the modifiers
     ``before`` (types) ahead of it; ``capped_array``: a Mirror and an Array
     of two with a cube at each end after it."""
-    import bmesh  # (importable only once bpy is)
-
     scene = scenes.empty_scene(*size, transparent=False)
     if shape == "Cylinder":
-        monkey = scenes.mesh_object(
-            scene,
-            "Cylinder",
-            lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=32, radius1=1.0, radius2=1.0, depth=2.0),
-            rotation=(0.3, 0.0, 0.5),
-        )
+        monkey = scenes.tube(scene, "Cylinder", segments=32, rotation=(0.3, 0.0, 0.5))
     else:
         monkey = scenes.monkey(scene, rotation=(0.0, 0.0, 0.5))
     for edge in monkey.data.edges[:80]:  # marked edges for the edge classes
@@ -249,8 +242,6 @@ def ngon_diagonal_table(size, repeats: int, corners=(32, 256, 1024)) -> None:
     """F12 of a tube whose caps are n-gons of ``corners`` corners, seen
     from above at an angle, in each diagonal mode (best of ``repeats``):
     what showing the diagonals of large n-gons costs."""
-    import bmesh  # (importable only once bpy is)
-
     modes = ("HIDDEN", "SOLID", "DASHED")
     print("| cap corners | " + " | ".join(f"{mode.lower()} diagonals (ms)" for mode in modes) + " |")
     print("|---:|" + "---:|" * len(modes))
@@ -258,14 +249,7 @@ def ngon_diagonal_table(size, repeats: int, corners=(32, 256, 1024)) -> None:
         bpy.ops.wm.read_factory_settings(use_empty=True)
         solidwire_addon.register()
         scene = scenes.empty_scene(*size, transparent=False)
-        scenes.mesh_object(
-            scene,
-            "Tube",
-            lambda bm, count=count: bmesh.ops.create_cone(
-                bm, cap_ends=True, segments=count, radius1=1.0, radius2=1.0, depth=2.0
-            ),
-            rotation=(0.6, 0.0, 0.5),
-        )
+        scenes.tube(scene, segments=count, rotation=(0.6, 0.0, 0.5))
         scenes.add_camera(scene, location=(0.0, -3.4, 2.0), target=(0.0, 0.0, 0.0), lens=45.0)
         cells = []
         for mode in modes:

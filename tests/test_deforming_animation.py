@@ -45,11 +45,7 @@ def armature_tube(scene, collapse: bool = False):
     """A smooth tube of quads bent by a two-bone armature; with ``collapse``,
     one quad at the joint has an edge collapsed (two corners on one spot):
     its split is too close to call in every frame."""
-    tube = scenes.mesh_object(
-        scene,
-        "Tube",
-        lambda bm: bmesh.ops.create_cone(bm, cap_ends=False, segments=16, radius1=0.5, radius2=0.5, depth=4.0),
-    )
+    tube = scenes.tube(scene, segments=16, radius=0.5, depth=4.0, caps=False)
     mesh = tube.data
     # Rings of quads along z, so the bend shows on many faces.
     bm = bmesh.new()
@@ -277,12 +273,7 @@ def test_a_mesh_of_ngons_moves_without_extraction_while_blender_splits_it_alike(
     move that makes Blender split a cap another way (a corner pushed deep
     inside it) is extracted again, and draws what the reference does too."""
     scene = scenes.empty_scene(200, 150, thickness=1.5)
-    tube = scenes.mesh_object(
-        scene,
-        "Tube",
-        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=16, radius1=1.0, radius2=1.0, depth=1.0),
-        rotation=(0.9, 0.1, 0.3),
-    )
+    tube = scenes.tube(scene, segments=16, depth=1.0, rotation=(0.9, 0.1, 0.3))
     scenes.add_camera(scene, location=(0.0, -5.0, 3.0), target=(0.0, 0.0, 0.0))
     cap = max(tube.data.polygons, key=lambda face: len(face.vertices))
     corner = tube.data.vertices[cap.vertices[5]]

@@ -146,10 +146,7 @@ def test_suzanne_cage_at_every_level(level, monkeypatch):
 
 
 def _cylinder(scene, segments=12):
-    def build(bm):
-        bmesh.ops.create_cone(bm, cap_ends=True, segments=segments, radius1=1.0, radius2=1.0, depth=2.0)
-
-    return scenes.mesh_object(scene, "Cylinder", build)
+    return scenes.tube(scene, "Cylinder", segments=segments)
 
 
 @pytest.mark.parametrize("level", [1, 3])
@@ -196,11 +193,7 @@ def test_chains_with_the_same_ends_take_the_lines_per_edge(monkeypatch):
 def test_triangles_and_ngons_under_the_edge_angle_take_the_general_marks(monkeypatch):
     scene = scenes.empty_scene()
     obj = _cylinder(scene, segments=24)
-    cone = scenes.mesh_object(
-        scene,
-        "Cone",
-        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=32, radius1=1.0, radius2=0.0, depth=2.0),
-    )
+    cone = scenes.tube(scene, "Cone", segments=32, top_radius=0.0)
     angle = edge_select.Selection(edge_angle=math.radians(20.0))
     for mesh_object in (obj, cone):
         _assert_same_as_general(mesh_object, angle, monkeypatch, rows_expected=False)

@@ -97,13 +97,7 @@ def test_an_ngon_cage_keeps_its_whole_outline(level, diagonals, output_dir):
     """A cylinder's 16-gon caps under subdivision: each cap is one region of
     16 * 2^level drawn edges around a fan of child faces."""
     scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5, diagonal_mode=diagonals)
-    tube = scenes.mesh_object(
-        scene,
-        "Tube",
-        lambda bm: bmesh.ops.create_cone(
-            bm, cap_ends=True, cap_tris=False, segments=16, radius1=1.0, radius2=1.0, depth=1.6
-        ),
-    )
+    tube = scenes.tube(scene, segments=16, depth=1.6)
     _subdivided(tube, level)
     scenes.add_camera(scene, location=(2.2, -3.4, 3.0), target=(0, 0, 0))
     report = accuracy.measure(scene, f"regions_ngon_cap_level{level}", output_dir)
@@ -237,13 +231,7 @@ def _ngon_shapes(scene):
     """A 24-sided tube (n-gon caps), the grid with an n-gon inside and a
     wobbly grid whose faces are dissolved into n-gons of up to a few dozen
     corners: what a CAD import or a limited dissolve leaves."""
-    scenes.mesh_object(
-        scene,
-        "Tube",
-        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=24, radius1=0.7, radius2=0.7, depth=1.2),
-        location=(-1.4, 0.6, 0.0),
-        rotation=(0.5, 0.2, 0.0),
-    )
+    scenes.tube(scene, segments=24, radius=0.7, depth=1.2, location=(-1.4, 0.6, 0.0), rotation=(0.5, 0.2, 0.0))
     scenes.mesh_object(scene, "Holey", _grid_with_ngon, location=(1.2, 0.8, 0.0), rotation=(0.6, 0.0, 0.3))
 
     def dissolved(bm):
@@ -289,12 +277,7 @@ def test_diagonals_of_a_large_ngon(diagonals, target, output_dir):
 
     width, height = 200, 150
     scene = scenes.empty_scene(width, height, thickness=1.0, diagonal_mode=diagonals)
-    tube = scenes.mesh_object(
-        scene,
-        "Tube",
-        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=160, radius1=1.0, radius2=1.0, depth=0.8),
-        rotation=(0.5, 0.0, 0.3),
-    )
+    tube = scenes.tube(scene, segments=160, depth=0.8, rotation=(0.5, 0.0, 0.3))
     scenes.add_camera(scene, location=(0.3, -2.6, 2.8), target=(0, 0, 0))
     assert max(len(face.vertices) for face in tube.data.polygons) == 160
     if target == "render":
@@ -363,11 +346,7 @@ def test_many_objects_sharing_a_mesh_of_ngons_draw_it_instanced(output_dir):
     """Copies of a tube with 20-sided caps, the plain look: the caps' outlines
     come from the region-lines pass once per instance."""
     scene = scenes.empty_scene(220, 160, thickness=1.5)
-    tube = scenes.mesh_object(
-        scene,
-        "Tube",
-        lambda bm: bmesh.ops.create_cone(bm, cap_ends=True, segments=20, radius1=0.4, radius2=0.4, depth=0.6),
-    )
+    tube = scenes.tube(scene, segments=20, radius=0.4, depth=0.6)
     rng = np.random.default_rng(4)
     for i in range(draw.INSTANCING_MIN + 2):
         copy = bpy.data.objects.new(f"Tube{i}", tube.data)
@@ -486,14 +465,7 @@ def test_the_overlay_draws_region_lines_as_the_render_does(look, output_dir):
     for edge in cube.data.edges[:4]:
         edge.use_edge_sharp = True
     _subdivided(cube, 3)
-    tube = scenes.mesh_object(
-        scene,
-        "Tube",
-        lambda bm: bmesh.ops.create_cone(
-            bm, cap_ends=True, cap_tris=False, segments=12, radius1=0.6, radius2=0.6, depth=1.0
-        ),
-        location=(1.6, 0.4, 0),
-    )
+    tube = scenes.tube(scene, segments=12, radius=0.6, depth=1.0, location=(1.6, 0.4, 0))
     _subdivided(tube, 2)
     scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0.5, 0, 0))
     depsgraph = bpy.context.evaluated_depsgraph_get()

@@ -126,6 +126,19 @@ def monkey(scene, name="Suzanne", subdivisions: int = 0, **kwargs):
     return obj
 
 
+def tube(scene, name="Tube", segments=16, radius=1.0, depth=2.0, *, top_radius=None, caps=True, **kwargs):
+    """A cylinder (a cone where ``top_radius`` differs) of ``segments``
+    sides whose caps (``caps``) are single n-gons."""
+    top = radius if top_radius is None else top_radius
+
+    def build(bm):
+        bmesh.ops.create_cone(
+            bm, cap_ends=caps, cap_tris=False, segments=segments, radius1=radius, radius2=top, depth=depth
+        )
+
+    return mesh_object(scene, name, build, **kwargs)
+
+
 def grid(scene, name="Grid", x_segments=10, y_segments=10, size=10.0, **kwargs):
     return mesh_object(
         scene,
