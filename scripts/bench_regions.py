@@ -8,10 +8,13 @@ whose cage regions are read from the evaluated mesh's layout (a modifier
 before the subdivision, Edit Mode) and for the object's own mesh, the cage
 look with those regions and with the regions found from the mesh, against
 every edge. ``--ngon-diagonals`` instead measures F12 of a tube with caps
-of 32 to 1,024 corners in each diagonal mode.
+of 32 to 1,024 corners in each diagonal mode; ``--walks`` the cage look's
+F12 with hidden lines and with the Edge Distance pass (levels up to 4),
+where pixels still walk their regions' edges.
 
     .venv/bin/python -m scripts.bench_regions [--size 1280x720] [--repeats 3] [--levels 2 3 4 5] [--stacks [--stack NAME]]
     .venv/bin/python -m scripts.bench_regions --ngon-diagonals
+    .venv/bin/python -m scripts.bench_regions --walks [--levels 2 3 4]
 
 Every ratio is taken within one process, rounds alternating between the two
 looks so that a change in machine load hits both alike; the table gives the
@@ -32,7 +35,7 @@ import solidwire_addon
 from solidwire_addon.blender import engine, overlay, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.blender.views import camera_view
-from solidwire_addon.core import edge_select
+from solidwire_addon.core import edge_select, passes
 from tests.support import scenes
 
 PLAIN = dict(
@@ -87,10 +90,10 @@ def apply(scene, look: dict) -> None:
         setattr(scene.solidwire, name, value)
 
 
-def f12_ms(scene, size) -> float:
+def f12_ms(scene, size, extra_passes=()) -> float:
     depsgraph = bpy.context.evaluated_depsgraph_get()
     start = time.perf_counter()
-    engine.render_scene(depsgraph, size)
+    engine.render_scene(depsgraph, size, extra_passes=extra_passes)
     return (time.perf_counter() - start) * 1000.0
 
 
@@ -259,6 +262,32 @@ def ngon_diagonal_table(size, repeats: int, corners=(32, 256, 1024)) -> None:
         print(f"| {count} | " + " | ".join(cells) + " |", flush=True)
 
 
+def walk_table(size, levels, repeats: int) -> None:
+    """F12 of the cage look against every edge where pixels still walk
+    their regions' edges instead of reading the region-lines image (image
+    model §2.6): with hidden lines, and with the Edge Distance pass."""
+    cases = (
+        ("hidden lines", dict(use_hidden_lines=True), ()),
+        ("Edge Distance pass", dict(use_hidden_lines=False), (passes.EDGE_DISTANCE_PASS,)),
+    )
+    print("| case | level | every edge (ms) | cage (ms) | ratio |")
+    print("|---|---:|---:|---:|---:|")
+    for name, look, extra in cases:
+        for level in levels:
+            bpy.ops.wm.read_factory_settings(use_empty=True)
+            solidwire_addon.register()
+            scene, _monkey = build_scene(size, level)
+            best = {}
+            for round_ in range(repeats + 1):  # the first round warms up
+                for cage in (False, True):
+                    apply(scene, dict(look, use_cage_edges=cage))
+                    ms = f12_ms(scene, size, extra)
+                    if round_:
+                        best[cage] = min(best.get(cage, math.inf), ms)
+            a, c = best[False], best[True]
+            print(f"| {name} | {level} | {a:.0f} | {c:.0f} | {c / a:.2f}x |", flush=True)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="1280x720")
@@ -267,11 +296,16 @@ def main(argv=None) -> int:
     parser.add_argument("--stacks", action="store_true", help="the first extraction behind other stacks only")
     parser.add_argument("--stack", action="append", default=[], help="with --stacks: only stacks whose name holds this")
     parser.add_argument("--ngon-diagonals", action="store_true", help="F12 of large n-gons' diagonals only")
+    parser.add_argument("--walks", action="store_true", help="F12 with hidden lines and the Edge Distance pass only")
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.split("x"))
     solidwire_addon.register()
     try:
         ensure_gpu()
+        if args.walks:
+            print(f"{size[0]}x{size[1]}, F12, best of {args.repeats} alternating rounds\n")
+            walk_table(size, [level for level in args.levels if level <= 4], args.repeats)
+            return 0
         if args.ngon_diagonals:
             print(f"{size[0]}x{size[1]}, F12, best of {args.repeats}\n")
             ngon_diagonal_table(size, args.repeats)
