@@ -518,3 +518,52 @@ def test_the_overlay_reuses_its_region_lines_until_something_changes(output_dir)
     runtime.mesh_cache.clear()  # a fresh frame draws the same image
     fresh, _stats = redraw()
     assert np.array_equal(moved, fresh)
+
+
+def _folded_ngon(bm):
+    """One face: a strip folded back over itself (a U seen from its side),
+    its long sides lined with corners, the upper leg's a half step off the
+    lower's: seen from above, the lower leg's diagonals lie under the
+    upper leg, between its own."""
+    steps, width, rise = 10, 0.5, 0.25
+    lower = [(-1.0 + 2.0 * k / steps, 0.0) for k in range(steps + 1)]
+    upper = [(1.0 - 2.0 * (k + 0.5) / steps, rise) for k in range(steps)]
+    ring = [(x, -width, z) for x, z in lower] + [(1.0, -width, rise)]
+    ring += [(x, -width, z) for x, z in upper] + [(x, width, z) for x, z in upper[::-1]]
+    ring += [(1.0, width, rise)] + [(x, width, z) for x, z in lower[::-1]]
+    bm.faces.new([bm.verts.new(co) for co in ring])
+
+
+@pytest.mark.parametrize("diagonals", ["SOLID", "DASHED"])
+def test_diagonals_of_a_folded_ngon(diagonals, output_dir):
+    """A face that is not flat can fold over itself on screen: where the
+    upper leg of this U shows, its pixels take their line from the lower
+    leg's diagonals too (every diagonal of the face counts, image model
+    §3.3), which no edge of their own triangle bounds. Its diagonals are
+    walked (extract.ngons_flat); taking each triangle's own instead
+    misses lines over two thousand pixels here."""
+    scene = scenes.empty_scene(200, 150, thickness=2.0, diagonal_mode=diagonals)
+    scenes.mesh_object(scene, "Folded", _folded_ngon, rotation=(0.15, 0.0, 0.1))
+    scenes.add_camera(scene, location=(0.0, -0.4, 3.0), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, f"regions_folded_ngon_{diagonals.lower()}", output_dir)
+    accuracy.assert_accurate(report)
+
+
+def test_a_moved_ngon_is_asked_again_whether_it_is_flat(output_dir):
+    """A cap corner lifted out of the cap's plane moves the mesh without
+    extracting it again, and the cap, no longer flat, walks its diagonals
+    from then on (extract.ngons_flat is asked again after each move)."""
+    from solidwire_addon.blender import runtime
+
+    scene = scenes.empty_scene(200, 150, thickness=1.5, diagonal_mode="SOLID")
+    tube = scenes.tube(scene, segments=24, depth=1.0, rotation=(0.6, 0.0, 0.3))
+    scenes.add_camera(scene, location=(0.0, -3.0, 2.4), target=(0.0, 0.0, 0.0))
+    accuracy.assert_accurate(accuracy.measure(scene, "regions_moved_ngon_flat", output_dir))
+    (mesh,) = runtime.mesh_cache.meshes()
+    assert mesh.ngons_flat()
+    cap = max(tube.data.polygons, key=lambda face: len(face.vertices))
+    tube.data.vertices[cap.vertices[5]].co += cap.normal * 0.3
+    tube.data.update()
+    accuracy.assert_accurate(accuracy.measure(scene, "regions_moved_ngon_bent", output_dir))
+    assert solidwire_addon.stats()["meshes_extracted"] == 0
+    assert runtime.mesh_cache.meshes() == [mesh] and not mesh.ngons_flat()

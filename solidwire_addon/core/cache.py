@@ -17,7 +17,15 @@ import gpu
 import numpy as np
 
 from .edge_select import TEXELS_PER_REGION_LINE
-from .extract import IN_REGION, IS_NGON, NORMALS_BY_TRIANGLE, NORMALS_BY_VERTEX, REGION_LINES, MeshArrays
+from .extract import (
+    IN_REGION,
+    IS_NGON,
+    NORMALS_BY_TRIANGLE,
+    NORMALS_BY_VERTEX,
+    REGION_LINES,
+    MeshArrays,
+    ngons_flat,
+)
 
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
@@ -141,6 +149,8 @@ class GPUMesh:
         region_pass_only = arrays.region_lines is not None and not walks_ngon_outline
         self.blocks_hold_ngon_diagonals = arrays.has_ngons
         self.ngons_alone = arrays.ngons_alone
+        self._ngon_outlines = arrays.ngon_outlines
+        self._ngons_flat = None  # (version, ngons_flat()), found on first use after each move
         # Every triangle flagged REGION_LINES (a cage look): one reduction
         # answers both questions below.
         every_triangle_region_lines = region_pass_only and bool(np.bitwise_and.reduce(flags) & REGION_LINES)
@@ -237,6 +247,15 @@ class GPUMesh:
             self._flag_table = gpu.types.GPUTexture((width, height), format="RG32F", data=buf)
             self.gpu_bytes += texture_bytes(self._flag_table)
         return self._flag_table
+
+    def ngons_flat(self) -> bool:
+        """Whether every n-gon of the mesh lies in one plane at its current
+        positions (extract.ngons_flat; True without n-gon outlines)."""
+        known = self._ngons_flat
+        if known is None or known[0] != self.version:
+            flat = self._ngon_outlines is None or ngons_flat(self._position_rows, self._ngon_outlines)
+            known = self._ngons_flat = (self.version, flat)
+        return known[1]
 
     @property
     def region_line_count(self) -> int:

@@ -485,7 +485,8 @@ def draw(
                 stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view, window=target.scissor_window
             ),
         )
-        parts = _parts(groups, program, stage, view)
+        # (Diagonals from the settings, not the variant: every stage must part alike.)
+        parts = _parts(groups, program, stage, view, settings.diagonal_mode != "HIDDEN")
         # One variant per part; parts in a fixed order (both deferred stages
         # must draw, and so number, alike).
         for part in sorted(parts):
@@ -530,7 +531,7 @@ class _Part:
     run_segments: int = 1  # the region-lines pass's segments per quad
     lines_from_image_only: bool = False  # every triangle's lines come from the region-lines pass
     ngon_diagonals: bool = False  # blocks hold listed n-gons' diagonals (walked where a diagonal shows)
-    ngons_alone: bool = False  # every n-gon is a region of its own
+    ngons_alone: bool = False  # every n-gon is a region of its own and flat (asked where diagonals show)
 
     def variant(self, variant):
         """``variant`` for this part. The visibility and region-lines passes
@@ -538,10 +539,11 @@ class _Part:
         the region lines needs no block code for a mesh whose blocks only
         hold them (and n-gon diagonals, where no diagonal shows)."""
         plain_stage = variant.visibility or variant.region_lines_pass
-        # Where every n-gon is a region of its own (all its edges lines),
-        # the nearest of its diagonals that is not one of the pixel's own
-        # triangle lies beyond an edge of that triangle: a diagonal, nearer,
-        # or a line, nearer and as wide, so brighter than it could be. The
+        # Where every n-gon is a region of its own (all its edges lines) and
+        # flat (its triangles' windows never overlap), the nearest of its
+        # diagonals that is not one of the pixel's own triangle lies beyond
+        # an edge of that triangle: a diagonal, nearer, or a line, nearer
+        # and as wide, so brighter than it could be. The
         # triangle's own diagonals then give max(P(d_real), m P(d_diag))
         # exactly (image model §4.4), in every diagonal mode. Not where each
         # line keeps a maximum of its own (density fade, edge classes of
@@ -574,7 +576,7 @@ class _Part:
         return part_variant
 
 
-def _parts(groups, program, stage, view: View) -> dict:
+def _parts(groups, program, stage, view: View, diagonals_shown: bool = False) -> dict:
     """DrawGroups by _Part.
 
     Meshes with n-gons need the fragment stage's outline walk; the rest use
@@ -602,7 +604,7 @@ def _parts(groups, program, stage, view: View) -> dict:
             run_segments=getattr(mesh, "region_run_segments", 1),
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
             ngon_diagonals=getattr(mesh, "blocks_hold_ngon_diagonals", False),
-            ngons_alone=getattr(mesh, "ngons_alone", False),
+            ngons_alone=diagonals_shown and getattr(mesh, "ngons_alone", False) and mesh.ngons_flat(),
         )
         parts.setdefault(part, []).append(g)
     return parts

@@ -388,8 +388,17 @@ def select_edges(
     # cost that grows with its corners (five times a triangulated copy of
     # a mesh of n-gons of up to 57 corners, on llvmpipe); the pass draws each
     # outline edge once (image model §2.6).
-    walked_region = (region_size > 1) | ((region_size == 1) & (sizes > 4))
-    arrays.ngons_alone = bool((region_size[label[sizes > 4]] == 1).all())
+    ngon_face = sizes > 4
+    walked_region = (region_size > 1) | ((region_size == 1) & ngon_face)
+    arrays.ngons_alone = bool((region_size[label[ngon_face]] == 1).all())
+    if arrays.ngons_alone and ngon_face.any():
+        ngon_sizes = sizes[ngon_face]
+        first = offsets[:-1][ngon_face]
+        rank = np.arange(ngon_sizes.sum()) - np.repeat(np.cumsum(ngon_sizes) - ngon_sizes, ngon_sizes)
+        arrays.ngon_outlines = (
+            np.asarray(corner_vert, np.intp)[np.repeat(first, ngon_sizes) + rank],
+            np.concatenate(([0], np.cumsum(ngon_sizes)[:-1])),
+        )
     styled_face = np.zeros(face_count, bool)
     if has_classes:
         styled_face[corner_face[classes.take(corner_edge) != 0]] = True
@@ -402,7 +411,6 @@ def select_edges(
     lines_corner = drawn_corner & (walked | styled_face)[corner_face]
     keys = distinct(label[corner_face[lines_corner]] * edge_count + corner_edge[lines_corner])
     pairs = np.stack(np.divmod(keys, edge_count), axis=1)
-    ngon_face = sizes > 4
     # A region too large to walk (see WALK_LIMIT): its faces' blocks hold
     # their own drawn edges (the walk is then face by face); the region-lines
     # pass still draws the whole region.

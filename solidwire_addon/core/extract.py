@@ -90,9 +90,12 @@ class MeshArrays:
     # run holds (1, 2, 4 or 8).
     region_line_runs: np.ndarray = None
     region_run_segments: int = 1
-    # Every n-gon is a region of its own (edge_select.select_edges), so a
-    # triangle's own diagonals give its n-gon's (draw._Part.variant).
+    # Every n-gon is a region of its own (edge_select.select_edges): then,
+    # where they are flat (ngons_flat), a triangle's own diagonals give its
+    # n-gon's (draw._Part.variant). Their outlines: every n-gon's corner
+    # vertex ids, one after another, and where each starts.
     ngons_alone: bool = False
+    ngon_outlines: tuple = None
     # The ATTRIBUTE fill source: the active colour attribute as (R, 4)
     # float32 scene-linear RGBA rows, one per vertex (attribute_domain
     # NORMALS_BY_VERTEX) or per triangle corner (NORMALS_BY_CORNER); None:
@@ -473,6 +476,35 @@ def _quad_flip(positions, quads, columns):
     n12 *= np.float32(QUAD_UNDECIDED)
     undecided = np.abs(dot) <= n12
     return flip, undecided
+
+
+def ngons_flat(positions: np.ndarray, outlines) -> bool:
+    """Whether every n-gon of ``outlines`` (MeshArrays.ngon_outlines) lies
+    in one plane, up to the rounding of float32 coordinates: each corner
+    within a millionth of the n-gon's size and distance from the origin of
+    the plane through its centroid normal to its Newell normal. The
+    projection of such a face folds nowhere (only a plane seen edge-on,
+    where it is no wider than that rounding), so its triangles' windows
+    never overlap. A face with no area is not flat."""
+    corners, starts = outlines
+    if not len(starts):
+        return True
+    points = np.asarray(positions, np.float64)[corners, :3]
+    sizes = np.diff(np.append(starts, len(corners)))
+    # Each corner's next one round its face.
+    following = np.arange(1, len(corners) + 1)
+    following[starts + sizes - 1] = starts
+    after = points[following]
+    normal = np.add.reduceat(np.cross(points, after), starts, axis=0)  # Newell's (twice the area vector)
+    length = np.linalg.norm(normal, axis=1)
+    if not (length > 0.0).all():
+        return False
+    normal /= length[:, None]
+    centre = np.add.reduceat(points, starts, axis=0) / sizes[:, None]
+    offset = points - np.repeat(centre, sizes, axis=0)
+    distance = np.abs(np.einsum("ij,ij->i", offset, np.repeat(normal, sizes, axis=0)))
+    scale = np.maximum.reduceat(np.linalg.norm(offset, axis=1), starts) + np.abs(centre).max(axis=1)
+    return bool((np.maximum.reduceat(distance, starts) <= 1e-6 * scale).all())
 
 
 def build_arrays_fast(

@@ -304,3 +304,29 @@ def test_ngon_blocks_hold_the_outline_then_each_diagonal_once():
     np.testing.assert_array_equal(ngon_corners, np.concatenate(expected))
     starts = np.concatenate([[0], np.cumsum([len(block) for block in expected])[:-1]])
     np.testing.assert_array_equal(block_start, starts[polys])
+
+
+def test_ngons_flat_holds_for_a_turned_plane_and_not_for_a_bend():
+    """A 40-gon in a plane turned every way (its float32 corners rounded
+    off that plane) is flat, far from the origin too (the tolerance follows
+    the coordinates' rounding); lifting one corner by a thousandth of its
+    size, or a face with no area, is not."""
+    rng = np.random.default_rng(3)
+    angle = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
+    ring = np.stack([np.cos(angle), np.sin(angle), np.zeros_like(angle)], axis=1)
+    turn, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    outlines = (np.arange(40), np.array([0]))
+    for origin in (np.zeros(3), np.array([1.0e4, -3.0e3, 7.0e2])):
+        corners = (ring @ turn.T + origin).astype(np.float32)
+        assert extract.ngons_flat(corners, outlines)
+    lifted = (ring @ turn.T).astype(np.float32)
+    lifted[7] += (1.0e-3 * turn[:, 2]).astype(np.float32)
+    assert not extract.ngons_flat(lifted, outlines)
+    assert not extract.ngons_flat(np.zeros((40, 3), np.float32), outlines)
+    # Two faces: each judged by itself, and one bent face is enough.
+    two = (np.concatenate([np.arange(40), np.arange(40, 80)]), np.array([0, 40]))
+    flat = ring @ turn.T
+    bent = flat.copy()
+    bent[3, 2] += 0.1
+    assert extract.ngons_flat(np.concatenate([flat, flat + 5.0]).astype(np.float32), two)
+    assert not extract.ngons_flat(np.concatenate([flat, bent]).astype(np.float32), two)
