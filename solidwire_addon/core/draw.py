@@ -531,7 +531,7 @@ class _Part:
     run_segments: int = 1  # the region-lines pass's segments per quad
     lines_from_image_only: bool = False  # every triangle's lines come from the region-lines pass
     ngon_diagonals: bool = False  # blocks hold listed n-gons' diagonals (walked where a diagonal shows)
-    ngons_alone: bool = False  # every n-gon is a region of its own and flat (asked where diagonals show)
+    flat_ngons_alone: bool = False  # every n-gon is a region of its own and flat (asked where diagonals show)
 
     def variant(self, variant):
         """``variant`` for this part. The visibility and region-lines passes
@@ -543,12 +543,12 @@ class _Part:
         # flat (its triangles' windows never overlap), the nearest of its
         # diagonals that is not one of the pixel's own triangle lies beyond
         # an edge of that triangle: a diagonal, nearer, or a line, nearer
-        # and as wide, so brighter than it could be. The
-        # triangle's own diagonals then give max(P(d_real), m P(d_diag))
-        # exactly (image model §4.4), in every diagonal mode. Not where each
-        # line keeps a maximum of its own (density fade, edge classes of
-        # their own widths, §3.6-§3.7): then the n-gon's are walked.
-        own_diagonals_do = self.ngons_alone and not (variant.density_fade or variant.edge_classes)
+        # and as wide, so brighter than it could be. The triangle's own
+        # diagonals then give max(P(d_real), m P(d_diag)) exactly (image
+        # model §2.6, §4.4), in every diagonal mode. Not where each line
+        # keeps a maximum of its own (density fade, edge classes of their
+        # own widths, §3.6-§3.7): then the n-gon's are walked.
+        own_diagonals_do = self.flat_ngons_alone and not (variant.density_fade or variant.edge_classes)
         diagonals_walked = (
             self.ngon_diagonals and variant.diagonals != shaders.DIAGONALS_HIDDEN and not own_diagonals_do
         )
@@ -604,7 +604,7 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False) ->
             run_segments=getattr(mesh, "region_run_segments", 1),
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
             ngon_diagonals=getattr(mesh, "blocks_hold_ngon_diagonals", False),
-            ngons_alone=diagonals_shown and getattr(mesh, "ngons_alone", False) and mesh.ngons_flat(),
+            flat_ngons_alone=diagonals_shown and getattr(mesh, "ngons_alone", False) and mesh.ngons_flat(),
         )
         parts.setdefault(part, []).append(g)
     return parts
