@@ -142,8 +142,8 @@ class GPUMesh:
         # walks an n-gon's own outline (edge selection lists every n-gon as a
         # region: edge_select.select_edges): where the region-lines pass
         # measures the lines, no triangle walks anything but a listed
-        # n-gon's diagonals, which only a shown diagonal needs
-        # (draw._Part.variant).
+        # n-gon's diagonals, which only a shown diagonal needs, and not even
+        # that where each triangle's own give them (draw._Part.variant).
         flags = arrays.edge_flags
         walks_ngon_outline = arrays.has_ngons and bool(np.any(flags & IS_NGON))
         region_pass_only = arrays.region_lines is not None and not walks_ngon_outline

@@ -530,14 +530,15 @@ class _Part:
     in_front: bool  # every triangle lies in front of the near plane
     run_segments: int = 1  # the region-lines pass's segments per quad
     lines_from_image_only: bool = False  # every triangle's lines come from the region-lines pass
-    ngon_diagonals: bool = False  # blocks hold listed n-gons' diagonals (walked where a diagonal shows)
+    ngon_diagonals: bool = False  # blocks hold listed n-gons' diagonals (walked where they show, see variant)
     flat_ngons_alone: bool = False  # every n-gon is a region of its own and flat (asked where diagonals show)
 
     def variant(self, variant):
         """``variant`` for this part. The visibility and region-lines passes
         read neither n-gon outlines nor the set-up table; a draw that reads
         the region lines needs no block code for a mesh whose blocks only
-        hold them (and n-gon diagonals, where no diagonal shows)."""
+        hold them (and n-gon diagonals, where no diagonal shows or each
+        triangle's own give them)."""
         plain_stage = variant.visibility or variant.region_lines_pass
         # Where every n-gon is a region of its own (all its edges lines) and
         # flat (its triangles' windows never overlap), the nearest of its
