@@ -31,3 +31,8 @@
  * front of the near plane and its polygon projects convex, so line
  * distances are segment distances for every sample inside it. */
 #define SIMPLE_TRIANGLE 32
+/* The region lines' distance image (the Edge Distance pass over regions,
+ * LINE_DISTANCE in region_lines_frag.glsl): a window distance d is kept as
+ * the depth d * LINE_DISTANCE_SCALE, below the cleared 1.0 that means "no
+ * line within reach". */
+#define LINE_DISTANCE_SCALE (1.0 / 65536.0)

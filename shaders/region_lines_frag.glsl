@@ -98,6 +98,15 @@ void main()
   if (region < 0.0 || (region != line_regions.x && region != line_regions.y)) {
     discard; /* the visible face is not bounded by this line */
   }
+#ifdef LINE_DISTANCE
+  /* The Edge Distance pass: the nearest line's distance, kept per pixel by
+   * the LESS test as the strongest line is otherwise. */
+#  if THICKNESS_MODE == 1
+  run_segments(p, 0.0, false, nearest, strongest);
+#  endif
+  gl_FragDepth = min(sqrt(nearest) * LINE_DISTANCE_SCALE, 0.99999994);
+  return;
+#endif
   /* Width at the visible point: its view depth is in the record, its clip
    * w follows from the projection (clip_w_of_depth). */
   float view_depth = visible.w;

@@ -527,10 +527,25 @@ void main()
 #else
   NearLines found = own_edge_lines(p, half_thickness, listed);
 #endif
+#ifdef WRITE_AOVS
+  /* The Edge Distance pass needs d_real itself, which the image does not
+   * hold: the block is walked whole too, and the image's line, the exact
+   * strongest, still gives the intensity (visible_intensity). */
+  walk_blocks(p, half_thickness, listed, false, found);
+#else
   walk_blocks(p, half_thickness, listed, lines_from_image, found);
+#endif
   vec3 real_line;
   vec2 real_span;
   float d_real = nearest_line(found, listed ? STYLE_COUNT : 1, real_line, real_span);
+#ifdef REGION_DISTANCE_IMAGE
+  /* A region past the walk's size is walked face by face: the region-lines
+   * pass measured every line of it within reach (image model §2.6). */
+  float coded_distance = texelFetch(region_distance_image, ivec2(gl_FragCoord.xy), 0).r;
+  if (coded_distance < 1.0) { /* (1.0: no line within reach, the walk's value stands) */
+    d_real = min(d_real, coded_distance / LINE_DISTANCE_SCALE);
+  }
+#endif
   int winner = 0;
 #ifdef HIDDEN_PASS
   float intensity = hidden_intensity(p, half_thickness, d_real, real_line, real_span);

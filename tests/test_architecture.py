@@ -618,6 +618,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "display": (object(), lambda v: v.display_transform),
         "stage": (draw.RESOLVE, lambda v: v.resolve),
         "region_lines": (object(), lambda v: v.region_lines),
+        "region_distance": (object(), lambda v: v.region_distance),
         "view_depth": (True, lambda v: v.write_view_depth),
         "aovs": (True, lambda v: v.write_aovs),
         "lines": (draw.HIDDEN_LINES, lambda v: v.hidden_pass),
@@ -627,6 +628,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "depth_write",
         "visibility",
         "triangle_ids_by_vertex",
+        "line_distance",
         "record_depth",
         "scissor_window",  # what a partial redraw leaves out (region-lines runs, record blocks)
     }
@@ -635,7 +637,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
     for name, (value, says) in selects_code.items():
         variant = draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value}))
         assert variant != plain and says(variant), name
-    for name in state_or_input - {"triangle_ids_by_vertex", "record_depth"}:
+    for name in state_or_input - {"triangle_ids_by_vertex", "line_distance", "record_depth"}:
         value = {
             "depth_test": "GREATER",
             "depth_write": False,
@@ -647,6 +649,10 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
     record = draw.DrawTarget(stage=draw.VISIBILITY, linear_depth=True)
     numbered = draw.shader_variant(settings, replace(record, triangle_ids_by_vertex=True))
     assert numbered.triangle_ids_by_vertex and not draw.shader_variant(settings, record).triangle_ids_by_vertex
+    # So is the region-lines stage's keeping of distances.
+    lines = draw.DrawTarget(stage=draw.LINES)
+    distances = draw.shader_variant(settings, replace(lines, line_distance=True))
+    assert distances.line_distance and not draw.shader_variant(settings, lines).line_distance
     # So is the resolve's writing of the record's depth (the overlay's
     # resolve straight into Blender's buffer).
     resolve = draw.DrawTarget(stage=draw.RESOLVE, depth_bias=2.0**-18)

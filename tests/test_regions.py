@@ -32,7 +32,7 @@ def _assert_region_lines_drawn():
     assert solidwire_addon.stats().get("region_line_entries", 0) > 0
 
 
-@pytest.mark.parametrize("level", [1, 2, 3, 4, 5])
+@pytest.mark.parametrize("level", [1, 2, 3, 4, 5, 6])
 def test_cage_edges_of_a_cube_at_every_level(level, output_dir):
     scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5)
     cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
@@ -406,7 +406,8 @@ def test_edge_classes_on_large_regions(case, output_dir):
 
 def test_the_edge_distance_pass_walks_regions_whole(output_dir):
     """The Edge Distance pass needs d_real itself, not a line's intensity:
-    with it the resolve walks the region (no region-lines pass)."""
+    with it the resolve walks the region for d, while the image's lines
+    still come from the region-lines pass."""
     scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
     cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
     _subdivided(cube, 3)
@@ -423,7 +424,47 @@ def test_the_edge_distance_pass_walks_regions_whole(output_dir):
     assert near.sum() > 200 and (covered & ~near).sum() > 200
     assert np.abs(distance[near] - ref.d_real[near]).max() <= 2e-3
     assert (distance[covered & ~near] >= reach - 2e-3).all()
-    assert "region_line_entries" not in solidwire_addon.stats()
+    _assert_region_lines_drawn()
+
+
+def test_the_edge_distance_pass_past_the_walk_limit(output_dir):
+    """A cage face at level 6 is one region of 256 drawn edges, past what
+    the resolve walks whole (WALK_LIMIT, image model §2.6): with the Edge
+    Distance pass on, the image's lines still come whole from the
+    region-lines pass, and the pass is exact within a line's reach, where
+    the region lines' own nearest distance meets the face-by-face walk."""
+    scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
+    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    _subdivided(cube, 6)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    scene.view_layers[0].solidwire.use_pass_edge_distance = True
+    passes = scenes.render_multilayer_exr(scene, output_dir / "regions_edge_distance_level6.exr")
+    _assert_region_lines_drawn()
+    ref = reference.render_reference(scene)
+    layer = scene.view_layers[0].name
+    alpha = exr.exr_pass(passes, layer, "Combined", "A")[..., 0]  # wire alone on a transparent film
+    accuracy.assert_accurate(reference.error_report(alpha, ref))
+    distance = exr.exr_pass(passes, layer, "Edge Distance", "X")[..., 0]
+    covered = (ref.face >= 0) & ~ref.on_silhouette
+    reach = 0.5 * 1.5 + 2.0 * 1.0
+    near = covered & (ref.d_real <= reach)
+    assert near.sum() > 200
+    assert np.abs(distance[near] - ref.d_real[near]).max() <= 2e-3
+    assert (distance[covered & ~near] >= reach - 2e-3).all()
+
+
+def test_the_wire_over_hidden_lines_past_the_walk_limit(output_dir):
+    """Under hidden lines the visible wire is drawn on its own, after the
+    hidden layers: its regions' lines come from a region-lines pass of
+    their own over the surface already drawn, so a level-6 cage face (256
+    drawn edges) keeps its whole outline (a flat grid: nothing is hidden)."""
+    scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5, use_hidden_lines=True)
+    grid = scenes.grid(scene, x_segments=2, y_segments=2, size=3.0, rotation=(0.2, 0.1, 0.4))
+    _subdivided(grid, 6)
+    scenes.add_camera(scene, location=(1.0, -3.5, 3.0), target=(0, 0, 0))
+    report = accuracy.measure(scene, "regions_hidden_lines_level6", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
 
 
 def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):

@@ -64,7 +64,10 @@ class DrawTarget:
     or RESOLVE one half of the deferred surface (RESOLVE reads the record
     in ``visibility``), LINES the lines of multi-face regions over that
     record into the bound region-lines target; ``region_lines`` is that
-    target's image, which a surface draw then reads. ``record_depth`` (the
+    target's image, which a surface draw then reads. ``line_distance``
+    (LINES): each pixel's nearest line distance instead of its strongest
+    line, whose image ``region_distance`` a RESOLVE with ``aovs`` reads for
+    the Edge Distance pass. ``record_depth`` (the
     viewport overlay's record depth, RESOLVE only): the resolve writes that
     window depth less ``depth_bias`` and meets the bound depth with
     ``depth_test``, as the overlay's composite would, so it can resolve
@@ -90,6 +93,8 @@ class DrawTarget:
     stage: str | None = None
     visibility: object = None
     region_lines: object = None
+    line_distance: bool = False
+    region_distance: object = None
     record_depth: object = None
     view_depth: bool = False
     aovs: bool = False
@@ -159,11 +164,14 @@ def shader_variant(settings, target: DrawTarget | None = None) -> shaders.Shader
             thickness_mode=variant.thickness_mode,
             edge_classes=variant.edge_classes,
             density_fade=variant.density_fade,
+            line_distance=target.line_distance,
         )
     if target.clip_planes is not None:
         variant = replace(variant, clip_planes=True)
     if target.region_lines is not None:
         variant = replace(variant, region_lines=True)
+    if target.region_distance is not None:
+        variant = replace(variant, region_distance=True)
     if target.display is not None:
         variant = replace(variant, display_transform=True)
     return variant
@@ -421,6 +429,8 @@ def draw(
     extras = {}
     if target.region_lines is not None:
         extras["region_line_image"] = target.region_lines
+    if target.region_distance is not None:
+        extras["region_distance_image"] = target.region_distance
     if target.display is not None:
         extras["display"] = target.display
     if target.visibility is not None:
@@ -553,7 +563,9 @@ class _Part:
         diagonals_walked = (
             self.ngon_diagonals and variant.diagonals != shaders.DIAGONALS_HIDDEN and not own_diagonals_do
         )
-        lines_elsewhere = self.lines_only and variant.region_lines and not diagonals_walked
+        # (The render passes' outputs walk the blocks for d_real whatever
+        # the image holds.)
+        lines_elsewhere = self.lines_only and variant.region_lines and not diagonals_walked and not variant.write_aovs
         part_variant = replace(
             variant,
             ngons=self.ngons and not plain_stage and not lines_elsewhere,
@@ -663,6 +675,8 @@ def _bind_extras(shader, variant, extras) -> None:
         bind_display_transform(shader, extras["display"])
     if variant.region_lines:
         shader.uniform_sampler("region_line_image", extras["region_line_image"])
+    if variant.region_distance:
+        shader.uniform_sampler("region_distance_image", extras["region_distance_image"])
     if variant.record_depth:
         shader.uniform_sampler("record_depth", extras["record_depth"])
 

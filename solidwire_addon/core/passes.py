@@ -238,10 +238,33 @@ class WirePass(RenderPass):
     surface's depth and view depth alone."""
 
     def render(self, frame: Frame) -> None:
-        _blended(frame, lambda: _draw(frame, self.settings, replace(frame.base, depth_write=False)))
+        lines = _wire_region_lines(frame, self.settings)
+        _blended(frame, lambda: _draw(frame, self.settings, replace(frame.base, depth_write=False, region_lines=lines)))
 
     def over_viewport(self, frame: Frame) -> None:
         frame.stats = _draw(frame, self.settings, replace(frame.base, region_lines=frame.region_lines))
+
+
+def _wire_region_lines(frame: Frame, settings):
+    """The region-lines image for the offscreen wire drawn on its own (under
+    hidden lines), or None where no mesh has multi-face regions: a
+    visibility record of those meshes over the surface depth already drawn
+    (only the nearest surface passes it), then the region-lines pass over
+    it, so that the wire's pixels read their lines instead of walking their
+    regions (docs/image_model.md §2.6). Where the deferred stages are not
+    to be used the wire walks."""
+    items = [item for item in frame.items if item.mesh.region_line_count]
+    if not items or not (frame.options.deferred_surface and shaders.deferred_available()):
+        return None
+    stats = frame.stats if frame.stats is not None else DrawStats()
+    try:
+        _record_visibility(
+            frame.targets, items, frame.view, settings, frame.base, frame.options, cull=frame.cull, keep_depth=True
+        )
+        return _draw_region_lines(frame.targets, items, frame.view, settings, frame.base, frame.cull, stats)
+    except shaders.DeferredUnavailable as exc:
+        _refused(exc)
+        return None
 
 
 class OutputsPass(RenderPass):
@@ -441,10 +464,7 @@ def draw_surface(
                 _deferred_surface(targets, deferred, view, settings, target, cull, options, after_direct=bool(direct))
             )
         except shaders.DeferredUnavailable as exc:
-            shaders.disable_deferred()
-            warn_once(
-                ("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly"
-            )
+            _refused(exc)
             return draw_surface(targets, items, view, settings, wire=wire, aovs=aovs, cull=cull, options=options)
     return stats
 
@@ -478,17 +498,30 @@ def _deferred_surface(
         targets, items, view, settings, target, options, cull=cull, keep_depth=True, clear_record=after_direct
     )
     # The lines of multi-face regions as quads over the record, so that no
-    # pixel walks a region's edges (docs/image_model.md §2.6). The Edge
-    # Distance pass needs d itself, so with the render passes' outputs the
-    # resolve walks the regions instead; a pass with the wire switched off
-    # needs no lines.
-    lines = None
-    if not target.aovs and target.lines != draw_mod.NO_LINES and _has_region_lines(items):
-        lines = _draw_region_lines(targets, items, view, settings, replace(target, aovs=False), cull, stats)
+    # pixel walks a region's edges (docs/image_model.md §2.6); a pass with
+    # the wire switched off needs no lines. The Edge Distance pass needs d
+    # itself: with the render passes' outputs the resolve walks the regions
+    # as well, for d alone, and takes the nearer of that and the region
+    # lines' own nearest distance (exact within their reach however large
+    # the region, where the walk goes face by face).
+    lines = distances = None
+    if _has_region_lines(items):
+        lines_target = replace(target, aovs=False)
+        if target.lines != draw_mod.NO_LINES:
+            lines = _draw_region_lines(targets, items, view, settings, lines_target, cull, stats)
+        if target.aovs:
+            distances = _draw_region_lines(
+                targets, items, view, settings, replace(lines_target, line_distance=True), cull, stats
+            )
     with targets.resolve_framebuffer(aovs=target.aovs).bind():
         gpu.state.viewport_set(0, 0, width, height)
         resolve = replace(
-            target, stage=draw_mod.RESOLVE, visibility=targets.visible, view_depth=True, region_lines=lines
+            target,
+            stage=draw_mod.RESOLVE,
+            visibility=targets.visible,
+            view_depth=True,
+            region_lines=lines,
+            region_distance=distances,
         )
         draw_mod.draw(items, view, settings, target=resolve, cull=cull)
     return stats
@@ -564,9 +597,10 @@ def _has_region_lines(items) -> bool:
 def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget, cull: bool, stats, scissor=None):
     """The region-lines pass over ``targets.visible`` (the visibility
     record of ``items``, numbered as draw() numbers them): the strongest
-    line per pixel into ``targets.lines``, which it returns; ``scissor``
-    as _record_visibility's."""
-    framebuffer = targets.region_lines_framebuffer()
+    line per pixel into ``targets.lines``, which it returns (with
+    ``target.line_distance`` the nearest line's distance into
+    ``targets.line_distances``); ``scissor`` as _record_visibility's."""
+    framebuffer = targets.line_distance_framebuffer() if target.line_distance else targets.region_lines_framebuffer()
     # Inside a scissor a software rasteriser draws only the runs whose
     # lines reach it (the scissor comes from _redraw_rect, which measures the
     # lines' reach): it would set up every run's quad before the scissor
@@ -586,7 +620,7 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
     stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
     if "region_runs_left_out" in drawn.extra:
         stats.extra["region_runs_left_out"] = drawn.extra["region_runs_left_out"]
-    return targets.lines
+    return targets.line_distances if target.line_distance else targets.lines
 
 
 def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptions = DEFAULT_OPTIONS):

@@ -123,6 +123,13 @@ class ShaderVariant:
     # pass's image for those regions' triangles.
     region_lines_pass: bool = False
     region_lines: bool = False
+    # The Edge Distance pass over regions (docs/image_model.md §2.6): the
+    # region-lines pass keeping each pixel's nearest line distance instead
+    # of its strongest line (``line_distance``, LINE_DISTANCE), and a
+    # resolve that takes d_real from that image where it is nearer than
+    # what its own walk found (``region_distance``, REGION_DISTANCE_IMAGE).
+    line_distance: bool = False
+    region_distance: bool = False
     # Region-lines pass only: segments per quad (1, 2, 4 or 8; the mesh's
     # cache.GPUMesh.region_run_segments).
     run_segments: int = 1
@@ -247,6 +254,8 @@ SAMPLERS = {
     "attribute_colors": (13, "FLOAT_2D"),
     "record_depth": (14, "DEPTH_2D"),
     "surface_image": (15, "FLOAT_2D"),
+    # (The render's resolve binds no surface image.)
+    "region_distance_image": (15, "DEPTH_2D"),
 }
 
 
@@ -373,6 +382,11 @@ def _create_info(variant: ShaderVariant):
     if variant.region_lines:
         add_sampler(info, "region_line_image")
         info.define("REGION_LINE_IMAGE", "1")
+    if variant.region_distance:
+        if not (variant.resolve and variant.write_aovs):
+            raise ValueError("only the render passes' resolve over region lines reads their distances")
+        add_sampler(info, "region_distance_image")
+        info.define("REGION_DISTANCE_IMAGE", "1")
     if variant.no_edge_setup:
         if not (variant.resolve and variant.region_lines) or variant.ngons or variant.setup_table:
             raise ValueError("only a resolve whose lines all come from the region-lines image skips the edge set-up")
@@ -501,6 +515,8 @@ def _region_lines_create_info(variant: ShaderVariant):
         info.define("USE_DENSITY_FADE", "1")
     if variant.in_front:
         info.define("ALL_IN_FRONT", "1")
+    if variant.line_distance:
+        info.define("LINE_DISTANCE", "1")
     body = (
         read_source("common.glsl")
         + read_source("edge_geometry.glsl")

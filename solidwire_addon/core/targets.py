@@ -44,6 +44,7 @@ class Targets:
         self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
         self.outer = self.outer_depth = None  # silhouette targets, made on first use
         self.lines = None  # the region lines' strongest line per pixel, made on first use
+        self.line_distances = None  # their nearest line's distance per pixel (Edge Distance), likewise
         self.lines_key = None  # what the overlay's lines were drawn for (passes._overlay_lines_key)
         self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
         self.visible = None  # the deferred surface's visibility record, made on first use
@@ -128,6 +129,14 @@ class Targets:
         if self.lines is None:
             self.lines = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self.lines)
+
+    def line_distance_framebuffer(self):
+        """The region lines' nearest line per pixel for the Edge Distance
+        pass: a depth buffer alone holding the distance (shaders/
+        region_lines_frag.glsl LINE_DISTANCE), created on first use."""
+        if self.line_distances is None:
+            self.line_distances = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
+        return gpu.types.GPUFrameBuffer(depth_slot=self.line_distances)
 
     def clear_view_depth(self) -> None:
         """The view-depth target to BACKGROUND_DEPTH: where no surface is
