@@ -153,18 +153,6 @@ void write_linear_depth()
 #endif
 }
 
-/* Outside the viewport's clipping region nothing of this face exists
- * (docs/image_model.md §5.6). */
-bool outside_clip_region()
-{
-#ifdef USE_CLIP_PLANES
-  return min(min(min(clip_distance_a.x, clip_distance_a.y), min(clip_distance_a.z, clip_distance_a.w)),
-             min(clip_distance_b.x, clip_distance_b.y)) < 0.0;
-#else
-  return false;
-#endif
-}
-
 /* Squared distances from window point p to the five candidate edges. */
 void own_edge_distances(vec2 p, out float d0, out float d1, out float d2, out float d3, out float d4)
 {

@@ -329,21 +329,6 @@ void fill_outputs(int triangle, int corner, float vertex_id)
 #endif
 }
 
-#ifdef USE_CLIP_PLANES
-/* Viewport clipping region: signed distances to the clip-space planes
- * (draw.py, clip_space_planes), linear in clip space so the interpolated
- * value is exact; the fragment stage discards where one is negative.
- * Taken before the depth bias, which moves only z. */
-void clip_distances(vec4 position)
-{
-  clip_distance_a = vec4(dot(clip_params.planes[0], position),
-                         dot(clip_params.planes[1], position),
-                         dot(clip_params.planes[2], position),
-                         dot(clip_params.planes[3], position));
-  clip_distance_b = vec2(dot(clip_params.planes[4], position), dot(clip_params.planes[5], position));
-}
-#endif
-
 /* Viewport overlay only: Blender's own Solid shading has already written
  * (nearly) the same depth for the same surface, but from its own float32
  * matrices and positions, so ours differs by a few ULPs either way and a
@@ -402,7 +387,7 @@ void main()
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
   fill_outputs(triangle, corner, vertex_id);
 #ifdef USE_CLIP_PLANES
-  clip_distances(position);
+  clip_distances(position); /* (before the depth bias, which moves only z) */
 #endif
 #ifndef RESOLVE_PASS
   gl_Position = biased(position);

@@ -9,6 +9,9 @@
 
 void main()
 {
+  if (outside_clip_region()) {
+    discard;
+  }
 #ifdef LINEAR_DEPTH
   /* See LINEAR_DEPTH in solidwire_frag.glsl. Kept below 1.0, the cleared
    * background: a surface right at the far clip plane is recorded as one,

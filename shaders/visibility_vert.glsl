@@ -22,4 +22,7 @@ void main()
   visible_instance = float(gl_InstanceID);
 #endif
   gl_Position = object_to_clip * vec4(position, 1.0); /* as vertex_clip() */
+#ifdef USE_CLIP_PLANES
+  clip_distances(gl_Position);
+#endif
 }

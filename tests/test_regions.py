@@ -523,6 +523,33 @@ def test_the_overlay_draws_region_lines_as_the_render_does(look, output_dir):
     assert diff[off].max() <= 0.1
 
 
+def test_the_overlay_inside_a_clipping_region_keeps_whole_regions():
+    """Alt+B: the overlay's record of the meshes with regions is cut by the
+    clipping region as their surface is, so a level-6 cage face (past the
+    walk limit) keeps its whole outline inside the region: there the image
+    is the unclipped one (a face-on grid, the plane x = 0.2 keeps x >= 0.2)."""
+    from solidwire_addon.blender.views import camera_view
+    from solidwire_addon.core.overlay_state import ViewportState
+    from tests.test_overlay import HEIGHT, WIDTH
+    from tests.test_overlay_states import draw_state
+
+    scene = scenes.empty_scene(WIDTH, HEIGHT, use_cage_edges=True, thickness=1.5)
+    scenes.add_camera(scene, location=(0.0, -10.0, 0.0))
+    grid = scenes.grid(scene, x_segments=2, y_segments=2, size=3.0, rotation=(1.5708, 0.0, 0.0))
+    _subdivided(grid, 6)
+    planes = [(1.0, 0.0, 0.0, -0.2)] + [(0.0, 0.0, 0.0, 0.0)] * 5
+    free, _ = draw_state(scene, ViewportState(), (grid,))
+    clipped, stats = draw_state(scene, ViewportState(clip_planes=planes), (grid,))
+    assert stats.get("region_line_entries", 0) > 0
+    view = camera_view(scene, bpy.context.evaluated_depsgraph_get(), (WIDTH, HEIGHT))
+    clip = view.projection @ view.view_matrix @ np.array([0.2, 0.0, 0.0, 1.0])
+    column = (clip[0] / clip[3] * 0.5 + 0.5) * WIDTH
+    columns = np.arange(WIDTH) + 0.5
+    outside, inside = columns < column - 0.5, columns > column + 0.5
+    assert free[:, inside].max() > 0.9 and clipped[:, outside].max() == 0.0
+    assert np.abs(clipped[:, inside] - free[:, inside]).max() <= 1.0 / 255.0
+
+
 def test_the_overlay_reuses_its_region_lines_until_something_changes(output_dir):
     """A redraw that changes nothing reuses the last region-lines image; a
     moved vertex, another view or another setting draws them again, and

@@ -166,7 +166,9 @@ def shader_variant(settings, target: DrawTarget | None = None) -> shaders.Shader
             density_fade=variant.density_fade,
             line_distance=target.line_distance,
         )
-    if target.clip_planes is not None:
+    if target.clip_planes is not None and target.stage != LINES:
+        # (The region-lines pass keeps a line only where the record's
+        # triangle is: a record inside the clipping region clips it.)
         variant = replace(variant, clip_planes=True)
     if target.region_lines is not None:
         variant = replace(variant, region_lines=True)

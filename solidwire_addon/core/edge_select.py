@@ -62,12 +62,12 @@ DIAGONAL_STYLE = 15
 # and (chain end, chain end, 0, 0) for the density fade.
 TEXELS_PER_SEGMENT = 2
 # The block walk — what a pixel does where the region-lines pass does not
-# run: the Edge Distance pass, hidden lines, the overlay inside a clipping
-# region, a backend without the deferred surface — takes a region whole up
-# to this many drawn edges (a cage face subdivided five times); a larger
-# region is walked face by face there, so that those paths' cost per pixel
-# stays bounded (docs/image_model.md §2.6). The lines of the image never
-# are: the region-lines pass has no limit.
+# run: the layers behind the surface under hidden lines, a backend without
+# the deferred surface, and the Edge Distance pass's d beyond a line's
+# reach — takes a region whole up to this many drawn edges (a cage face
+# subdivided five times); a larger region is walked face by face there, so
+# that those paths' cost per pixel stays bounded (docs/image_model.md
+# §2.6). The visible lines never are: the region-lines pass has no limit.
 WALK_LIMIT = 128
 # Texels per region line (shaders/region_lines_vert.glsl): (lower id, upper
 # id, style, region) and (chain end, chain end, other region or NO_REGION, 0).

@@ -154,14 +154,12 @@ class RegionLinesPass(RenderPass):
     deferred stages, over its own visibility record."""
 
     def over_viewport(self, frame: Frame) -> None:
-        # (Inside a clipping region the record would keep clipped-away
-        # surfaces: there the regions are walked.)
-        if frame.base.clip_planes is not None or not _has_region_lines(frame.direct):
+        if not _has_region_lines(frame.direct):
             return
         saved_viewport = gpu.state.viewport_get()
         try:
             frame.region_lines = _overlay_region_lines(
-                frame.direct, frame.view, self.settings, frame.line_stats, frame.options
+                frame.direct, frame.view, self.settings, frame.line_stats, frame.options, frame.base.clip_planes
             )
         finally:
             gpu.state.viewport_set(*saved_viewport)
@@ -623,11 +621,12 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
     return targets.line_distances if target.line_distance else targets.lines
 
 
-def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptions = DEFAULT_OPTIONS):
+def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptions = DEFAULT_OPTIONS, clip_planes=None):
     """The viewport overlay's region lines: a visibility record of the
     meshes with multi-face regions at the region's size (own depth:
-    Blender's depth buffer cannot be read back here), then the region-lines
-    pass over it. The overlay's surface pass reads the result where its
+    Blender's depth buffer cannot be read back here; inside the viewport's
+    clipping region ``clip_planes``, which cuts the record as it cuts the
+    surface), then the region-lines pass over it. The overlay's surface pass reads the result where its
     depth test lets a region's triangle through: the depth it tests against
     (Blender's, or our own pre-pass of every mesh) lets only the nearest
     surface pass, and where that is a region's triangle, the record holds it
@@ -639,23 +638,23 @@ def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptio
     changes."""
     items = [item for item in items if item.mesh.region_line_count]
     targets = overlay_targets_for(view.width, view.height)
-    key = _overlay_lines_key(items, view, settings)
+    key = _overlay_lines_key(items, view, settings, clip_planes)
     if key is not None and targets.lines_key == key and targets.lines is not None:
         stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
         stats.extra["region_lines_reused"] = 1
         return targets.lines
     targets.lines_key = None
-    _record_visibility(targets, items, view, settings, DrawTarget(linear_depth=True), options)
+    _record_visibility(targets, items, view, settings, DrawTarget(linear_depth=True, clip_planes=clip_planes), options)
     lines = _draw_region_lines(targets, items, view, settings, DrawTarget(linear_depth=True), True, stats)
     targets.lines_key = key
     return lines
 
 
-def _overlay_lines_key(items, view: View, settings):
+def _overlay_lines_key(items, view: View, settings, clip_planes=None):
     """What the overlay's region lines depend on, or None when that cannot
     be told (a setting that does not hash): each mesh by its serial and
-    shape version (cache.GPUMesh), its matrix and style, the view and the
-    settings."""
+    shape version (cache.GPUMesh), its matrix and style, the view, the
+    settings and the clipping region."""
     try:
         return (
             view.view_matrix.tobytes(),
@@ -663,6 +662,7 @@ def _overlay_lines_key(items, view: View, settings):
             tuple(view.viewport),
             hash(settings),
             tuple((item.mesh.serial, item.mesh.version, item.matrix.tobytes(), item.style) for item in items),
+            None if clip_planes is None else np.asarray(clip_planes, dtype=np.float64).tobytes(),
         )
     except (TypeError, AttributeError):
         return None
@@ -864,7 +864,11 @@ def _moved_items(before_key, key, items):
     if before_key is None or key is None or before_key[0] != key[0] or before_key[2:] != key[2:]:
         return None
     before_lines, now_lines = before_key[1], key[1]
-    if before_lines[:4] != now_lines[:4] or len(before_lines[4]) != len(now_lines[4]):
+    if (
+        before_lines[:4] != now_lines[:4]
+        or before_lines[5:] != now_lines[5:]
+        or len(before_lines[4]) != len(now_lines[4])
+    ):
         return None
     moved = []
     for item, before, now in zip(items, before_lines[4], now_lines[4]):

@@ -343,13 +343,7 @@ def _create_info(variant: ShaderVariant):
         add_sampler(info, "instance_table")
         iface.flat("INT", "instance_slot")
     if variant.clip_planes:
-        # A block of their own, not push constants: those stay within the
-        # 128 bytes every backend guarantees (object_to_clip, object_to_view_z
-        # and item_slot use 84, the overlay's display_shaper 8 more).
-        info.uniform_buf(2, "SolidWireClip", "clip_params")
-        iface.smooth("VEC4", "clip_distance_a")
-        iface.smooth("VEC2", "clip_distance_b")
-        info.define("USE_CLIP_PLANES", "1")
+        _add_clip_planes(info, iface)
     add_sampler(info, "triangle_vertices")
     add_sampler(info, "ngon_corners")
     _add_fill_and_colours(info, iface, variant)
@@ -431,6 +425,18 @@ def _create_info(variant: ShaderVariant):
     return info
 
 
+def _add_clip_planes(info, iface) -> None:
+    """The clipping region's planes and distances (shaders/clip_region.glsl).
+    A block of their own, not push constants: those stay within the 128
+    bytes every backend guarantees (object_to_clip, object_to_view_z and
+    item_slot use 84, the overlay's display_shaper 8 more). The caller
+    puts CLIP_BLOCK_GLSL in the typedef source."""
+    info.uniform_buf(2, "SolidWireClip", "clip_params")
+    iface.smooth("VEC4", "clip_distance_a")
+    iface.smooth("VEC2", "clip_distance_b")
+    info.define("USE_CLIP_PLANES", "1")
+
+
 def _visibility_create_info(variant: ShaderVariant):
     """The visibility pass (visibility_vert.glsl): positions pulled as the
     exact path pulls them (from the position table, by each vertex's
@@ -449,6 +455,11 @@ def _visibility_create_info(variant: ShaderVariant):
         info.push_constant("INT", "instance_base")
         add_sampler(info, "instance_table")
     info.vertex_in(0, "INT", "source_vertex")
+    if variant.clip_planes:
+        # (The viewport overlay's record inside a clipping region: what the
+        # region cuts away is not the surface a pixel shows.)
+        _add_clip_planes(info, iface)
+        info.typedef_source(schema.param_block_glsl() + CLIP_BLOCK_GLSL)
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_visible")
     if variant.linear_depth:
@@ -465,8 +476,9 @@ def _visibility_create_info(variant: ShaderVariant):
             + read_source("instancing.glsl")
             + prologue
         )
-    info.vertex_source(prologue + read_source("visibility_vert.glsl"))
-    info.fragment_source(read_source("visibility_frag.glsl"))
+    clip = read_source("clip_region.glsl")
+    info.vertex_source(prologue + clip + read_source("visibility_vert.glsl"))
+    info.fragment_source(_CLIP_DISTANCES_IN + clip + read_source("visibility_frag.glsl"))
     return info
 
 
@@ -636,6 +648,7 @@ def _add_sources(info, variant: ShaderVariant, iface: _Interface) -> None:
         fragment_head = _INSTANCE_SLOT_FRAG + instancing
     else:
         vertex_head = fragment_head = read_source("item_table.glsl") if variant.per_item else ""
+    clip = read_source("clip_region.glsl")
     fragment_tail = fill + _display_source(variant) + read_source("solidwire_frag.glsl")
     if variant.resolve:
         instance_slot = (
@@ -651,21 +664,29 @@ def _add_sources(info, variant: ShaderVariant, iface: _Interface) -> None:
             + (instancing if variant.instanced else vertex_head)
             + common
             + styles
+            + clip
             + read_source("solidwire_vert.glsl")
             + fragment_tail
             + read_source("resolve_frag.glsl")
         )
         return
     info.vertex_source(
-        "#define SW_VERTEX_ID gl_VertexID\n" + vertex_head + common + styles + read_source("solidwire_vert.glsl")
+        "#define SW_VERTEX_ID gl_VertexID\n" + vertex_head + common + styles + clip + read_source("solidwire_vert.glsl")
     )
     info.fragment_source(
         "#define SW_FRONT_FACING gl_FrontFacing\n#define SW_INV_CLIP_W gl_FragCoord.w\n"
         + fragment_head
         + common
         + styles
+        + _CLIP_DISTANCES_IN
+        + clip
         + fragment_tail
     )
+
+
+# What a stage that reads the clipping region's distances as inputs says
+# before shaders/clip_region.glsl.
+_CLIP_DISTANCES_IN = "#define SW_CLIP_DISTANCES_IN\n"
 
 
 # The resolve pass's stand-ins for the vertex stage's inputs and the
