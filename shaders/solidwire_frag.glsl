@@ -515,22 +515,23 @@ void main()
 #else
   NearLines found = own_edge_lines(p, half_thickness, listed);
 #endif
-#ifdef WRITE_AOVS
-  /* The Edge Distance pass needs d_real itself, which the image does not
-   * hold: the block is walked whole too, and the image's line, the exact
-   * strongest, still gives the intensity (visible_intensity). */
-  walk_blocks(p, half_thickness, listed, false, found);
-#else
+#ifdef SW_LINES_FROM_IMAGE
   walk_blocks(p, half_thickness, listed, lines_from_image, found);
+#else
+  /* (The Edge Distance pass without the region lines' distances: the block
+   * is walked whole for d, and the image's line, the exact strongest, still
+   * gives the intensity, visible_intensity.) */
+  walk_blocks(p, half_thickness, listed, false, found);
 #endif
   vec3 real_line;
   vec2 real_span;
   float d_real = nearest_line(found, listed ? STYLE_COUNT : 1, real_line, real_span);
 #ifdef REGION_DISTANCE_IMAGE
-  /* A region past the walk's size is walked face by face: the region-lines
-   * pass measured every line of it within reach (image model §2.6). */
+  /* The region-lines pass measured every line of the region within reach
+   * (image model §2.6); beyond it d is what the triangle's own edges give,
+   * at least the reach. */
   float coded_distance = texelFetch(region_distance_image, ivec2(gl_FragCoord.xy), 0).r;
-  if (coded_distance < 1.0) { /* (1.0: no line within reach, the walk's value stands) */
+  if (coded_distance < 1.0) { /* (1.0: no line within reach) */
     d_real = min(d_real, coded_distance / LINE_DISTANCE_SCALE);
   }
 #endif

@@ -267,9 +267,8 @@ void select_block_segments(int corner, bool in_front, vec2 t0, vec2 t1, vec2 t2,
     store_segment(k, vec3(0.0, 0.0, NO_EDGE), vec2(0.0), 0.0, 0.0);
   }
   bool provoking = (corner == 2) || (PROVOKING_CORNERS == 2 && corner == 0);
-#  if defined(REGION_LINE_IMAGE) && !defined(WRITE_AOVS)
-  /* Lines from the region-lines pass: only the block's diagonals are walked
-   * (the Edge Distance pass walks the whole block for d_real). */
+#  ifdef SW_LINES_FROM_IMAGE
+  /* Lines from the region-lines pass: only the block's diagonals are walked. */
   bool lines_elsewhere = (edge_flags & REGION_LINES) != 0;
 #  else
   const bool lines_elsewhere = false;

@@ -404,41 +404,21 @@ def test_edge_classes_on_large_regions(case, output_dir):
     assert green.sum() > 50 and (wrong & solid).sum() <= 0.005 * solid.sum()
 
 
-def test_the_edge_distance_pass_walks_regions_whole(output_dir):
-    """The Edge Distance pass needs d_real itself, not a line's intensity:
-    with it the resolve walks the region for d, while the image's lines
-    still come from the region-lines pass."""
+@pytest.mark.parametrize("level", [3, 6])
+def test_the_edge_distance_pass_over_regions(level, output_dir):
+    """The Edge Distance pass needs d_real itself, not a line's intensity: a
+    second run of the region-lines pass keeps each pixel's nearest line, so
+    the pass is exact within a line's reach (h + 2s) however large the
+    region (at level 6 a cage face has 256 drawn edges, past what a walk
+    takes whole, WALK_LIMIT); beyond it no edge can change a pixel, and the
+    pass says "at least that far". The image's lines still come whole from
+    the region-lines pass."""
     scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
     cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
-    _subdivided(cube, 3)
+    _subdivided(cube, level)
     scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
     scene.view_layers[0].solidwire.use_pass_edge_distance = True
-    passes = scenes.render_multilayer_exr(scene, output_dir / "regions_edge_distance.exr")
-    ref = reference.render_reference(scene)
-    distance = exr.exr_pass(passes, scene.view_layers[0].name, "Edge Distance", "X")[..., 0]
-    covered = (ref.face >= 0) & ~ref.on_silhouette
-    # Exact within a line's reach (h + 2s), where lines are drawn; beyond
-    # it no edge can change a pixel, and the pass says "at least that far".
-    reach = 0.5 * 1.5 + 2.0 * 1.0
-    near = covered & (ref.d_real <= reach)
-    assert near.sum() > 200 and (covered & ~near).sum() > 200
-    assert np.abs(distance[near] - ref.d_real[near]).max() <= 2e-3
-    assert (distance[covered & ~near] >= reach - 2e-3).all()
-    _assert_region_lines_drawn()
-
-
-def test_the_edge_distance_pass_past_the_walk_limit(output_dir):
-    """A cage face at level 6 is one region of 256 drawn edges, past what
-    the resolve walks whole (WALK_LIMIT, image model §2.6): with the Edge
-    Distance pass on, the image's lines still come whole from the
-    region-lines pass, and the pass is exact within a line's reach, where
-    the region lines' own nearest distance meets the face-by-face walk."""
-    scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
-    cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
-    _subdivided(cube, 6)
-    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
-    scene.view_layers[0].solidwire.use_pass_edge_distance = True
-    passes = scenes.render_multilayer_exr(scene, output_dir / "regions_edge_distance_level6.exr")
+    passes = scenes.render_multilayer_exr(scene, output_dir / f"regions_edge_distance_level{level}.exr")
     _assert_region_lines_drawn()
     ref = reference.render_reference(scene)
     layer = scene.view_layers[0].name
@@ -448,7 +428,7 @@ def test_the_edge_distance_pass_past_the_walk_limit(output_dir):
     covered = (ref.face >= 0) & ~ref.on_silhouette
     reach = 0.5 * 1.5 + 2.0 * 1.0
     near = covered & (ref.d_real <= reach)
-    assert near.sum() > 200
+    assert near.sum() > 200 and (covered & ~near).sum() > 200
     assert np.abs(distance[near] - ref.d_real[near]).max() <= 2e-3
     assert (distance[covered & ~near] >= reach - 2e-3).all()
 
@@ -469,9 +449,11 @@ def test_the_wire_over_hidden_lines_past_the_walk_limit(output_dir):
 
 def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
     """A cage look's resolve takes every line from the region-lines image
-    and reads no triangle's edge flags: their table (8 bytes a triangle) is
-    made only when a pass walks the regions, here the Edge Distance pass,
-    on the mesh already extracted."""
+    and reads no triangle's edge flags, with the Edge Distance pass too (d
+    comes from the region lines' distances): their table (8 bytes a
+    triangle) is made only when a resolve walks the regions, here the
+    fill-only surface pass under hidden lines, on the mesh already
+    extracted."""
     from solidwire_addon.core import cache
 
     scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
@@ -482,11 +464,15 @@ def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
     plain = solidwire_addon.stats()
     _assert_region_lines_drawn()
     scene.view_layers[0].solidwire.use_pass_edge_distance = True
+    scenes.render_multilayer_exr(scene, output_dir / "regions_flags_not_made.exr")
+    assert solidwire_addon.stats()["gpu_bytes"] == plain["gpu_bytes"]
+    scene.solidwire.use_hidden_lines = True
     scenes.render_multilayer_exr(scene, output_dir / "regions_flags_made.exr")
     walked = solidwire_addon.stats()
     assert walked["meshes_extracted"] == 0
     width, height = cache.table_shape(plain["triangles_drawn"])
-    assert walked["gpu_bytes"] - plain["gpu_bytes"] == 8 * width * height
+    # (The hidden layers' direct draw adds its own vertex flags besides.)
+    assert walked["gpu_bytes"] - plain["gpu_bytes"] >= 8 * width * height
 
 
 @pytest.mark.parametrize(

@@ -502,14 +502,15 @@ def _deferred_surface(
     # as well, for d alone, and takes the nearer of that and the region
     # lines' own nearest distance (exact within their reach however large
     # the region, where the walk goes face by face).
+    # (The lines pass keeps ``aovs``: with it draw() groups and numbers the
+    # draws as the record and the resolve do; it writes no output of them.)
     lines = distances = None
     if _has_region_lines(items):
-        lines_target = replace(target, aovs=False)
         if target.lines != draw_mod.NO_LINES:
-            lines = _draw_region_lines(targets, items, view, settings, lines_target, cull, stats)
+            lines = _draw_region_lines(targets, items, view, settings, target, cull, stats)
         if target.aovs:
             distances = _draw_region_lines(
-                targets, items, view, settings, replace(lines_target, line_distance=True), cull, stats
+                targets, items, view, settings, replace(target, line_distance=True), cull, stats
             )
     with targets.resolve_framebuffer(aovs=target.aovs).bind():
         gpu.state.viewport_set(0, 0, width, height)

@@ -126,8 +126,9 @@ class ShaderVariant:
     # The Edge Distance pass over regions (docs/image_model.md §2.6): the
     # region-lines pass keeping each pixel's nearest line distance instead
     # of its strongest line (``line_distance``, LINE_DISTANCE), and a
-    # resolve that takes d_real from that image where it is nearer than
-    # what its own walk found (``region_distance``, REGION_DISTANCE_IMAGE).
+    # resolve that takes d_real from that image where a line is within
+    # reach, so that it need not walk its regions for d (``region_distance``,
+    # REGION_DISTANCE_IMAGE).
     line_distance: bool = False
     region_distance: bool = False
     # Region-lines pass only: segments per quad (1, 2, 4 or 8; the mesh's
