@@ -25,13 +25,6 @@
 /* The triangle's lines come from the region-lines pass where one ran
  * (REGION_LINES variant); its block then starts with its diagonals. */
 #define REGION_LINES 4096
-/* Such a triangle walks only its block's diagonals, its lines being in the
- * image; the render passes' outputs too where the region lines also kept
- * each pixel's nearest distance for the Edge Distance pass
- * (REGION_DISTANCE_IMAGE), else they walk the whole block for d. */
-#if defined(REGION_LINE_IMAGE) && (!defined(WRITE_AOVS) || defined(REGION_DISTANCE_IMAGE))
-#  define SW_LINES_FROM_IMAGE
-#endif
 #define SEGMENT_TEXELS 2 /* (lower id, upper id, style, 0), (chain end, chain end, 0, 0) */
 #define DIAGONAL_STYLE 15
 /* Set by the vertex stage: the whole triangle (and a quad's 4th corner) is in

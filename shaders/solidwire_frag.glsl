@@ -515,14 +515,7 @@ void main()
 #else
   NearLines found = own_edge_lines(p, half_thickness, listed);
 #endif
-#ifdef SW_LINES_FROM_IMAGE
   walk_blocks(p, half_thickness, listed, lines_from_image, found);
-#else
-  /* (The Edge Distance pass without the region lines' distances: the block
-   * is walked whole for d, and the image's line, the exact strongest, still
-   * gives the intensity, visible_intensity.) */
-  walk_blocks(p, half_thickness, listed, false, found);
-#endif
   vec3 real_line;
   vec2 real_span;
   float d_real = nearest_line(found, listed ? STYLE_COUNT : 1, real_line, real_span);

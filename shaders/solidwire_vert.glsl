@@ -267,7 +267,7 @@ void select_block_segments(int corner, bool in_front, vec2 t0, vec2 t1, vec2 t2,
     store_segment(k, vec3(0.0, 0.0, NO_EDGE), vec2(0.0), 0.0, 0.0);
   }
   bool provoking = (corner == 2) || (PROVOKING_CORNERS == 2 && corner == 0);
-#  ifdef SW_LINES_FROM_IMAGE
+#  ifdef REGION_LINE_IMAGE
   /* Lines from the region-lines pass: only the block's diagonals are walked. */
   bool lines_elsewhere = (edge_flags & REGION_LINES) != 0;
 #  else

@@ -565,14 +565,7 @@ class _Part:
         diagonals_walked = (
             self.ngon_diagonals and variant.diagonals != shaders.DIAGONALS_HIDDEN and not own_diagonals_do
         )
-        # (The render passes' outputs need d_real too: from the region
-        # lines' distances where they were kept, else from a walk.)
-        lines_elsewhere = (
-            self.lines_only
-            and variant.region_lines
-            and not diagonals_walked
-            and (variant.region_distance or not variant.write_aovs)
-        )
+        lines_elsewhere = self.lines_only and variant.region_lines and not diagonals_walked
         part_variant = replace(
             variant,
             ngons=self.ngons and not plain_stage and not lines_elsewhere,

@@ -498,12 +498,12 @@ def _deferred_surface(
     # The lines of multi-face regions as quads over the record, so that no
     # pixel walks a region's edges (docs/image_model.md §2.6); a pass with
     # the wire switched off needs no lines. The Edge Distance pass needs d
-    # itself: with the render passes' outputs the resolve walks the regions
-    # as well, for d alone, and takes the nearer of that and the region
-    # lines' own nearest distance (exact within their reach however large
-    # the region, where the walk goes face by face).
-    # (The lines pass keeps ``aovs``: with it draw() groups and numbers the
-    # draws as the record and the resolve do; it writes no output of them.)
+    # itself: with the render passes' outputs a second run keeps each
+    # pixel's nearest line distance, which the resolve reads in place of a
+    # walk (it walks for d only where no lines are drawn, under hidden
+    # lines). The lines pass keeps ``aovs``: with it draw() groups and
+    # numbers the draws as the record and the resolve do; it writes no
+    # output of them.
     lines = distances = None
     if _has_region_lines(items):
         if target.lines != draw_mod.NO_LINES:
@@ -627,8 +627,9 @@ def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptio
     meshes with multi-face regions at the region's size (own depth:
     Blender's depth buffer cannot be read back here; inside the viewport's
     clipping region ``clip_planes``, which cuts the record as it cuts the
-    surface), then the region-lines pass over it. The overlay's surface pass reads the result where its
-    depth test lets a region's triangle through: the depth it tests against
+    surface), then the region-lines pass over it. The overlay's surface
+    pass reads the result where its depth test lets a region's triangle
+    through: the depth it tests against
     (Blender's, or our own pre-pass of every mesh) lets only the nearest
     surface pass, and where that is a region's triangle, the record holds it
     too. So the record needs no other mesh.

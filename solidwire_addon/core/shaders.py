@@ -375,6 +375,9 @@ def _create_info(variant: ShaderVariant):
     else:
         info.vertex_in(0, "INT", "edge_flags")
     if variant.region_lines:
+        if variant.write_aovs and not variant.region_distance:
+            # (Its pixels would not walk their regions for d.)
+            raise ValueError("the render passes' outputs over region lines need the lines' distances too")
         add_sampler(info, "region_line_image")
         info.define("REGION_LINE_IMAGE", "1")
     if variant.region_distance:
