@@ -6,7 +6,8 @@
 # out (Cycles' GPU kernels, the USD and OpenImageIO Python modules, the CJK
 # font, OpenImageDenoise's device back-ends), every shared object is
 # stripped, and the system libraries bpy and Python's own modules link
-# beyond the C library are carried along.
+# beyond the C library are carried along (not OpenGL's: the other machine
+# needs its own, libEGL.so.1 and libGL.so.1 from glvnd).
 #
 #   scripts/portable_bench.sh build/portable-bench.tar.xz
 #
@@ -38,8 +39,10 @@ rm -rf "$bpy"/lib/libOpenImageDenoise_device_* "$bpy/$version/scripts/addons_cor
   "$bpy/$version/python/lib/python3.11/site-packages"/{pxr,MaterialX,OpenImageIO,oslquery,openvdb*} \
   "$bpy/lib/usd" "$bpy/$version/datafiles/fonts/Noto Sans CJK Regular.woff2"
 
-# System libraries beyond the C runtime that bpy and Python's modules load.
-core='^(libc|libm|libdl|libpthread|librt|libutil|libresolv|ld-linux-x86-64|libgcc_s|libstdc\+\+)\.so'
+# System libraries beyond the C runtime that bpy and Python's modules load;
+# not OpenGL's dispatch libraries either, which must be the other machine's
+# own, matching its driver.
+core='^(libc|libm|libdl|libpthread|librt|libutil|libresolv|ld-linux-x86-64|libgcc_s|libstdc\+\+|libGL|libGLX|libGLdispatch|libEGL|libOpenGL)\.so'
 { ldd "$bpy/__init__.so"; ldd "$stage"/py/lib/python3.11/lib-dynload/*.so; } 2>/dev/null |
   awk '$2 == "=>" && $3 ~ /^\/(usr\/)?lib/ {print $1, $3}' | sort -u |
   while read -r name path; do
