@@ -13,7 +13,7 @@
 #
 # On the other machine, from a checkout of the same commit:
 #
-#   mkdir -p /tmp/b && tar xf portable-bench.tar.xz -C /tmp/b && . /tmp/b/env.sh
+#   mkdir -p ../portable && tar xf portable-bench.tar.xz -C ../portable && . ../portable/env.sh
 #   PYTHONPATH=$PWD:$PYTHONPATH $PY -m scripts.bench_regions
 #
 # (About 230 MB with xz -9; packing takes several minutes on two cores.)
