@@ -36,3 +36,6 @@
  * the depth d * LINE_DISTANCE_SCALE, below the cleared 1.0 that means "no
  * line within reach". */
 #define LINE_DISTANCE_SCALE (1.0 / 65536.0)
+/* The largest float below 1.0: the nearest a written depth may come to the
+ * cleared background. */
+#define BELOW_ONE 0.99999994

@@ -104,7 +104,7 @@ void main()
 #  if THICKNESS_MODE == 1
   run_segments(p, 0.0, false, nearest, strongest);
 #  endif
-  gl_FragDepth = min(sqrt(nearest) * LINE_DISTANCE_SCALE, 0.99999994);
+  gl_FragDepth = min(sqrt(nearest) * LINE_DISTANCE_SCALE, BELOW_ONE);
   return;
 #endif
   /* Width at the visible point: its view depth is in the record, its clip

@@ -4,9 +4,6 @@
  * depth). Whole numbers below 2^24 are exact in float32; bigger meshes stay
  * on the direct path (passes.deferred_surface). */
 
-/* The largest float below 1.0. */
-#define BELOW_ONE 0.99999994
-
 void main()
 {
   if (outside_clip_region()) {

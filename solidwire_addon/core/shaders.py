@@ -482,7 +482,7 @@ def _visibility_create_info(variant: ShaderVariant):
         )
     clip = read_source("clip_region.glsl")
     info.vertex_source(prologue + clip + read_source("visibility_vert.glsl"))
-    info.fragment_source(_CLIP_DISTANCES_IN + clip + read_source("visibility_frag.glsl"))
+    info.fragment_source(read_source("common.glsl") + _CLIP_DISTANCES_IN + clip + read_source("visibility_frag.glsl"))
     return info
 
 
