@@ -4,17 +4,6 @@
  * own edges once per corner; the fragment stage uses the same code for the
  * boundary of an n-gon, which no fixed number of varyings can carry. */
 
-/* Texel `index` of a table. A table longer than TABLE_WIDTH (4096) texels
- * is 4096 wide, a shorter one is a single row (core/cache.py, table_shape),
- * so texel i is at (i & 4095, i >> 12) in every table: no size query and no
- * integer division (a CPU rasteriser runs those lane by lane), with GLSL
- * every Blender backend translates. */
-#define TABLE_ROW_SHIFT 12
-vec4 fetch_texel(sampler2D table, int index)
-{
-  return texelFetch(table, ivec2(index & ((1 << TABLE_ROW_SHIFT) - 1), index >> TABLE_ROW_SHIFT), 0);
-}
-
 vec4 vertex_clip(float vertex_index)
 {
   vec3 p = fetch_texel(vertex_positions, int(vertex_index)).xyz;

@@ -110,6 +110,10 @@ void main()
 #ifdef SW_INSTANCED
   line_instance = float(gl_InstanceID);
 #endif
+#ifdef ITEM_COLORS
+  /* A hidden layer's colour: its object's wire colour (core/colors.py). */
+  item_wire = fetch_texel(item_colors, int(item_info.x)).rgb;
+#endif
   run_length = count;
 
   float half_width = style_half_thickness(line_style, max(params.half_thickness, params.half_thickness_far));

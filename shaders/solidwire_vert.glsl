@@ -353,6 +353,15 @@ void solidwire_corner()
 void main()
 #endif
 {
+#ifdef REGION_LAYERS_PEELED
+  /* A hidden-line pass whose multi-face regions' layers were drawn by depth
+   * peeling (passes.py, docs/image_model.md §2.6): their triangles are
+   * dropped before any set-up (outside the clip volume). */
+  if ((edge_flags & REGION_LINES) != 0) {
+    gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
+    return;
+  }
+#endif
   int triangle = SW_VERTEX_ID / 3;
   int corner = SW_VERTEX_ID - triangle * 3;
   vec4 ids = fetch_texel(triangle_vertices, triangle);

@@ -411,13 +411,13 @@ def test_a_new_setting_needs_only_a_schema_entry(monkeypatch):
 
 
 def test_every_table_is_laid_out_as_fetch_texel_reads_it():
-    """fetch_texel (shaders/edge_geometry.glsl) finds texel i at
+    """fetch_texel (shaders/common.glsl) finds texel i at
     (i & (2^TABLE_ROW_SHIFT - 1), i >> TABLE_ROW_SHIFT) without asking the
     texture's size: every table (cache.table_shape) is TABLE_WIDTH wide, or
     a single row when shorter."""
     from solidwire_addon.core import cache
 
-    source = (shaders.SHADER_DIR / "edge_geometry.glsl").read_text(encoding="utf-8")
+    source = (shaders.SHADER_DIR / "common.glsl").read_text(encoding="utf-8")
     shift = int(re.search(r"#define TABLE_ROW_SHIFT (\d+)", source).group(1))
     assert cache.TABLE_WIDTH == 1 << shift
     for count in (0, 1, 7, 2048, 4095, 4096, 4097, 123_457, 10_000_000):
@@ -631,13 +631,17 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "line_distance",
         "record_depth",
         "scissor_window",  # what a partial redraw leaves out (region-lines runs, record blocks)
+        "region_layers",
+        "peel_depth",
+        "region_layers_peeled",
     }
     names = {f.name for f in fields(draw.DrawTarget)}
     assert names == set(selects_code) | state_or_input, "classify every DrawTarget field here"
     for name, (value, says) in selects_code.items():
         variant = draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value}))
         assert variant != plain and says(variant), name
-    for name in state_or_input - {"triangle_ids_by_vertex", "line_distance", "record_depth"}:
+    stage_only = {"triangle_ids_by_vertex", "line_distance", "record_depth", "region_layers", "peel_depth"}
+    for name in state_or_input - stage_only - {"region_layers_peeled"}:
         value = {
             "depth_test": "GREATER",
             "depth_write": False,
@@ -658,6 +662,14 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
     resolve = draw.DrawTarget(stage=draw.RESOLVE, depth_bias=2.0**-18)
     straight = draw.shader_variant(settings, replace(resolve, record_depth=object()))
     assert straight.record_depth and not draw.shader_variant(settings, resolve).record_depth
+    # So are the hidden region layers' record (which triangles, behind which
+    # depth) and the direct hidden-line pass that leaves them out.
+    layers = draw.shader_variant(settings, replace(record, region_layers=True, peel_depth=object()))
+    assert layers.region_layers and layers.peel_layer
+    assert not (draw.shader_variant(settings, record).region_layers or draw.shader_variant(settings, record).peel_layer)
+    hidden = draw.DrawTarget().hidden()
+    assert draw.shader_variant(settings, hidden.hidden(region_layers_peeled=True)).region_layers_peeled
+    assert not draw.shader_variant(settings, hidden).region_layers_peeled
     assert not draw.shader_variant(settings, replace(draw.DrawTarget(), record_depth=object())).record_depth
     # "No wire" is said once, by the description: the plan leaves the
     # settings' wire colour alone.

@@ -6,6 +6,7 @@ are compared with the float64 reference, which walks each region whole."""
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 
@@ -16,7 +17,7 @@ import pytest
 from mathutils import Matrix
 
 import solidwire_addon
-from solidwire_addon.core import draw, exr
+from solidwire_addon.core import draw, exr, passes
 from tests.support import accuracy, reference, scenes
 
 
@@ -447,6 +448,43 @@ def test_the_wire_over_hidden_lines_past_the_walk_limit(output_dir):
     _assert_region_lines_drawn()
 
 
+def _cubes_one_behind_another(scene, level: int):
+    """A subdivided cube and a second one behind it, half hidden by it: up
+    to three layers behind the surface (the near cube's far side, the far
+    cube's near and far sides)."""
+    near = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+    far = scenes.cube(scene, "Far", rotation=(0.5, 0.2, 0.1), location=(-1.2, 3.2, -0.3))
+    for cube in (near, far):
+        _subdivided(cube, level)
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+
+
+@pytest.mark.parametrize("level", [3, 4, 6])
+def test_hidden_layers_of_regions_at_every_size(level, output_dir):
+    """Under hidden lines the layers behind the surface of a mesh with large
+    regions take their lines from the region-lines pass too, one peeled
+    layer at a time (level 4: 64 lines a region, level 6: 256, past the
+    walk's limit); smaller regions are walked. Either way a cage face keeps
+    its whole outline behind the surface, dashed and dimmed, and the
+    Hidden Wire pass says the same."""
+    scene = scenes.empty_scene(
+        200, 150, use_cage_edges=True, thickness=1.5, use_hidden_lines=True, hidden_alpha=0.5, hidden_period=6.0
+    )
+    _cubes_one_behind_another(scene, level)
+    report = accuracy.measure(scene, f"regions_hidden_layers_level{level}", output_dir)
+    accuracy.assert_accurate(report)
+    # (A cage face at level L is a region of 4 * 2^L lines.)
+    peeled = 4 * 2**level >= passes.PEEL_MIN_REGION_LINES
+    assert solidwire_addon.stats().get("hidden_region_layers") == (3 if peeled else None)
+
+    scene.view_layers[0].solidwire.use_pass_hidden_wire = True
+    channels = scenes.render_multilayer_exr(scene, output_dir / f"regions_hidden_wire_level{level}.exr")
+    hidden = exr.exr_pass(channels, scene.view_layers[0].name, "Hidden Wire", "X")[..., 0]
+    ref = reference.render_reference(scene)
+    assert ref.hidden.max() > 0.45
+    accuracy.assert_accurate(reference.error_report(hidden, dataclasses.replace(ref, intensity=ref.hidden)))
+
+
 def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
     """A cage look's resolve takes every line from the region-lines image
     and reads no triangle's edge flags, with the Edge Distance pass too (d
@@ -505,6 +543,35 @@ def test_the_overlay_draws_region_lines_as_the_render_does(look, output_dir):
     diff = np.abs(viewport.rgba()[..., 3] - rgba_engine[..., 3])
     off = ~silhouette_mask(depth_engine)
     assert rgba_engine[..., 3].max() > 0.9
+    assert np.percentile(diff[off], 99.9) <= 2.0 / 255.0 + 1e-9
+    assert diff[off].max() <= 0.1
+
+
+def test_the_overlay_peels_hidden_region_layers_as_the_render_does(output_dir):
+    """Under hidden lines the viewport overlay peels the layers of large
+    regions in its own targets, from the front (Blender's depth cannot be
+    read), and Blender's depth test keeps those behind the surface: the
+    engine's image, three layers deep at level 4."""
+    from solidwire_addon.blender import engine
+    from solidwire_addon.blender.views import camera_view
+    from tests.test_overlay import FakeViewport, silhouette_mask
+
+    width, height = 200, 150
+    scene = scenes.empty_scene(width, height, use_cage_edges=True, thickness=1.5, use_hidden_lines=True)
+    _cubes_one_behind_another(scene, 4)
+    cubes = [bpy.data.objects["Cube"], bpy.data.objects["Far"]]
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    rgba_engine, depth_engine = engine.render_scene(depsgraph, (width, height))
+    assert solidwire_addon.stats().get("hidden_region_layers") == 3
+    view = camera_view(scene, depsgraph, (width, height))
+    viewport = FakeViewport(width, height)
+    viewport.depth_pass(depsgraph, view, cubes)
+    stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
+    assert stats.get("hidden_region_layers") == 4  # (from the front: the surface's own layer too)
+    diff = np.abs(viewport.rgba()[..., 3] - rgba_engine[..., 3])
+    off = ~silhouette_mask(depth_engine)
+    hidden_only = (rgba_engine[..., 3] > 0.2) & (rgba_engine[..., 3] < 0.4)  # (hidden_alpha 0.35)
+    assert hidden_only.sum() > 100
     assert np.percentile(diff[off], 99.9) <= 2.0 / 255.0 + 1e-9
     assert diff[off].max() <= 0.1
 

@@ -42,7 +42,7 @@ def table_shape(count: int) -> tuple[int, int]:
     """(width, height) of a table of ``count`` texels: TABLE_WIDTH texels a
     row, or one row of ``count`` for a shorter table. Every shader finds
     texel i at (i % TABLE_WIDTH, i // TABLE_WIDTH) with a mask and a shift
-    (fetch_texel in shaders/edge_geometry.glsl, TABLE_ROW_SHIFT): no integer
+    (fetch_texel in shaders/common.glsl, TABLE_ROW_SHIFT): no integer
     division, which a CPU rasteriser runs lane by lane."""
     count = max(count, 1)
     width = min(count, TABLE_WIDTH)
@@ -185,6 +185,7 @@ class GPUMesh:
         self.lines_only_from_region_pass = every_triangle_region_lines
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
+        self._region_sizes = None  # (region lines, region_sizes()), made on first use
         self._run_vertices = None  # run_points(), made on first use
         self._block_boxes = None  # (version, low, high) of triangle_block_corners(), made on first use
         self._moved_triangles = None  # (version, which triangles the move to it moved): _change_box
@@ -268,6 +269,27 @@ class GPUMesh:
         """Runs of the region-lines table: the quads the pass draws."""
         runs = self._region_line_runs_cpu
         return 0 if runs is None else len(runs)
+
+    def region_sizes(self) -> tuple[int, float]:
+        """(the most line entries a region has, the mean over the triangles
+        in regions of their own region's entries): what a walk of the
+        regions' edges costs per triangle, against the hidden layers' depth
+        peeling (passes._peeled_items). Computed on first use after the
+        region lines change (topology or classes), not at extraction."""
+        lines, regions = self._region_lines_cpu, self._triangle_regions_cpu
+        known = self._region_sizes
+        if known is not None and known[0] is lines:
+            return known[1]
+        if lines is None or regions is None:
+            sizes = (0, 0.0)
+        else:
+            owners = np.concatenate([lines[0::2, 3], lines[1::2, 2]]).astype(np.int64)
+            counts = np.bincount(owners[owners >= 0])
+            of_triangle = regions[regions >= 0].astype(np.int64)
+            mean = float(counts[of_triangle].mean()) if len(of_triangle) else 0.0
+            sizes = (int(counts.max()) if len(counts) else 0, mean)
+        self._region_sizes = (lines, sizes)
+        return sizes
 
     def region_tables(self):
         """(region-lines table, per-triangle region table) as textures

@@ -82,7 +82,14 @@ class DrawTarget:
     cannot reach the rectangle is left out of the draw (a partial redraw
     on a software rasteriser): the runs of LINES whose lines cannot reach
     it, the blocks of triangles of VISIBILITY that lie outside it (numbered
-    by vertex only: gl_PrimitiveID would start again at each range)."""
+    by vertex only: gl_PrimitiveID would start again at each range).
+
+    The hidden layers of multi-face regions (passes._peel_hidden_regions):
+    ``region_layers`` (VISIBILITY) records only the triangles whose lines
+    come from the region-lines pass, with ``peel_depth`` (a depth image)
+    only those strictly behind it; LINES with HIDDEN_LINES draws such a layer's lines (the
+    nearest line per pixel and its colour); a direct HIDDEN_LINES draw with
+    ``region_layers_peeled`` leaves those triangles out."""
 
     depth_test: str = "LESS_EQUAL"
     depth_write: bool = True
@@ -101,8 +108,11 @@ class DrawTarget:
     lines: str = WIRE_LINES
     triangle_ids_by_vertex: bool = False
     scissor_window: tuple | None = None
+    region_layers: bool = False
+    peel_depth: object = None
+    region_layers_peeled: bool = False
 
-    def hidden(self) -> DrawTarget:
+    def hidden(self, region_layers_peeled: bool = False) -> DrawTarget:
         """The hidden-line layer over this target (image model §5.4): every
         face behind the depth already in the framebuffer draws its real
         edges dimmed and dashed, blended "over" (the caller sets the blend
@@ -110,9 +120,16 @@ class DrawTarget:
         passes: the same shader wrote that depth, so there is no z-fight.
         With one wire colour "over" is commutative (alpha = 1 - prod(1 -
         a_k)), so draw order does not matter. No region-lines image: the
-        layer walks every region itself."""
+        layer walks every region itself, unless ``region_layers_peeled``
+        says those layers were drawn already (passes._peel_hidden_regions)."""
         return replace(
-            self, depth_test="GREATER", depth_write=False, lines=HIDDEN_LINES, region_lines=None, view_depth=False
+            self,
+            depth_test="GREATER",
+            depth_write=False,
+            lines=HIDDEN_LINES,
+            region_lines=None,
+            view_depth=False,
+            region_layers_peeled=region_layers_peeled,
         )
 
 
@@ -152,11 +169,31 @@ def shader_variant(settings, target: DrawTarget | None = None) -> shaders.Shader
         )
     if target.aovs:
         variant = replace(variant, write_aovs=True)
+    elif target.lines == NO_LINES and target.stage in (None, RESOLVE):
+        # The fill alone (under hidden lines): no line to measure.
+        variant = replace(
+            variant, no_lines=True, diagonals=shaders.DIAGONALS_HIDDEN, edge_classes=False, density_fade=False
+        )
+    if target.region_layers_peeled and target.stage is None:
+        variant = replace(variant, region_layers_peeled=True)
     if target.stage == RESOLVE:
         variant = replace(variant, resolve=True, linear_depth=False, record_depth=target.record_depth is not None)
     elif target.stage == VISIBILITY:
         variant = shaders.ShaderVariant(
-            visibility=True, linear_depth=target.linear_depth, triangle_ids_by_vertex=target.triangle_ids_by_vertex
+            visibility=True,
+            linear_depth=target.linear_depth,
+            triangle_ids_by_vertex=target.triangle_ids_by_vertex,
+            region_layers=target.region_layers,
+            peel_layer=target.peel_depth is not None,
+        )
+    elif target.stage == LINES and target.lines == HIDDEN_LINES:
+        # A hidden layer's lines: the wire's style alone (image model §5.4).
+        variant = shaders.ShaderVariant(
+            region_lines_pass=True,
+            hidden_pass=True,
+            thickness_mode=variant.thickness_mode,
+            use_fade=variant.use_fade,
+            item_colors=variant.item_colors,
         )
     elif target.stage == LINES:
         variant = shaders.ShaderVariant(
@@ -439,6 +476,8 @@ def draw(
         extras["visibility"] = target.visibility
     if target.record_depth is not None:
         extras["record_depth"] = target.record_depth
+    if target.peel_depth is not None:
+        extras["peel_depth"] = target.peel_depth
     if target.clip_planes is not None:
         clip_rows = clip_space_planes(target.clip_planes, view)
         extras["clip_block"] = gpu.types.GPUUniformBuf(np.asarray(clip_rows, dtype=np.float32).tobytes())
@@ -586,6 +625,8 @@ class _Part:
             part_variant = replace(part_variant, no_edge_setup=True)
         if lines_elsewhere and variant.edge_classes:
             part_variant = replace(part_variant, edge_classes=False, style_colors=True)
+        if variant.no_lines:
+            part_variant = replace(part_variant, ngons=False, setup_table=False, no_edge_setup=True)
         return part_variant
 
 
@@ -679,6 +720,8 @@ def _bind_extras(shader, variant, extras) -> None:
         shader.uniform_sampler("region_distance_image", extras["region_distance_image"])
     if variant.record_depth:
         shader.uniform_sampler("record_depth", extras["record_depth"])
+    if variant.peel_layer:
+        shader.uniform_sampler("peel_depth", extras["peel_depth"])
 
 
 def bind_display_transform(shader, display) -> None:
@@ -690,6 +733,8 @@ def bind_display_transform(shader, display) -> None:
 def _bind_mesh(shader, variant, mesh) -> None:
     shader.uniform_sampler("vertex_positions", mesh.positions)
     if variant.visibility:
+        if variant.region_layers:
+            shader.uniform_sampler("triangle_regions", mesh.region_tables()[1])
         return  # its batch holds the rest (cache.GPUMesh.visibility_batch)
     shader.uniform_sampler("triangle_vertices", mesh.triangles)
     if variant.resolve and not variant.no_edge_setup:

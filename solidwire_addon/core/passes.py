@@ -41,6 +41,7 @@ from . import compositing, schema, shaders, silhouettes
 from . import draw as draw_mod
 from . import strands as strands_mod
 from .draw import DrawTarget
+from .edge_select import WALK_LIMIT
 from .log import warn_once
 from .options import DEFAULT as DEFAULT_OPTIONS
 from .options import DrawOptions
@@ -222,13 +223,43 @@ class SurfacePass(RenderPass):
 
 class HiddenLinesPass(RenderPass):
     """Hidden lines (image model §5.4), behind the surface depth, blended
-    "over" (draw.DrawTarget.hidden)."""
+    "over" (draw.DrawTarget.hidden): first the layers of multi-face
+    regions, peeled one at a time (_peel_hidden_regions), then every other
+    triangle's directly."""
 
     def render(self, frame: Frame) -> None:
-        _blended(frame, lambda: _draw(frame, self.settings, frame.base.hidden()))
+        targets = frame.targets
+        peeled = _peel_hidden_regions(
+            frame, self.settings, targets, into=targets.color_framebuffer, behind=targets.depth, stats=frame.stats
+        )
+        _blended(frame, lambda: _draw_hidden(frame.items, peeled, frame.view, self.settings, frame.base, frame.cull))
 
     def over_viewport(self, frame: Frame) -> None:
-        _draw(frame, self.settings, frame.base.hidden())
+        # The overlay's own targets; Blender's depth cannot be read, so the
+        # layers are peeled from the front and Blender's depth test keeps
+        # those behind its surface when they are composited.
+        view = frame.view
+        targets = overlay_targets_for(view.width, view.height)
+        saved_viewport = gpu.state.viewport_get()
+        try:
+            peeled = _peel_hidden_regions(
+                frame, self.settings, targets, into=None, stats=frame.line_stats, restore_viewport=saved_viewport
+            )
+        finally:
+            gpu.state.viewport_set(*saved_viewport)
+        if peeled:
+            targets.surface_key = None  # its record was drawn over: the next redraw records it whole
+        _draw_hidden(frame.items, peeled, view, self.settings, frame.base, frame.cull)
+
+
+def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bool) -> None:
+    """The direct hidden-line pass into the bound framebuffer: every
+    triangle of ``items`` walks its region, except those whose layers
+    _peel_hidden_regions drew (the region triangles of ``peeled``)."""
+    peeled_ids = {id(item) for item in peeled}
+    walked = [item for item in items if id(item) not in peeled_ids]
+    draw_mod.draw(walked, view, settings, target=base.hidden(), cull=cull)
+    draw_mod.draw(peeled, view, settings, target=base.hidden(region_layers_peeled=True), cull=cull)
 
 
 class WirePass(RenderPass):
@@ -272,7 +303,7 @@ class OutputsPass(RenderPass):
     def render(self, frame: Frame) -> None:
         targets = frame.targets
         if HIDDEN_WIRE_PASS in frame.extra_passes:
-            frame.extra[HIDDEN_WIRE_PASS] = _hidden_wire(targets, frame.items, frame.view, self.settings, frame.cull)
+            frame.extra[HIDDEN_WIRE_PASS] = _hidden_wire(frame, self.settings)
         # The surface passes' outputs need the coverage that the view depth holds.
         aovs = frame.aovs
         frame.rgba, frame.depth = targets.read(keep=frame.keep_readback, depth=frame.read_depth or aovs)
@@ -538,14 +569,17 @@ def _record_visibility(
     keep_depth=False,
     scissor=None,
     clear_record=True,
+    framebuffer=None,
 ):
     """The visibility record of ``items`` into ``targets.visible`` (which
     triangle each pixel shows; depth test, no shading), drawn as ``target``
     says apart from its stage; ``keep_depth`` keeps the depth already in the
     targets; ``scissor`` (x, y, width, height) records that rectangle alone;
     ``clear_record`` False leaves the last record where nothing is drawn
-    now (for a reader that tests depth first). Returns the DrawStats."""
-    framebuffer = targets.visibility_framebuffer()
+    now (for a reader that tests depth first); ``framebuffer`` another
+    framebuffer over that texture (a hidden region layer's). Returns the
+    DrawStats."""
+    framebuffer = framebuffer or targets.visibility_framebuffer()
     # Inside a scissor a software rasteriser records only the blocks of
     # triangles that can cover it (as the region lines' runs below): it
     # would transform and set up every triangle before the scissor drops
@@ -598,15 +632,23 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
     record of ``items``, numbered as draw() numbers them): the strongest
     line per pixel into ``targets.lines``, which it returns (with
     ``target.line_distance`` the nearest line's distance into
-    ``targets.line_distances``); ``scissor`` as _record_visibility's."""
-    framebuffer = targets.line_distance_framebuffer() if target.line_distance else targets.region_lines_framebuffer()
+    ``targets.line_distances``; with HIDDEN_LINES a hidden layer's lines
+    into ``targets.hidden_lines``); ``scissor`` as _record_visibility's."""
+    hidden = target.lines == draw_mod.HIDDEN_LINES
+    if hidden:
+        framebuffer = targets.hidden_lines_framebuffer()
+    elif target.line_distance:
+        framebuffer = targets.line_distance_framebuffer()
+    else:
+        framebuffer = targets.region_lines_framebuffer()
     # Inside a scissor a software rasteriser draws only the runs whose
     # lines reach it (the scissor comes from _redraw_rect, which measures the
     # lines' reach): it would set up every run's quad before the scissor
     # drops it, where a GPU drops them for less than picking them costs.
     reach = None if scissor is None or not shaders.software_rasteriser() else _line_reach_px(settings, items)
     with framebuffer.bind(), _scissored(scissor):
-        _clear(framebuffer, view.width, view.height, color=False)  # the lines are the depth alone
+        # The lines are the depth alone, or (a hidden layer's) depth and colour.
+        _clear(framebuffer, view.width, view.height, color=hidden)
         lines = replace(
             target,
             stage=draw_mod.LINES,
@@ -619,6 +661,8 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
     stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
     if "region_runs_left_out" in drawn.extra:
         stats.extra["region_runs_left_out"] = drawn.extra["region_runs_left_out"]
+    if hidden:
+        return targets.hidden_lines
     return targets.line_distances if target.line_distance else targets.lines
 
 
@@ -987,19 +1031,166 @@ def _composite_overlay_surface(targets, depth_bias: float) -> None:
     draw_mod.draw_rectangle(shader, targets.surface_rect)
 
 
-def _hidden_wire(targets, items, view, settings, cull: bool) -> np.ndarray:
+def _peel_hidden_regions(
+    frame: Frame, settings, targets, *, into, behind=None, stats=None, restore_viewport=None
+) -> list:
+    """The hidden layers (image model §5.4) of the triangles whose lines come
+    from the region-lines pass, without walking a region's edges (§2.6):
+    peeled one layer at a time. Each layer is a visibility record of those
+    triangles (the nearest strictly behind the layer before, or behind
+    ``behind``, the surface depth, for the first), the region-lines pass
+    over it keeping each pixel's nearest line and the layer's colour there,
+    and that colour blended "over" into ``into()`` (a framebuffer; None:
+    the one bound, the viewport's) at the layer's depth, tested GREATER
+    against its depth, as the direct hidden-line pass is. Each layer's depth
+    is read back (a fraction of a millisecond): the next layer can only lie
+    where this one does, so it is drawn inside their box, and the peeling
+    stops at the first empty layer.
+
+    Only the meshes that _peeled_items picks are peeled; returns them (the
+    direct hidden-line pass leaves their region triangles out, and walks
+    the rest: _draw_hidden). None where the deferred stages are not to be
+    used."""
+    items = _peeled_items(frame.items)
+    if not items or not (frame.options.deferred_surface and shaders.deferred_available()):
+        return []
+    view, base, options, cull = frame.view, frame.base, frame.options, frame.cull
+    stats = stats if stats is not None else DrawStats()
+    # The overlay's record holds window depth (Blender's depth test meets it
+    # in the composite, less the bias), the render's its linear depth.
+    record = DrawTarget(linear_depth=base.linear_depth, clip_planes=base.clip_planes, region_layers=True)
+    lines = DrawTarget(linear_depth=True, lines=draw_mod.HIDDEN_LINES, display=base.display)
+    # The state the caller's own passes draw with stays (over the viewport
+    # they blend as the composite does).
+    saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
+    try:
+        # (Compiled before anything is drawn.) Over the viewport the layer
+        # moves towards the camera by twice the overlay's bias: half meets
+        # the bias our own surface was drawn with, the other half keeps the
+        # surface's own layer (peeled too, from the front) from passing
+        # GREATER by a rounding of Blender's depth. The render's depth has
+        # no bias and its first layer lies behind the surface already.
+        composite = shaders.get_overlay_composite(2.0 * base.depth_bias)
+        box, layer = (0, 0, view.width, view.height), 0
+        while True:
+            layer += 1
+            previous = behind if layer == 1 else targets.peel_depths[(layer - 1) % 2]
+            _record_visibility(
+                targets,
+                items,
+                view,
+                settings,
+                replace(record, peel_depth=previous),
+                options,
+                cull=cull,
+                scissor=box,
+                framebuffer=targets.peel_framebuffer(layer),
+            )
+            box = _layer_box(targets.peel_depths[layer % 2], box)
+            if box is None:
+                break
+            _draw_region_lines(targets, items, view, settings, lines, cull, stats, box)
+            if restore_viewport is not None:
+                gpu.state.viewport_set(*restore_viewport)
+            _composite_hidden_layer(composite, targets, layer, box, view, into)
+        stats.extra["hidden_region_layers"] = layer - 1
+    except shaders.DeferredUnavailable as exc:
+        # (Only the first layer's draws compile anything: nothing was
+        # composited yet.)
+        _refused(exc)
+        return []
+    finally:
+        gpu.state.blend_set(saved[0])
+        gpu.state.depth_test_set(saved[1])
+        gpu.state.depth_mask_set(saved[2])
+    return items
+
+
+# Under hidden lines the direct pass walks each region triangle's region
+# lines (solidwire_vert.glsl select_segments), a cost that grows with the
+# region; peeling the layers costs a record and a lines pass per layer
+# instead, whatever the regions' size. A region past the walk's limit
+# (edge_select.WALK_LIMIT) is walked face by face, where a line can stop
+# short: a mesh with one is always peeled. Otherwise a mesh is peeled where
+# its triangles' regions hold this many lines or more on average. Measured
+# (scripts/bench_regions.py --walks, 2-core VM, llvmpipe, 1280 x 720,
+# Suzanne with cage edges, F12 walked / peeled): level 3 (32 lines a
+# region) 322 / 394 ms, level 4 (64) 1,161 / 635 ms.
+PEEL_MIN_REGION_LINES = 48
+
+
+def _peeled_items(items) -> list:
+    """The items whose hidden region layers are peeled (see
+    PEEL_MIN_REGION_LINES)."""
+    peeled = []
+    for item in items:
+        if item.mesh.region_line_count:
+            most, mean = item.mesh.region_sizes()
+            if most > WALK_LIMIT or mean >= PEEL_MIN_REGION_LINES:
+                peeled.append(item)
+    return peeled
+
+
+def _layer_box(depth_image, scissor):
+    """The box (x, y, width, height) around the pixels inside ``scissor``
+    where a layer was recorded into ``depth_image`` (cleared to 1.0 there),
+    or None where none was."""
+    x, y, w, h = scissor
+    recorded = read_texture(depth_image, 1)[y : y + h, x : x + w, 0] < 1.0
+    columns, rows = recorded.any(axis=0), recorded.any(axis=1)
+    if not columns.any():
+        return None
+    xs, ys = np.flatnonzero(columns), np.flatnonzero(rows)
+    return x + int(xs[0]), y + int(ys[0]), int(xs[-1] - xs[0] + 1), int(ys[-1] - ys[0] + 1)
+
+
+def _composite_hidden_layer(shader, targets, layer: int, scissor, view: View, into) -> None:
+    """Blend hidden region layer ``layer``'s lines "over" into ``into()``
+    (None: the bound framebuffer) inside ``scissor``, each pixel at the
+    layer's depth (less the overlay's bias), tested GREATER against the
+    surface's depth."""
+    x, y, w, h = scissor
+    rect = (
+        2.0 * x / view.width - 1.0,
+        2.0 * y / view.height - 1.0,
+        2.0 * (x + w) / view.width - 1.0,
+        2.0 * (y + h) / view.height - 1.0,
+    )
+
+    def draw():
+        gpu.state.blend_set("ALPHA_PREMULT")
+        gpu.state.depth_test_set("GREATER")
+        gpu.state.depth_mask_set(False)
+        shader.bind()
+        shader.uniform_sampler("record_depth", targets.peel_depths[layer % 2])
+        shader.uniform_sampler("surface_image", targets.hidden_lines)
+        draw_mod.draw_rectangle(shader, rect)
+
+    if into is None:
+        draw()
+        return
+    with into().bind():
+        gpu.state.viewport_set(0, 0, view.width, view.height)
+        draw()
+
+
+def _hidden_wire(frame: Frame, settings) -> np.ndarray:
     """The Hidden Wire pass: H of image model §5.4 (coverage of the hidden
     layers, wire alpha included), whether or not Hidden Lines is on in the
     image. The hidden-line pass again, into a target of its own over the
     surface depth: "over" blending of the a_k on 0 leaves 1 - prod(1 - a_k)
     in alpha."""
+    targets, view = frame.targets, frame.view
     framebuffer = targets.hidden_framebuffer()
     with framebuffer.bind():
         _clear(framebuffer, view.width, view.height, depth=False)  # the surface depth stays
+    settings = replace(settings, use_fill=False)
+    peeled = _peel_hidden_regions(frame, settings, targets, into=targets.hidden_framebuffer, behind=targets.depth)
+    with framebuffer.bind():
+        gpu.state.viewport_set(0, 0, view.width, view.height)
         gpu.state.blend_set("ALPHA_PREMULT")
         try:
-            hidden = DrawTarget(linear_depth=True).hidden()
-            draw_mod.draw(items, view, replace(settings, use_fill=False), target=hidden, cull=cull)
+            _draw_hidden(frame.items, peeled, view, settings, frame.base, frame.cull)
         finally:
             gpu.state.blend_set("NONE")
             gpu.state.depth_test_set("NONE")

@@ -134,10 +134,25 @@ class ShaderVariant:
     # Region-lines pass only: segments per quad (1, 2, 4 or 8; the mesh's
     # cache.GPUMesh.region_run_segments).
     run_segments: int = 1
+    # The hidden layers of multi-face regions, drawn by depth peeling
+    # (docs/image_model.md §2.6, passes._peel_hidden_regions). Visibility
+    # pass: ``region_layers`` records only the triangles whose lines come
+    # from the region-lines pass (REGION_LAYERS), ``peel_layer`` only those
+    # strictly behind the depth in the ``peel_depth`` image (PEEL_LAYER). The
+    # region-lines pass with ``hidden_pass`` draws such a layer's lines. A
+    # direct hidden-line pass with ``region_layers_peeled`` leaves those
+    # triangles out (REGION_LAYERS_PEELED).
+    region_layers: bool = False
+    peel_layer: bool = False
+    region_layers_peeled: bool = False
     # Resolve only: every triangle of the draw takes its lines from the
     # region-lines image and no diagonal is drawn (a cage look), so no
     # triangle edge is set up per pixel (NO_EDGE_SETUP).
     no_edge_setup: bool = False
+    # The fill alone: a surface pass that shows no line and writes no render
+    # pass (the surface under hidden lines, whose wire is drawn on its own):
+    # no line is measured (NO_EDGE_SETUP, no block walk).
+    no_lines: bool = False
     # Resolve only, viewport overlay: the resolve writes the record's window
     # depth less DEPTH_BIAS (RECORD_DEPTH), as the overlay's composite does,
     # to resolve straight into Blender's buffer.
@@ -254,6 +269,7 @@ SAMPLERS = {
     "region_line_image": (12, "DEPTH_2D"),
     "attribute_colors": (13, "FLOAT_2D"),
     "record_depth": (14, "DEPTH_2D"),
+    "peel_depth": (14, "DEPTH_2D"),
     "surface_image": (15, "FLOAT_2D"),
     # (The render's resolve binds no surface image.)
     "region_distance_image": (15, "DEPTH_2D"),
@@ -386,8 +402,11 @@ def _create_info(variant: ShaderVariant):
         add_sampler(info, "region_distance_image")
         info.define("REGION_DISTANCE_IMAGE", "1")
     if variant.no_edge_setup:
-        if not (variant.resolve and variant.region_lines) or variant.ngons or variant.setup_table:
-            raise ValueError("only a resolve whose lines all come from the region-lines image skips the edge set-up")
+        lines_elsewhere = variant.resolve and variant.region_lines
+        if not (lines_elsewhere or variant.no_lines) or variant.ngons or variant.setup_table:
+            raise ValueError(
+                "only a resolve whose lines all come from the region-lines image, or a fill alone, skips the edge set-up"
+            )
         info.define("NO_EDGE_SETUP", "1")
     output_and_feature_defines(info, variant)
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
@@ -395,6 +414,10 @@ def _create_info(variant: ShaderVariant):
         info.define("ALL_IN_FRONT", "1")
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
+    if variant.region_layers_peeled:
+        if not variant.hidden_pass or variant.resolve:
+            raise ValueError("only the direct hidden-line pass leaves the peeled region layers out")
+        info.define("REGION_LAYERS_PEELED", "1")
     if variant.linear_depth:
         if variant.resolve:
             raise ValueError("the resolve pass writes no depth (the visibility pass did)")
@@ -464,6 +487,14 @@ def _visibility_create_info(variant: ShaderVariant):
         # region cuts away is not the surface a pixel shows.)
         _add_clip_planes(info, iface)
         info.typedef_source(schema.param_block_glsl() + CLIP_BLOCK_GLSL)
+    if variant.region_layers:
+        add_sampler(info, "triangle_regions")
+        info.define("REGION_LAYERS", "1")
+    if variant.peel_layer:
+        if not variant.region_layers:
+            raise ValueError("only the region layers are peeled")
+        add_sampler(info, "peel_depth")
+        info.define("PEEL_LAYER", "1")
     info.vertex_out(iface)
     info.fragment_out(0, "VEC4", "frag_visible")
     if variant.linear_depth:
@@ -471,7 +502,7 @@ def _visibility_create_info(variant: ShaderVariant):
         # overlay's record, whose resolve hands it to Blender's depth test.)
         info.define("LINEAR_DEPTH", "1")
         compat.depth_write(info, "ANY")
-    # (edge_geometry.glsl: fetch_texel, as the exact path reads positions.)
+    # (fetch_texel, common.glsl: the exact path reads positions so.)
     prologue = read_source("common.glsl") + read_source("edge_geometry.glsl")
     if variant.instanced:
         info.define("SW_INSTANCED", "1")
@@ -520,9 +551,30 @@ def _region_lines_create_info(variant: ShaderVariant):
         prologue = f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * gl_InstanceID)\n" + read_source(
             "instancing.glsl"
         )
+    display = ""
+    if variant.hidden_pass:
+        # A hidden layer's lines (HIDDEN_PASS): the nearest line's distance
+        # as depth and the layer's colour, in the wire's style alone.
+        if variant.edge_classes or variant.density_fade or variant.line_distance:
+            raise ValueError("a hidden layer's lines have the wire's style alone")
+        info.define("HIDDEN_PASS", "1")
+        info.fragment_out(0, "VEC4", "frag_color")
+        if variant.use_fade:
+            info.define("USE_FADE", "1")
+        if variant.item_colors:
+            if not variant.instanced:
+                info.push_constant("INT", "item_slot")
+                add_sampler(info, "item_table")
+                prologue = read_source("item_table.glsl")
+            add_sampler(info, "item_colors")
+            info.define("ITEM_COLORS", "1")
+            iface.flat("VEC3", "item_wire")
+        if variant.display_transform:
+            add_display_transform(info)
+            display = read_source("display_transform.glsl")
     info.vertex_in(0, "INT", "quad_corner")
     info.vertex_out(iface)
-    # No colour output: the line is its depth (edge_styles.glsl line_code).
+    # Otherwise no colour output: the line is its depth (edge_styles.glsl line_code).
     compat.depth_write(info, "ANY")
     info.define("THICKNESS_MODE", str(variant.thickness_mode))
     info.define("RUN_SEGMENTS", str(variant.run_segments))
@@ -541,7 +593,7 @@ def _region_lines_create_info(variant: ShaderVariant):
     )
     info.vertex_source(prologue + body + read_source("region_lines_vert.glsl"))
     fragment_prologue = prologue.replace("gl_InstanceID", "0")  # the fragment stage transforms nothing
-    info.fragment_source(fragment_prologue + body + read_source("region_lines_frag.glsl"))
+    info.fragment_source(fragment_prologue + body + display + read_source("region_lines_frag.glsl"))
     return info
 
 

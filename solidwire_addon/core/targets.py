@@ -48,6 +48,12 @@ class Targets:
         self.lines_key = None  # what the overlay's lines were drawn for (passes._overlay_lines_key)
         self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
         self.visible = None  # the deferred surface's visibility record, made on first use
+        # The hidden layers of multi-face regions (passes._peel_hidden_regions),
+        # made on first use: two depth images the layers alternate between,
+        # and a layer's lines (colour, and the nearest line's distance as
+        # depth).
+        self.peel_depths = None
+        self.hidden_lines = self.hidden_line_depth = None
         # The viewport overlay's resolved surface (premultiplied, as it
         # leaves the display transform) and what it was resolved for
         # (passes._overlay_surface), made on first use.
@@ -137,6 +143,23 @@ class Targets:
         if self.line_distances is None:
             self.line_distances = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self.line_distances)
+
+    def peel_framebuffer(self, layer: int):
+        """Hidden region layer ``layer`` (0, 1, ...): its record into the
+        visibility record's texture, its depth into one of two depth images
+        (the other holds the layer before, which this one reads)."""
+        self.visibility_framebuffer()  # the record's texture
+        if self.peel_depths is None:
+            self.peel_depths = tuple(gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F") for _ in range(2))
+        return gpu.types.GPUFrameBuffer(depth_slot=self.peel_depths[layer % 2], color_slots=(self.visible,))
+
+    def hidden_lines_framebuffer(self):
+        """A hidden region layer's lines: their colour (RGBA32F, premultiplied)
+        and the nearest line's distance as depth, created on first use."""
+        if self.hidden_lines is None:
+            self.hidden_lines = gpu.types.GPUTexture(self.size, format="RGBA32F")
+            self.hidden_line_depth = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
+        return gpu.types.GPUFrameBuffer(depth_slot=self.hidden_line_depth, color_slots=(self.hidden_lines,))
 
     def clear_view_depth(self) -> None:
         """The view-depth target to BACKGROUND_DEPTH: where no surface is

@@ -8,11 +8,7 @@
  * same inputs, so they compute bit-identical per-triangle values; those are
  * passed `flat` where the papers pass constants over the triangle. */
 
-vec4 fetch_texel(sampler2D table, int index)
-{
-  int width = textureSize(table, 0).x;
-  return texelFetch(table, ivec2(index % width, index / width), 0);
-}
+/* (fetch_texel: shaders/common.glsl, which every variant includes.) */
 
 vec3 pulled_position(float vertex_index)
 {
