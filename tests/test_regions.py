@@ -485,6 +485,44 @@ def test_hidden_layers_of_regions_at_every_size(level, output_dir):
     accuracy.assert_accurate(reference.error_report(hidden, dataclasses.replace(ref, intensity=ref.hidden)))
 
 
+PEELED_LOOKS = {
+    "world_width_fade": dict(thickness_mode="WORLD", world_thickness=0.02, use_fade=True, fade_start=3.0, fade_end=9.0),
+    "culling": dict(use_backface_culling=True),
+    "object_colours": dict(wire_color_source="RANDOM"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(PEELED_LOOKS))
+def test_peeled_hidden_layers_in_every_look(name, output_dir):
+    """The peeled layers follow the look as the walked ones do: widths in
+    scene units at each layer's depth, the depth fade, back faces culled (no
+    layer), each object's own wire colour."""
+    look = PEELED_LOOKS[name]
+    scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5, use_hidden_lines=True, **look)
+    _cubes_one_behind_another(scene, 4)
+    report = accuracy.measure(scene, f"regions_peeled_{name}", output_dir)
+    accuracy.assert_accurate(report)
+    layers = 1 if look.get("use_backface_culling") else 3  # (culled: the far cube's near side alone)
+    assert solidwire_addon.stats().get("hidden_region_layers") == layers
+
+
+def test_peeled_hidden_layers_of_instances(output_dir):
+    """Sixteen copies of one flat grid, drawn instanced, one behind another:
+    under the edge angle each grid is one region of 80 lines (its outline),
+    peeled through every copy."""
+    scene = scenes.empty_scene(200, 150, use_cage_edges=False, edge_angle=math.radians(10.0), use_hidden_lines=True)
+    first = scenes.grid(scene, x_segments=20, y_segments=20, size=1.6, rotation=(1.2, 0.0, 0.3))
+    for k in range(1, 16):
+        copy = first.copy()  # (the same mesh: one instanced draw)
+        copy.location = (0.25 * k, 0.6 * k, 0.1 * k)
+        scene.collection.objects.link(copy)
+    scenes.add_camera(scene, location=(-1.5, -7.0, 2.0), target=(1.5, 4.0, 0.8))
+    report = accuracy.measure(scene, "regions_peeled_instances", output_dir)
+    accuracy.assert_accurate(report)
+    assert solidwire_addon.stats().get("instanced_draws", 0) > 0
+    assert solidwire_addon.stats().get("hidden_region_layers", 0) >= 4
+
+
 def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
     """A cage look's resolve takes every line from the region-lines image
     and reads no triangle's edge flags, with the Edge Distance pass too (d
