@@ -506,6 +506,19 @@ def test_peeled_hidden_layers_in_every_look(name, output_dir):
     assert solidwire_addon.stats().get("hidden_region_layers") == layers
 
 
+def test_peeling_stops_at_its_guard(output_dir, monkeypatch, capsys):
+    """The peeling ends at the first empty layer; its guard against a
+    driver that never empties one stops it with a one-line warning and
+    keeps the layers drawn so far."""
+    scene = scenes.empty_scene(200, 150, use_cage_edges=True, thickness=1.5, use_hidden_lines=True)
+    _cubes_one_behind_another(scene, 4)
+    monkeypatch.setattr(passes, "PEEL_MOST_LAYERS", 2)
+    monkeypatch.setattr(passes, "warn_once", lambda key, message: print(message))
+    bpy.ops.render.render(scene=scene.name)
+    assert solidwire_addon.stats().get("hidden_region_layers") == 2
+    assert "hidden lines stop after 2 layers" in capsys.readouterr().out
+
+
 def test_peeled_hidden_layers_of_instances(output_dir):
     """Sixteen copies of one flat grid, drawn instanced, one behind another:
     under the edge angle each grid is one region of 80 lines (its outline),

@@ -1071,9 +1071,8 @@ def _peel_hidden_regions(
         # GREATER by a rounding of Blender's depth. The render's depth has
         # no bias and its first layer lies behind the surface already.
         composite = shaders.get_overlay_composite(2.0 * base.depth_bias)
-        box, layer = (0, 0, view.width, view.height), 0
-        while True:
-            layer += 1
+        box, layers = (0, 0, view.width, view.height), 0
+        for layer in range(1, PEEL_MOST_LAYERS + 1):
             previous = behind if layer == 1 else targets.peel_depths[(layer - 1) % 2]
             _record_visibility(
                 targets,
@@ -1093,7 +1092,10 @@ def _peel_hidden_regions(
             if restore_viewport is not None:
                 gpu.state.viewport_set(*restore_viewport)
             _composite_hidden_layer(composite, targets, layer, box, view, into)
-        stats.extra["hidden_region_layers"] = layer - 1
+            layers = layer
+        else:
+            warn_once(("peel",), f"SolidWire: hidden lines stop after {layers} layers behind the surface")
+        stats.extra["hidden_region_layers"] = layers
     except shaders.DeferredUnavailable as exc:
         # (Only the first layer's draws compile anything: nothing was
         # composited yet.)
@@ -1117,6 +1119,10 @@ def _peel_hidden_regions(
 # Suzanne with cage edges, F12 walked / peeled): level 3 (32 lines a
 # region) 322 / 394 ms, level 4 (64) 1,161 / 635 ms.
 PEEL_MIN_REGION_LINES = 48
+# Each peeled layer lies strictly behind the one before at every pixel, so
+# the peeling ends; this only guards against a driver that breaks that
+# (a NaN depth passes every test) turning the frame into an endless loop.
+PEEL_MOST_LAYERS = 4096
 
 
 def _peeled_items(items) -> list:
