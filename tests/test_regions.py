@@ -19,6 +19,7 @@ from mathutils import Matrix
 import solidwire_addon
 from solidwire_addon.core import draw, exr, passes
 from tests.support import accuracy, reference, scenes
+from tests.test_render_reference import _Override
 
 
 def _subdivided(obj, levels: int, *, optimal_display: bool = True):
@@ -405,27 +406,35 @@ def test_edge_classes_on_large_regions(case, output_dir):
     assert green.sum() > 50 and (wrong & solid).sum() <= 0.005 * solid.sum()
 
 
-@pytest.mark.parametrize("level", [3, 6])
-def test_the_edge_distance_pass_over_regions(level, output_dir):
+@pytest.mark.parametrize("level, hidden_lines", [(3, False), (6, False), (6, True)])
+def test_the_edge_distance_pass_over_regions(level, hidden_lines, output_dir):
     """The Edge Distance pass needs d_real itself, not a line's intensity: a
     second run of the region-lines pass keeps each pixel's nearest line, so
     the pass is exact within a line's reach (h + 2s) however large the
     region (at level 6 a cage face has 256 drawn edges, past what a walk
     takes whole, WALK_LIMIT); beyond it no edge can change a pixel, and the
     pass says "at least that far". The image's lines still come whole from
-    the region-lines pass."""
-    scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
+    the region-lines pass, and so does the Wire pass's intensity under
+    hidden lines, where the image's surface pass shows no line."""
+    scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5, use_hidden_lines=hidden_lines)
     cube = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
     _subdivided(cube, level)
     scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
-    scene.view_layers[0].solidwire.use_pass_edge_distance = True
-    passes = scenes.render_multilayer_exr(scene, output_dir / f"regions_edge_distance_level{level}.exr")
+    settings = scene.view_layers[0].solidwire
+    settings.use_pass_edge_distance = settings.use_pass_wire = True
+    name = f"regions_edge_distance_level{level}{'_hidden' if hidden_lines else ''}.exr"
+    channels = scenes.render_multilayer_exr(scene, output_dir / name)
     _assert_region_lines_drawn()
     ref = reference.render_reference(scene)
     layer = scene.view_layers[0].name
-    alpha = exr.exr_pass(passes, layer, "Combined", "A")[..., 0]  # wire alone on a transparent film
+    alpha = exr.exr_pass(channels, layer, "Combined", "A")[..., 0]  # wire alone on a transparent film
     accuracy.assert_accurate(reference.error_report(alpha, ref))
-    distance = exr.exr_pass(passes, layer, "Edge Distance", "X")[..., 0]
+    visible = ref
+    if hidden_lines:
+        visible = reference.render_reference(scene, settings=_Override(scene.solidwire, use_hidden_lines=False))
+    wire = exr.exr_pass(channels, layer, "Wire", "X")[..., 0]
+    accuracy.assert_accurate(reference.error_report(wire, visible))
+    distance = exr.exr_pass(channels, layer, "Edge Distance", "X")[..., 0]
     covered = (ref.face >= 0) & ~ref.on_silhouette
     reach = 0.5 * 1.5 + 2.0 * 1.0
     near = covered & (ref.d_real <= reach)
@@ -539,10 +548,10 @@ def test_peeled_hidden_layers_of_instances(output_dir):
 def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
     """A cage look's resolve takes every line from the region-lines image
     and reads no triangle's edge flags, with the Edge Distance pass too (d
-    comes from the region lines' distances): their table (8 bytes a
-    triangle) is made only when a resolve walks the regions, here the
-    fill-only surface pass under hidden lines, on the mesh already
-    extracted."""
+    comes from the region lines' distances) and under hidden lines (the
+    Wire pass's intensity from the same image): their table (8 bytes a
+    triangle) is made only when a resolve sets up a triangle's own edges,
+    here its diagonals, on the mesh already extracted."""
     from solidwire_addon.core import cache
 
     scene = scenes.empty_scene(160, 120, use_cage_edges=True, thickness=1.5)
@@ -552,16 +561,26 @@ def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
     bpy.ops.render.render(scene=scene.name)
     plain = solidwire_addon.stats()
     _assert_region_lines_drawn()
-    scene.view_layers[0].solidwire.use_pass_edge_distance = True
+    passes_on = scene.view_layers[0].solidwire
+    passes_on.use_pass_edge_distance = passes_on.use_pass_wire = True
     scenes.render_multilayer_exr(scene, output_dir / "regions_flags_not_made.exr")
     assert solidwire_addon.stats()["gpu_bytes"] == plain["gpu_bytes"]
+    # Under hidden lines the hidden layers' direct draw adds its own batch
+    # (vertex flags of its own), with or without the render passes.
     scene.solidwire.use_hidden_lines = True
+    passes_on.use_pass_edge_distance = passes_on.use_pass_wire = False
+    bpy.ops.render.render(scene=scene.name)
+    hidden = solidwire_addon.stats()
+    passes_on.use_pass_edge_distance = passes_on.use_pass_wire = True
+    scenes.render_multilayer_exr(scene, output_dir / "regions_flags_not_made_hidden.exr")
+    assert solidwire_addon.stats()["gpu_bytes"] == hidden["gpu_bytes"]
+    scene.solidwire.use_hidden_lines = False
+    scene.solidwire.diagonal_mode = "SOLID"
     scenes.render_multilayer_exr(scene, output_dir / "regions_flags_made.exr")
-    walked = solidwire_addon.stats()
-    assert walked["meshes_extracted"] == 0
+    diagonals = solidwire_addon.stats()
+    assert diagonals["meshes_extracted"] == 0
     width, height = cache.table_shape(plain["triangles_drawn"])
-    # (The hidden layers' direct draw adds its own vertex flags besides.)
-    assert walked["gpu_bytes"] - plain["gpu_bytes"] >= 8 * width * height
+    assert diagonals["gpu_bytes"] - hidden["gpu_bytes"] >= 8 * width * height
 
 
 @pytest.mark.parametrize(

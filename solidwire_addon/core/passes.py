@@ -528,16 +528,17 @@ def _deferred_surface(
     )
     # The lines of multi-face regions as quads over the record, so that no
     # pixel walks a region's edges (docs/image_model.md §2.6); a pass with
-    # the wire switched off needs no lines. The Edge Distance pass needs d
-    # itself: with the render passes' outputs a second run keeps each
-    # pixel's nearest line distance, which the resolve reads in place of a
-    # walk (it walks for d only where no lines are drawn, under hidden
-    # lines). The lines pass keeps ``aovs``: with it draw() groups and
+    # the wire switched off needs none, unless it writes the render passes
+    # (the Wire pass is the visible lines' intensity whether or not the
+    # image shows them: the fill under hidden lines). The Edge Distance pass
+    # needs d itself: with the render passes' outputs a second run keeps
+    # each pixel's nearest line distance, which the resolve reads in place
+    # of a walk. The lines pass keeps ``aovs``: with it draw() groups and
     # numbers the draws as the record and the resolve do; it writes no
     # output of them.
     lines = distances = None
     if _has_region_lines(items):
-        if target.lines != draw_mod.NO_LINES:
+        if target.lines != draw_mod.NO_LINES or target.aovs:
             lines = _draw_region_lines(targets, items, view, settings, target, cull, stats)
         if target.aovs:
             distances = _draw_region_lines(
