@@ -1050,7 +1050,7 @@ def _peel_hidden_regions(
 
     Only the meshes that _peeled_items picks are peeled; returns them (the
     direct hidden-line pass leaves their region triangles out, and walks
-    the rest: _draw_hidden). None where the deferred stages are not to be
+    the rest: _draw_hidden); none where the deferred stages are not to be
     used."""
     items = _peeled_items(frame.items)
     if not items or not (frame.options.deferred_surface and shaders.deferred_available()):
