@@ -7,7 +7,7 @@
  * The hidden layers of multi-face regions (docs/image_model.md §2.6) use it
  * too, on those regions' triangles alone (REGION_LAYERS): PEEL_LAYER
  * records the nearest of them strictly behind the depth in `peel_depth`
- * (the surface, or the layer recorded before), one layer per run. */
+ * (the surface, or the layer recorded before), one layer per draw. */
 
 void main()
 {

@@ -87,9 +87,10 @@ class DrawTarget:
     The hidden layers of multi-face regions (passes._peel_hidden_regions):
     ``region_layers`` (VISIBILITY) records only the triangles whose lines
     come from the region-lines pass, with ``peel_depth`` (a depth image)
-    only those strictly behind it; LINES with HIDDEN_LINES draws such a layer's lines (the
-    nearest line per pixel and its colour); a direct HIDDEN_LINES draw with
-    ``region_layers_peeled`` leaves those triangles out."""
+    only those strictly behind it; LINES with HIDDEN_LINES draws such a
+    layer's lines (the nearest line per pixel and its colour); a direct
+    HIDDEN_LINES draw with ``region_layers_peeled`` leaves those triangles
+    out."""
 
     depth_test: str = "LESS_EQUAL"
     depth_write: bool = True
