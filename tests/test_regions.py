@@ -492,6 +492,9 @@ def test_hidden_layers_of_regions_at_every_size(level, output_dir):
     ref = reference.render_reference(scene)
     assert ref.hidden.max() > 0.45
     accuracy.assert_accurate(reference.error_report(hidden, dataclasses.replace(ref, intensity=ref.hidden)))
+    # (With the pass the image blends the pass's layers over itself.)
+    alpha = exr.exr_pass(channels, scene.view_layers[0].name, "Combined", "A")[..., 0]
+    accuracy.assert_accurate(reference.error_report(alpha, ref))
 
 
 PEELED_LOOKS = {

@@ -229,6 +229,13 @@ class HiddenLinesPass(RenderPass):
 
     def render(self, frame: Frame) -> None:
         targets = frame.targets
+        if HIDDEN_WIRE_PASS in frame.extra_passes:
+            # The Hidden Wire pass is these layers on their own: drawn once
+            # into its target and blended over the image from there ("over"
+            # is associative), not drawn twice.
+            frame.extra[HIDDEN_WIRE_PASS] = _hidden_wire(frame, self.settings)
+            _blended(frame, lambda: _blend_hidden_target(targets))
+            return
         peeled = _peel_hidden_regions(
             frame, self.settings, targets, into=targets.color_framebuffer, behind=targets.depth, stats=frame.stats
         )
@@ -302,7 +309,7 @@ class OutputsPass(RenderPass):
 
     def render(self, frame: Frame) -> None:
         targets = frame.targets
-        if HIDDEN_WIRE_PASS in frame.extra_passes:
+        if HIDDEN_WIRE_PASS in frame.extra_passes and HIDDEN_WIRE_PASS not in frame.extra:
             frame.extra[HIDDEN_WIRE_PASS] = _hidden_wire(frame, self.settings)
         # The surface passes' outputs need the coverage that the view depth holds.
         aovs = frame.aovs
@@ -1192,7 +1199,9 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
     with framebuffer.bind():
         _clear(framebuffer, view.width, view.height, depth=False)  # the surface depth stays
     settings = replace(settings, use_fill=False)
-    peeled = _peel_hidden_regions(frame, settings, targets, into=targets.hidden_framebuffer, behind=targets.depth)
+    peeled = _peel_hidden_regions(
+        frame, settings, targets, into=targets.hidden_framebuffer, behind=targets.depth, stats=frame.stats
+    )
     with framebuffer.bind():
         gpu.state.viewport_set(0, 0, view.width, view.height)
         gpu.state.blend_set("ALPHA_PREMULT")
@@ -1202,6 +1211,19 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
             gpu.state.blend_set("NONE")
             gpu.state.depth_test_set("NONE")
     return read_texture(targets.hidden, 4)[..., 3:4]
+
+
+def _blend_hidden_target(targets) -> None:
+    """``targets.hidden`` (the hidden layers "over" each other on nothing)
+    blended as the caller set over the bound colour target, where a surface
+    is (no layer lies behind the background)."""
+    shader = shaders.get_overlay_composite(0.0)
+    shader.bind()
+    shader.uniform_sampler("record_depth", targets.depth)
+    shader.uniform_sampler("surface_image", targets.hidden)
+    gpu.state.depth_test_set("NONE")
+    gpu.state.depth_mask_set(False)
+    draw_mod.draw_rectangle(shader, (-1.0, -1.0, 1.0, 1.0))
 
 
 def _composite_silhouettes(rgba, targets, items, view, settings):
