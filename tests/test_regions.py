@@ -485,6 +485,8 @@ def test_hidden_layers_of_regions_at_every_size(level, output_dir):
     # (A cage face at level L is a region of 4 * 2^L lines.)
     peeled = 4 * 2**level >= passes.PEEL_MIN_REGION_LINES
     assert solidwire_addon.stats().get("hidden_region_layers") == (3 if peeled else None)
+    if peeled:  # (the layers behind the first skip the blocks in front of the layer before)
+        assert solidwire_addon.stats().get("peel_triangles_left_out", 0) > 0
 
     scene.view_layers[0].solidwire.use_pass_hidden_wire = True
     channels = scenes.render_multilayer_exr(scene, output_dir / f"regions_hidden_wire_level{level}.exr")
@@ -518,6 +520,47 @@ def test_peeled_hidden_layers_in_every_look(name, output_dir):
     assert solidwire_addon.stats().get("hidden_region_layers") == layers
 
 
+def test_depth_tiles_keep_every_block_that_may_lie_behind():
+    """The peeling's record leaves out the blocks of triangles wholly in
+    front of the layer before (draw.DepthTiles): every box some pixel of
+    which lies in front of its deepest point is kept, at any size, next to
+    and over pixels where the layer holds nothing; a box in front of every
+    pixel it covers, or over none the layer holds, is left out."""
+    rng = np.random.default_rng(7)
+    height, width, origin = 70, 100, (13, 7)
+    # A slope, as a surface seen at an angle, with some roughness.
+    ramp = 0.2 + 0.6 * np.arange(width) / width + 0.1 * np.arange(height)[:, None] / height
+    depth = (ramp + rng.uniform(0.0, 0.02, (height, width))).astype(np.float32)
+    depth[20:45, 30:70] = 1.0  # nothing recorded there
+    tiles = draw.DepthTiles(depth, origin, linear=False, inv_clip_end=1.0)
+    count = 4000
+    x_low = rng.uniform(-20.0, 130.0, count)
+    y_low = rng.uniform(-20.0, 90.0, count)
+    size = rng.choice([0.5, 3.0, 12.0, 40.0, 90.0], count)
+    x_high, y_high = x_low + size * rng.uniform(0.2, 1.0, count), y_low + size * rng.uniform(0.2, 1.0, count)
+    deepest = rng.uniform(0.15, 1.0, count)
+    reached = tiles.reached(x_low, x_high, y_low, y_high, deepest)
+    truth = np.zeros(count, bool)
+    for k in range(count):
+        # The pixels whose centres the box covers, one to spare each way.
+        x0 = max(int(np.floor(x_low[k] - 1.0)) - origin[0], 0)
+        x1 = min(int(np.floor(x_high[k] + 1.0)) - origin[0], width - 1)
+        y0 = max(int(np.floor(y_low[k] - 1.0)) - origin[1], 0)
+        y1 = min(int(np.floor(y_high[k] + 1.0)) - origin[1], height - 1)
+        if x0 <= x1 and y0 <= y1:
+            truth[k] = (depth[y0 : y1 + 1, x0 : x1 + 1] < deepest[k]).any()
+    assert truth.sum() > 500 and (~truth).sum() > 500
+    assert reached[truth].all()
+    # (Tiles, and the coarser level a large box is looked up at, are
+    # coarser than pixels: some boxes that reach nothing are kept.)
+    assert (~reached[~truth]).mean() > 0.3
+    in_front = tiles.reached(np.array([40.0]), np.array([60.0]), np.array([20.0]), np.array([40.0]), np.array([0.1]))
+    over_nothing = tiles.reached(
+        np.array([53.0]), np.array([59.0]), np.array([33.0]), np.array([37.0]), np.array([1.0])
+    )
+    assert not in_front[0] and not over_nothing[0]
+
+
 def test_peeling_stops_at_its_guard(output_dir, monkeypatch, capsys):
     """The peeling ends at the first empty layer; its guard against a
     driver that never empties one stops it with a one-line warning and
@@ -546,6 +589,44 @@ def test_peeled_hidden_layers_of_instances(output_dir):
     accuracy.assert_accurate(report)
     assert solidwire_addon.stats().get("instanced_draws", 0) > 0
     assert solidwire_addon.stats().get("hidden_region_layers", 0) >= 4
+
+
+def _grid_with_pillars(bm):
+    """A flat 24 x 24 grid with two faces pushed up into thin pillars and a
+    3 x 3 block of faces into a thick one: under the edge angle the grid is
+    one region of over a hundred lines (its outline and the feet), the thick
+    pillar's top and sides are regions of several faces, and every face of
+    a thin pillar is a face of its own."""
+    bmesh.ops.create_grid(bm, x_segments=24, y_segments=24, size=1.0)
+    bm.faces.ensure_lookup_table()
+    block = [bm.faces[24 * row + column] for row in range(14, 17) for column in range(8, 11)]
+    feet = [bm.faces[index] for index in (100, 455)]
+    extruded = bmesh.ops.extrude_face_region(bm, geom=block)["geom"]
+    raised = [element for element in extruded if isinstance(element, bmesh.types.BMVert)]
+    bmesh.ops.translate(bm, verts=raised, vec=(0.0, 0.0, 0.5))
+    bmesh.ops.delete(bm, geom=block, context="FACES_ONLY")  # (the block's old faces, left under it)
+    for top in bmesh.ops.extrude_discrete_faces(bm, faces=feet)["faces"]:
+        bmesh.ops.translate(bm, verts=list(top.verts), vec=(0.0, 0.0, 0.35))
+
+
+def test_peeled_hidden_layers_beside_faces_of_their_own(output_dir):
+    """A peeled mesh whose triangles are not all in multi-face regions: the
+    flat grid's layers are peeled, the pillars' faces (regions of one face)
+    still go through the direct hidden-line pass (a mesh with no such
+    triangle skips it)."""
+    from solidwire_addon.blender import runtime
+    from solidwire_addon.core.view import DrawItem
+
+    scene = scenes.empty_scene(200, 150, use_cage_edges=False, edge_angle=math.radians(10.0), use_hidden_lines=True)
+    # Seen from under the grid: the pillars lie behind it.
+    scenes.mesh_object(scene, "Pillars", _grid_with_pillars, rotation=(-1.1, 0.0, 0.4))
+    scenes.add_camera(scene, location=(0.0, -5.0, -0.5), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, "regions_peeled_beside_own_faces", output_dir)
+    accuracy.assert_accurate(report)
+    (mesh,) = runtime.mesh_cache.meshes()
+    assert passes._peeled_items([DrawItem(mesh, np.eye(4))])
+    assert mesh.region_sizes()[2] == 2 * 5 * 2  # the thin pillars' 10 faces, two triangles each
+    assert solidwire_addon.stats().get("hidden_region_layers", 0) >= 2
 
 
 def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
@@ -647,6 +728,57 @@ def test_the_overlay_peels_hidden_region_layers_as_the_render_does(output_dir):
     assert hidden_only.sum() > 100
     assert np.percentile(diff[off], 99.9) <= 2.0 / 255.0 + 1e-9
     assert diff[off].max() <= 0.1
+
+
+def test_the_overlay_keeps_its_hidden_region_layers_between_redraws(output_dir):
+    """The overlay's peeled hidden layers are kept as two images (the front
+    layer, every layer behind it) and composited again while the meshes,
+    the view and the settings stay: each redraw then equals a fresh one,
+    also when only Blender's depth changed (an object SolidWire does not
+    draw now hides part of the near cube, whose own lines then show as
+    hidden lines there); a moved vertex or another setting peels again."""
+    from solidwire_addon.blender.views import camera_view
+    from solidwire_addon.core import targets
+    from tests.test_overlay import FakeViewport
+
+    width, height = 200, 150
+    scene = scenes.empty_scene(width, height, use_cage_edges=True, thickness=1.5, use_hidden_lines=True)
+    _cubes_one_behind_another(scene, 4)
+    cubes = [bpy.data.objects["Cube"], bpy.data.objects["Far"]]
+    occluder = scenes.cube(scene, "Occluder", size=0.5, location=(1.6, -2.25, 1.2))
+    occluder.solidwire_exclude = True
+
+    def redraw(depth_of):
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        view = camera_view(scene, depsgraph, (width, height))
+        viewport = FakeViewport(width, height)
+        viewport.depth_pass(depsgraph, view, depth_of)
+        stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
+        return viewport.rgba()[..., 3], stats
+
+    def fresh(depth_of):
+        targets.release()  # nothing kept
+        return redraw(depth_of)
+
+    first, stats = fresh(cubes)
+    assert stats.get("hidden_region_layers") == 4 and not stats.get("hidden_layers_reused")
+    again, stats = redraw(cubes)
+    assert stats.get("hidden_layers_reused") == 1 and stats.get("hidden_region_layers") == 4
+    assert np.array_equal(first, again)
+    hidden_front, stats = redraw([*cubes, occluder])
+    assert stats.get("hidden_layers_reused") == 1
+    assert np.array_equal(hidden_front, fresh([*cubes, occluder])[0])
+    # Under the occluder the near cube's own cage lines are hidden lines now.
+    assert ((first > 0.9) & (hidden_front > 0.2) & (hidden_front < 0.45)).sum() > 50
+    scene.solidwire.hidden_alpha = 0.6
+    brighter, stats = redraw(cubes)
+    assert not stats.get("hidden_layers_reused") and np.array_equal(brighter, fresh(cubes)[0])
+    cube = cubes[0]
+    cube.data.vertices[0].co.z += 0.3
+    cube.data.update()
+    moved, stats = redraw(cubes)
+    assert not stats.get("hidden_layers_reused") and not np.array_equal(brighter, moved)
+    assert np.array_equal(moved, fresh(cubes)[0])
 
 
 def test_the_overlay_inside_a_clipping_region_keeps_whole_regions():

@@ -270,24 +270,29 @@ class GPUMesh:
         runs = self._region_line_runs_cpu
         return 0 if runs is None else len(runs)
 
-    def region_sizes(self) -> tuple[int, float]:
+    def region_sizes(self) -> tuple[int, float, int]:
         """(the most line entries a region has, the mean over the triangles
-        in regions of their own region's entries): what a walk of the
-        regions' edges costs per triangle, against the hidden layers' depth
-        peeling (passes._peeled_items). Computed on first use after the
-        region lines change (topology or classes), not at extraction."""
+        in regions of their own region's entries, the triangles in no
+        multi-face region): what a walk of the regions' edges costs per
+        triangle, against the hidden layers' depth peeling
+        (passes._peeled_items), and whether a peeled mesh leaves any
+        triangle to the direct hidden-line pass. Computed on first use
+        after the region lines change (topology or classes), not at
+        extraction."""
         lines, regions = self._region_lines_cpu, self._triangle_regions_cpu
         known = self._region_sizes
         if known is not None and known[0] is lines:
             return known[1]
         if lines is None or regions is None:
-            sizes = (0, 0.0)
+            sizes = (0, 0.0, self.triangle_count)
         else:
             owners = np.concatenate([lines[0::2, 3], lines[1::2, 2]]).astype(np.int64)
             counts = np.bincount(owners[owners >= 0])
-            of_triangle = regions[regions >= 0].astype(np.int64)
+            in_regions = regions >= 0
+            of_triangle = regions[in_regions].astype(np.int64)
             mean = float(counts[of_triangle].mean()) if len(of_triangle) else 0.0
-            sizes = (int(counts.max()) if len(counts) else 0, mean)
+            outside = self.triangle_count - len(of_triangle)
+            sizes = (int(counts.max()) if len(counts) else 0, mean, outside)
         self._region_sizes = (lines, sizes)
         return sizes
 

@@ -90,7 +90,9 @@ class DrawTarget:
     only those strictly behind it; LINES with HIDDEN_LINES draws such a
     layer's lines (the nearest line per pixel and its colour); a direct
     HIDDEN_LINES draw with ``region_layers_peeled`` leaves those triangles
-    out."""
+    out. ``behind_tiles`` (VISIBILITY with ``peel_depth``, numbered by
+    vertex): that depth image by tiles (DepthTiles), so that the blocks of
+    triangles that lie wholly in front of it are left out of the draw."""
 
     depth_test: str = "LESS_EQUAL"
     depth_write: bool = True
@@ -111,6 +113,7 @@ class DrawTarget:
     scissor_window: tuple | None = None
     region_layers: bool = False
     peel_depth: object = None
+    behind_tiles: object = None
     region_layers_peeled: bool = False
 
     def hidden(self, region_layers_peeled: bool = False) -> DrawTarget:
@@ -534,7 +537,12 @@ def draw(
             # instancing does not depend on the stage's variant.
             instancing=program.supports_instancing and not target.aovs,
             numbering=_DrawNumbers(
-                stage, extras, by_vertex=variant.triangle_ids_by_vertex, view=view, window=target.scissor_window
+                stage,
+                extras,
+                by_vertex=variant.triangle_ids_by_vertex,
+                view=view,
+                window=target.scissor_window,
+                behind=target.behind_tiles,
             ),
         )
         # (Diagonals from the settings, not the variant: every stage must part alike.)
@@ -759,11 +767,12 @@ class _DrawNumbers:
     rectangle over the draw's window box. A direct draw (stage None) just
     draws the batch."""
 
-    def __init__(self, stage, extras, by_vertex: bool = False, view: View | None = None, window=None):
+    def __init__(self, stage, extras, by_vertex: bool = False, view: View | None = None, window=None, behind=None):
         self.stage, self.extras, self.count = stage, extras, 0
         self.by_vertex = by_vertex  # the visibility batch's numbering (ShaderVariant.triangle_ids_by_vertex)
         self.view = view
         self.window = window  # DrawTarget.scissor_window
+        self.behind = behind  # DrawTarget.behind_tiles
         self.runs_left_out = 0  # region-lines runs that the window left out
         self.triangles_left_out = 0  # recorded triangles that the window left out
 
@@ -787,9 +796,11 @@ class _DrawNumbers:
             row = self.view.projection[3]
             shader.uniform_float("clip_w_of_depth", (float(-row[2]), float(row[3])))
 
-    def draw(self, shader, mesh, batch_of, object_to_clip, instance_count: int = 0) -> None:
+    def draw(self, shader, mesh, batch_of, object_to_clip, instance_count: int = 0, object_to_view_z=None) -> None:
         """One draw call of ``mesh``; ``batch_of()`` gives the direct draw's
-        batch (asked for only when drawing directly)."""
+        batch (asked for only when drawing directly). ``object_to_view_z``:
+        the row of the object-to-view matrix giving view z (for
+        ``behind``)."""
         if self.stage is None:
             batch = batch_of()
             if instance_count:
@@ -821,8 +832,11 @@ class _DrawNumbers:
         if self.stage == VISIBILITY:
             batch = mesh.visibility_batch(by_vertex=self.by_vertex)
             ranges = None
-            if self.window is not None and self.by_vertex and not instance_count:
-                ranges = triangle_ranges_reaching(mesh, object_to_clip, self.view.viewport, self.window)
+            behind = self.behind if object_to_view_z is not None else None
+            if (self.window is not None or behind is not None) and self.by_vertex and not instance_count:
+                ranges = triangle_ranges_reaching(
+                    mesh, object_to_clip, self.view.viewport, self.window, behind, object_to_view_z
+                )
             if instance_count:
                 batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
             elif ranges is None:
@@ -890,18 +904,26 @@ def runs_reaching(mesh, object_to_clip: np.ndarray, viewport, window) -> np.ndar
     return None if len(picked) == corners.shape[1] else picked
 
 
-def triangle_ranges_reaching(mesh, object_to_clip: np.ndarray, viewport, window):
+def triangle_ranges_reaching(mesh, object_to_clip: np.ndarray, viewport, window, behind=None, object_to_view_z=None):
     """(first triangle, triangle count) (int64 arrays) of each range of
     consecutive triangles of ``mesh`` that may cover a pixel of the window
-    rectangle of ``window`` (DrawTarget.scissor_window), in order, or None
-    where that is every triangle: the blocks of
-    cache.GPUMesh.triangle_block_corners whose box projects within
-    ``reach`` px of the rectangle, neighbours joined. A box wholly in front
-    of the camera projects inside the window box of its corners, so every
-    triangle it holds does."""
+    rectangle of ``window`` (DrawTarget.scissor_window; None: anywhere),
+    and with ``behind`` (DepthTiles; ``object_to_view_z`` the object's view
+    z row) lie behind its depth there, in order, or None where that is
+    every triangle: the blocks of cache.GPUMesh.triangle_block_corners
+    whose box projects within ``reach`` px of the rectangle (and reaches
+    behind the tiles it projects onto), neighbours joined. A box wholly in
+    front of the camera projects inside the window box of its corners, so
+    every triangle it holds does, and no point of it lies deeper than its
+    deepest corner."""
     points = mesh.triangle_block_corners()
     x, y, ahead = _window_points(points, object_to_clip, viewport)
-    kept = _boxes_reaching(x.reshape(8, -1), y.reshape(8, -1), ahead.reshape(8, -1), window)
+    x, y, ahead = x.reshape(8, -1), y.reshape(8, -1), ahead.reshape(8, -1)
+    kept = np.ones(x.shape[1], bool) if window is None else _boxes_reaching(x, y, ahead, window)
+    if behind is not None:
+        deepest = behind.record_depth(points, object_to_clip, object_to_view_z).reshape(8, -1).max(axis=0)
+        kept &= behind.reached(x.min(axis=0), x.max(axis=0), y.min(axis=0), y.max(axis=0), deepest)
+        kept |= ~ahead.all(axis=0)
     if kept.all():
         return None
     # Where kept blocks start and stop: the rises and falls of the padded mask.
@@ -936,6 +958,75 @@ def _boxes_reaching(x: np.ndarray, y: np.ndarray, ahead: np.ndarray, window) -> 
         & (y.min(axis=0) < rect_y + rect_height + reach)
         & (y.max(axis=0) > rect_y - reach)
     ) | ~ahead.all(axis=0)
+
+
+class DepthTiles:
+    """A depth image (a hidden layer's, passes._peel_hidden_regions) by
+    tiles of TILE px: each tile's least depth where the image holds one,
+    and coarser levels of 2 x 2 tiles each up to one tile, so that what a
+    box of triangles could find behind it is looked up in at most four
+    tiles. A pixel where the image holds nothing counts as infinitely deep:
+    a peeled layer can only lie where the layer before it does.
+
+    ``linear``: the depth is view depth / clip end (the render's record,
+    ``inv_clip_end``), else window depth (the overlay's)."""
+
+    TILE = 8
+
+    def __init__(self, depth: np.ndarray, origin, *, linear: bool, inv_clip_end: float):
+        tile = self.TILE
+        height, width = depth.shape
+        padded = np.full((-(-height // tile) * tile, -(-width // tile) * tile), np.inf, np.float32)
+        padded[:height, :width] = np.where(depth < 1.0, depth, np.inf)
+        level = padded.reshape(padded.shape[0] // tile, tile, -1, tile).min(axis=(1, 3))
+        self.levels = [level]
+        while max(level.shape) > 1:
+            rows, columns = -(-level.shape[0] // 2), -(-level.shape[1] // 2)
+            even = np.full((2 * rows, 2 * columns), np.inf, np.float32)
+            even[: level.shape[0], : level.shape[1]] = level
+            level = even.reshape(rows, 2, columns, 2).min(axis=(1, 3))
+            self.levels.append(level)
+        self.origin = origin
+        self.linear, self.inv_clip_end = linear, inv_clip_end
+
+    def record_depth(self, points: np.ndarray, object_to_clip: np.ndarray, object_to_view_z) -> np.ndarray:
+        """The depth the record writes at mesh-space ``points`` ((N, 4), w 0
+        as _window_points'), in float64 (where a point is at or behind the
+        camera plane the value means nothing: the caller keeps its box)."""
+        if self.linear:
+            row = np.asarray(object_to_view_z, np.float64)
+            return -(points[:, :3] @ row[:3] + row[3]) * self.inv_clip_end
+        to_clip = np.asarray(object_to_clip, np.float64)
+        z = points[:, :3] @ to_clip[2, :3] + to_clip[2, 3]
+        w = points[:, :3] @ to_clip[3, :3] + to_clip[3, 3]
+        return 0.5 * z / np.where(w > 0.0, w, 1.0) + 0.5
+
+    def reached(self, x_low, x_high, y_low, y_high, deepest) -> np.ndarray:
+        """Whether a box whose window extent is ``x_low``..``y_high`` (one
+        pixel to spare is added) and whose deepest point is ``deepest`` may
+        reach behind the image: some tile it covers holds a depth in front
+        of that point (with a margin for the GPU's float32 rounding)."""
+        ox, oy = self.origin
+        finest = self.levels[0]
+        rows, columns = finest.shape
+        tx0 = np.clip(np.floor((x_low - 1.0 - ox) / self.TILE), 0, columns - 1).astype(np.int64)
+        tx1 = np.clip(np.floor((x_high + 1.0 - ox) / self.TILE), 0, columns - 1).astype(np.int64)
+        ty0 = np.clip(np.floor((y_low - 1.0 - oy) / self.TILE), 0, rows - 1).astype(np.int64)
+        ty1 = np.clip(np.floor((y_high + 1.0 - oy) / self.TILE), 0, rows - 1).astype(np.int64)
+        # The level at which the box spans at most two tiles each way: the
+        # first whose tiles are as wide as its span (bit length of span - 1).
+        span = np.maximum(tx1 - tx0, ty1 - ty0)
+        level_of = np.frexp(np.maximum(span - 1, 0).astype(np.float64))[1]
+        least = np.full(len(tx0), np.inf)
+        for number in np.unique(level_of).tolist():
+            at = np.flatnonzero(level_of == number)
+            level = self.levels[min(number, len(self.levels) - 1)]
+            shift = min(number, len(self.levels) - 1)
+            for tx in (tx0, tx1):
+                for ty in (ty0, ty1):
+                    least[at] = np.minimum(least[at], level[ty[at] >> shift, tx[at] >> shift])
+        margin = 1e-6 + 1e-5 * np.abs(deepest)
+        return deepest + margin > least
 
 
 # Each quad's two triangles over its four corners.
@@ -1086,7 +1177,13 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
             if variant.per_item:
                 shader.uniform_int("item_slot", slot)
             _bind_mesh(shader, variant, mesh)
-            numbering.draw(shader, mesh, lambda mesh=mesh: program.batch(mesh), object_to_clip)
+            numbering.draw(
+                shader,
+                mesh,
+                lambda mesh=mesh: program.batch(mesh),
+                object_to_clip,
+                object_to_view_z=one.object_to_view[2],
+            )
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
     if instanced:

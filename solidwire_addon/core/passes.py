@@ -56,7 +56,7 @@ from .schema import (
     OBJECT_INDEX_PASS,
     WIRE_PASS,
 )
-from .settings import pack_params
+from .settings import clip_end_of, pack_params
 from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, targets_for
 from .view import DrawStats, View, window_boxes
 
@@ -242,31 +242,25 @@ class HiddenLinesPass(RenderPass):
         _blended(frame, lambda: _draw_hidden(frame.items, peeled, frame.view, self.settings, frame.base, frame.cull))
 
     def over_viewport(self, frame: Frame) -> None:
-        # The overlay's own targets; Blender's depth cannot be read, so the
-        # layers are peeled from the front and Blender's depth test keeps
-        # those behind its surface when they are composited.
         view = frame.view
-        targets = overlay_targets_for(view.width, view.height)
         saved_viewport = gpu.state.viewport_get()
         try:
-            peeled = _peel_hidden_regions(
-                frame, self.settings, targets, into=None, stats=frame.line_stats, restore_viewport=saved_viewport
-            )
+            peeled = _overlay_hidden_layers(frame, self.settings, saved_viewport)
         finally:
             gpu.state.viewport_set(*saved_viewport)
-        if peeled:
-            targets.surface_key = None  # its record was drawn over: the next redraw records it whole
         _draw_hidden(frame.items, peeled, view, self.settings, frame.base, frame.cull)
 
 
 def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bool) -> None:
     """The direct hidden-line pass into the bound framebuffer: every
     triangle of ``items`` walks its region, except those whose layers
-    _peel_hidden_regions drew (the region triangles of ``peeled``)."""
+    _peel_hidden_regions drew (the region triangles of ``peeled``; a peeled
+    mesh with no other triangle is not drawn at all)."""
     peeled_ids = {id(item) for item in peeled}
     walked = [item for item in items if id(item) not in peeled_ids]
+    rest = [item for item in peeled if item.mesh.region_sizes()[2]]
     draw_mod.draw(walked, view, settings, target=base.hidden(), cull=cull)
-    draw_mod.draw(peeled, view, settings, target=base.hidden(region_layers_peeled=True), cull=cull)
+    draw_mod.draw(rest, view, settings, target=base.hidden(region_layers_peeled=True), cull=cull)
 
 
 class WirePass(RenderPass):
@@ -722,6 +716,21 @@ def _overlay_lines_key(items, view: View, settings, clip_planes=None):
         return None
 
 
+def _overlay_image_key(kind: str, items, view: View, settings, display, clip_planes=None):
+    """What an image the overlay keeps depends on (the region lines' key,
+    _overlay_lines_key, with the display transform and each mesh's colour
+    source), or None when that cannot be told."""
+    key = _overlay_lines_key(items, view, settings, clip_planes)
+    if key is None:
+        return None
+    key = (kind, key, None if display is None else display.key, tuple(item.source for item in items))
+    try:
+        hash(key)
+    except TypeError:
+        return None
+    return key
+
+
 def _sync_overlay_surface(frame: Frame) -> None:
     """The overlay's sync step: where Blender's depth holds every surface
     and the frame is the surface pass alone (silhouettes may follow), the
@@ -816,13 +825,7 @@ def _overlay_surface(items, view: View, settings, display, frame: Frame) -> Over
       composite, while an image kept for a key that changes at every
       redraw (a drag, an orbit) is never used."""
     targets = overlay_targets_for(view.width, view.height)
-    key = _overlay_lines_key(items, view, settings)
-    if key is not None:
-        key = ("surface", key, None if display is None else display.key, tuple(item.source for item in items))
-        try:
-            hash(key)
-        except TypeError:
-            key = None
+    key = _overlay_image_key("surface", items, view, settings, display)
     line_count = sum(item.mesh.region_line_count for item in items)
     record_stats = DrawStats()
     if key is not None and targets.surface_key == key and targets.lines_key == key:
@@ -1039,8 +1042,58 @@ def _composite_overlay_surface(targets, depth_bias: float) -> None:
     draw_mod.draw_rectangle(shader, targets.surface_rect)
 
 
+def _overlay_hidden_layers(frame: Frame, settings, restore_viewport) -> list:
+    """The overlay's hidden region layers (_peel_hidden_regions), blended
+    into the bound framebuffer (Blender's). Blender's depth cannot be read,
+    so the layers are peeled from the front, in the overlay's own targets,
+    into two images: the front layer (the surface's own) and every layer
+    behind it, "over" each other at the farthest one's depth
+    (``keep``). These are composited in that order, each tested GREATER
+    against Blender's depth, which gives what compositing each layer in
+    turn gives: by now Blender's depth holds our own surfaces (the surface
+    pass drew them, nearer by the bias), so at every pixel it is at or in
+    front of the front layer, and every layer behind that one passes the
+    test wherever any of them does; the front layer passes only where
+    something Blender drew hides it.
+
+    So the two images depend only on the meshes, the view and the settings
+    (their key, as _overlay_surface's), not on Blender's depth: a redraw
+    with the same key composites them again without peeling. Returns the
+    peeled items (see _peel_hidden_regions)."""
+    view = frame.view
+    targets = overlay_targets_for(view.width, view.height)
+    items = _peeled_items(frame.items)
+    if not items or not (frame.options.deferred_surface and shaders.deferred_available()):
+        return []
+    key = _overlay_image_key("hidden layers", items, view, settings, frame.base.display, frame.base.clip_planes)
+    stats = frame.line_stats
+    if key is None or targets.kept_layers_key != key:
+        targets.kept_layers_key = None
+        peeled = _peel_hidden_regions(
+            frame, settings, targets, into=None, stats=stats, restore_viewport=restore_viewport, keep=True
+        )
+        if not peeled:
+            return []
+        targets.surface_key = None  # its record was drawn over: the next redraw records it whole
+        targets.kept_layers_key, targets.kept_layers_count = key, stats.extra.get("hidden_region_layers", 0)
+    else:
+        stats.extra.update(hidden_region_layers=targets.kept_layers_count, hidden_layers_reused=1)
+    if targets.kept_layers_box is not None:
+        composite = shaders.get_overlay_composite(2.0 * frame.base.depth_bias)
+        saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
+        try:
+            for behind in (False, True):
+                depth, colour = targets.kept_layer_images(behind)
+                _composite_hidden_layer(composite, depth, colour, targets.kept_layers_box, view, None)
+        finally:
+            gpu.state.blend_set(saved[0])
+            gpu.state.depth_test_set(saved[1])
+            gpu.state.depth_mask_set(saved[2])
+    return items
+
+
 def _peel_hidden_regions(
-    frame: Frame, settings, targets, *, into, behind=None, stats=None, restore_viewport=None
+    frame: Frame, settings, targets, *, into, behind=None, stats=None, restore_viewport=None, keep: bool = False
 ) -> list:
     """The hidden layers (image model §5.4) of the triangles whose lines come
     from the region-lines pass, without walking a region's edges (§2.6):
@@ -1054,6 +1107,12 @@ def _peel_hidden_regions(
     is read back (a fraction of a millisecond): the next layer can only lie
     where this one does, so it is drawn inside their box, and the peeling
     stops at the first empty layer.
+
+    ``keep`` (the overlay, _overlay_hidden_layers): the layers go into the
+    two kept images of ``targets`` instead, the first one into the front
+    image, the others "over" each other into the one behind it, each with
+    its own depth (the last, farthest one's stays), and
+    ``targets.kept_layers_box`` is the box they cover (None: no layer).
 
     Only the meshes that _peeled_items picks are peeled; returns them (the
     direct hidden-line pass leaves their region triangles out, and walks
@@ -1078,32 +1137,59 @@ def _peel_hidden_regions(
         # surface's own layer (peeled too, from the front) from passing
         # GREATER by a rounding of Blender's depth. The render's depth has
         # no bias and its first layer lies behind the surface already.
-        composite = shaders.get_overlay_composite(2.0 * base.depth_bias)
+        # (Kept layers keep their own depth: the bias is the final composite's.)
+        composite = shaders.get_overlay_composite(0.0 if keep else 2.0 * base.depth_bias)
         box, layers = (0, 0, view.width, view.height), 0
+        behind_tiles = None  # (the first layer lies behind ``behind``, or in front of everything)
+        if keep:
+            targets.kept_layers_box = None
+            for kept_behind in (False, True):
+                framebuffer = targets.kept_layers_framebuffer(kept_behind)
+                with framebuffer.bind():
+                    _clear(framebuffer, view.width, view.height)
+        left_out = 0  # triangles the records left out (behind_tiles, and outside the box)
         for layer in range(1, PEEL_MOST_LAYERS + 1):
             previous = behind if layer == 1 else targets.peel_depths[(layer - 1) % 2]
-            _record_visibility(
+            recorded = _record_visibility(
                 targets,
                 items,
                 view,
                 settings,
-                replace(record, peel_depth=previous),
+                replace(record, peel_depth=previous, behind_tiles=behind_tiles),
                 options,
                 cull=cull,
                 scissor=box,
                 framebuffer=targets.peel_framebuffer(layer),
             )
-            box = _layer_box(targets.peel_depths[layer % 2], box)
-            if box is None:
+            left_out += recorded.extra.get("record_triangles_left_out", 0)
+            extent = _layer_extent(targets.peel_depths[layer % 2], box, view, base.linear_depth)
+            if extent is None:
                 break
+            box, behind_tiles = extent
             _draw_region_lines(targets, items, view, settings, lines, cull, stats, box)
             if restore_viewport is not None:
                 gpu.state.viewport_set(*restore_viewport)
-            _composite_hidden_layer(composite, targets, layer, box, view, into)
+            layer_images = (targets.peel_depths[layer % 2], targets.hidden_lines)
+            if keep:
+                if layer == 1:
+                    targets.kept_layers_box = box  # (every later layer lies inside it)
+                kept_behind = layer > 1
+                _composite_hidden_layer(
+                    composite,
+                    *layer_images,
+                    box,
+                    view,
+                    lambda kept_behind=kept_behind: targets.kept_layers_framebuffer(kept_behind),
+                    keep_depth=True,
+                    blend="ALPHA_PREMULT" if kept_behind else "NONE",
+                )
+            else:
+                _composite_hidden_layer(composite, *layer_images, box, view, into)
             layers = layer
         else:
             warn_once(("peel",), f"SolidWire: hidden lines stop after {layers} layers behind the surface")
         stats.extra["hidden_region_layers"] = layers
+        stats.extra["peel_triangles_left_out"] = left_out
     except shaders.DeferredUnavailable as exc:
         # (Only the first layer's draws compile anything: nothing was
         # composited yet.)
@@ -1139,30 +1225,46 @@ def _peeled_items(items) -> list:
     peeled = []
     for item in items:
         if item.mesh.region_line_count:
-            most, mean = item.mesh.region_sizes()
+            most, mean, _outside = item.mesh.region_sizes()
             if most > WALK_LIMIT or mean >= PEEL_MIN_REGION_LINES:
                 peeled.append(item)
     return peeled
 
 
-def _layer_box(depth_image, scissor):
-    """The box (x, y, width, height) around the pixels inside ``scissor``
+def _layer_extent(depth_image, scissor, view: View, linear: bool):
+    """(the box (x, y, width, height) around the pixels inside ``scissor``
     where a layer was recorded into ``depth_image`` (cleared to 1.0 there),
-    or None where none was."""
+    that depth by tiles (draw.DepthTiles) or None), or None where no pixel
+    was recorded. The next layer can only lie inside the box, and only
+    behind the tiles: a software rasteriser's record leaves out the blocks
+    of triangles that lie wholly in front of them (it would set up every
+    triangle of a block before the depth test drops its pixels; a GPU drops
+    them for less than picking them costs)."""
     x, y, w, h = scissor
-    recorded = read_texture(depth_image, 1)[y : y + h, x : x + w, 0] < 1.0
+    depth = read_texture(depth_image, 1)[y : y + h, x : x + w, 0]
+    recorded = depth < 1.0
     columns, rows = recorded.any(axis=0), recorded.any(axis=1)
     if not columns.any():
         return None
     xs, ys = np.flatnonzero(columns), np.flatnonzero(rows)
-    return x + int(xs[0]), y + int(ys[0]), int(xs[-1] - xs[0] + 1), int(ys[-1] - ys[0] + 1)
+    box = x + int(xs[0]), y + int(ys[0]), int(xs[-1] - xs[0] + 1), int(ys[-1] - ys[0] + 1)
+    tiles = None
+    if shaders.software_rasteriser():
+        x0, y0, bw, bh = box
+        inside = depth[y0 - y : y0 - y + bh, x0 - x : x0 - x + bw]
+        tiles = draw_mod.DepthTiles(inside, (x0, y0), linear=linear, inv_clip_end=1.0 / clip_end_of(view.projection))
+    return box, tiles
 
 
-def _composite_hidden_layer(shader, targets, layer: int, scissor, view: View, into) -> None:
-    """Blend hidden region layer ``layer``'s lines "over" into ``into()``
-    (None: the bound framebuffer) inside ``scissor``, each pixel at the
-    layer's depth (less the overlay's bias), tested GREATER against the
-    surface's depth."""
+def _composite_hidden_layer(
+    shader, depth, colour, scissor, view: View, into, *, keep_depth: bool = False, blend: str = "ALPHA_PREMULT"
+) -> None:
+    """Blend a hidden layer's lines (``colour``, premultiplied, at the
+    depth image ``depth``) into ``into()`` (None: the bound framebuffer)
+    inside ``scissor``, each pixel at the layer's depth less the bias
+    ``shader`` moves it by (shaders.get_overlay_composite), tested GREATER
+    against the surface's depth; ``keep_depth``: not tested, and its
+    depth written (into a kept image: _peel_hidden_regions)."""
     x, y, w, h = scissor
     rect = (
         2.0 * x / view.width - 1.0,
@@ -1172,12 +1274,12 @@ def _composite_hidden_layer(shader, targets, layer: int, scissor, view: View, in
     )
 
     def draw():
-        gpu.state.blend_set("ALPHA_PREMULT")
-        gpu.state.depth_test_set("GREATER")
-        gpu.state.depth_mask_set(False)
+        gpu.state.blend_set(blend)
+        gpu.state.depth_test_set("ALWAYS" if keep_depth else "GREATER")
+        gpu.state.depth_mask_set(keep_depth)
         shader.bind()
-        shader.uniform_sampler("record_depth", targets.peel_depths[layer % 2])
-        shader.uniform_sampler("surface_image", targets.hidden_lines)
+        shader.uniform_sampler("record_depth", depth)
+        shader.uniform_sampler("surface_image", colour)
         draw_mod.draw_rectangle(shader, rect)
 
     if into is None:

@@ -54,6 +54,14 @@ class Targets:
         # depth).
         self.peel_depths = None
         self.hidden_lines = self.hidden_line_depth = None
+        # The viewport overlay's hidden region layers, kept between redraws
+        # (passes._overlay_hidden_layers): (colour, depth) of the front layer
+        # and of every layer behind it, made on first use; what they were
+        # drawn for, how many layers and the box they cover.
+        self.kept_layers = None
+        self.kept_layers_key = None
+        self.kept_layers_count = 0
+        self.kept_layers_box = None
         # The viewport overlay's resolved surface (premultiplied, as it
         # leaves the display transform) and what it was resolved for
         # (passes._overlay_surface), made on first use.
@@ -160,6 +168,26 @@ class Targets:
             self.hidden_lines = gpu.types.GPUTexture(self.size, format="RGBA32F")
             self.hidden_line_depth = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self.hidden_line_depth, color_slots=(self.hidden_lines,))
+
+    def kept_layers_framebuffer(self, behind: bool):
+        """The overlay's kept hidden layers: the front one (``behind``
+        False) or every one behind it, "over" each other. Colour RGBA16F
+        (premultiplied; no finer than the viewport's own buffer) and the
+        layer's depth, the farthest one's where several are kept; created
+        on first use."""
+        if self.kept_layers is None:
+            self.kept_layers = tuple(
+                gpu.types.GPUTexture(self.size, format=kind)
+                for _ in range(2)
+                for kind in ("RGBA16F", "DEPTH_COMPONENT32F")
+            )
+        colour, depth = self.kept_layers[2 * behind : 2 * behind + 2]
+        return gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=(colour,))
+
+    def kept_layer_images(self, behind: bool):
+        """(depth, colour) textures of kept_layers_framebuffer(``behind``)."""
+        colour, depth = self.kept_layers[2 * behind : 2 * behind + 2]
+        return depth, colour
 
     def clear_view_depth(self) -> None:
         """The view-depth target to BACKGROUND_DEPTH: where no surface is
