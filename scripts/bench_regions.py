@@ -10,11 +10,14 @@ look with those regions and with the regions found from the mesh, against
 every edge. ``--ngon-diagonals`` instead measures F12 of a tube with caps
 of 32 to 1,024 corners in each diagonal mode; ``--walks`` the cage look's
 F12 with hidden lines and with the Edge Distance pass (levels up to 4),
-where pixels still walk their regions' edges.
+where pixels still walk their regions' edges. ``--hidden-lines`` gives the
+main table with hidden lines on in both looks (the overlay keeps its hidden
+lines, fill and wire between redraws).
 
     .venv/bin/python -m scripts.bench_regions [--size 1280x720] [--repeats 3] [--levels 2 3 4 5] [--stacks [--stack NAME]]
     .venv/bin/python -m scripts.bench_regions --ngon-diagonals
     .venv/bin/python -m scripts.bench_regions --walks [--levels 2 3 4]
+    .venv/bin/python -m scripts.bench_regions --hidden-lines [--levels 2 3 4 5]
 
 Every ratio is taken within one process, rounds alternating between the two
 looks so that a change in machine load hits both alike; the table gives the
@@ -297,6 +300,7 @@ def main(argv=None) -> int:
     parser.add_argument("--stack", action="append", default=[], help="with --stacks: only stacks whose name holds this")
     parser.add_argument("--ngon-diagonals", action="store_true", help="F12 of large n-gons' diagonals only")
     parser.add_argument("--walks", action="store_true", help="F12 with hidden lines and the Edge Distance pass only")
+    parser.add_argument("--hidden-lines", action="store_true", help="the main table with hidden lines on")
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.split("x"))
     solidwire_addon.register()
@@ -315,7 +319,9 @@ def main(argv=None) -> int:
             stack_table(size, args.levels, args.repeats, args.stack)
             return 0
         viewport = Viewport(size)
-        print(f"{size[0]}x{size[1]}, best of {args.repeats} alternating rounds; ratio = cage / every edge\n")
+        base = dict(use_hidden_lines=True) if args.hidden_lines else {}
+        print(f"{size[0]}x{size[1]}, best of {args.repeats} alternating rounds; ratio = cage / every edge")
+        print("hidden lines on in both looks\n" if args.hidden_lines else "")
         print(
             "| level | triangles | F12 every edge (ms) | F12 cage | ratio | overlay redraw every edge | cage | ratio |"
             " edit redraw every edge | cage | ratio | first extraction every edge | cage | ratio |"
@@ -326,12 +332,15 @@ def main(argv=None) -> int:
             solidwire_addon.register()
             scene, monkey = build_scene(size, level)
             triangles = len(monkey.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
-            best = compare(scene, monkey, size, {"all": {}, "cage": dict(use_cage_edges=True)}, args.repeats, viewport)
+            looks = {"all": base, "cage": dict(base, use_cage_edges=True)}
+            best = compare(scene, monkey, size, looks, args.repeats, viewport)
             cells = []
             for key in ("f12", "redraw", "edit", "extract"):
                 a, c = best["all"][key], best["cage"][key]
                 cells += [f"{a:.0f}", f"{c:.0f}", f"{c / a:.2f}x"]
             print(f"| {level} | {triangles:,} | " + " | ".join(cells) + " |", flush=True)
+        if args.hidden_lines:
+            return 0
 
         bpy.ops.wm.read_factory_settings(use_empty=True)
         solidwire_addon.register()

@@ -631,6 +631,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "line_distance",
         "record_depth",
         "scissor_window",  # what a partial redraw leaves out (region-lines runs, record blocks)
+        "behind_tiles",  # what a peeled layer's record leaves out (record blocks)
         "region_layers",
         "peel_depth",
         "region_layers_peeled",
@@ -647,6 +648,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
             "depth_write": False,
             "visibility": object(),
             "scissor_window": (0, 0, 8, 8, 3.0),
+            "behind_tiles": object(),
         }[name]
         assert draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value})) == plain, name
     # The visibility stage's numbering is compiled code of that stage only.

@@ -215,7 +215,17 @@ class SurfacePass(RenderPass):
         # pre-pass did not.
         if not self.wire and not self.settings.use_fill:
             return
-        frame.stats = draw_mod.draw(frame.direct, view, self.settings, target=_with_lines(base, self.wire))
+        target = _with_lines(base, self.wire)
+        if self.wire:
+            frame.stats = draw_mod.draw(frame.direct, view, self.settings, target=target)
+        else:
+            # The fill under hidden lines: kept between redraws as the
+            # hidden lines and the wire over it are.
+            saved_viewport = gpu.state.viewport_get()
+            try:
+                frame.stats = _overlay_kept_pass(frame, "fill", frame.direct, self.settings, target, saved_viewport)
+            finally:
+                gpu.state.viewport_set(*saved_viewport)
         if frame.overlay_surface is not None:
             _draw_overlay_surface(frame, _with_lines(base, self.wire))
             frame.stats.add(frame.line_stats)
@@ -242,13 +252,12 @@ class HiddenLinesPass(RenderPass):
         _blended(frame, lambda: _draw_hidden(frame.items, peeled, frame.view, self.settings, frame.base, frame.cull))
 
     def over_viewport(self, frame: Frame) -> None:
-        view = frame.view
         saved_viewport = gpu.state.viewport_get()
         try:
             peeled = _overlay_hidden_layers(frame, self.settings, saved_viewport)
+            _overlay_walked_hidden(frame, self.settings, peeled, saved_viewport)
         finally:
             gpu.state.viewport_set(*saved_viewport)
-        _draw_hidden(frame.items, peeled, view, self.settings, frame.base, frame.cull)
 
 
 def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bool) -> None:
@@ -256,11 +265,146 @@ def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bo
     triangle of ``items`` walks its region, except those whose layers
     _peel_hidden_regions drew (the region triangles of ``peeled``; a peeled
     mesh with no other triangle is not drawn at all)."""
-    peeled_ids = {id(item) for item in peeled}
-    walked = [item for item in items if id(item) not in peeled_ids]
-    rest = [item for item in peeled if item.mesh.region_sizes()[2]]
+    walked, rest = _walked_items(items, peeled)
     draw_mod.draw(walked, view, settings, target=base.hidden(), cull=cull)
     draw_mod.draw(rest, view, settings, target=base.hidden(region_layers_peeled=True), cull=cull)
+
+
+def _walked_items(items, peeled):
+    """(the items the direct hidden-line pass draws whole, the peeled ones
+    it draws the other triangles of: those that have any)."""
+    peeled_ids = {id(item) for item in peeled}
+    walked = [item for item in items if id(item) not in peeled_ids]
+    return walked, [item for item in peeled if item.mesh.region_sizes()[2]]
+
+
+def _window_box_px(items, view: View):
+    """The pixels (x, y, width, height) the items' window boxes cover
+    (draw.window_union), or None where they cover none."""
+    x0, y0, x1, y1 = draw_mod.window_union(items, view)
+    left = max(int(np.floor((x0 + 1.0) * 0.5 * view.width)), 0)
+    bottom = max(int(np.floor((y0 + 1.0) * 0.5 * view.height)), 0)
+    right = min(int(np.ceil((x1 + 1.0) * 0.5 * view.width)), view.width)
+    top = min(int(np.ceil((y1 + 1.0) * 0.5 * view.height)), view.height)
+    if right <= left or top <= bottom:
+        return None
+    return left, bottom, right - left, top - bottom
+
+
+def _overlay_walked_hidden(frame: Frame, settings, peeled, restore_viewport) -> None:
+    """The direct hidden-line pass over the viewport (_draw_hidden), kept as
+    the peeled layers are (_overlay_hidden_layers) once a redraw repeats the
+    key of the one before (_keeping): drawn twice into the overlay's own
+    targets, first tested LESS with depth writes (the nearest fragment's
+    colour and depth alone: the front layer), then tested GREATER against
+    that depth ("over" each other: everything behind it). The front layer
+    composited tested GREATER against Blender's depth and the rest untested
+    give what the direct pass gives: Blender's depth holds our surfaces by
+    now, so what lies behind our nearest fragment lies behind it too, and
+    the nearest itself passes only where something Blender drew hides it."""
+    view, base = frame.view, frame.base
+    walked, rest = _walked_items(frame.items, peeled)
+    if not walked and not rest:
+        return
+    targets = overlay_targets_for(view.width, view.height)
+    key = _overlay_image_key("walked hidden", walked + rest, view, settings, base.display, base.clip_planes)
+    front, behind = targets.kept_image("walked front"), targets.kept_image("walked behind")
+    composite = _keeping(targets, "walked front", key)
+    if composite is None:
+        _draw_hidden(frame.items, peeled, view, settings, base, frame.cull)
+        return
+    if front.key == key:
+        frame.line_stats.extra["hidden_walked_reused"] = 1
+    else:
+        draws = (
+            (front, False, replace(base.hidden(), depth_test="LESS", depth_write=True), "NONE"),
+            (behind, True, base.hidden(), "ALPHA_PREMULT"),
+        )
+        for image, over_front, target, blend in draws:
+            framebuffer = image.framebuffer(front.depth if over_front else None)
+            with framebuffer.bind():
+                _clear(framebuffer, view.width, view.height, depth=not over_front)
+                gpu.state.blend_set(blend)
+                draw_mod.draw(walked, view, settings, target=target, cull=frame.cull)
+                draw_mod.draw(rest, view, settings, target=replace(target, region_layers_peeled=True), cull=frame.cull)
+        front.key, front.box = key, _window_box_px(walked + rest, view)
+    if front.box is None:
+        return
+    gpu.state.viewport_set(*restore_viewport)
+    with _state_kept():
+        # (Both at the front layer's depth: the rest lies wherever it does.)
+        _composite_kept(composite, front.depth, front.colour, front.box, view, None)
+        _composite_kept(composite, front.depth, behind.colour, front.box, view, None, test="NONE")
+
+
+def _keeping(targets, name: str, key):
+    """Whether the overlay composites its kept image ``name`` (drawn for
+    ``key``: kept now, or already) instead of drawing the pass directly:
+    the composite shader where the image has that key or the redraw before
+    drew that key (a redraw that changes nothing; the caller then draws it
+    into the image first), else None, the key remembered. A redraw with a
+    new key (an orbit, a drag) draws directly, which costs one pass, where
+    keeping costs a pass into the image and a composite."""
+    kept = targets.kept_image(name)
+    drawn, targets.drawn_keys[name] = targets.drawn_keys.get(name), key
+    if key is None or (kept.key != key and drawn != key):
+        return None
+    try:
+        return shaders.get_overlay_composite(0.0)
+    except shaders.DeferredUnavailable:
+        return None
+
+
+def _overlay_kept_pass(frame: Frame, name: str, items, settings, target: DrawTarget, restore_viewport) -> DrawStats:
+    """A direct pass over the viewport (``target``: tested LESS_EQUAL with
+    depth writes, blended as the caller set), kept once a redraw repeats
+    the key of the one before (_keeping): drawn into the kept image
+    ``name``, where only our own fragments meet each other's depth, then
+    composited at that depth, tested LESS_EQUAL against Blender's and
+    written. Our own depth is drawn into the image first, so only our
+    nearest fragment at each pixel draws its colour there, as Blender's
+    depth (which holds our surfaces) lets only that one through the direct
+    pass; the composite then keeps it where the direct pass would.
+    Returns the draw's DrawStats."""
+    view = frame.view
+    targets = overlay_targets_for(view.width, view.height)
+    key = _overlay_image_key(name, items, view, settings, frame.base.display, frame.base.clip_planes)
+    composite = _keeping(targets, name, key)
+    if composite is None:
+        return draw_mod.draw(items, view, settings, target=target, cull=frame.cull)
+    kept = targets.kept_image(name)
+    if kept.key == key:
+        stats = DrawStats(*kept.counts)
+        frame.line_stats.extra[f"{name}_reused"] = 1
+    else:
+        blend = gpu.state.blend_get()
+        framebuffer = kept.framebuffer()
+        with framebuffer.bind():
+            _clear(framebuffer, view.width, view.height)
+            # Our own depth first, as Blender's holds it for the direct pass:
+            # a fragment behind our nearest one blends nothing in.
+            gpu.state.color_mask_set(False, False, False, False)
+            draw_mod.draw(items, view, settings, target=target, cull=frame.cull)
+            gpu.state.color_mask_set(True, True, True, True)
+            gpu.state.blend_set(blend)
+            stats = draw_mod.draw(items, view, settings, target=target, cull=frame.cull)
+        gpu.state.blend_set(blend)
+        kept.key, kept.box = key, _window_box_px(items, view)
+        kept.counts = (stats.objects_drawn, stats.objects_culled, stats.triangles_drawn)
+    gpu.state.viewport_set(*restore_viewport)
+    if kept.box is not None:
+        _composite_kept(
+            composite,
+            kept.depth,
+            kept.colour,
+            kept.box,
+            view,
+            None,
+            test="LESS_EQUAL",
+            write_depth=True,
+            blend=gpu.state.blend_get(),
+        )
+    return stats
 
 
 class WirePass(RenderPass):
@@ -272,7 +416,12 @@ class WirePass(RenderPass):
         _blended(frame, lambda: _draw(frame, self.settings, replace(frame.base, depth_write=False, region_lines=lines)))
 
     def over_viewport(self, frame: Frame) -> None:
-        frame.stats = _draw(frame, self.settings, replace(frame.base, region_lines=frame.region_lines))
+        target = replace(frame.base, region_lines=frame.region_lines)
+        saved_viewport = gpu.state.viewport_get()
+        try:
+            frame.stats = _overlay_kept_pass(frame, "wire", frame.items, self.settings, target, saved_viewport)
+        finally:
+            gpu.state.viewport_set(*saved_viewport)
 
 
 def _wire_region_lines(frame: Frame, settings):
@@ -1067,29 +1216,36 @@ def _overlay_hidden_layers(frame: Frame, settings, restore_viewport) -> list:
         return []
     key = _overlay_image_key("hidden layers", items, view, settings, frame.base.display, frame.base.clip_planes)
     stats = frame.line_stats
-    if key is None or targets.kept_layers_key != key:
-        targets.kept_layers_key = None
+    front, behind = targets.kept_image("peeled front"), targets.kept_image("peeled behind")
+    if key is None or front.key != key:
+        front.key = None
         peeled = _peel_hidden_regions(
             frame, settings, targets, into=None, stats=stats, restore_viewport=restore_viewport, keep=True
         )
         if not peeled:
             return []
         targets.surface_key = None  # its record was drawn over: the next redraw records it whole
-        targets.kept_layers_key, targets.kept_layers_count = key, stats.extra.get("hidden_region_layers", 0)
+        front.key, front.counts = key, stats.extra.get("hidden_region_layers", 0)
     else:
-        stats.extra.update(hidden_region_layers=targets.kept_layers_count, hidden_layers_reused=1)
-    if targets.kept_layers_box is not None:
+        stats.extra.update(hidden_region_layers=front.counts, hidden_layers_reused=1)
+    if front.box is not None:
         composite = shaders.get_overlay_composite(2.0 * frame.base.depth_bias)
-        saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
-        try:
-            for behind in (False, True):
-                depth, colour = targets.kept_layer_images(behind)
-                _composite_hidden_layer(composite, depth, colour, targets.kept_layers_box, view, None)
-        finally:
-            gpu.state.blend_set(saved[0])
-            gpu.state.depth_test_set(saved[1])
-            gpu.state.depth_mask_set(saved[2])
+        with _state_kept():
+            for kept in (front, behind):
+                _composite_kept(composite, kept.depth, kept.colour, front.box, view, None)
     return items
+
+
+@contextmanager
+def _state_kept():
+    """Blending, depth test and depth writes as they were on entry, on exit."""
+    saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
+    try:
+        yield
+    finally:
+        gpu.state.blend_set(saved[0])
+        gpu.state.depth_test_set(saved[1])
+        gpu.state.depth_mask_set(saved[2])
 
 
 def _peel_hidden_regions(
@@ -1109,10 +1265,11 @@ def _peel_hidden_regions(
     stops at the first empty layer.
 
     ``keep`` (the overlay, _overlay_hidden_layers): the layers go into the
-    two kept images of ``targets`` instead, the first one into the front
-    image, the others "over" each other into the one behind it, each with
-    its own depth (the last, farthest one's stays), and
-    ``targets.kept_layers_box`` is the box they cover (None: no layer).
+    kept images "peeled front" and "peeled behind" of ``targets`` instead,
+    the first one into the front image, the others "over" each other into
+    the one behind it, each with its own depth (the last, farthest one's
+    stays), and the front image's box is the box they cover (None: no
+    layer).
 
     Only the meshes that _peeled_items picks are peeled; returns them (the
     direct hidden-line pass leaves their region triangles out, and walks
@@ -1141,12 +1298,12 @@ def _peel_hidden_regions(
         composite = shaders.get_overlay_composite(0.0 if keep else 2.0 * base.depth_bias)
         box, layers = (0, 0, view.width, view.height), 0
         behind_tiles = None  # (the first layer lies behind ``behind``, or in front of everything)
-        if keep:
-            targets.kept_layers_box = None
-            for kept_behind in (False, True):
-                framebuffer = targets.kept_layers_framebuffer(kept_behind)
-                with framebuffer.bind():
-                    _clear(framebuffer, view.width, view.height)
+        kept = (targets.kept_image("peeled front"), targets.kept_image("peeled behind")) if keep else ()
+        for image in kept:
+            image.box = None
+            framebuffer = image.framebuffer()
+            with framebuffer.bind():
+                _clear(framebuffer, view.width, view.height)
         left_out = 0  # triangles the records left out (behind_tiles, and outside the box)
         for layer in range(1, PEEL_MOST_LAYERS + 1):
             previous = behind if layer == 1 else targets.peel_depths[(layer - 1) % 2]
@@ -1172,19 +1329,19 @@ def _peel_hidden_regions(
             layer_images = (targets.peel_depths[layer % 2], targets.hidden_lines)
             if keep:
                 if layer == 1:
-                    targets.kept_layers_box = box  # (every later layer lies inside it)
-                kept_behind = layer > 1
-                _composite_hidden_layer(
+                    kept[0].box = box  # (every later layer lies inside it)
+                _composite_kept(
                     composite,
                     *layer_images,
                     box,
                     view,
-                    lambda kept_behind=kept_behind: targets.kept_layers_framebuffer(kept_behind),
-                    keep_depth=True,
-                    blend="ALPHA_PREMULT" if kept_behind else "NONE",
+                    kept[layer > 1].framebuffer,
+                    test="ALWAYS",
+                    write_depth=True,
+                    blend="ALPHA_PREMULT" if layer > 1 else "NONE",
                 )
             else:
-                _composite_hidden_layer(composite, *layer_images, box, view, into)
+                _composite_kept(composite, *layer_images, box, view, into)
             layers = layer
         else:
             warn_once(("peel",), f"SolidWire: hidden lines stop after {layers} layers behind the surface")
@@ -1256,15 +1413,25 @@ def _layer_extent(depth_image, scissor, view: View, linear: bool):
     return box, tiles
 
 
-def _composite_hidden_layer(
-    shader, depth, colour, scissor, view: View, into, *, keep_depth: bool = False, blend: str = "ALPHA_PREMULT"
+def _composite_kept(
+    shader,
+    depth,
+    colour,
+    scissor,
+    view: View,
+    into,
+    *,
+    test: str = "GREATER",
+    write_depth: bool = False,
+    blend: str = "ALPHA_PREMULT",
 ) -> None:
-    """Blend a hidden layer's lines (``colour``, premultiplied, at the
-    depth image ``depth``) into ``into()`` (None: the bound framebuffer)
-    inside ``scissor``, each pixel at the layer's depth less the bias
-    ``shader`` moves it by (shaders.get_overlay_composite), tested GREATER
-    against the surface's depth; ``keep_depth``: not tested, and its
-    depth written (into a kept image: _peel_hidden_regions)."""
+    """Blend an image (``colour``, premultiplied, at the depth image
+    ``depth``: a hidden layer's lines, a kept image) ``blend`` into
+    ``into()`` (None: the bound framebuffer) inside ``scissor``, each pixel
+    at its depth less the bias ``shader`` moves it by
+    (shaders.get_overlay_composite), tested ``test`` against the depth
+    there (GREATER: a hidden layer, behind the surface) and written with
+    ``write_depth``."""
     x, y, w, h = scissor
     rect = (
         2.0 * x / view.width - 1.0,
@@ -1275,8 +1442,8 @@ def _composite_hidden_layer(
 
     def draw():
         gpu.state.blend_set(blend)
-        gpu.state.depth_test_set("ALWAYS" if keep_depth else "GREATER")
-        gpu.state.depth_mask_set(keep_depth)
+        gpu.state.depth_test_set(test)
+        gpu.state.depth_mask_set(write_depth)
         shader.bind()
         shader.uniform_sampler("record_depth", depth)
         shader.uniform_sampler("surface_image", colour)

@@ -54,14 +54,11 @@ class Targets:
         # depth).
         self.peel_depths = None
         self.hidden_lines = self.hidden_line_depth = None
-        # The viewport overlay's hidden region layers, kept between redraws
-        # (passes._overlay_hidden_layers): (colour, depth) of the front layer
-        # and of every layer behind it, made on first use; what they were
-        # drawn for, how many layers and the box they cover.
-        self.kept_layers = None
-        self.kept_layers_key = None
-        self.kept_layers_count = 0
-        self.kept_layers_box = None
+        # Images the viewport overlay keeps between redraws under hidden
+        # lines (passes: _overlay_hidden_layers, _overlay_kept_pass), by
+        # name, and the key each direct pass was last drawn for.
+        self.kept: dict[str, KeptImage] = {}
+        self.drawn_keys: dict = {}
         # The viewport overlay's resolved surface (premultiplied, as it
         # leaves the display transform) and what it was resolved for
         # (passes._overlay_surface), made on first use.
@@ -169,25 +166,12 @@ class Targets:
             self.hidden_line_depth = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self.hidden_line_depth, color_slots=(self.hidden_lines,))
 
-    def kept_layers_framebuffer(self, behind: bool):
-        """The overlay's kept hidden layers: the front one (``behind``
-        False) or every one behind it, "over" each other. Colour RGBA16F
-        (premultiplied; no finer than the viewport's own buffer) and the
-        layer's depth, the farthest one's where several are kept; created
-        on first use."""
-        if self.kept_layers is None:
-            self.kept_layers = tuple(
-                gpu.types.GPUTexture(self.size, format=kind)
-                for _ in range(2)
-                for kind in ("RGBA16F", "DEPTH_COMPONENT32F")
-            )
-        colour, depth = self.kept_layers[2 * behind : 2 * behind + 2]
-        return gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=(colour,))
-
-    def kept_layer_images(self, behind: bool):
-        """(depth, colour) textures of kept_layers_framebuffer(``behind``)."""
-        colour, depth = self.kept_layers[2 * behind : 2 * behind + 2]
-        return depth, colour
+    def kept_image(self, name: str) -> KeptImage:
+        """The kept image ``name`` (made on first use)."""
+        kept = self.kept.get(name)
+        if kept is None:
+            kept = self.kept[name] = KeptImage(self.size)
+        return kept
 
     def clear_view_depth(self) -> None:
         """The view-depth target to BACKGROUND_DEPTH: where no surface is
@@ -221,6 +205,28 @@ class Targets:
             color_buffer, depth_buffer = self.kept_readback
         rgba = read_texture(self.color, 4, color_buffer)
         return rgba, read_texture(self.view_depth, 1, depth_buffer)[..., 0] if depth else None
+
+
+class KeptImage:
+    """An image the viewport overlay keeps between redraws: colour (RGBA16F,
+    premultiplied; no finer than the viewport's own buffer) over a depth
+    image, both made on first use, with what it was drawn for (``key``),
+    the pixels it covers (``box``: x, y, width, height; None: none) and
+    what drawing it counted (``counts``)."""
+
+    def __init__(self, size):
+        self.size = size
+        self.colour = self.depth = None
+        self.key = self.box = self.counts = None
+
+    def framebuffer(self, depth=None):
+        """Its colour over its own depth, or over the depth image ``depth``
+        (another kept image's; its own is then not made)."""
+        if self.colour is None:
+            self.colour = gpu.types.GPUTexture(self.size, format="RGBA16F")
+        if depth is None and self.depth is None:
+            self.depth = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth if depth is None else depth, color_slots=(self.colour,))
 
 
 _targets: Targets | None = None
