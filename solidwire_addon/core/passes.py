@@ -57,7 +57,7 @@ from .schema import (
     WIRE_PASS,
 )
 from .settings import clip_end_of, pack_params
-from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, targets_for
+from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, release_kept_images, targets_for
 from .view import DrawStats, View, window_boxes
 
 # Written by the surface pass's extra outputs (the rest has its own pass).
@@ -117,6 +117,9 @@ class Frame:
     # and the deferred ones' OverlaySurface.
     direct: list | None = None
     overlay_surface: OverlaySurface | None = None
+    # Under hidden lines: the surface pass composited the kept frame
+    # (_overlay_hidden_frame), so the hidden-line and wire passes draw nothing.
+    hidden_frame_kept: bool = False
 
     def overlay_stats(self) -> DrawStats:
         """The surface pass's DrawStats over the viewport, with what the
@@ -205,6 +208,8 @@ class SurfacePass(RenderPass):
         if not frame.scene_depth:
             gpu.state.depth_mask_set(True)
             gpu.state.active_framebuffer_get().clear(depth=1.0)
+        if not self.wire and _overlay_hidden_frame(frame, self.settings):
+            return  # (its composite writes our depth where the pre-pass would)
         if not (frame.scene_depth and frame.scene_surfaces and all(item.in_scene_depth for item in items)):
             gpu.state.blend_set("NONE")
             gpu.state.color_mask_set(False, False, False, False)
@@ -215,17 +220,7 @@ class SurfacePass(RenderPass):
         # pre-pass did not.
         if not self.wire and not self.settings.use_fill:
             return
-        target = _with_lines(base, self.wire)
-        if self.wire:
-            frame.stats = draw_mod.draw(frame.direct, view, self.settings, target=target)
-        else:
-            # The fill under hidden lines: kept between redraws as the
-            # hidden lines and the wire over it are.
-            saved_viewport = gpu.state.viewport_get()
-            try:
-                frame.stats = _overlay_kept_pass(frame, "fill", frame.direct, self.settings, target, saved_viewport)
-            finally:
-                gpu.state.viewport_set(*saved_viewport)
+        frame.stats = draw_mod.draw(frame.direct, view, self.settings, target=_with_lines(base, self.wire))
         if frame.overlay_surface is not None:
             _draw_overlay_surface(frame, _with_lines(base, self.wire))
             frame.stats.add(frame.line_stats)
@@ -247,35 +242,52 @@ class HiddenLinesPass(RenderPass):
             _blended(frame, lambda: _blend_hidden_target(targets))
             return
         peeled = _peel_hidden_regions(
-            frame, self.settings, targets, into=targets.color_framebuffer, behind=targets.depth, stats=frame.stats
+            frame,
+            self.settings,
+            targets,
+            into=((targets.color_framebuffer, "GREATER"),),
+            behind=targets.depth,
+            stats=frame.stats,
         )
         _blended(frame, lambda: _draw_hidden(frame.items, peeled, frame.view, self.settings, frame.base, frame.cull))
 
     def over_viewport(self, frame: Frame) -> None:
+        if frame.hidden_frame_kept:
+            return
+        # The overlay's own targets; Blender's depth cannot be read, so the
+        # layers are peeled from the front and Blender's depth test keeps
+        # those behind its surface when they are composited.
+        view = frame.view
+        targets = overlay_targets_for(view.width, view.height)
         saved_viewport = gpu.state.viewport_get()
         try:
-            peeled = _overlay_hidden_layers(frame, self.settings, saved_viewport)
-            _overlay_walked_hidden(frame, self.settings, peeled, saved_viewport)
+            peeled = _peel_hidden_regions(
+                frame,
+                self.settings,
+                targets,
+                into=((None, "GREATER"),),
+                stats=frame.line_stats,
+                restore_viewport=saved_viewport,
+            )
         finally:
             gpu.state.viewport_set(*saved_viewport)
+        if peeled:
+            targets.surface_key = None  # its record was drawn over: the next redraw records it whole
+        _draw_hidden(frame.items, peeled, view, self.settings, frame.base, frame.cull)
 
 
-def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bool) -> None:
+def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bool, test: str = "GREATER") -> None:
     """The direct hidden-line pass into the bound framebuffer: every
     triangle of ``items`` walks its region, except those whose layers
     _peel_hidden_regions drew (the region triangles of ``peeled``; a peeled
-    mesh with no other triangle is not drawn at all)."""
-    walked, rest = _walked_items(items, peeled)
-    draw_mod.draw(walked, view, settings, target=base.hidden(), cull=cull)
-    draw_mod.draw(rest, view, settings, target=base.hidden(region_layers_peeled=True), cull=cull)
-
-
-def _walked_items(items, peeled):
-    """(the items the direct hidden-line pass draws whole, the peeled ones
-    it draws the other triangles of: those that have any)."""
+    mesh with no other triangle is not drawn at all); ``test``: its depth
+    test (ALWAYS: every fragment, whatever lies in front)."""
     peeled_ids = {id(item) for item in peeled}
     walked = [item for item in items if id(item) not in peeled_ids]
-    return walked, [item for item in peeled if item.mesh.region_sizes()[2]]
+    rest = [item for item in peeled if item.mesh.region_sizes()[2]]
+    draw_mod.draw(walked, view, settings, target=replace(base.hidden(), depth_test=test), cull=cull)
+    peeled_target = replace(base.hidden(region_layers_peeled=True), depth_test=test)
+    draw_mod.draw(rest, view, settings, target=peeled_target, cull=cull)
 
 
 def _window_box_px(items, view: View):
@@ -291,59 +303,116 @@ def _window_box_px(items, view: View):
     return left, bottom, right - left, top - bottom
 
 
-def _overlay_walked_hidden(frame: Frame, settings, peeled, restore_viewport) -> None:
-    """The direct hidden-line pass over the viewport (_draw_hidden), kept as
-    the peeled layers are (_overlay_hidden_layers) once a redraw repeats the
-    key of the one before (_keeping): drawn twice into the overlay's own
-    targets, first tested LESS with depth writes (the nearest fragment's
-    colour and depth alone: the front layer), then tested GREATER against
-    that depth ("over" each other: everything behind it). The front layer
-    composited tested GREATER against Blender's depth and the rest untested
-    give what the direct pass gives: Blender's depth holds our surfaces by
-    now, so what lies behind our nearest fragment lies behind it too, and
-    the nearest itself passes only where something Blender drew hides it."""
-    view, base = frame.view, frame.base
-    walked, rest = _walked_items(frame.items, peeled)
-    if not walked and not rest:
-        return
+def _overlay_hidden_frame(frame: Frame, settings) -> bool:
+    """Under hidden lines, the overlay's fill, hidden lines and wire kept
+    as two images once a redraw repeats the key of the one before
+    (_keeping), and composited from then on; False where they are drawn
+    directly (a new key: an orbit, a drag, which pays nothing for the
+    keeping). ``settings``: the fill's (the surface pass's).
+
+    Blender's depth at a pixel is either our nearest surface (less the
+    bias: ours, or Blender's own drawing of it) or something Blender drew
+    in front of it, so the passes drawn directly leave one of two images
+    there: the first, as if Blender's depth held our own surfaces alone
+    (the fill, the hidden lines behind our nearest surface, the wire), or
+    the second, as if something hid every one of our surfaces (every
+    hidden line of every layer, nothing else). _draw_hidden_frame draws
+    both; the first is composited at our nearest surface's depth, tested
+    LESS_EQUAL against Blender's and written, the second at the same depth
+    tested GREATER, so each pixel takes the one its depth picks."""
+    view = frame.view
     targets = overlay_targets_for(view.width, view.height)
-    key = _overlay_image_key("walked hidden", walked + rest, view, settings, base.display, base.clip_planes)
-    front, behind = targets.kept_image("walked front"), targets.kept_image("walked behind")
-    composite = _keeping(targets, "walked front", key)
+    key = _overlay_image_key("hidden lines", frame.items, view, settings, frame.base.display, frame.base.clip_planes)
+    composite = _keeping(targets, "hidden lines", key)
     if composite is None:
-        _draw_hidden(frame.items, peeled, view, settings, base, frame.cull)
-        return
-    if front.key == key:
-        frame.line_stats.extra["hidden_walked_reused"] = 1
+        return False
+    visible, occluded = targets.kept_image("hidden lines"), targets.kept_image("hidden lines, occluded")
+    if visible.key == key:
+        frame.line_stats.extra["hidden_lines_reused"] = 1
     else:
-        draws = (
-            (front, False, replace(base.hidden(), depth_test="LESS", depth_write=True), "NONE"),
-            (behind, True, base.hidden(), "ALPHA_PREMULT"),
-        )
-        for image, over_front, target, blend in draws:
-            framebuffer = image.framebuffer(front.depth if over_front else None)
-            with framebuffer.bind():
-                _clear(framebuffer, view.width, view.height, depth=not over_front)
-                gpu.state.blend_set(blend)
-                draw_mod.draw(walked, view, settings, target=target, cull=frame.cull)
-                draw_mod.draw(rest, view, settings, target=replace(target, region_layers_peeled=True), cull=frame.cull)
-        front.key, front.box = key, _window_box_px(walked + rest, view)
-    if front.box is None:
-        return
-    gpu.state.viewport_set(*restore_viewport)
-    with _state_kept():
-        # (Both at the front layer's depth: the rest lies wherever it does.)
-        _composite_kept(composite, front.depth, front.colour, front.box, view, None)
-        _composite_kept(composite, front.depth, behind.colour, front.box, view, None, test="NONE")
+        visible.key = None
+        saved_viewport = gpu.state.viewport_get()
+        try:
+            with _state_kept():
+                visible.counts = _draw_hidden_frame(frame, settings, targets, visible, occluded)
+        finally:
+            gpu.state.viewport_set(*saved_viewport)
+        visible.key, visible.box = key, _window_box_px(frame.items, view)
+    drawn, culled, triangles, layers = visible.counts
+    frame.stats = DrawStats(drawn, culled, triangles)
+    if layers:
+        frame.line_stats.extra["hidden_region_layers"] = layers
+    if visible.box is not None:
+        with _state_kept():
+            _composite_kept(
+                composite, visible.depth, visible.colour, visible.box, view, None, test="LESS_EQUAL", write_depth=True
+            )
+            _composite_kept(composite, visible.depth, occluded.colour, visible.box, view, None)
+    frame.hidden_frame_kept = True
+    return True
+
+
+def _draw_hidden_frame(frame: Frame, settings, targets, visible, occluded) -> tuple:
+    """The two images of _overlay_hidden_frame, drawn as the passes under
+    hidden lines draw over the viewport, into ``visible`` over our own depth
+    (a depth-only pass of our surfaces first, as Blender's depth holds
+    them), and the hidden lines alone, untested, into ``occluded``. Returns
+    (objects drawn, culled, triangles drawn, hidden layers peeled)."""
+    view, base, cull = frame.view, frame.base, frame.cull
+    items = frame.items
+    width, height = view.width, view.height
+    lines_base = replace(base, region_lines=frame.region_lines)
+    wire_only = replace(settings, use_fill=False)  # (as plan() gives the hidden-line and wire passes)
+    front = visible.framebuffer()
+    with front.bind():
+        _clear(front, width, height)
+        gpu.state.color_mask_set(False, False, False, False)
+        draw_mod.draw(items, view, settings, target=lines_base, cull=cull)
+        gpu.state.color_mask_set(True, True, True, True)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        if settings.use_fill:
+            draw_mod.draw(items, view, settings, target=_with_lines(lines_base, False), cull=cull)
+    behind = occluded.framebuffer(visible.depth)  # (never written: only the visible image's depth is)
+    with behind.bind():
+        _clear(behind, width, height, depth=False)
+    into = ((visible.framebuffer, "GREATER"), (lambda: occluded.framebuffer(visible.depth), "ALWAYS"))
+    peeled = _peel_hidden_regions(frame, wire_only, targets, into=into, stats=frame.line_stats)
+    if peeled:
+        targets.surface_key = None  # its record was drawn over: the next redraw records it whole
+    for framebuffer_of, test in into:
+        framebuffer = framebuffer_of()
+        with framebuffer.bind():
+            _no_clear(width, height)
+            gpu.state.blend_set("ALPHA_PREMULT")
+            _draw_hidden(items, peeled, view, wire_only, base, cull, test=test)
+    with front.bind():
+        _no_clear(width, height)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        stats = draw_mod.draw(items, view, wire_only, target=lines_base, cull=cull)
+    layers = frame.line_stats.extra.get("hidden_region_layers", 0) if peeled else 0
+    return stats.objects_drawn, stats.objects_culled, stats.triangles_drawn, layers
+
+
+def _window_box_px(items, view: View):
+    """The pixels (x, y, width, height) the items' window boxes cover
+    (draw.window_union), or None where they cover none."""
+    x0, y0, x1, y1 = draw_mod.window_union(items, view)
+    left = max(int(np.floor((x0 + 1.0) * 0.5 * view.width)), 0)
+    bottom = max(int(np.floor((y0 + 1.0) * 0.5 * view.height)), 0)
+    right = min(int(np.ceil((x1 + 1.0) * 0.5 * view.width)), view.width)
+    top = min(int(np.ceil((y1 + 1.0) * 0.5 * view.height)), view.height)
+    if right <= left or top <= bottom:
+        return None
+    return left, bottom, right - left, top - bottom
 
 
 def _keeping(targets, name: str, key):
     """Whether the overlay composites its kept image ``name`` (drawn for
-    ``key``: kept now, or already) instead of drawing the pass directly:
-    the composite shader where the image has that key or the redraw before
-    drew that key (a redraw that changes nothing; the caller then draws it
-    into the image first), else None, the key remembered. A redraw with a
-    new key (an orbit, a drag) draws directly, which costs one pass, where
+    ``key``: kept now, or already) instead of drawing directly: the
+    composite shader where the image has that key or the redraw before
+    drew that key (a redraw that changes nothing; the caller then draws
+    the image first), else None, the key remembered. A redraw with a new
+    key (an orbit, a drag) draws directly, which costs one pass, where
     keeping costs a pass into the image and a composite."""
     kept = targets.kept_image(name)
     drawn, targets.drawn_keys[name] = targets.drawn_keys.get(name), key
@@ -355,56 +424,16 @@ def _keeping(targets, name: str, key):
         return None
 
 
-def _overlay_kept_pass(frame: Frame, name: str, items, settings, target: DrawTarget, restore_viewport) -> DrawStats:
-    """A direct pass over the viewport (``target``: tested LESS_EQUAL with
-    depth writes, blended as the caller set), kept once a redraw repeats
-    the key of the one before (_keeping): drawn into the kept image
-    ``name``, where only our own fragments meet each other's depth, then
-    composited at that depth, tested LESS_EQUAL against Blender's and
-    written. Our own depth is drawn into the image first, so only our
-    nearest fragment at each pixel draws its colour there, as Blender's
-    depth (which holds our surfaces) lets only that one through the direct
-    pass; the composite then keeps it where the direct pass would.
-    Returns the draw's DrawStats."""
-    view = frame.view
-    targets = overlay_targets_for(view.width, view.height)
-    key = _overlay_image_key(name, items, view, settings, frame.base.display, frame.base.clip_planes)
-    composite = _keeping(targets, name, key)
-    if composite is None:
-        return draw_mod.draw(items, view, settings, target=target, cull=frame.cull)
-    kept = targets.kept_image(name)
-    if kept.key == key:
-        stats = DrawStats(*kept.counts)
-        frame.line_stats.extra[f"{name}_reused"] = 1
-    else:
-        blend = gpu.state.blend_get()
-        framebuffer = kept.framebuffer()
-        with framebuffer.bind():
-            _clear(framebuffer, view.width, view.height)
-            # Our own depth first, as Blender's holds it for the direct pass:
-            # a fragment behind our nearest one blends nothing in.
-            gpu.state.color_mask_set(False, False, False, False)
-            draw_mod.draw(items, view, settings, target=target, cull=frame.cull)
-            gpu.state.color_mask_set(True, True, True, True)
-            gpu.state.blend_set(blend)
-            stats = draw_mod.draw(items, view, settings, target=target, cull=frame.cull)
-        gpu.state.blend_set(blend)
-        kept.key, kept.box = key, _window_box_px(items, view)
-        kept.counts = (stats.objects_drawn, stats.objects_culled, stats.triangles_drawn)
-    gpu.state.viewport_set(*restore_viewport)
-    if kept.box is not None:
-        _composite_kept(
-            composite,
-            kept.depth,
-            kept.colour,
-            kept.box,
-            view,
-            None,
-            test="LESS_EQUAL",
-            write_depth=True,
-            blend=gpu.state.blend_get(),
-        )
-    return stats
+@contextmanager
+def _state_kept():
+    """Blending, depth test and depth writes as they were on entry, on exit."""
+    saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
+    try:
+        yield
+    finally:
+        gpu.state.blend_set(saved[0])
+        gpu.state.depth_test_set(saved[1])
+        gpu.state.depth_mask_set(saved[2])
 
 
 class WirePass(RenderPass):
@@ -416,12 +445,8 @@ class WirePass(RenderPass):
         _blended(frame, lambda: _draw(frame, self.settings, replace(frame.base, depth_write=False, region_lines=lines)))
 
     def over_viewport(self, frame: Frame) -> None:
-        target = replace(frame.base, region_lines=frame.region_lines)
-        saved_viewport = gpu.state.viewport_get()
-        try:
-            frame.stats = _overlay_kept_pass(frame, "wire", frame.items, self.settings, target, saved_viewport)
-        finally:
-            gpu.state.viewport_set(*saved_viewport)
+        if not frame.hidden_frame_kept:
+            frame.stats = _draw(frame, self.settings, replace(frame.base, region_lines=frame.region_lines))
 
 
 def _wire_region_lines(frame: Frame, settings):
@@ -1191,65 +1216,8 @@ def _composite_overlay_surface(targets, depth_bias: float) -> None:
     draw_mod.draw_rectangle(shader, targets.surface_rect)
 
 
-def _overlay_hidden_layers(frame: Frame, settings, restore_viewport) -> list:
-    """The overlay's hidden region layers (_peel_hidden_regions), blended
-    into the bound framebuffer (Blender's). Blender's depth cannot be read,
-    so the layers are peeled from the front, in the overlay's own targets,
-    into two images: the front layer (the surface's own) and every layer
-    behind it, "over" each other at the farthest one's depth
-    (``keep``). These are composited in that order, each tested GREATER
-    against Blender's depth, which gives what compositing each layer in
-    turn gives: by now Blender's depth holds our own surfaces (the surface
-    pass drew them, nearer by the bias), so at every pixel it is at or in
-    front of the front layer, and every layer behind that one passes the
-    test wherever any of them does; the front layer passes only where
-    something Blender drew hides it.
-
-    So the two images depend only on the meshes, the view and the settings
-    (their key, as _overlay_surface's), not on Blender's depth: a redraw
-    with the same key composites them again without peeling. Returns the
-    peeled items (see _peel_hidden_regions)."""
-    view = frame.view
-    targets = overlay_targets_for(view.width, view.height)
-    items = _peeled_items(frame.items)
-    if not items or not (frame.options.deferred_surface and shaders.deferred_available()):
-        return []
-    key = _overlay_image_key("hidden layers", items, view, settings, frame.base.display, frame.base.clip_planes)
-    stats = frame.line_stats
-    front, behind = targets.kept_image("peeled front"), targets.kept_image("peeled behind")
-    if key is None or front.key != key:
-        front.key = None
-        peeled = _peel_hidden_regions(
-            frame, settings, targets, into=None, stats=stats, restore_viewport=restore_viewport, keep=True
-        )
-        if not peeled:
-            return []
-        targets.surface_key = None  # its record was drawn over: the next redraw records it whole
-        front.key, front.counts = key, stats.extra.get("hidden_region_layers", 0)
-    else:
-        stats.extra.update(hidden_region_layers=front.counts, hidden_layers_reused=1)
-    if front.box is not None:
-        composite = shaders.get_overlay_composite(2.0 * frame.base.depth_bias)
-        with _state_kept():
-            for kept in (front, behind):
-                _composite_kept(composite, kept.depth, kept.colour, front.box, view, None)
-    return items
-
-
-@contextmanager
-def _state_kept():
-    """Blending, depth test and depth writes as they were on entry, on exit."""
-    saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
-    try:
-        yield
-    finally:
-        gpu.state.blend_set(saved[0])
-        gpu.state.depth_test_set(saved[1])
-        gpu.state.depth_mask_set(saved[2])
-
-
 def _peel_hidden_regions(
-    frame: Frame, settings, targets, *, into, behind=None, stats=None, restore_viewport=None, keep: bool = False
+    frame: Frame, settings, targets, *, into, behind=None, stats=None, restore_viewport=None
 ) -> list:
     """The hidden layers (image model §5.4) of the triangles whose lines come
     from the region-lines pass, without walking a region's edges (§2.6):
@@ -1257,19 +1225,14 @@ def _peel_hidden_regions(
     triangles (the nearest strictly behind the layer before, or behind
     ``behind``, the surface depth, for the first), the region-lines pass
     over it keeping each pixel's nearest line and the layer's colour there,
-    and that colour blended "over" into ``into()`` (a framebuffer; None:
-    the one bound, the viewport's) at the layer's depth, tested GREATER
-    against its depth, as the direct hidden-line pass is. Each layer's depth
+    and that colour blended "over" at the layer's depth into each of
+    ``into``: (a function giving a framebuffer, None for the one bound (the
+    viewport's, whose viewport ``restore_viewport`` is), and its depth
+    test: GREATER against the depth there, as the direct hidden-line pass
+    is, or ALWAYS). Each layer's depth
     is read back (a fraction of a millisecond): the next layer can only lie
     where this one does, so it is drawn inside their box, and the peeling
     stops at the first empty layer.
-
-    ``keep`` (the overlay, _overlay_hidden_layers): the layers go into the
-    kept images "peeled front" and "peeled behind" of ``targets`` instead,
-    the first one into the front image, the others "over" each other into
-    the one behind it, each with its own depth (the last, farthest one's
-    stays), and the front image's box is the box they cover (None: no
-    layer).
 
     Only the meshes that _peeled_items picks are peeled; returns them (the
     direct hidden-line pass leaves their region triangles out, and walks
@@ -1294,16 +1257,9 @@ def _peel_hidden_regions(
         # surface's own layer (peeled too, from the front) from passing
         # GREATER by a rounding of Blender's depth. The render's depth has
         # no bias and its first layer lies behind the surface already.
-        # (Kept layers keep their own depth: the bias is the final composite's.)
-        composite = shaders.get_overlay_composite(0.0 if keep else 2.0 * base.depth_bias)
+        composite = shaders.get_overlay_composite(2.0 * base.depth_bias)
         box, layers = (0, 0, view.width, view.height), 0
         behind_tiles = None  # (the first layer lies behind ``behind``, or in front of everything)
-        kept = (targets.kept_image("peeled front"), targets.kept_image("peeled behind")) if keep else ()
-        for image in kept:
-            image.box = None
-            framebuffer = image.framebuffer()
-            with framebuffer.bind():
-                _clear(framebuffer, view.width, view.height)
         left_out = 0  # triangles the records left out (behind_tiles, and outside the box)
         for layer in range(1, PEEL_MOST_LAYERS + 1):
             previous = behind if layer == 1 else targets.peel_depths[(layer - 1) % 2]
@@ -1326,22 +1282,16 @@ def _peel_hidden_regions(
             _draw_region_lines(targets, items, view, settings, lines, cull, stats, box)
             if restore_viewport is not None:
                 gpu.state.viewport_set(*restore_viewport)
-            layer_images = (targets.peel_depths[layer % 2], targets.hidden_lines)
-            if keep:
-                if layer == 1:
-                    kept[0].box = box  # (every later layer lies inside it)
+            for framebuffer_of, test in into:
                 _composite_kept(
                     composite,
-                    *layer_images,
+                    targets.peel_depths[layer % 2],
+                    targets.hidden_lines,
                     box,
                     view,
-                    kept[layer > 1].framebuffer,
-                    test="ALWAYS",
-                    write_depth=True,
-                    blend="ALPHA_PREMULT" if layer > 1 else "NONE",
+                    framebuffer_of,
+                    test=test,
                 )
-            else:
-                _composite_kept(composite, *layer_images, box, view, into)
             layers = layer
         else:
             warn_once(("peel",), f"SolidWire: hidden lines stop after {layers} layers behind the surface")
@@ -1469,7 +1419,12 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
         _clear(framebuffer, view.width, view.height, depth=False)  # the surface depth stays
     settings = replace(settings, use_fill=False)
     peeled = _peel_hidden_regions(
-        frame, settings, targets, into=targets.hidden_framebuffer, behind=targets.depth, stats=frame.stats
+        frame,
+        settings,
+        targets,
+        into=((targets.hidden_framebuffer, "GREATER"),),
+        behind=targets.depth,
+        stats=frame.stats,
     )
     with framebuffer.bind():
         gpu.state.viewport_set(0, 0, view.width, view.height)
@@ -1558,6 +1513,8 @@ def draw_over_viewport(
         scene_depth=scene_depth,
         scene_surfaces=scene_surfaces,
     )
+    if not settings.use_hidden_lines:
+        release_kept_images(view.width, view.height)
     try:
         _sync_overlay_surface(frame)
         for unit in plan(settings, strands=bool(strands)):

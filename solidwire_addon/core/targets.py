@@ -55,8 +55,8 @@ class Targets:
         self.peel_depths = None
         self.hidden_lines = self.hidden_line_depth = None
         # Images the viewport overlay keeps between redraws under hidden
-        # lines (passes: _overlay_hidden_layers, _overlay_kept_pass), by
-        # name, and the key each direct pass was last drawn for.
+        # lines (passes._overlay_hidden_frame), by name, and the key each
+        # was last drawn for directly (passes._keeping).
         self.kept: dict[str, KeptImage] = {}
         self.drawn_keys: dict = {}
         # The viewport overlay's resolved surface (premultiplied, as it
@@ -256,6 +256,15 @@ def overlay_targets_for(width: int, height: int) -> Targets:
         targets = Targets(width, height)
     _overlay_targets[(width, height)] = targets  # most recently used last
     return targets
+
+
+def release_kept_images(width: int, height: int) -> None:
+    """Free the images the overlay of this size keeps under hidden lines
+    (a frame without hidden lines has no use for them)."""
+    targets = _overlay_targets.get((width, height))
+    if targets is not None and targets.kept:
+        targets.kept.clear()
+        targets.drawn_keys.clear()
 
 
 def release() -> None:
