@@ -730,6 +730,21 @@ def test_the_overlay_peels_hidden_region_layers_as_the_render_does(output_dir):
     assert diff[off].max() <= 0.1
 
 
+def _overlay_redraw(scene, size, depth_of, alpha: bool = False):
+    """(the overlay drawn over a viewport whose depth holds the objects
+    ``depth_of``, RGBA or ``alpha`` alone; its stats)."""
+    from solidwire_addon.blender.views import camera_view
+    from tests.test_overlay import FakeViewport
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    view = camera_view(scene, depsgraph, size)
+    viewport = FakeViewport(*size)
+    viewport.depth_pass(depsgraph, view, depth_of)
+    stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
+    rgba = viewport.rgba()
+    return (rgba[..., 3] if alpha else rgba), stats
+
+
 def _assert_kept_redraw(image, expected):
     """A redraw from the overlay's kept images against one drawn directly:
     the same but for a rounding (kept colour is half float) in 1 pixel of
@@ -746,9 +761,7 @@ def test_the_overlay_keeps_its_peeled_hidden_layers_between_redraws(output_dir):
     Blender's depth changed (an object SolidWire does not draw now hides
     part of the near cube, whose own lines then show as hidden lines
     there); a moved vertex or another setting draws directly again."""
-    from solidwire_addon.blender.views import camera_view
     from solidwire_addon.core import targets
-    from tests.test_overlay import FakeViewport
 
     width, height = 200, 150
     scene = scenes.empty_scene(width, height, use_cage_edges=True, thickness=1.5, use_hidden_lines=True)
@@ -758,12 +771,7 @@ def test_the_overlay_keeps_its_peeled_hidden_layers_between_redraws(output_dir):
     occluder.solidwire_exclude = True
 
     def redraw(depth_of):
-        depsgraph = bpy.context.evaluated_depsgraph_get()
-        view = camera_view(scene, depsgraph, (width, height))
-        viewport = FakeViewport(width, height)
-        viewport.depth_pass(depsgraph, view, depth_of)
-        stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
-        return viewport.rgba()[..., 3], stats
+        return _overlay_redraw(scene, (width, height), depth_of, alpha=True)
 
     def fresh(depth_of):
         targets.release()  # nothing kept, no key drawn before: drawn directly
@@ -806,9 +814,7 @@ def test_the_overlay_keeps_its_direct_hidden_lines_between_redraws(cage, fill, o
     also when only Blender's depth changed (an object SolidWire does not
     draw hides part of Suzanne, whose front lines then show as hidden
     lines)."""
-    from solidwire_addon.blender.views import camera_view
     from solidwire_addon.core import targets
-    from tests.test_overlay import FakeViewport
 
     width, height = 200, 150
     scene = scenes.empty_scene(width, height, use_cage_edges=cage, use_fill=fill, thickness=1.5, use_hidden_lines=True)
@@ -819,12 +825,7 @@ def test_the_overlay_keeps_its_direct_hidden_lines_between_redraws(cage, fill, o
     occluder.solidwire_exclude = True
 
     def redraw(depth_of):
-        depsgraph = bpy.context.evaluated_depsgraph_get()
-        view = camera_view(scene, depsgraph, (width, height))
-        viewport = FakeViewport(width, height)
-        viewport.depth_pass(depsgraph, view, depth_of)
-        stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), display=None)
-        return viewport.rgba(), stats
+        return _overlay_redraw(scene, (width, height), depth_of)
 
     targets.release()
     direct, stats = redraw([near, far])

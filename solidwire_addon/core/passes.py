@@ -290,19 +290,6 @@ def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bo
     draw_mod.draw(rest, view, settings, target=peeled_target, cull=cull)
 
 
-def _window_box_px(items, view: View):
-    """The pixels (x, y, width, height) the items' window boxes cover
-    (draw.window_union), or None where they cover none."""
-    x0, y0, x1, y1 = draw_mod.window_union(items, view)
-    left = max(int(np.floor((x0 + 1.0) * 0.5 * view.width)), 0)
-    bottom = max(int(np.floor((y0 + 1.0) * 0.5 * view.height)), 0)
-    right = min(int(np.ceil((x1 + 1.0) * 0.5 * view.width)), view.width)
-    top = min(int(np.ceil((y1 + 1.0) * 0.5 * view.height)), view.height)
-    if right <= left or top <= bottom:
-        return None
-    return left, bottom, right - left, top - bottom
-
-
 def _overlay_hidden_frame(frame: Frame, settings) -> bool:
     """Under hidden lines, the overlay's fill, hidden lines and wire kept
     as two images once a redraw repeats the key of the one before
