@@ -208,7 +208,10 @@ class SurfacePass(RenderPass):
         if not frame.scene_depth:
             gpu.state.depth_mask_set(True)
             gpu.state.active_framebuffer_get().clear(depth=1.0)
-        if not self.wire and _overlay_hidden_frame(frame, self.settings):
+        if self.wire:
+            # (No hidden lines in this frame: what was kept for them goes.)
+            release_kept_images(view.width, view.height)
+        elif _overlay_hidden_frame(frame, self.settings):
             return  # (its composite writes our depth where the pre-pass would)
         if not (frame.scene_depth and frame.scene_surfaces and all(item.in_scene_depth for item in items)):
             gpu.state.blend_set("NONE")
@@ -1500,8 +1503,6 @@ def draw_over_viewport(
         scene_depth=scene_depth,
         scene_surfaces=scene_surfaces,
     )
-    if not settings.use_hidden_lines:
-        release_kept_images(view.width, view.height)
     try:
         _sync_overlay_surface(frame)
         for unit in plan(settings, strands=bool(strands)):
