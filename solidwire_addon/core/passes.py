@@ -1220,7 +1220,7 @@ def _peel_hidden_regions(
     viewport's, whose viewport ``restore_viewport`` is), and its depth
     test: GREATER against the depth there, as the direct hidden-line pass
     is, or ALWAYS). Each layer's depth
-    is read back (a fraction of a millisecond): the next layer can only lie
+    is read back (about 2 ms at 1280 x 720 on llvmpipe): the next layer can only lie
     where this one does, so it is drawn inside their box, and the peeling
     stops at the first empty layer.
 
@@ -1363,10 +1363,9 @@ def _composite_kept(
     *,
     test: str = "GREATER",
     write_depth: bool = False,
-    blend: str = "ALPHA_PREMULT",
 ) -> None:
     """Blend an image (``colour``, premultiplied, at the depth image
-    ``depth``: a hidden layer's lines, a kept image) ``blend`` into
+    ``depth``: a hidden layer's lines, a kept image) "over" into
     ``into()`` (None: the bound framebuffer) inside ``scissor``, each pixel
     at its depth less the bias ``shader`` moves it by
     (shaders.get_overlay_composite), tested ``test`` against the depth
@@ -1381,7 +1380,7 @@ def _composite_kept(
     )
 
     def draw():
-        gpu.state.blend_set(blend)
+        gpu.state.blend_set("ALPHA_PREMULT")
         gpu.state.depth_test_set(test)
         gpu.state.depth_mask_set(write_depth)
         shader.bind()
