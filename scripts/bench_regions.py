@@ -12,12 +12,14 @@ of 32 to 1,024 corners in each diagonal mode; ``--walks`` the cage look's
 F12 with hidden lines and with the Edge Distance pass (levels up to 4),
 where pixels still walk their regions' edges. ``--hidden-lines`` gives the
 main table with hidden lines on in both looks (the overlay keeps its hidden
-lines, fill and wire between redraws).
+lines, fill and wire between redraws), ``--shading xray|wireframe`` with
+the overlay's redraws in X-ray or Wireframe shading (X-ray alpha 0.5).
 
     .venv/bin/python -m scripts.bench_regions [--size 1280x720] [--repeats 3] [--levels 2 3 4 5] [--stacks [--stack NAME]]
     .venv/bin/python -m scripts.bench_regions --ngon-diagonals
     .venv/bin/python -m scripts.bench_regions --walks [--levels 2 3 4]
     .venv/bin/python -m scripts.bench_regions --hidden-lines [--levels 2 3 4 5]
+    .venv/bin/python -m scripts.bench_regions --shading xray|wireframe [--levels 2 3 4 5]
 
 Every ratio is taken within one process, rounds alternating between the two
 looks so that a change in machine load hits both alike; the table gives the
@@ -38,7 +40,7 @@ import solidwire_addon
 from solidwire_addon.blender import engine, overlay, runtime
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.blender.views import camera_view
-from solidwire_addon.core import edge_select, passes
+from solidwire_addon.core import edge_select, overlay_state, passes
 from tests.support import scenes
 
 PLAIN = dict(
@@ -100,13 +102,23 @@ def f12_ms(scene, size, extra_passes=()) -> float:
     return (time.perf_counter() - start) * 1000.0
 
 
+# Viewport states for --shading (core/overlay_state.py), X-ray at half alpha.
+SHADINGS = {
+    "solid": overlay_state.ViewportState(),
+    "xray": overlay_state.ViewportState(xray=True, xray_alpha=0.5),
+    "wireframe": overlay_state.ViewportState(shading=overlay_state.WIREFRAME, xray=True, xray_alpha=0.5),
+}
+
+
 class Viewport:
     """An offscreen standing in for a 3D viewport (colour + depth), drawn
-    into by the overlay as its POST_VIEW handler would."""
+    into by the overlay as its POST_VIEW handler would, in the viewport
+    state ``shading`` (a key of SHADINGS)."""
 
-    def __init__(self, size):
+    def __init__(self, size, shading: str = "solid"):
         self.size = size
         self.offscreen = gpu.types.GPUOffScreen(*size, format="RGBA8")
+        self.plan = overlay_state.plan_overlay(SHADINGS[shading])
 
     def redraw_ms(self, scene) -> float:
         depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -116,7 +128,7 @@ class Viewport:
             fb = gpu.state.active_framebuffer_get()
             fb.clear(color=(0.2, 0.2, 0.2, 1.0), depth=1.0)
             gpu.state.viewport_set(0, 0, *self.size)
-            overlay.draw_scene_overlay(depsgraph, view, scene.solidwire.snapshot())
+            overlay.draw_scene_overlay(depsgraph, view, scene.solidwire.snapshot(), plan=self.plan)
             fb.read_color(0, 0, 1, 1, 4, 0, "UBYTE")  # waits for the GPU
         return (time.perf_counter() - start) * 1000.0
 
@@ -301,6 +313,9 @@ def main(argv=None) -> int:
     parser.add_argument("--ngon-diagonals", action="store_true", help="F12 of large n-gons' diagonals only")
     parser.add_argument("--walks", action="store_true", help="F12 with hidden lines and the Edge Distance pass only")
     parser.add_argument("--hidden-lines", action="store_true", help="the main table with hidden lines on")
+    parser.add_argument(
+        "--shading", choices=tuple(SHADINGS), default="solid", help="the viewport state of the overlay's redraws"
+    )
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.split("x"))
     solidwire_addon.register()
@@ -318,9 +333,11 @@ def main(argv=None) -> int:
             print(f"{size[0]}x{size[1]}, first extraction, best of {args.repeats} alternating rounds\n")
             stack_table(size, args.levels, args.repeats, args.stack)
             return 0
-        viewport = Viewport(size)
+        viewport = Viewport(size, args.shading)
         base = dict(use_hidden_lines=True) if args.hidden_lines else {}
         print(f"{size[0]}x{size[1]}, best of {args.repeats} alternating rounds; ratio = cage / every edge")
+        if args.shading != "solid":
+            print(f"overlay redraws in {args.shading} shading (X-ray, alpha 0.5)")
         print("hidden lines on in both looks\n" if args.hidden_lines else "")
         print(
             "| level | triangles | F12 every edge (ms) | F12 cage | ratio | overlay redraw every edge | cage | ratio |"
@@ -339,7 +356,7 @@ def main(argv=None) -> int:
                 a, c = best["all"][key], best["cage"][key]
                 cells += [f"{a:.0f}", f"{c:.0f}", f"{c / a:.2f}x"]
             print(f"| {level} | {triangles:,} | " + " | ".join(cells) + " |", flush=True)
-        if args.hidden_lines:
+        if args.hidden_lines or args.shading != "solid":
             return 0
 
         bpy.ops.wm.read_factory_settings(use_empty=True)

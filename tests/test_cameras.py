@@ -8,11 +8,11 @@ import bpy
 import numpy as np
 import pytest
 
-from solidwire_addon.blender import overlay
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.blender.views import camera_view
 from solidwire_addon.core import log
 from tests.support import scenes
+from tests.test_overlay import FakeViewport
 
 W, H = 40, 30
 
@@ -75,24 +75,18 @@ def test_stereo_multiview_is_refused_with_one_line(output_dir):
 def test_overlay_draws_with_a_panoramic_scene_camera():
     """The overlay draws the viewport's view, whatever the scene camera is:
     the same view draws the same pixels with a panoramic camera."""
-    import gpu
-
     ensure_gpu()
     scene = _cube_scene()
     # A view like a viewport's: the perspective camera's matrices.
     view = camera_view(scene, bpy.context.evaluated_depsgraph_get(), (W, H))
 
     def draw() -> np.ndarray:
-        color = gpu.types.GPUTexture((W, H), format="RGBA8")
-        depth = gpu.types.GPUTexture((W, H), format="DEPTH32F_STENCIL8")
-        framebuffer = gpu.types.GPUFrameBuffer(depth_slot=depth, color_slots=(color,))
-        with framebuffer.bind():
-            framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
-            gpu.state.viewport_set(0, 0, W, H)
-            overlay.draw_scene_overlay(bpy.context.evaluated_depsgraph_get(), view, scene.solidwire.snapshot())
-        buf = color.read()
-        buf.dimensions = W * H * 4
-        return np.array(buf, dtype=np.float64).reshape(H, W, 4)
+        # Solid shading: Blender's depth holds the cube's surface.
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        viewport = FakeViewport(W, H)
+        viewport.depth_pass(depsgraph, view, [scene.objects["Cube"]])
+        viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot())
+        return viewport.rgba()
 
     perspective = draw()
     scene.camera.data.type = "PANO"

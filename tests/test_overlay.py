@@ -14,7 +14,6 @@ from __future__ import annotations
 import bpy
 import numpy as np
 import pytest
-from mathutils import Matrix
 
 from solidwire_addon.blender import engine, overlay, runtime
 from solidwire_addon.blender.gather import gather
@@ -24,6 +23,7 @@ from solidwire_addon.core import draw, log, overlay_state, passes
 from solidwire_addon.core.targets import BACKGROUND_DEPTH
 from solidwire_addon.core.view import View
 from tests.support import scenes
+from tests.support.viewport import draw_scene_depth
 
 WIDTH, HEIGHT = 200, 150
 
@@ -48,39 +48,8 @@ class FakeViewport:
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
 
     def depth_pass(self, depsgraph, view: View, objects) -> None:
-        """Blender-like depth of ``objects``: object-space float32 positions and
-        a float32 model-view-projection (no re-centring, no float64)."""
-        import gpu
-        from gpu_extras.batch import batch_for_shader
-
-        shader = gpu.shader.from_builtin("UNIFORM_COLOR")
-        view_matrix = Matrix(view.view_matrix.tolist())
-        projection = Matrix(view.projection.tolist())
-        with self.framebuffer.bind():
-            gpu.state.viewport_set(0, 0, *self.size)
-            gpu.state.depth_test_set("LESS_EQUAL")
-            gpu.state.depth_mask_set(True)
-            gpu.state.color_mask_set(False, False, False, False)
-            with gpu.matrix.push_pop(), gpu.matrix.push_pop_projection():
-                gpu.matrix.load_projection_matrix(projection)
-                for obj in objects:
-                    obj_eval = obj.evaluated_get(depsgraph)
-                    mesh = obj_eval.data
-                    mesh.calc_loop_triangles()
-                    coords = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-                    mesh.vertices.foreach_get("co", coords)
-                    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
-                    mesh.loop_triangles.foreach_get("vertices", tris)
-                    batch = batch_for_shader(
-                        shader, "TRIS", {"pos": coords.reshape(-1, 3)}, indices=tris.reshape(-1, 3)
-                    )
-                    gpu.matrix.load_matrix(view_matrix @ obj_eval.matrix_world)
-                    shader.bind()
-                    shader.uniform_float("color", (0.5, 0.5, 0.5, 1.0))
-                    batch.draw(shader)
-            gpu.state.color_mask_set(True, True, True, True)
-            gpu.state.depth_test_set("NONE")
-            gpu.state.depth_mask_set(False)
+        """Blender-like depth of ``objects`` (viewport.draw_scene_depth)."""
+        draw_scene_depth(self.framebuffer, self.size, depsgraph, view, objects)
 
     def draw_overlay(self, depsgraph, view, settings, **kwargs) -> dict:
         with self.framebuffer.bind():
@@ -442,6 +411,7 @@ def test_redraws_reuse_meshes_and_see_edits():
         depsgraph = bpy.context.evaluated_depsgraph_get()
         view = camera_view(scene, depsgraph, (WIDTH, HEIGHT))
         viewport = FakeViewport(WIDTH, HEIGHT)
+        viewport.depth_pass(depsgraph, view, objects)  # (Solid shading: Blender's depth holds the surfaces)
         stats = viewport.draw_overlay(depsgraph, view, scene.solidwire.snapshot(), object_filter=keep)
         return stats, viewport.rgba()[..., 3]
 

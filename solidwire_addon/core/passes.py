@@ -117,9 +117,9 @@ class Frame:
     # and the deferred ones' OverlaySurface.
     direct: list | None = None
     overlay_surface: OverlaySurface | None = None
-    # Under hidden lines: the surface pass composited the kept frame
-    # (_overlay_hidden_frame), so the hidden-line and wire passes draw nothing.
-    hidden_frame_kept: bool = False
+    # The surface pass composited the kept frame (_overlay_kept_frame), so
+    # the hidden-line and wire passes draw nothing.
+    frame_kept: bool = False
 
     def overlay_stats(self) -> DrawStats:
         """The surface pass's DrawStats over the viewport, with what the
@@ -208,10 +208,10 @@ class SurfacePass(RenderPass):
         if not frame.scene_depth:
             gpu.state.depth_mask_set(True)
             gpu.state.active_framebuffer_get().clear(depth=1.0)
-        if self.wire:
-            # (No hidden lines in this frame: what was kept for them goes.)
+        if frame.overlay_surface is not None:
+            # (The deferred surface keeps an image of its own.)
             release_kept_images(view.width, view.height)
-        elif _overlay_hidden_frame(frame, self.settings):
+        elif _overlay_kept_frame(frame, self.settings, hidden=not self.wire):
             return  # (its composite writes our depth where the pre-pass would)
         if not (frame.scene_depth and frame.scene_surfaces and all(item.in_scene_depth for item in items)):
             gpu.state.blend_set("NONE")
@@ -255,7 +255,7 @@ class HiddenLinesPass(RenderPass):
         _blended(frame, lambda: _draw_hidden(frame.items, peeled, frame.view, self.settings, frame.base, frame.cull))
 
     def over_viewport(self, frame: Frame) -> None:
-        if frame.hidden_frame_kept:
+        if frame.frame_kept:
             return
         # The overlay's own targets; Blender's depth cannot be read, so the
         # layers are peeled from the front and Blender's depth test keeps
@@ -293,38 +293,46 @@ def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bo
     draw_mod.draw(rest, view, settings, target=peeled_target, cull=cull)
 
 
-def _overlay_hidden_frame(frame: Frame, settings) -> bool:
-    """Under hidden lines, the overlay's fill, hidden lines and wire kept
-    as two images once a redraw repeats the key of the one before
-    (_keeping), and composited from then on; False where they are drawn
-    directly (a new key: an orbit, a drag, which pays nothing for the
-    keeping). ``settings``: the fill's (the surface pass's).
+def _overlay_kept_frame(frame: Frame, settings, hidden: bool) -> bool:
+    """A frame the overlay draws directly (nothing deferred: under hidden
+    lines, in X-ray or Wireframe shading, inside a clipping region, sparse
+    meshes), kept as one or two images once a redraw repeats the key of
+    the one before (_keeping), and composited from then on; False where it
+    is drawn directly (a new key: an orbit, a drag, which pays nothing for
+    the keeping). ``settings``: the surface pass's; ``hidden``: hidden
+    lines are on.
 
     Blender's depth at a pixel is either our nearest surface (less the
     bias: ours, or Blender's own drawing of it) or something Blender drew
     in front of it, so the passes drawn directly leave one of two images
     there: the first, as if Blender's depth held our own surfaces alone
-    (the fill, the hidden lines behind our nearest surface, the wire), or
-    the second, as if something hid every one of our surfaces (every
-    hidden line of every layer, nothing else). _draw_hidden_frame draws
-    both; the first is composited at our nearest surface's depth, tested
-    LESS_EQUAL against Blender's and written, the second at the same depth
-    tested GREATER, so each pixel takes the one its depth picks."""
+    (the surface; under hidden lines the fill, the hidden lines behind our
+    nearest surface and the wire), or the second, as if something hid every
+    one of our surfaces (every hidden line of every layer, nothing else;
+    without hidden lines, nothing). _draw_kept_frame draws them; the first
+    is composited at our nearest surface's depth, tested LESS_EQUAL against
+    Blender's and written, the second at the same depth tested GREATER, so
+    each pixel takes the one its depth picks."""
+    if not frame.items:
+        return False  # (strands alone: nothing of ours to keep)
     view = frame.view
     targets = overlay_targets_for(view.width, view.height)
-    key = _overlay_image_key("hidden lines", frame.items, view, settings, frame.base.display, frame.base.clip_planes)
-    composite = _keeping(targets, "hidden lines", key)
+    key = _overlay_image_key("frame", frame.items, view, settings, frame.base.display, frame.base.clip_planes)
+    composite = _keeping(targets, "frame", key)
     if composite is None:
         return False
-    visible, occluded = targets.kept_image("hidden lines"), targets.kept_image("hidden lines, occluded")
+    visible = targets.kept_image("frame")
+    occluded = targets.kept_image("frame, occluded") if hidden else None
+    if not hidden:
+        targets.kept.pop("frame, occluded", None)
     if visible.key == key:
-        frame.line_stats.extra["hidden_lines_reused"] = 1
+        frame.line_stats.extra["frame_reused"] = 1
     else:
         visible.key = None
         saved_viewport = gpu.state.viewport_get()
         try:
             with _state_kept():
-                visible.counts = _draw_hidden_frame(frame, settings, targets, visible, occluded)
+                visible.counts = _draw_kept_frame(frame, settings, targets, visible, occluded)
         finally:
             gpu.state.viewport_set(*saved_viewport)
         visible.key, visible.box = key, _window_box_px(frame.items, view)
@@ -337,22 +345,23 @@ def _overlay_hidden_frame(frame: Frame, settings) -> bool:
             _composite_kept(
                 composite, visible.depth, visible.colour, visible.box, view, None, test="LESS_EQUAL", write_depth=True
             )
-            _composite_kept(composite, visible.depth, occluded.colour, visible.box, view, None)
-    frame.hidden_frame_kept = True
+            if occluded is not None:
+                _composite_kept(composite, visible.depth, occluded.colour, visible.box, view, None)
+    frame.frame_kept = True
     return True
 
 
-def _draw_hidden_frame(frame: Frame, settings, targets, visible, occluded) -> tuple:
-    """The two images of _overlay_hidden_frame, drawn as the passes under
-    hidden lines draw over the viewport, into ``visible`` over our own depth
-    (a depth-only pass of our surfaces first, as Blender's depth holds
-    them), and the hidden lines alone, untested, into ``occluded``. Returns
-    (objects drawn, culled, triangles drawn, hidden layers peeled)."""
+def _draw_kept_frame(frame: Frame, settings, targets, visible, occluded) -> tuple:
+    """The images of _overlay_kept_frame, drawn as the passes draw over the
+    viewport: into ``visible`` over our own depth (a depth-only pass of our
+    surfaces first, as Blender's depth holds them), and with hidden lines
+    (``occluded`` not None) the hidden lines alone, untested, into
+    ``occluded``. Returns (objects drawn, culled, triangles drawn, hidden
+    layers peeled)."""
     view, base, cull = frame.view, frame.base, frame.cull
     items = frame.items
     width, height = view.width, view.height
     lines_base = replace(base, region_lines=frame.region_lines)
-    wire_only = replace(settings, use_fill=False)  # (as plan() gives the hidden-line and wire passes)
     front = visible.framebuffer()
     with front.bind():
         _clear(front, width, height)
@@ -360,8 +369,12 @@ def _draw_hidden_frame(frame: Frame, settings, targets, visible, occluded) -> tu
         draw_mod.draw(items, view, settings, target=lines_base, cull=cull)
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set("ALPHA_PREMULT")
+        if occluded is None:
+            stats = draw_mod.draw(items, view, settings, target=lines_base, cull=cull)
+            return stats.objects_drawn, stats.objects_culled, stats.triangles_drawn, 0
         if settings.use_fill:
             draw_mod.draw(items, view, settings, target=_with_lines(lines_base, False), cull=cull)
+    wire_only = replace(settings, use_fill=False)  # (as plan() gives the hidden-line and wire passes)
     behind = occluded.framebuffer(visible.depth)  # (never written: only the visible image's depth is)
     with behind.bind():
         _clear(behind, width, height, depth=False)
@@ -435,7 +448,7 @@ class WirePass(RenderPass):
         _blended(frame, lambda: _draw(frame, self.settings, replace(frame.base, depth_write=False, region_lines=lines)))
 
     def over_viewport(self, frame: Frame) -> None:
-        if not frame.hidden_frame_kept:
+        if not frame.frame_kept:
             frame.stats = _draw(frame, self.settings, replace(frame.base, region_lines=frame.region_lines))
 
 

@@ -54,9 +54,9 @@ class Targets:
         # depth).
         self.peel_depths = None
         self.hidden_lines = self.hidden_line_depth = None
-        # Images the viewport overlay keeps between redraws under hidden
-        # lines (passes._overlay_hidden_frame), by name, and the key each
-        # was last drawn for directly (passes._keeping).
+        # Images the viewport overlay keeps of a frame it draws directly
+        # (passes._overlay_kept_frame), by name, and the key each was last
+        # drawn for directly (passes._keeping).
         self.kept: dict[str, KeptImage] = {}
         self.drawn_keys: dict = {}
         # The viewport overlay's resolved surface (premultiplied, as it
@@ -208,9 +208,9 @@ class Targets:
 
 
 class KeptImage:
-    """An image the viewport overlay keeps between redraws: colour (RGBA16F,
-    premultiplied; no finer than the viewport's own buffer) over a depth
-    image, both made on first use, with what it was drawn for (``key``),
+    """An image the viewport overlay keeps between redraws: colour (RGBA32F,
+    premultiplied: compositing it blends exactly what drawing straight into
+    the viewport's buffer blends) over a depth image, both made on first use, with what it was drawn for (``key``),
     the pixels it covers (``box``: x, y, width, height; None: none) and
     what drawing it counted (``counts``)."""
 
@@ -223,7 +223,7 @@ class KeptImage:
         """Its colour over its own depth, or over the depth image ``depth``
         (another kept image's; its own is then not made)."""
         if self.colour is None:
-            self.colour = gpu.types.GPUTexture(self.size, format="RGBA16F")
+            self.colour = gpu.types.GPUTexture(self.size, format="RGBA32F")
         if depth is None and self.depth is None:
             self.depth = gpu.types.GPUTexture(self.size, format="DEPTH_COMPONENT32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self.depth if depth is None else depth, color_slots=(self.colour,))
@@ -259,8 +259,8 @@ def overlay_targets_for(width: int, height: int) -> Targets:
 
 
 def release_kept_images(width: int, height: int) -> None:
-    """Free the images the overlay of this size keeps under hidden lines
-    (a frame without hidden lines has no use for them)."""
+    """Free the images the overlay of this size keeps of a frame drawn
+    directly (a frame that defers its surface has no use for them)."""
     targets = _overlay_targets.get((width, height))
     if targets is not None and targets.kept:
         targets.kept.clear()

@@ -129,12 +129,19 @@ class Viewport:
         self.framebuffer = gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.color,))
 
     def draw(self, scene, depsgraph=None) -> tuple[dict, np.ndarray]:
+        """The overlay over Blender's Solid shading depth of the scene's
+        visible objects (viewport.draw_scene_depth): (stats, alpha)."""
         import gpu
+
+        from tests.support.viewport import draw_scene_depth
 
         depsgraph = depsgraph or bpy.context.evaluated_depsgraph_get()
         view = camera_view(scene, depsgraph, self.size)
         with self.framebuffer.bind():
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
+        visible = [obj for obj in scene.objects if obj.visible_get()]
+        draw_scene_depth(self.framebuffer, self.size, depsgraph, view, visible)
+        with self.framebuffer.bind():
             gpu.state.viewport_set(0, 0, *self.size)
             stats = overlay.draw_scene_overlay(depsgraph, view, scene.solidwire.snapshot())
         buf = self.color.read()

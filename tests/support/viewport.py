@@ -23,6 +23,47 @@ from solidwire_addon.blender.views import camera_view
 from solidwire_addon.core.view import View
 
 
+def draw_scene_depth(framebuffer, size, depsgraph, view: View, objects) -> None:
+    """Into ``framebuffer``, the depth Blender's Solid shading leaves for
+    ``objects`` (evaluated meshes; others, and meshes without triangles, are
+    skipped): object-space float32 positions through a float32
+    model-view-projection, no re-centring, no float64. The overlay plans
+    Solid shading with Blender's depth holding every surface it draws, so a
+    test of that mode draws this first."""
+    from gpu_extras.batch import batch_for_shader
+
+    shader = gpu.shader.from_builtin("UNIFORM_COLOR")
+    view_matrix = Matrix(view.view_matrix.tolist())
+    projection = Matrix(view.projection.tolist())
+    with framebuffer.bind():
+        gpu.state.viewport_set(0, 0, *size)
+        gpu.state.depth_test_set("LESS_EQUAL")
+        gpu.state.depth_mask_set(True)
+        gpu.state.color_mask_set(False, False, False, False)
+        with gpu.matrix.push_pop(), gpu.matrix.push_pop_projection():
+            gpu.matrix.load_projection_matrix(projection)
+            for obj in objects:
+                obj_eval = obj.evaluated_get(depsgraph)
+                if obj_eval.type != "MESH":
+                    continue
+                mesh = obj_eval.data
+                mesh.calc_loop_triangles()
+                if not len(mesh.loop_triangles):
+                    continue
+                coords = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+                mesh.vertices.foreach_get("co", coords)
+                tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+                mesh.loop_triangles.foreach_get("vertices", tris)
+                batch = batch_for_shader(shader, "TRIS", {"pos": coords.reshape(-1, 3)}, indices=tris.reshape(-1, 3))
+                gpu.matrix.load_matrix(view_matrix @ obj_eval.matrix_world)
+                shader.bind()
+                shader.uniform_float("color", (0.5, 0.5, 0.5, 1.0))
+                batch.draw(shader)
+        gpu.state.color_mask_set(True, True, True, True)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+
+
 class ViewportUnavailable(RuntimeError):
     """This Blender cannot draw its viewport headless (no draw_view3d, no
     3D View in the startup screens, or the call fails)."""
