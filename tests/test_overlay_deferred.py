@@ -95,6 +95,54 @@ def test_deferred_overlay_draws_the_direct_image(silhouettes, monkeypatch):
     assert np.abs(deferred - direct).max() <= 1.0 / 255.0 + 1e-9
 
 
+# The viewport states whose depth holds none of our surfaces
+# (test_overlay_states.SHADING_STATES): X-ray, Wireframe shading.
+WITHOUT_SCENE_SURFACES = ("solid_xray_half", "solid_xray_zero", "wireframe_xray", "wireframe_opaque")
+
+
+@pytest.mark.parametrize("name", WITHOUT_SCENE_SURFACES)
+def test_deferred_overlay_without_blenders_surfaces(name, monkeypatch):
+    """In X-ray and Wireframe shading Blender's depth holds none of our
+    surfaces: every mesh deferred, the composite writes our nearest depth
+    itself (no depth-only pre-pass), and the image is the reference's and
+    the direct pass's, with Blender's depth present or cleared."""
+    from tests.test_overlay_states import SHADING_STATES
+
+    state, with_depth = SHADING_STATES[name]
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    depth = objects if with_depth else ()
+    calls = _stages(monkeypatch)
+    deferred, stats = _draw(scene, depth, state)
+    assert stats["objects_drawn"] == 2
+    assert calls.count(draw.VISIBILITY) == 1 and calls.count(draw.RESOLVE) == 1, calls
+    _assert_matches_reference(scene, deferred[..., 3], state)
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
+    calls.clear()
+    direct, _stats = _draw(scene, depth, state)
+    assert draw.RESOLVE not in calls
+    assert np.abs(deferred - direct).max() <= 1.0 / 255.0 + 1e-9
+
+
+@pytest.mark.parametrize("name", ["solid", "solid_xray_half"])
+def test_a_frame_of_deferred_and_direct_meshes(name, monkeypatch):
+    """One mesh deferred, one drawn directly: over Blender's depth of both
+    (Solid) the split stands; where that depth holds none of our surfaces
+    (X-ray) the direct mesh would need the deferred one's depth before its
+    colour and the other way round, so the whole frame is drawn directly.
+    Either way the image is the reference's."""
+    from tests.test_overlay_states import SHADING_STATES
+
+    state, _with_depth = SHADING_STATES[name]
+    scene, objects = build_scene(thickness=1.5, diagonal_mode="SOLID")
+    split = draw.split_deferred
+    monkeypatch.setattr(draw, "split_deferred", lambda items, *args: (split(items, *args)[0][:1], items[1:]))
+    calls = _stages(monkeypatch)
+    rgba, stats = _draw(scene, objects, state)
+    assert stats["objects_drawn"] == 2
+    assert (draw.RESOLVE in calls) == (name == "solid"), calls
+    _assert_matches_reference(scene, rgba[..., 3], state)
+
+
 def test_material_preview_and_blender_only_occluder():
     """Material Preview keeps Blender's depth too; a cube that only Blender
     draws (opted out of SolidWire) hides what lies behind it, though the

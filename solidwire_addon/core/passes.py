@@ -198,9 +198,10 @@ class SurfacePass(RenderPass):
         show through where the scene depth is empty). Where it does, the
         scene's depth already is that surface (our surfaces win the tie by
         the depth bias) and the pre-pass would only cost a second pass over
-        every triangle. Without scene depth (X-ray: Blender's depth is no
-        surface there) the bound depth is cleared first, so only our own
-        surfaces occlude."""
+        every triangle; a deferred surface needs none either (its composite
+        writes the record's depth). Without scene depth (X-ray: Blender's
+        depth is no surface there) the bound depth is cleared first, so only
+        our own surfaces occlude."""
         items, view, settings = frame.items, frame.view, frame.settings
         # The pre-pass gets the clipping planes and the LUT too: with the LUT
         # its variant, and so its compiled program, is the surface pass's.
@@ -213,7 +214,9 @@ class SurfacePass(RenderPass):
             release_kept_images(view.width, view.height)
         elif _overlay_kept_frame(frame, self.settings, hidden=not self.wire):
             return  # (its composite writes our depth where the pre-pass would)
-        if not (frame.scene_depth and frame.scene_surfaces and all(item.in_scene_depth for item in items)):
+        if frame.overlay_surface is None and not (
+            frame.scene_depth and frame.scene_surfaces and all(item.in_scene_depth for item in items)
+        ):
             gpu.state.blend_set("NONE")
             gpu.state.color_mask_set(False, False, False, False)
             draw_mod.draw(items, view, settings, target=base)
@@ -909,18 +912,24 @@ def _overlay_image_key(kind: str, items, view: View, settings, display, clip_pla
 
 
 def _sync_overlay_surface(frame: Frame) -> None:
-    """The overlay's sync step: where Blender's depth holds every surface
-    and the frame is the surface pass alone (silhouettes may follow), the
-    meshes dense on screen (OVERLAY_DEFERRED_MIN_DENSITY, and every mesh
-    with multi-face regions) are recorded into the overlay's own targets
-    (_overlay_surface) for the surface pass to draw (_draw_overlay_surface);
-    the rest stays in ``frame.direct``. A deferred stage the backend
-    refuses falls back to drawing directly, said once."""
+    """The overlay's sync step: where the frame is the surface pass alone
+    (silhouettes may follow), the meshes dense on screen
+    (OVERLAY_DEFERRED_MIN_DENSITY, and every mesh with multi-face regions)
+    are recorded into the overlay's own targets (_overlay_surface) for the
+    surface pass to draw (_draw_overlay_surface); the rest stays in
+    ``frame.direct``. The record knows which of our own triangles is
+    nearest at each pixel, and its composite writes that depth, so Blender's
+    depth need not hold our surfaces (X-ray, Wireframe shading) where every
+    mesh is deferred. A deferred stage the backend refuses falls back to
+    drawing directly, said once."""
     frame.direct = list(frame.items)
-    if not (frame.scene_depth and frame.scene_surfaces and _overlay_defers(frame)):
+    if not _overlay_defers(frame):
         return
     deferred, direct = draw_mod.split_deferred(frame.items, frame.view, OVERLAY_DEFERRED_MIN_DENSITY)
-    if not deferred:
+    if not deferred or (direct and not frame.scene_surfaces):
+        # (Without Blender's depth of our surfaces a mesh drawn directly
+        # would need the deferred ones' depth before its colour, and they
+        # its depth before theirs: such a frame is drawn directly.)
         return
     saved_viewport = gpu.state.viewport_get()
     try:
@@ -941,9 +950,9 @@ def _refused(exc: Exception) -> None:
 def _overlay_defers(frame: Frame) -> bool:
     """Whether the overlay's surface may be deferred: the frame's passes are
     the surface pass alone (silhouettes may follow), no clipping region, and
-    the deferred stages are in use. (The caller also asks that Blender's
-    depth hold every surface: the record then only has to know which of our
-    own triangles is nearest, and Blender's depth test does the rest.)"""
+    the deferred stages are in use, and every item is drawn as a surface
+    Blender's depth test can meet (item.in_scene_depth: not as wire, not in
+    front)."""
     units = plan(frame.settings)
     drawing = [unit for unit in units if not isinstance(unit, (RegionLinesPass, OutputsPass, SilhouettePass))]
     return (
