@@ -796,6 +796,14 @@ class _DrawNumbers:
             row = self.view.projection[3]
             shader.uniform_float("clip_w_of_depth", (float(-row[2]), float(row[3])))
 
+    def _draw_ranges(self, shader, batch, mesh, ranges) -> None:
+        """``batch`` (three elements a triangle, in table order) for the
+        triangle ranges ``ranges`` (triangle_ranges_reaching) alone."""
+        first, count = ranges
+        for start, size in zip((3 * first).tolist(), (3 * count).tolist()):
+            batch.draw_range(shader, elem_start=start, elem_count=size)  # (size > 0: 0 would draw to the end)
+        self.triangles_left_out += mesh.triangle_count - int(count.sum())
+
     def draw(self, shader, mesh, batch_of, object_to_clip, instance_count: int = 0, object_to_view_z=None) -> None:
         """One draw call of ``mesh``; ``batch_of()`` gives the direct draw's
         batch (asked for only when drawing directly). ``object_to_view_z``:
@@ -803,10 +811,16 @@ class _DrawNumbers:
         ``behind``)."""
         if self.stage is None:
             batch = batch_of()
+            ranges = None
+            if self.window is not None and not instance_count:
+                # (A triangle list in table order: triangle t is corners 3t..3t+2.)
+                ranges = triangle_ranges_reaching(mesh, object_to_clip, self.view.viewport, self.window)
             if instance_count:
                 batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
-            else:
+            elif ranges is None:
                 batch.draw(shader)
+            else:
+                self._draw_ranges(shader, batch, mesh, ranges)
             return
         self.count += 1
         if self.stage == LINES:
@@ -842,10 +856,7 @@ class _DrawNumbers:
             elif ranges is None:
                 batch.draw(shader)
             else:
-                first, count = ranges
-                for start, size in zip((3 * first).tolist(), (3 * count).tolist()):
-                    batch.draw_range(shader, elem_start=start, elem_count=size)  # (size > 0: 0 would draw to the end)
-                self.triangles_left_out += mesh.triangle_count - int(count.sum())
+                self._draw_ranges(shader, batch, mesh, ranges)
             return
         shader.uniform_float("resolve_rect", window_rect(object_to_clip, mesh.bounds_min, mesh.bounds_max))
         _rectangle().draw(shader)

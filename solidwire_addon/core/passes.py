@@ -321,24 +321,39 @@ def _overlay_kept_frame(frame: Frame, settings, hidden: bool) -> bool:
     view = frame.view
     targets = overlay_targets_for(view.width, view.height)
     key = _overlay_image_key("frame", frame.items, view, settings, frame.base.display, frame.base.clip_planes)
-    composite = _keeping(targets, "frame", key)
+    edited, rect = _kept_frame_rect(targets, key, frame, settings, hidden)
+    if edited:
+        # An edit: drawn into the kept images (inside ``rect`` where known),
+        # so that the next edit of a drag can redraw only what it changes.
+        targets.drawn_keys["frame"] = key
+        composite = _composite_shader()
+    else:
+        composite = _keeping(targets, "frame", key)
     if composite is None:
         return False
     visible = targets.kept_image("frame")
     occluded = targets.kept_image("frame, occluded") if hidden else None
     if not hidden:
         targets.kept.pop("frame, occluded", None)
-    if visible.key == key:
+    if visible.key == key or rect == ():
         frame.line_stats.extra["frame_reused"] = 1
     else:
         visible.key = None
         saved_viewport = gpu.state.viewport_get()
         try:
             with _state_kept():
-                visible.counts = _draw_kept_frame(frame, settings, targets, visible, occluded)
+                counts = _draw_kept_frame(frame, settings, targets, visible, occluded, rect)
         finally:
             gpu.state.viewport_set(*saved_viewport)
-        visible.key, visible.box = key, _window_box_px(frame.items, view)
+        if rect is None:
+            visible.counts = counts
+            _ready_for_partial_redraws(frame.items)
+        else:
+            frame.line_stats.extra["frame_partial"] = 1
+        if edited and rect is None:
+            frame.line_stats.extra["frame_edited"] = 1
+        visible.box = _window_box_px(frame.items, view)
+    visible.key = key
     drawn, culled, triangles, layers = visible.counts
     frame.stats = DrawStats(drawn, culled, triangles)
     if layers:
@@ -354,19 +369,49 @@ def _overlay_kept_frame(frame: Frame, settings, hidden: bool) -> bool:
     return True
 
 
-def _draw_kept_frame(frame: Frame, settings, targets, visible, occluded) -> tuple:
+def _kept_frame_rect(targets, key, frame: Frame, settings, hidden: bool):
+    """(edited, rect): whether the kept frame (_overlay_kept_frame) was
+    drawn for a key that differs from ``key`` only by meshes that moved
+    some vertices (an edit, a drag: _moved_items), and then the window
+    rectangle the moves changed (_redraw_rect; () where they changed
+    nothing; None where that is not known), all of the kept images that
+    needs drawing again."""
+    visible = targets.kept.get("frame")
+    if visible is None or visible.key is None or (hidden and "frame, occluded" not in targets.kept):
+        return False, None
+    moved = _moved_items(visible.key, key, frame.items)
+    if moved is None:
+        return False, None
+    return True, _redraw_rect(moved, frame.view, settings, frame.items)
+
+
+def _composite_shader():
+    """The kept images' composite shader, or None where the backend refuses it."""
+    try:
+        return shaders.get_overlay_composite(0.0)
+    except shaders.DeferredUnavailable:
+        return None
+
+
+def _draw_kept_frame(frame: Frame, settings, targets, visible, occluded, rect=None) -> tuple:
     """The images of _overlay_kept_frame, drawn as the passes draw over the
     viewport: into ``visible`` over our own depth (a depth-only pass of our
     surfaces first, as Blender's depth holds them), and with hidden lines
     (``occluded`` not None) the hidden lines alone, untested, into
-    ``occluded``. Returns (objects drawn, culled, triangles drawn, hidden
-    layers peeled)."""
+    ``occluded``; with ``rect`` (x, y, width, height) inside that window
+    rectangle alone, the rest of both images kept (each pixel depends only
+    on the triangles that cover it, and on a software rasteriser only the
+    triangle blocks that can reach the rectangle are drawn). Returns
+    (objects drawn, culled, triangles drawn, hidden layers peeled)."""
     view, base, cull = frame.view, frame.base, frame.cull
+    if rect is not None and shaders.software_rasteriser():
+        base = replace(base, scissor_window=(*rect, 1.0))  # (a triangle draws only where it covers)
     items = frame.items
     width, height = view.width, view.height
     lines_base = replace(base, region_lines=frame.region_lines)
+    # (A framebuffer brings its own scissor when bound: set after each bind.)
     front = visible.framebuffer()
-    with front.bind():
+    with front.bind(), _scissored(rect):
         _clear(front, width, height)
         gpu.state.color_mask_set(False, False, False, False)
         draw_mod.draw(items, view, settings, target=lines_base, cull=cull)
@@ -379,19 +424,19 @@ def _draw_kept_frame(frame: Frame, settings, targets, visible, occluded) -> tupl
             draw_mod.draw(items, view, settings, target=_with_lines(lines_base, False), cull=cull)
     wire_only = replace(settings, use_fill=False)  # (as plan() gives the hidden-line and wire passes)
     behind = occluded.framebuffer(visible.depth)  # (never written: only the visible image's depth is)
-    with behind.bind():
+    with behind.bind(), _scissored(rect):
         _clear(behind, width, height, depth=False)
     into = ((visible.framebuffer, "GREATER"), (lambda: occluded.framebuffer(visible.depth), "ALWAYS"))
-    peeled = _peel_hidden_regions(frame, wire_only, targets, into=into, stats=frame.line_stats)
+    peeled = _peel_hidden_regions(frame, wire_only, targets, into=into, stats=frame.line_stats, box=rect)
     if peeled:
         targets.surface_key = None  # its record was drawn over: the next redraw records it whole
     for framebuffer_of, test in into:
         framebuffer = framebuffer_of()
-        with framebuffer.bind():
+        with framebuffer.bind(), _scissored(rect):
             _no_clear(width, height)
             gpu.state.blend_set("ALPHA_PREMULT")
             _draw_hidden(items, peeled, view, wire_only, base, cull, test=test)
-    with front.bind():
+    with front.bind(), _scissored(rect):
         _no_clear(width, height)
         gpu.state.blend_set("ALPHA_PREMULT")
         stats = draw_mod.draw(items, view, wire_only, target=lines_base, cull=cull)
@@ -424,10 +469,7 @@ def _keeping(targets, name: str, key):
     drawn, targets.drawn_keys[name] = targets.drawn_keys.get(name), key
     if key is None or (kept.key != key and drawn != key):
         return None
-    try:
-        return shaders.get_overlay_composite(0.0)
-    except shaders.DeferredUnavailable:
-        return None
+    return _composite_shader()
 
 
 @contextmanager
@@ -784,19 +826,40 @@ def _record_visibility(
     return stats
 
 
+# The scissor _scissored set, innermost last (gpu.state has no getter for
+# the scissor test, so the nesting is kept here).
+_scissors: list = []
+
+
 @contextmanager
 def _scissored(scissor):
     """Clears and draws inside the bound framebuffer limited to ``scissor``
-    (x, y, width, height; None: the whole framebuffer)."""
+    (x, y, width, height; None: no further limit), inside the scissor of
+    an enclosing _scissored, which holds again on exit."""
     if scissor is None:
         yield
         return
+    if _scissors:
+        scissor = _intersection(_scissors[-1], scissor)
+    _scissors.append(scissor)
     gpu.state.scissor_test_set(True)
     gpu.state.scissor_set(*scissor)
     try:
         yield
     finally:
-        gpu.state.scissor_test_set(False)
+        _scissors.pop()
+        if _scissors:
+            gpu.state.scissor_set(*_scissors[-1])
+        else:
+            gpu.state.scissor_test_set(False)
+
+
+def _intersection(a, b) -> tuple:
+    """The rectangle (x, y, width, height) two rectangles share (width or
+    height 0 where they share none)."""
+    x0, y0 = max(a[0], b[0]), max(a[1], b[1])
+    x1, y1 = min(a[0] + a[2], b[0] + b[2]), min(a[1] + a[3], b[1] + b[3])
+    return x0, y0, max(x1 - x0, 0), max(y1 - y0, 0)
 
 
 def _triangle_ids_by_vertex(options: DrawOptions) -> bool:
@@ -871,9 +934,24 @@ def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptio
         stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
         stats.extra["region_lines_reused"] = 1
         return targets.lines
+    # Only vertices moved since the last image: record and draw the lines
+    # again inside the rectangle the moves changed (as _overlay_surface).
+    moved = _moved_in_lines(targets.lines_key, key, items) if targets.lines is not None else None
+    scissor = None if moved is None else _redraw_rect(moved, view, settings, items)
     targets.lines_key = None
-    _record_visibility(targets, items, view, settings, DrawTarget(linear_depth=True, clip_planes=clip_planes), options)
-    lines = _draw_region_lines(targets, items, view, settings, DrawTarget(linear_depth=True), True, stats)
+    record = DrawTarget(linear_depth=True, clip_planes=clip_planes)
+    if scissor is not None:
+        stats.extra["region_lines_partial"] = 1
+        lines = targets.lines
+        if scissor:
+            _record_visibility(targets, items, view, settings, record, options, scissor=scissor)
+            lines = _draw_region_lines(
+                targets, items, view, settings, DrawTarget(linear_depth=True), True, stats, scissor
+            )
+    else:
+        _record_visibility(targets, items, view, settings, record, options)
+        _ready_for_partial_redraws(items)
+        lines = _draw_region_lines(targets, items, view, settings, DrawTarget(linear_depth=True), True, stats)
     targets.lines_key = key
     return lines
 
@@ -1106,7 +1184,13 @@ def _moved_items(before_key, key, items):
     cache.GPUMesh.last_move cannot tell). Else None."""
     if before_key is None or key is None or before_key[0] != key[0] or before_key[2:] != key[2:]:
         return None
-    before_lines, now_lines = before_key[1], key[1]
+    return _moved_in_lines(before_key[1], key[1], items)
+
+
+def _moved_in_lines(before_lines, now_lines, items):
+    """_moved_items for two region-lines keys (_overlay_lines_key)."""
+    if before_lines is None or now_lines is None:
+        return None
     if (
         before_lines[:4] != now_lines[:4]
         or before_lines[5:] != now_lines[5:]
@@ -1229,7 +1313,7 @@ def _composite_overlay_surface(targets, depth_bias: float) -> None:
 
 
 def _peel_hidden_regions(
-    frame: Frame, settings, targets, *, into, behind=None, stats=None, restore_viewport=None
+    frame: Frame, settings, targets, *, into, behind=None, stats=None, restore_viewport=None, box=None
 ) -> list:
     """The hidden layers (image model §5.4) of the triangles whose lines come
     from the region-lines pass, without walking a region's edges (§2.6):
@@ -1244,7 +1328,8 @@ def _peel_hidden_regions(
     is, or ALWAYS). Each layer's depth
     is read back (about 2 ms at 1280 x 720 on llvmpipe): the next layer can only lie
     where this one does, so it is drawn inside their box, and the peeling
-    stops at the first empty layer.
+    stops at the first empty layer. ``box`` (x, y, width, height): the
+    pixels to peel, all of them where None.
 
     Only the meshes that _peeled_items picks are peeled; returns them (the
     direct hidden-line pass leaves their region triangles out, and walks
@@ -1270,7 +1355,7 @@ def _peel_hidden_regions(
         # GREATER by a rounding of Blender's depth. The render's depth has
         # no bias and its first layer lies behind the surface already.
         composite = shaders.get_overlay_composite(2.0 * base.depth_bias)
-        box, layers = (0, 0, view.width, view.height), 0
+        box, layers = box or (0, 0, view.width, view.height), 0
         behind_tiles = None  # (the first layer lies behind ``behind``, or in front of everything)
         left_out = 0  # triangles the records left out (behind_tiles, and outside the box)
         for layer in range(1, PEEL_MOST_LAYERS + 1):
