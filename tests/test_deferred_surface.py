@@ -255,8 +255,8 @@ def test_deferred_and_direct_meshes_share_one_surface(output_dir, monkeypatch):
     real_split = draw.split_deferred
     halves = []
 
-    def every_other_mesh(items, view):
-        deferred, rest = real_split(items, view)
+    def every_other_mesh(items, view, min_density=None):
+        deferred, rest = real_split(items, view, min_density)
         everything = deferred + rest
         meshes = sorted({id(item.mesh) for item in everything})
         chosen = set(meshes[::2])

@@ -275,15 +275,20 @@ SETUP_TABLE_MIN = 50_000
 # numbers in the visibility record: exact below 2^24.
 DEFERRED_MAX = 1 << 24
 # The deferred surface pays for a mesh with at least this many triangles
-# per pixel of its window boxes (measured on llvmpipe: a resolved pixel
-# costs about twice a directly shaded fragment, while every triangle of a
-# direct draw sets itself up at three corners and shades every fragment,
-# hidden ones too; break-even near one triangle per two covered pixels, a
-# box about half covered: the 1M-triangle Suzanne is deferred at 1280 x 720
-# and drawn directly at 3840 x 2160, the faster way at each size).
+# per pixel of its window boxes. Measured on llvmpipe (every edge of
+# Suzanne filling the frame, F12; docs/dev/benchmarks.md, "Deferred or
+# direct"): the break-even lies at 0.015-0.02 at 640 x 360, 1280 x 720,
+# 1920 x 1080 and 3840 x 2160 alike; from 0.03 on the deferred surface is
+# 1.1-2x faster (a direct draw sets every triangle up at three corners and
+# shades every fragment, hidden ones too; the resolve sets one triangle up
+# per visible pixel), below 0.008 the direct draw by about 1.1x.
 # A mesh whose triangles walk segment blocks (n-gons, regions, classes) has
 # a set-up several times dearer and counts DEFERRED_BLOCK_WEIGHT times.
-DEFERRED_MIN_DENSITY = 0.4
+DEFERRED_MIN_DENSITY = 0.02
+# A surface that shows no line (the fill under hidden lines) sets no edge
+# up in its direct draw, so that draw stays the cheaper one far longer
+# (Suzanne at 0.07 triangles per pixel: 109 against 116 ms deferred).
+DEFERRED_MIN_DENSITY_NO_LINES = 0.4
 DEFERRED_BLOCK_WEIGHT = 8.0
 
 
@@ -312,7 +317,8 @@ def window_union(items, view: View) -> tuple:
 def split_deferred(items, view: View, min_density: float | None = None) -> tuple[list, list]:
     """(items to draw deferred, items to draw directly): a mesh is deferred
     when its triangles are dense on screen (``min_density`` triangles per
-    pixel of its window boxes, by default DEFERRED_MIN_DENSITY), counted
+    pixel of its window boxes, by default DEFERRED_MIN_DENSITY; a surface
+    without lines passes DEFERRED_MIN_DENSITY_NO_LINES), counted
     over all its items at once; numbers the visibility record cannot hold
     exactly (DEFERRED_MAX) keep the direct draw."""
     if min_density is None:

@@ -71,13 +71,16 @@ _SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_IN
 OVERLAY_DEPTH_BIAS = 2.0**-18
 
 # The overlay defers a mesh from this many triangles per pixel of its
-# window box on (draw.split_deferred). Lower than the render's threshold:
-# the overlay's direct pass shades only what Blender's depth lets through,
-# but its image is kept between redraws, so a redraw that changes nothing
-# only composites. Measured on llvmpipe at 1280 x 720 (docs/dev/viewport-
-# benchmark.md): Suzanne at 0.1 triangles per pixel redraws an edit faster
-# directly (by ~8 ms of ~35), at 0.4 and above deferred (by ~15 ms of ~75).
-OVERLAY_DEFERRED_MIN_DENSITY = 0.2
+# window box on (draw.split_deferred). Higher than the render's threshold:
+# the overlay's direct pass shades only what Blender's depth lets through.
+# Both keep their image between redraws, so a redraw that changes nothing
+# only composites either way. Measured on llvmpipe at 1280 x 720 (every
+# edge of Suzanne filling the viewport; docs/dev/benchmarks.md, "Deferred
+# or direct"): an edit redraws about twice as fast deferred at every
+# density from 0.017 triangles per pixel up (15 against 30 ms there, 23
+# against 45 at 0.07), while a whole redraw (the view or the object moved)
+# costs 1.5x deferred at 0.017, the same at 0.07 and 0.7x at 0.27.
+OVERLAY_DEFERRED_MIN_DENSITY = 0.05
 
 
 @dataclass
@@ -702,7 +705,8 @@ def draw_surface(
     target = DrawTarget(linear_depth=True, aovs=aovs, lines=draw_mod.WIRE_LINES if wire else draw_mod.NO_LINES)
     deferred, direct = ([], list(items))
     if options.deferred_surface and shaders.deferred_available():
-        deferred, direct = draw_mod.split_deferred(items, view)
+        no_lines = None if wire else draw_mod.DEFERRED_MIN_DENSITY_NO_LINES
+        deferred, direct = draw_mod.split_deferred(items, view, no_lines)
     framebuffer = targets.framebuffer(aovs=aovs)
     with framebuffer.bind():
         _clear(framebuffer, width, height)
