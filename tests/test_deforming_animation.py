@@ -102,6 +102,8 @@ def test_deformation_uploads_positions_and_normals_only(build, setup_min, monkey
     if setup_min == 1 and not shaders.setup_available():
         pytest.skip("no compute shaders here")
     monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
+    # (Tested in renders here too, where a software rasteriser leaves it off.)
+    monkeypatch.setattr(shaders, "setup_dispatch_allowed", shaders.setup_available)
     monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=setup_min != 1))
     setup_calls = []
     real_setup = draw._run_setup

@@ -261,7 +261,7 @@ def test_a_matcap_is_never_decoded_inside_a_render(monkeypatch):
     monkeypatch.setattr(matcap_files, "_requested", set())
     decoded = []
     monkeypatch.setattr(matcap_files, "decode_pixels", lambda name: decoded.append(name) or None)
-    with shaders.gl_context("render-engine"):
+    with shaders.gl_context(shaders.RENDER_ENGINE_CONTEXT):
         assert matcap_files.load_pixels("clay_brown") is matcaps.PENDING
     assert decoded == []
     matcap_files.prepare("clay_brown")

@@ -16,6 +16,8 @@ from solidwire_addon.core import draw, shaders
 from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 
+_DISPATCH_ALLOWED = shaders.setup_dispatch_allowed  # as shipped (the tests below patch it)
+
 
 def _quads_tris_mirrored_shared(scene):
     scenes.near_plane_scene(scene)  # edges crossing the near plane
@@ -30,11 +32,17 @@ def _quads_tris_mirrored_shared(scene):
     scenes.cube(scene, "Box", location=(1.0, 3.0, 0.3), size=0.6)
 
 
-def _render(scene, path, setup_min, monkeypatch):
+def _render(scene, path, setup_min, monkeypatch, software_renders: bool = True):
+    """A render with the surface pass drawn directly, the pre-pass from
+    ``setup_min`` triangles on; ``software_renders``: whether a software
+    rasteriser's render may dispatch it too (shaders.setup_dispatch_allowed
+    says no; allowed here by default, to test the pre-pass on this machine)."""
     calls = []
     real = draw._run_setup
     monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
     monkeypatch.setattr(draw, "SETUP_TABLE_MIN", setup_min)
+    allowed = shaders.setup_available if software_renders else _DISPATCH_ALLOWED
+    monkeypatch.setattr(shaders, "setup_dispatch_allowed", allowed)
     # Per pre-pass run: whether it ran without its clipping code (in_front).
     monkeypatch.setattr(draw, "_run_setup", lambda *args: (calls.append(args[3:4] == (True,)), real(*args)))
     channels = scenes.render_multilayer_exr(scene, path)
@@ -59,6 +67,23 @@ def test_setup_table_gives_the_same_image(fill, output_dir, monkeypatch):
     assert per_corner.keys() == table.keys()
     for name, values in per_corner.items():
         np.testing.assert_array_equal(table[name], values, err_msg=name)
+
+
+def test_a_software_render_keeps_the_per_corner_set_up(output_dir, monkeypatch):
+    """On a software rasteriser the render engine's context dispatches no
+    pre-pass (its dispatch there has crashed llvmpipe), whatever the mesh
+    size, and draws the same image; the viewport's context still does
+    (test_a_redraw_that_changes_nothing_keeps_the_table)."""
+    if not shaders.setup_available():
+        pytest.skip("no compute shaders here")
+    scene = scenes.empty_scene(120, 90)
+    _quads_tris_mirrored_shared(scene)
+    with_table, runs = _render(scene, output_dir / "setup_software_on.exr", 1, monkeypatch)
+    assert len(runs) >= 4
+    default, runs = _render(scene, output_dir / "setup_software_default.exr", 1, monkeypatch, software_renders=False)
+    assert (runs == []) == shaders.software_rasteriser()
+    for name, values in with_table.items():
+        np.testing.assert_array_equal(default[name], values, err_msg=name)
 
 
 def test_a_failing_pre_pass_falls_back_to_the_per_corner_set_up(output_dir, monkeypatch):

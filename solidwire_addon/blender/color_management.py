@@ -202,7 +202,7 @@ def _can_build_now() -> bool:
     return (
         bpy.app.background
         and threading.current_thread() is threading.main_thread()
-        and shaders.current_gl_context() != "render-engine"
+        and not shaders.in_render_engine_context()
     )
 
 

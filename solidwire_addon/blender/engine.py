@@ -244,7 +244,7 @@ class SolidWireRenderEngine(bpy.types.RenderEngine):
         region = region_of(scene, width, height)
         layer_name = depsgraph.view_layer.name
         try:
-            with shaders.gl_context("render-engine"):
+            with shaders.gl_context(shaders.RENDER_ENGINE_CONTEXT):
                 self._render_frame(depsgraph, (width, height), region, layer_name)
         except NoCameraError as exc:
             self.report({"ERROR"}, f"SolidWire: {exc}")

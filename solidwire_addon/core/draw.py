@@ -1212,8 +1212,9 @@ _UNBOUND = object()
 
 def _setup_ready() -> bool:
     """Compute shaders run here and the pre-pass compiles; a backend that
-    refuses it keeps the per-corner set-up (said once), never a failed draw."""
-    if not shaders.setup_available():
+    refuses it keeps the per-corner set-up (said once), never a failed draw;
+    so does a context where it may not dispatch (shaders.setup_dispatch_allowed)."""
+    if not shaders.setup_dispatch_allowed():
         return False
     try:
         shaders.get_setup()
