@@ -89,9 +89,10 @@ void main()
 {
   int run = gl_VertexID / 4;
   int corner = quad_corner;
-  if (run >= line_count) {
-    /* The batch's padding (an instanced draw draws all of it): read no
-     * table past its end. */
+  if (run < line_first || run >= line_count) {
+    /* Runs this draw leaves to another (draw.ALL_RUNS...) and the batch's
+     * padding (an instanced draw draws all of it): read no table past its
+     * end. */
     gl_Position = COLLAPSED;
     return;
   }

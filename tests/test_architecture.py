@@ -635,13 +635,21 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "region_layers",
         "peel_depth",
         "region_layers_peeled",
+        "line_runs",
     }
     names = {f.name for f in fields(draw.DrawTarget)}
     assert names == set(selects_code) | state_or_input, "classify every DrawTarget field here"
     for name, (value, says) in selects_code.items():
         variant = draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value}))
         assert variant != plain and says(variant), name
-    stage_only = {"triangle_ids_by_vertex", "line_distance", "record_depth", "region_layers", "peel_depth"}
+    stage_only = {
+        "triangle_ids_by_vertex",
+        "line_distance",
+        "record_depth",
+        "region_layers",
+        "peel_depth",
+        "line_runs",
+    }
     for name in state_or_input - stage_only - {"region_layers_peeled"}:
         value = {
             "depth_test": "GREATER",
@@ -659,6 +667,10 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
     lines = draw.DrawTarget(stage=draw.LINES)
     distances = draw.shader_variant(settings, replace(lines, line_distance=True))
     assert distances.line_distance and not draw.shader_variant(settings, lines).line_distance
+    # And its drawing of the wire's runs without the edge classes' code.
+    classed = replace(settings, use_sharp_edges=True)
+    assert draw.shader_variant(classed, lines).edge_classes
+    assert not draw.shader_variant(classed, replace(lines, line_runs=draw.WIRE_RUNS)).edge_classes
     # So is the resolve's writing of the record's depth (the overlay's
     # resolve straight into Blender's buffer).
     resolve = draw.DrawTarget(stage=draw.RESOLVE, depth_bias=2.0**-18)

@@ -374,14 +374,23 @@ def test_the_edge_angle_beside_the_cage_joins_its_regions(shape, before, degrees
 
 @pytest.mark.parametrize(
     ("caps", "level", "stack"),
-    [("end", 1, "own mesh"), ("both", 3, "own mesh"), ("both", 2, "Mirror before"), ("end", 2, "Edit Mode")],
+    [
+        ("end", 1, "own mesh"),
+        ("both", 3, "own mesh"),
+        ("both", 2, "Mirror before"),
+        ("end", 2, "Edit Mode"),
+        ("big end", 1, "own mesh"),
+    ],
 )
 def test_an_array_with_caps_keeps_the_cage_regions(caps, level, stack, monkeypatch):
     """The caps an Array adds after its copies (quads here) are plain faces
-    past the listed regions: the regions the layout gives still apply, with
-    the general path's arrays, the caps' triangles in no region; read from
-    the object's own mesh, or from the evaluated mesh's layout (a modifier
-    before the subdivision, Edit Mode)."""
+    past the listed regions. Where they are a small share of the mesh
+    (edge_select.PLAIN_LISTED_SHARE) they are listed too, each face a
+    region of its own, and the general path lists them; where they are
+    more (a big grid as the cap), the regions the layout gives still apply,
+    with the general path's arrays, the caps' triangles in no region. The
+    regions are read from the object's own mesh, or from the evaluated
+    mesh's layout (a modifier before the subdivision, Edit Mode)."""
     import bpy
 
     scene = scenes.empty_scene()
@@ -390,20 +399,33 @@ def test_an_array_with_caps_keeps_the_cage_regions(caps, level, stack, monkeypat
         _modifier_before(capped, "MIRROR")
     _subdivide(capped, level)
     array = scenes.add_mirror_and_array(capped, count=2, offset=(1.3, 0.0, 0.0))
-    array.end_cap = scenes.cube(scene, "End cap", size=0.4)
+    if caps == "big end":
+        array.end_cap = scenes.grid(scene, "End cap", x_segments=61, y_segments=61, size=0.4)
+    else:
+        array.end_cap = scenes.cube(scene, "End cap", size=0.4)
     if caps == "both":
         array.start_cap = scenes.cube(scene, "Start cap", size=0.3, location=(0.0, 2.0, 0.0))
+    cap_faces = len(array.end_cap.data.polygons) + (6 if caps == "both" else 0)
+    face_count = len(capped.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.polygons)
+    listed_too = cap_faces <= edge_select.PLAIN_LISTED_SHARE * face_count
+    assert listed_too == (caps != "big end")
     if stack == "Edit Mode":
         bpy.context.view_layer.objects.active = capped
         capped.select_set(True)
         bpy.ops.object.mode_set(mode="EDIT")
     try:
-        general = _assert_same_as_general(capped, CAGE, monkeypatch, rows_expected=True, regions_expected=True)
+        general = _assert_same_as_general(
+            capped, CAGE, monkeypatch, rows_expected=True, regions_expected=not listed_too
+        )
     finally:
         if stack == "Edit Mode":
             bpy.ops.object.mode_set(mode="OBJECT")
-    cap_faces = 6 * (2 if caps == "both" else 1)
-    assert (general.triangle_regions[-2 * cap_faces :] == edge_select.NO_REGION).all()
+    cap_regions = general.triangle_regions[-2 * cap_faces :]
+    if listed_too:  # a region each
+        assert len(np.unique(cap_regions)) == cap_faces and (cap_regions >= 0).all()
+        assert not np.isin(cap_regions, general.triangle_regions[: -2 * cap_faces]).any()
+    else:
+        assert (cap_regions == edge_select.NO_REGION).all()
     assert (general.triangle_regions[: -2 * cap_faces] >= 0).all()
 
 

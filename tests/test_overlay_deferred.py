@@ -383,19 +383,26 @@ def _frames(scene, obj):
     return frame, frame_stats
 
 
-@pytest.mark.parametrize("software", [True, False])
-def test_a_partial_redraw_draws_the_region_lines_that_reach_it(monkeypatch, software):
+@pytest.mark.parametrize(("software", "classes"), [(True, False), (False, False), (True, True)])
+def test_a_partial_redraw_draws_the_region_lines_that_reach_it(monkeypatch, software, classes):
     """A dense subdivided grid, one vertex dragged near a corner: on a
     software rasteriser the partial redraw draws again only the
     region-lines runs that can reach its rectangle (their segments' window
     box widened by the lines' reach), elsewhere every run (the scissor drops
     the rest), and either equals a fresh frame: lines of edges just outside
     the rectangle that reach into it included (the grid's cells are
-    narrower than the reach)."""
+    narrower than the reach). With edge classes (sharp edges across the
+    grid, one of them through the rectangle) the wire's runs and the
+    classes' are drawn apart, each picked alike."""
     monkeypatch.setattr(passes.shaders, "software_rasteriser", lambda: software)
-    scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=2.0, use_cage_edges=True)
+    look = dict(use_sharp_edges=True, sharp_thickness=3.0, sharp_pattern="DASHED") if classes else {}
+    scene = scenes.empty_scene(WIDTH, HEIGHT, thickness=2.0, use_cage_edges=True, **look)
     scenes.add_camera(scene, location=(0.0, -10.0, 0.0))
     plane = scenes.grid(scene, "Grid", x_segments=40, y_segments=30, size=2.0, rotation=(1.5708, 0, 0))
+    if classes:
+        for edge in plane.data.edges:
+            ys = [plane.data.vertices[v].co.y for v in edge.vertices]
+            edge.use_edge_sharp = abs(ys[0] - ys[1]) < 1e-6 and round(ys[0] * 29 / 2.0) % 6 == 0
     plane.modifiers.new("Subdivision", "SUBSURF").levels = 1
     vertices = plane.data.vertices
     corners = sorted(vertices, key=lambda v: (v.co.x, v.co.y))
@@ -412,7 +419,9 @@ def test_a_partial_redraw_draws_the_region_lines_that_reach_it(monkeypatch, soft
         edited, path = frame()
         assert path == "surface_partial"
         # Runs of two entries (a cage edge cut once): most stay out.
-        runs = frame_stats[-1]["region_line_entries"] // 2
+        (mesh,) = runtime.mesh_cache.meshes()
+        runs = mesh.region_run_count
+        assert 0 < mesh.region_wire_runs < runs if classes else mesh.region_wire_runs == runs
         left_out = frame_stats[-1].get("region_runs_left_out", 0)
         assert left_out > 0.8 * runs if software else left_out == 0
     runtime.mesh_cache.clear()

@@ -363,11 +363,24 @@ def test_many_objects_sharing_a_mesh_of_ngons_draw_it_instanced(output_dir):
 
 
 @pytest.mark.parametrize("case", ["cage", "angle"])
-def test_edge_classes_on_large_regions(case, output_dir):
+def test_edge_classes_on_large_regions(case, output_dir, monkeypatch):
     """Edge classes with their own width, colour and pattern on regions of
     more than a hundred edges: the strongest line per pixel decides the
     style, with each class's pattern running along its own edges, and the
-    pixel takes that style's colour."""
+    pixel takes that style's colour. The region-lines pass draws the wire's
+    runs without the classes' code and the classes' runs with it (two
+    draws into one image, the same as one draw of every run)."""
+    from solidwire_addon.core import shaders
+
+    lines_variants = []
+    real_get = shaders.get
+
+    def spy(variant):
+        if variant.region_lines_pass:
+            lines_variants.append(variant)
+        return real_get(variant)
+
+    monkeypatch.setattr(shaders, "get", spy)
     look = dict(
         use_sharp_edges=True,
         sharp_thickness=3.0,
@@ -395,6 +408,19 @@ def test_edge_classes_on_large_regions(case, output_dir):
     report = accuracy.measure(scene, f"regions_classes_{case}", output_dir)
     accuracy.assert_accurate(report)
     _assert_region_lines_drawn()
+    from solidwire_addon.blender import runtime
+
+    (mesh,) = runtime.mesh_cache.meshes()
+    assert (mesh.region_wire_runs > 0) == (case == "cage")  # (the flat grid's lines all have a class)
+    assert {variant.edge_classes for variant in lines_variants} == ({False, True} if case == "cage" else {True})
+    # The same image, bit for bit, as every run drawn at once with the classes' code.
+    from solidwire_addon.blender import engine
+
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    apart, _depth = engine.render_scene(depsgraph, (200, 150))
+    monkeypatch.setattr(passes, "_line_run_draws", lambda *args: (draw.ALL_RUNS,))
+    together, _depth = engine.render_scene(depsgraph, (200, 150))
+    assert np.array_equal(apart, together)
     # Each solid sample has the colour of the style the reference picks
     # (but where two styles tie at full strength, which a rounding step
     # decides): the region lines carry the style beside the intensity.
@@ -591,22 +617,54 @@ def test_peeled_hidden_layers_of_instances(output_dir):
     assert solidwire_addon.stats().get("hidden_region_layers", 0) >= 4
 
 
-def _grid_with_pillars(bm):
-    """A flat 24 x 24 grid with two faces pushed up into thin pillars and a
-    3 x 3 block of faces into a thick one: under the edge angle the grid is
+# The faces of the grid below pushed up into thin pillars: their faces are
+# 6.5 % of the mesh's, more than edge selection lists beside regions
+# (edge_select.PLAIN_LISTED_SHARE), so they stay plain faces.
+PILLAR_FEET = (30, 100, 130, 200, 300, 455, 500, 560)
+
+
+def _grid_with_pillars(bm, feet=PILLAR_FEET):
+    """A flat 24 x 24 grid with the faces ``feet`` pushed up into thin pillars
+    and a 3 x 3 block of faces into a thick one: under the edge angle the grid is
     one region of over a hundred lines (its outline and the feet), the thick
     pillar's top and sides are regions of several faces, and every face of
     a thin pillar is a face of its own."""
     bmesh.ops.create_grid(bm, x_segments=24, y_segments=24, size=1.0)
     bm.faces.ensure_lookup_table()
     block = [bm.faces[24 * row + column] for row in range(14, 17) for column in range(8, 11)]
-    feet = [bm.faces[index] for index in (100, 455)]
+    feet = [bm.faces[index] for index in feet]
     extruded = bmesh.ops.extrude_face_region(bm, geom=block)["geom"]
     raised = [element for element in extruded if isinstance(element, bmesh.types.BMVert)]
     bmesh.ops.translate(bm, verts=raised, vec=(0.0, 0.0, 0.5))
     bmesh.ops.delete(bm, geom=block, context="FACES_ONLY")  # (the block's old faces, left under it)
     for top in bmesh.ops.extrude_discrete_faces(bm, faces=feet)["faces"]:
         bmesh.ops.translate(bm, verts=list(top.verts), vec=(0.0, 0.0, 0.35))
+
+
+def test_a_few_faces_of_their_own_are_listed_with_the_regions(output_dir, monkeypatch):
+    """Two thin pillars on the grid: their ten faces, each a region of its
+    own, are too few to keep apart from the regions
+    (edge_select.PLAIN_LISTED_SHARE) and are listed too. Every triangle then
+    takes its lines from the region-lines pass, and the resolve sets up no
+    triangle edge; the image is the reference's, from above and from under
+    the grid (the pillars behind it)."""
+    from solidwire_addon.blender import runtime
+    from solidwire_addon.core import shaders
+
+    variants = []
+    real_get = shaders.get
+    monkeypatch.setattr(shaders, "get", lambda variant: variants.append(variant) or real_get(variant))
+    scene = scenes.empty_scene(200, 150, use_cage_edges=False, edge_angle=math.radians(10.0))
+    scenes.mesh_object(scene, "Pillars", lambda bm: _grid_with_pillars(bm, feet=(100, 455)), rotation=(-1.1, 0.0, 0.4))
+    for name, location in (("above", (0.5, 4.0, 2.5)), ("under", (0.0, -5.0, -0.5))):
+        scenes.add_camera(scene, location=location, target=(0.0, 0.0, 0.0))
+        variants.clear()
+        report = accuracy.measure(scene, f"regions_faces_of_their_own_listed_{name}", output_dir)
+        accuracy.assert_accurate(report)
+        (mesh,) = runtime.mesh_cache.meshes()
+        assert mesh.region_sizes()[2] == 0  # no triangle outside the listed faces
+        assert mesh.lines_only_from_region_pass
+        assert any(variant.resolve and variant.no_edge_setup for variant in variants), name
 
 
 def test_peeled_hidden_layers_beside_faces_of_their_own(output_dir):
@@ -625,7 +683,8 @@ def test_peeled_hidden_layers_beside_faces_of_their_own(output_dir):
     accuracy.assert_accurate(report)
     (mesh,) = runtime.mesh_cache.meshes()
     assert passes._peeled_items([DrawItem(mesh, np.eye(4))])
-    assert mesh.region_sizes()[2] == 2 * 5 * 2  # the thin pillars' 10 faces, two triangles each
+    # The thin pillars' faces, five each, two triangles each.
+    assert mesh.region_sizes()[2] == 2 * 5 * len(PILLAR_FEET)
     assert solidwire_addon.stats().get("hidden_region_layers", 0) >= 2
 
 

@@ -179,6 +179,9 @@ class GPUMesh:
         self._region_lines_cpu = arrays.region_lines
         self._region_line_runs_cpu = arrays.region_line_runs
         self.region_run_segments = arrays.region_run_segments
+        # The runs of the wire (style 0): the first ones, as edge selection
+        # writes the entries by style (draw.WIRE_RUNS).
+        self.region_wire_runs = _wire_runs(arrays.region_line_runs, arrays.region_lines)
         # Every triangle takes its lines from the region-lines pass and
         # there is no n-gon (a cage look): a resolve that reads the pass's
         # image sets up no triangle edge (ShaderVariant.no_edge_setup).
@@ -584,6 +587,18 @@ class GPUMesh:
         count = np.searchsorted(polygons, faces, side="right") - first
         # first[k], first[k] + 1, ... for count[k] each, face after face.
         return np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+
+
+def _wire_runs(runs: np.ndarray | None, lines: np.ndarray | None) -> int:
+    """How many of the region-lines ``runs`` are of the wire (style 0):
+    they lead, as edge selection writes the entries by style; 0 where the
+    styles do not ascend (then every run is drawn with the classes' code)."""
+    if runs is None or not len(runs):
+        return 0
+    styles = lines[TEXELS_PER_REGION_LINE * runs[:, 0].astype(np.intp), 2]
+    if (styles[1:] < styles[:-1]).any():
+        return 0
+    return int(np.searchsorted(styles, 0.5))
 
 
 def _corner_vertex_rows(triangles: np.ndarray) -> np.ndarray:

@@ -38,6 +38,15 @@ from .view import (
 # dimmed and dashed, no fill).
 WIRE_LINES, NO_LINES, HIDDEN_LINES = "wire", "none", "hidden"
 
+# Which runs of a mesh's region-lines table a LINES draw draws
+# (DrawTarget.line_runs): all of them, or the wire's (style 0) apart from
+# the edge classes'. The table holds its entries by style, so the wire's
+# runs come first (cache.GPUMesh.region_wire_runs). Drawn apart, the
+# wire's runs take a shader without the per-style code: on a software
+# rasteriser that code costs every fragment of every run, although most
+# lines are the wire's (passes._draw_region_lines).
+ALL_RUNS, WIRE_RUNS, CLASS_RUNS = "all", "wire", "classes"
+
 # The two stages of the deferred surface (docs/image_model.md §2.5; see
 # passes.SurfacePass): VISIBILITY records which triangle of which draw
 # each pixel shows, RESOLVE runs the exact fragment stage once per pixel of
@@ -83,6 +92,9 @@ class DrawTarget:
     on a software rasteriser): the runs of LINES whose lines cannot reach
     it, the blocks of triangles of VISIBILITY that lie outside it (numbered
     by vertex only: gl_PrimitiveID would start again at each range).
+    ``line_runs`` (LINES): which runs of each mesh's region-lines table it
+    draws (ALL_RUNS, WIRE_RUNS: then without the edge classes' code,
+    CLASS_RUNS).
 
     The hidden layers of multi-face regions (passes._peel_hidden_regions):
     ``region_layers`` (VISIBILITY) records only the triangles whose lines
@@ -115,6 +127,7 @@ class DrawTarget:
     peel_depth: object = None
     behind_tiles: object = None
     region_layers_peeled: bool = False
+    line_runs: str = ALL_RUNS
 
     def hidden(self, region_layers_peeled: bool = False) -> DrawTarget:
         """The hidden-line layer over this target (image model §5.4): every
@@ -203,7 +216,7 @@ def shader_variant(settings, target: DrawTarget | None = None) -> shaders.Shader
         variant = shaders.ShaderVariant(
             region_lines_pass=True,
             thickness_mode=variant.thickness_mode,
-            edge_classes=variant.edge_classes,
+            edge_classes=variant.edge_classes and target.line_runs != WIRE_RUNS,
             density_fade=variant.density_fade,
             line_distance=target.line_distance,
         )
@@ -549,6 +562,7 @@ def draw(
                 view=view,
                 window=target.scissor_window,
                 behind=target.behind_tiles,
+                runs=target.line_runs,
             ),
         )
         # (Diagonals from the settings, not the variant: every stage must part alike.)
@@ -773,8 +787,18 @@ class _DrawNumbers:
     rectangle over the draw's window box. A direct draw (stage None) just
     draws the batch."""
 
-    def __init__(self, stage, extras, by_vertex: bool = False, view: View | None = None, window=None, behind=None):
+    def __init__(
+        self,
+        stage,
+        extras,
+        by_vertex: bool = False,
+        view: View | None = None,
+        window=None,
+        behind=None,
+        runs: str = ALL_RUNS,
+    ):
         self.stage, self.extras, self.count = stage, extras, 0
+        self.runs = runs  # DrawTarget.line_runs
         self.by_vertex = by_vertex  # the visibility batch's numbering (ShaderVariant.triangle_ids_by_vertex)
         self.view = view
         self.window = window  # DrawTarget.scissor_window
@@ -810,6 +834,39 @@ class _DrawNumbers:
             batch.draw_range(shader, elem_start=start, elem_count=size)  # (size > 0: 0 would draw to the end)
         self.triangles_left_out += mesh.triangle_count - int(count.sum())
 
+    def _draw_runs(self, shader, mesh, object_to_clip, instance_count: int) -> None:
+        """The LINES draw of ``mesh``: its runs ``self.runs`` asks for (the
+        quads first to end - 1 of its batch), those that can reach the
+        window alone where there is one."""
+        count = mesh.region_run_count
+        first, end = {
+            ALL_RUNS: (0, count),
+            WIRE_RUNS: (0, mesh.region_wire_runs),
+            CLASS_RUNS: (mesh.region_wire_runs, count),
+        }[self.runs]
+        picked = None
+        if end > first and self.window is not None and not instance_count:
+            picked = runs_reaching(mesh, object_to_clip, self.view.viewport, self.window)
+            if picked is not None:
+                picked = picked[(picked >= first) & (picked < end)]
+            self.runs_left_out += end - first - (end - first if picked is None else len(picked))
+        if end <= first or (picked is not None and not len(picked)):
+            return
+        shader.uniform_int("draw_number", self.count)
+        lines, regions = mesh.region_tables()
+        shader.uniform_sampler("region_lines", lines)
+        shader.uniform_sampler("triangle_regions", regions)
+        shader.uniform_int("line_first", first)
+        shader.uniform_int("line_count", end)
+        if instance_count:
+            # (Every run of the batch for each instance: line_first and
+            # line_count collapse the others.)
+            indexed_quad_batch(count).draw_instanced(shader, instance_start=0, instance_count=instance_count)
+        elif picked is None:
+            indexed_quad_batch(count).draw_range(shader, elem_start=6 * first, elem_count=6 * (end - first))
+        else:
+            picked_quad_batch(picked, count).draw(shader)
+
     def draw(self, shader, mesh, batch_of, object_to_clip, instance_count: int = 0, object_to_view_z=None) -> None:
         """One draw call of ``mesh``; ``batch_of()`` gives the direct draw's
         batch (asked for only when drawing directly). ``object_to_view_z``:
@@ -830,23 +887,7 @@ class _DrawNumbers:
             return
         self.count += 1
         if self.stage == LINES:
-            count = mesh.region_run_count
-            picked = None
-            if count and self.window is not None and not instance_count:
-                picked = runs_reaching(mesh, object_to_clip, self.view.viewport, self.window)
-                self.runs_left_out += count - (count if picked is None else len(picked))
-            if count and (picked is None or len(picked)):
-                shader.uniform_int("draw_number", self.count)
-                lines, regions = mesh.region_tables()
-                shader.uniform_sampler("region_lines", lines)
-                shader.uniform_sampler("triangle_regions", regions)
-                shader.uniform_int("line_count", count)
-                if instance_count:
-                    indexed_quad_batch(count).draw_instanced(shader, instance_start=0, instance_count=instance_count)
-                elif picked is None:
-                    indexed_quad_batch(count).draw_range(shader, elem_start=0, elem_count=6 * count)
-                else:
-                    picked_quad_batch(picked, count).draw(shader)
+            self._draw_runs(shader, mesh, object_to_clip, instance_count)
             return
         shader.uniform_int("draw_number", self.count)
         if self.stage == VISIBILITY:

@@ -80,6 +80,14 @@ NO_REGION = -1.0
 # pays per primitive and per covered pixel. Eight segments fill 40 varying
 # components, within every backend's limit.
 RUN_SEGMENTS = 8
+# The most a mesh's plain faces may hold of its triangles for them to be
+# listed too, where every other face is (_lists_plain_faces_too). The edge
+# angle at 20 degrees on Suzanne subdivided three times leaves 0.6 % of
+# its triangles plain; listing them took F12 from 1.3x to 1.2x the plain
+# look there (1280 x 720, llvmpipe). Each plain face listed adds its edges
+# to the pass (about 1.5 us a line there), and no set-up saves about 6 ms
+# over that frame: the two meet near 7 % of its 62k triangles.
+PLAIN_LISTED_SHARE = 0.05
 # The flag bits a listed triangle drops before its block's bits are set: its
 # quad edges and n-gon outline are in its block, and its block's segment
 # count takes the bits from NGON_SHIFT up.
@@ -199,6 +207,18 @@ class SelectionStats:
     listed_triangles: int = 0
     segments: int = 0
     region_lines: int = 0  # entries of the region-lines table
+
+
+def _lists_plain_faces_too(plain_triangles: int, triangles: int) -> bool:
+    """Whether a mesh whose other faces are all listed lists its
+    ``plain_triangles`` (those of plain faces, each a region of its own
+    with no classed edge) too: where they are at most PLAIN_LISTED_SHARE of
+    its triangles. Then every triangle takes its lines from the
+    region-lines pass, and a resolve that reads them sets up no triangle
+    edge per pixel (ShaderVariant.no_edge_setup), which a software
+    rasteriser pays for at every pixel; the pass then draws the plain
+    faces' edges too, as it draws those of a face with a classed edge."""
+    return 0 < plain_triangles <= PLAIN_LISTED_SHARE * triangles
 
 
 def _face_of_corner(sizes: np.ndarray) -> np.ndarray:
@@ -403,12 +423,20 @@ def select_edges(
     if has_classes:
         styled_face[corner_face[classes.take(corner_edge) != 0]] = True
     walked = walked_region[label]
+    # Faces listed on their own (a block of their own drawn edges, their
+    # lines drawn by the region-lines pass): those with a classed edge, and
+    # where nearly every face is listed anyway, the few plain ones too
+    # (_lists_plain_faces_too).
+    alone = styled_face
+    plain = ~walked & ~styled_face
+    if _lists_plain_faces_too(int(sizes.compress(plain).sum()) - 2 * int(plain.sum()), arrays.triangle_count):
+        alone = styled_face | plain
 
     # Drawn edges of each region whose lines are listed (unique (label,
     # edge) pairs, as one key, so sorted by region): those of multi-face
     # regions and of faces with a classed edge; a plain face needs none.
     drawn_corner = drawn[corner_edge]
-    lines_corner = drawn_corner & (walked | styled_face)[corner_face]
+    lines_corner = drawn_corner & (walked | alone)[corner_face]
     keys = distinct(label[corner_face[lines_corner]] * edge_count + corner_edge[lines_corner])
     pairs = np.stack(np.divmod(keys, edge_count), axis=1)
     # A region too large to walk (see WALK_LIMIT): its faces' blocks hold
@@ -422,7 +450,7 @@ def select_edges(
     # to walk, its own) plus its own n-gon diagonals: a diagonal belongs to
     # its face only (§1.3). -1: a plain face, drawn from its own edges.
     faces = np.arange(face_count)
-    own_block = (walked & (ngon_face | too_large)) | (~walked & styled_face)
+    own_block = (walked & (ngon_face | too_large)) | (~walked & alone)
     owner = np.where(own_block, face_count + faces, np.where(walked, label, -1))
 
     _mark_own_edges(arrays, verts, drawn, np.asarray(corner_vert), offsets, sizes, corner_edge)
@@ -519,7 +547,7 @@ def select_edges(
     stats.regions = int(walked_region.sum())  # sizes are counted at each region's label only
     stats.listed_triangles = listed_count
     stats.segments = len(seg_a)
-    _region_lines(arrays, verts, classes, ends, label, walked | styled_face, pairs, stats)
+    _region_lines(arrays, verts, classes, ends, label, walked | alone, pairs, stats)
     return stats
 
 
@@ -832,9 +860,12 @@ def _select_known_regions(
         return None
     if listed_faces < face_count:
         # Plain faces only where nothing joins them or lists them: every
-        # edge drawn and none with a class (all quads: 4 corners a face).
+        # edge drawn and none with a class (all quads: 4 corners a face),
+        # and too many to be listed too (as the general path lists them).
         tail = slice(4 * listed_faces, None)
         if not corner_drawn[tail].all() or (classes is not None and classes.take(corner_edge[tail]).any()):
+            return None
+        if _lists_plain_faces_too(2 * (face_count - listed_faces), 2 * face_count):
             return None
     stats = SelectionStats(hidden_edges=len(drawn) - prefix[0])
 

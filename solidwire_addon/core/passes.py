@@ -904,15 +904,35 @@ def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget,
             visibility=targets.visible,
             scissor_window=None if reach is None else (*scissor, reach),
         )
-        drawn = draw_mod.draw(items, view, settings, target=lines, cull=cull)
+        left_out = 0
+        for runs in _line_run_draws(items, settings, target):
+            drawn = draw_mod.draw(items, view, settings, target=replace(lines, line_runs=runs), cull=cull)
+            left_out += drawn.extra.get("region_runs_left_out", 0)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
     stats.extra["region_line_entries"] = sum(item.mesh.region_line_count for item in items)
-    if "region_runs_left_out" in drawn.extra:
-        stats.extra["region_runs_left_out"] = drawn.extra["region_runs_left_out"]
+    if left_out:
+        stats.extra["region_runs_left_out"] = left_out
     if hidden:
         return targets.hidden_lines
     return targets.line_distances if target.line_distance else targets.lines
+
+
+def _line_run_draws(items, settings, target: DrawTarget) -> tuple:
+    """The LINES draws of the strongest visible line (draw.ALL_RUNS...):
+    with edge classes on, the wire's runs apart from the classes', so that
+    most runs take the shader without per-style code; each draw keeps the
+    strongest line per pixel by the same depth test, so the image is the
+    one draw's. The nearest line's distance and a hidden layer's lines
+    take no class code anyway."""
+    if target.line_distance or target.lines == draw_mod.HIDDEN_LINES or not draw_mod.edge_classes_of(settings):
+        return (draw_mod.ALL_RUNS,)
+    draws = ()
+    if any(item.mesh.region_wire_runs for item in items):
+        draws += (draw_mod.WIRE_RUNS,)
+    if any(item.mesh.region_wire_runs < item.mesh.region_run_count for item in items):
+        draws += (draw_mod.CLASS_RUNS,)
+    return draws
 
 
 def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptions = DEFAULT_OPTIONS, clip_planes=None):

@@ -547,6 +547,7 @@ def _region_lines_create_info(variant: ShaderVariant):
     add_sampler(info, "triangle_regions")
     add_sampler(info, "visibility")
     info.push_constant("INT", "draw_number")
+    info.push_constant("INT", "line_first")
     info.push_constant("INT", "line_count")
     info.push_constant("VEC2", "clip_w_of_depth")
     prologue = ""
