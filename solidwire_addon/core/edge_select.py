@@ -81,13 +81,15 @@ NO_REGION = -1.0
 # components, within every backend's limit.
 RUN_SEGMENTS = 8
 # The most a mesh's plain faces may hold of its triangles for them to be
-# listed too, where every other face is (_lists_plain_faces_too). The edge
-# angle at 20 degrees on Suzanne subdivided three times leaves 0.6 % of
-# its triangles plain; listing them took F12 from 1.3x to 1.2x the plain
-# look there (1280 x 720, llvmpipe). Each plain face listed adds its edges
-# to the pass (about 1.5 us a line there), and no set-up saves about 6 ms
-# over that frame: the two meet near 7 % of its 62k triangles.
-PLAIN_LISTED_SHARE = 0.05
+# listed too, where every other face is (_lists_plain_faces_too). Each plain
+# face listed adds its edges to the region-lines pass; the resolve then sets
+# up no triangle edge at any pixel. Suzanne subdivided three times and
+# applied, filling a third of a 1280 x 720 F12 (llvmpipe), under the edge
+# angle: at 20 and 12 degrees 0.6 % and 4.3 % of its triangles are plain,
+# and listing them took the frame from 60 to 53 and from 80 to 69 ms; at 8
+# and 6 degrees (14 % and 25 %) it made no difference, at 4 degrees (43 %)
+# it cost 86 -> 103 ms.
+PLAIN_LISTED_SHARE = 0.1
 # The flag bits a listed triangle drops before its block's bits are set: its
 # quad edges and n-gon outline are in its block, and its block's segment
 # count takes the bits from NGON_SHIFT up.
