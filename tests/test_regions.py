@@ -362,6 +362,48 @@ def test_many_objects_sharing_a_mesh_of_ngons_draw_it_instanced(output_dir):
     assert solidwire_addon.stats().get("instanced_draws", 0) > 0
 
 
+def _rounded_cube(bm):
+    """A cube subdivided twice with smoothing: flat-ish faces meeting at
+    rounded edges, regions under the edge angle."""
+    bmesh.ops.create_cube(bm, size=0.7)
+    for _ in range(2):
+        bmesh.ops.subdivide_edges(bm, edges=bm.edges[:], cuts=1, use_grid_fill=True, smooth=0.6)
+
+
+def test_instanced_copies_draw_the_wire_and_the_classes_apart(output_dir, monkeypatch):
+    """Copies of one rounded cube with sharp edges under the edge angle,
+    drawn instanced: each of the region-lines pass's two draws (the wire's
+    runs, the classes' runs) leaves the other's runs out of every instance,
+    and the image is the reference's and one draw's of every run."""
+    from solidwire_addon.blender import engine
+
+    scene = scenes.empty_scene(
+        200, 150, edge_angle=math.radians(25.0), thickness=1.0, use_sharp_edges=True, sharp_thickness=2.5
+    )
+    cube = scenes.mesh_object(scene, "Rounded", _rounded_cube)
+    for edge in cube.data.edges:
+        edge.use_edge_sharp = edge.index % 7 == 0
+    rng = np.random.default_rng(7)
+    for i in range(draw.INSTANCING_MIN + 1):
+        copy = bpy.data.objects.new(f"Rounded{i}", cube.data)
+        scene.collection.objects.link(copy)
+        copy.location = (rng.uniform(-2.0, 2.0), rng.uniform(-1.0, 2.0), rng.uniform(-0.5, 0.5))
+        copy.rotation_euler = rng.uniform(-1.5, 1.5, 3)
+    scenes.add_camera(scene, location=(0.5, -6.0, 4.0), target=(0, 0.4, 0))
+    report = accuracy.measure(scene, "regions_instanced_classes", output_dir)
+    accuracy.assert_accurate(report)
+    assert solidwire_addon.stats().get("instanced_draws", 0) > 0
+    from solidwire_addon.blender import runtime
+
+    (mesh,) = runtime.mesh_cache.meshes()
+    assert 0 < mesh.region_wire_runs < mesh.region_run_count
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    apart, _depth = engine.render_scene(depsgraph, (200, 150))
+    monkeypatch.setattr(passes, "_line_run_draws", lambda *args: (draw.ALL_RUNS,))
+    together, _depth = engine.render_scene(depsgraph, (200, 150))
+    assert np.array_equal(apart, together)
+
+
 @pytest.mark.parametrize("case", ["cage", "angle"])
 def test_edge_classes_on_large_regions(case, output_dir, monkeypatch):
     """Edge classes with their own width, colour and pattern on regions of
