@@ -344,17 +344,23 @@ def test_lines_past_their_own_triangle_take_every_diagonal(case, look, diagonals
     accuracy.assert_accurate(report)
 
 
+def _scatter_copies(scene, obj, count: int, seed: int) -> None:
+    """``count`` objects sharing ``obj``'s mesh (one instanced draw), placed
+    and turned at random round it."""
+    rng = np.random.default_rng(seed)
+    for i in range(count):
+        copy = bpy.data.objects.new(f"{obj.name}{i}", obj.data)
+        scene.collection.objects.link(copy)
+        copy.location = (rng.uniform(-2.0, 2.0), rng.uniform(-1.0, 2.0), rng.uniform(-0.5, 0.5))
+        copy.rotation_euler = rng.uniform(-1.5, 1.5, 3)
+
+
 def test_many_objects_sharing_a_mesh_of_ngons_draw_it_instanced(output_dir):
     """Copies of a tube with 20-sided caps, the plain look: the caps' outlines
     come from the region-lines pass once per instance."""
     scene = scenes.empty_scene(220, 160, thickness=1.5)
     tube = scenes.tube(scene, segments=20, radius=0.4, depth=0.6)
-    rng = np.random.default_rng(4)
-    for i in range(draw.INSTANCING_MIN + 2):
-        copy = bpy.data.objects.new(f"Tube{i}", tube.data)
-        scene.collection.objects.link(copy)
-        copy.location = (rng.uniform(-2.0, 2.0), rng.uniform(-1.0, 2.0), rng.uniform(-0.5, 0.5))
-        copy.rotation_euler = rng.uniform(-1.5, 1.5, 3)
+    _scatter_copies(scene, tube, draw.INSTANCING_MIN + 2, seed=4)
     scenes.add_camera(scene, location=(0.5, -5.0, 3.6), target=(0, 0.4, 0))
     report = accuracy.measure(scene, "regions_instanced_ngons", output_dir)
     accuracy.assert_accurate(report)
@@ -383,12 +389,7 @@ def test_instanced_copies_draw_the_wire_and_the_classes_apart(output_dir, monkey
     cube = scenes.mesh_object(scene, "Rounded", _rounded_cube)
     for edge in cube.data.edges:
         edge.use_edge_sharp = edge.index % 7 == 0
-    rng = np.random.default_rng(7)
-    for i in range(draw.INSTANCING_MIN + 1):
-        copy = bpy.data.objects.new(f"Rounded{i}", cube.data)
-        scene.collection.objects.link(copy)
-        copy.location = (rng.uniform(-2.0, 2.0), rng.uniform(-1.0, 2.0), rng.uniform(-0.5, 0.5))
-        copy.rotation_euler = rng.uniform(-1.5, 1.5, 3)
+    _scatter_copies(scene, cube, draw.INSTANCING_MIN + 1, seed=7)
     scenes.add_camera(scene, location=(0.5, -6.0, 4.0), target=(0, 0.4, 0))
     report = accuracy.measure(scene, "regions_instanced_classes", output_dir)
     accuracy.assert_accurate(report)
