@@ -436,7 +436,7 @@ def select_edges(
 
     # Drawn edges of each region whose lines are listed (unique (label,
     # edge) pairs, as one key, so sorted by region): those of multi-face
-    # regions and of faces with a classed edge; a plain face needs none.
+    # regions and of the faces listed alone; a plain face needs none.
     drawn_corner = drawn[corner_edge]
     lines_corner = drawn_corner & (walked | alone)[corner_face]
     keys = distinct(label[corner_face[lines_corner]] * edge_count + corner_edge[lines_corner])
