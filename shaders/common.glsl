@@ -25,6 +25,14 @@
 /* The triangle's lines come from the region-lines pass where one ran
  * (REGION_LINES variant); its block then starts with its diagonals. */
 #define REGION_LINES 4096
+/* IN_REGION with HAS_QUAD_CORNER: a face of its own with a classed edge
+ * (core/edge_select.py OWN_EDGES_MEASURED). It measures its own edges as a
+ * plain triangle does, all but the classed ones (marked hidden), which its
+ * block holds; the block starts with the face's corners (a segment's
+ * texels), the quad's 4th among them. */
+#define OWN_EDGES_MEASURED (IN_REGION | HAS_QUAD_CORNER)
+/* triangle_regions of a plain face: in no region (core/edge_select.py). */
+#define NO_REGION -1.0
 #define SEGMENT_TEXELS 2 /* (lower id, upper id, style, 0), (chain end, chain end, 0, 0) */
 #define DIAGONAL_STYLE 15
 /* Set by the vertex stage: the whole triangle (and a quad's 4th corner) is in

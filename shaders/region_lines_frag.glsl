@@ -106,7 +106,7 @@ void main()
   }
 #endif
   float region = fetch_texel(triangle_regions, int(visible.x) - 1).x;
-  if (region < 0.0 || (region != line_regions.x && region != line_regions.y)) {
+  if (region == NO_REGION || (region != line_regions.x && region != line_regions.y)) {
     discard; /* the visible face is not bounded by this line */
   }
 #ifdef LINE_DISTANCE

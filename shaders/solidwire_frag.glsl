@@ -194,20 +194,27 @@ void own_edge_distances(vec2 p, out float d0, out float d1, out float d2, out fl
 
 /* The triangle's own edges: which are lines (drawn polygon edges) and
  * which diagonals (added by triangulation). A triangle that walks its
- * region's segments (`listed`) takes every line from that block instead;
- * its own edges then only give diagonals. Polygon edges that are not drawn
- * are neither. A quad's edges p2-p3, p3-p0 are NO_EDGE unless it has them. */
+ * region's segments (`listed`, unless it measures its own edges:
+ * OWN_EDGES_MEASURED) takes every line from that block instead; its own
+ * edges then only give diagonals. Polygon edges that are not drawn (or
+ * drawn from the block) are neither. A quad's edges p2-p3, p3-p0 are
+ * NO_EDGE unless it has them. */
 NearLines own_edge_lines(vec2 p, float half_thickness, bool listed)
 {
+  listed = listed && (triangle_flags & OWN_EDGES_MEASURED) != OWN_EDGES_MEASURED;
   float d0, d1, d2, d3, d4;
   own_edge_distances(p, d0, d1, d2, d3, d4);
   NearLines found = no_lines();
-  bool real0 = (triangle_flags & EDGE0_REAL) != 0;
-  bool real1 = (triangle_flags & EDGE1_REAL) != 0;
-  bool real2 = (triangle_flags & EDGE2_REAL) != 0;
-  bool diag0 = !real0 && (triangle_flags & EDGE0_HIDDEN) == 0;
-  bool diag1 = !real1 && (triangle_flags & (EDGE0_HIDDEN << 1)) == 0;
-  bool diag2 = !real2 && (triangle_flags & (EDGE0_HIDDEN << 2)) == 0;
+  /* (Real and hidden: a polygon edge whose line the block draws.) */
+  bool hidden0 = (triangle_flags & EDGE0_HIDDEN) != 0;
+  bool hidden1 = (triangle_flags & (EDGE0_HIDDEN << 1)) != 0;
+  bool hidden2 = (triangle_flags & (EDGE0_HIDDEN << 2)) != 0;
+  bool real0 = (triangle_flags & EDGE0_REAL) != 0 && !hidden0;
+  bool real1 = (triangle_flags & EDGE1_REAL) != 0 && !hidden1;
+  bool real2 = (triangle_flags & EDGE2_REAL) != 0 && !hidden2;
+  bool diag0 = (triangle_flags & EDGE0_REAL) == 0 && !hidden0;
+  bool diag1 = (triangle_flags & EDGE1_REAL) == 0 && !hidden1;
+  bool diag2 = (triangle_flags & EDGE2_REAL) == 0 && !hidden2;
 
   keep_nearest(real0 && !listed, d0, edge_line0, edge_span0, found.d_style[0], found.line_style[0], found.span_style[0]);
   keep_nearest(real1 && !listed, d1, edge_line1, edge_span1, found.d_style[0], found.line_style[0], found.span_style[0]);

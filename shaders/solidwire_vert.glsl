@@ -357,7 +357,7 @@ void main()
   /* A hidden-line pass whose multi-face regions' layers were drawn by depth
    * peeling (passes.py, docs/image_model.md §2.6): their triangles are
    * dropped before any set-up (outside the clip volume). */
-  if ((edge_flags & REGION_LINES) != 0) {
+  if ((edge_flags & REGION_LINES) != 0 && (edge_flags & OWN_EDGES_MEASURED) != OWN_EDGES_MEASURED) {
     gl_Position = vec4(2.0, 2.0, 2.0, 1.0);
     return;
   }
@@ -369,6 +369,23 @@ void main()
   bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
   bool is_ngon = (edge_flags & IS_NGON) != 0;
   ngon_corner_start = int(ids.w);
+  if ((edge_flags & OWN_EDGES_MEASURED) == OWN_EDGES_MEASURED) {
+    /* Its face's corners lead its block: its quad's 4th corner is the one
+     * that is not its own (a triangle face repeats one of its own, whose
+     * two quad edges are marked hidden). */
+    vec4 face = fetch_texel(ngon_corners, ngon_corner_start);
+    ids.w = face.w;
+    if (face.x != ids.x && face.x != ids.y && face.x != ids.z) {
+      ids.w = face.x;
+    }
+    else if (face.y != ids.x && face.y != ids.y && face.y != ids.z) {
+      ids.w = face.y;
+    }
+    else if (face.z != ids.x && face.z != ids.y && face.z != ids.z) {
+      ids.w = face.z;
+    }
+    ngon_corner_start += SEGMENT_TEXELS;
+  }
 #ifdef SETUP_TABLE
   bool simple = read_setup_table(triangle, ids, is_quad, is_ngon);
   vec3 local = fetch_texel(vertex_positions, int(vertex_id)).xyz;

@@ -475,6 +475,77 @@ def test_edge_classes_on_large_regions(case, output_dir, monkeypatch):
     assert green.sum() > 50 and (wrong & solid).sum() <= 0.005 * solid.sum()
 
 
+CLASSED_LOOK = dict(
+    thickness=1.5,
+    use_sharp_edges=True,
+    sharp_thickness=3.0,
+    sharp_pattern="DASHED",
+    sharp_color=(0.0, 1.0, 0.0, 1.0),
+    use_seam_edges=True,
+    seam_thickness=2.5,
+    seam_color=(1.0, 0.0, 0.0, 1.0),
+    use_boundary_edges=True,
+)
+
+
+@pytest.mark.parametrize("path", ["deferred", "direct", "hidden lines", "edge distance"])
+def test_faces_with_a_classed_edge_measure_their_other_edges(path, output_dir, monkeypatch):
+    """On a mesh with plain faces, a triangle or quad of its own with a
+    classed edge sets up its other edges itself, as a plain face does
+    (edge_select.OWN_EDGES_MEASURED): the region-lines pass draws the
+    classed edges alone, one entry per class of each, and the face's block
+    holds them for what has no such pass (a surface drawn directly, and the
+    faces behind it under hidden lines, drawn by the direct hidden-line
+    pass). Suzanne (triangles and quads) with a dashed sharp class, a wider
+    seam class and its eye holes' boundary, against the reference, and the
+    Edge Distance pass within a line's reach; under hidden lines a cube."""
+    from solidwire_addon.blender import runtime
+    from solidwire_addon.core.options import DrawOptions
+
+    scene = scenes.empty_scene(200, 150, use_hidden_lines=path == "hidden lines", **CLASSED_LOOK)
+    if path == "hidden lines":
+        obj = scenes.cube(scene, rotation=(0.3, 0.1, 0.6))
+        scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    else:
+        obj = scenes.monkey(scene, rotation=(1.2, 0.0, 0.5))
+        scenes.add_camera(scene, location=(0.6, -4.2, 1.2), target=(0, 0, 0))
+    edge_of_key = {key: index for index, key in enumerate(obj.data.edge_keys)}
+    faces_of_edge = np.bincount([edge_of_key[key] for face in obj.data.polygons for key in face.edge_keys])
+    for edge in obj.data.edges:
+        edge.use_edge_sharp = edge.index % 7 == 0
+        edge.use_seam = edge.index % 11 == 3
+    classes_per_edge = [
+        int(edge.use_edge_sharp) + int(edge.use_seam) + int(faces_of_edge[edge.index] == 1) for edge in obj.data.edges
+    ]
+    monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=path != "direct"))
+    if path == "edge distance":
+        settings = scene.view_layers[0].solidwire
+        settings.use_pass_edge_distance = settings.use_pass_wire = True
+        channels = scenes.render_multilayer_exr(scene, output_dir / "classed_faces_edge_distance.exr")
+        ref = reference.render_reference(scene)
+        layer = scene.view_layers[0].name
+        alpha = exr.exr_pass(channels, layer, "Combined", "A")[..., 0]
+        accuracy.assert_accurate(reference.error_report(alpha, ref))
+        distance = exr.exr_pass(channels, layer, "Edge Distance", "X")[..., 0]
+        covered = (ref.face >= 0) & ~ref.on_silhouette
+        reach = 0.5 * 1.5 + 2.0 * 1.0  # (the narrowest line's: the wire's)
+        near = covered & (ref.d_real <= reach)
+        assert near.sum() > 500 and (covered & ~near).sum() > 500
+        assert np.abs(distance[near] - ref.d_real[near]).max() <= 2e-3
+        assert (distance[covered & ~near] >= reach - 2e-3).all()
+    else:
+        report = accuracy.measure(scene, f"classed_faces_{path.replace(' ', '_')}", output_dir)
+        accuracy.assert_accurate(report)
+    (mesh,) = runtime.mesh_cache.meshes()
+    # Every classed edge is drawn by the pass, once per class, and no other.
+    assert mesh.region_line_count == sum(classes_per_edge) > (2 if path == "hidden lines" else 40)
+    flags = mesh.edge_flags_cpu
+    own = (flags & edge_select.OWN_EDGES_MEASURED) == edge_select.OWN_EDGES_MEASURED
+    assert own.any() and (flags & edge_select.IN_REGION == 0).any()  # beside plain faces
+    drawn_by_pass = solidwire_addon.stats().get("region_line_entries", 0)
+    assert drawn_by_pass == (0 if path == "direct" else mesh.region_line_count)
+
+
 @pytest.mark.parametrize("level, hidden_lines", [(3, False), (6, False), (6, True)])
 def test_the_edge_distance_pass_over_regions(level, hidden_lines, output_dir):
     """The Edge Distance pass needs d_real itself, not a line's intensity: a
@@ -710,22 +781,38 @@ def test_a_few_faces_of_their_own_are_listed_with_the_regions(output_dir, monkey
         assert any(variant.resolve and variant.no_edge_setup for variant in variants), name
 
 
-def test_peeled_hidden_layers_beside_faces_of_their_own(output_dir):
+@pytest.mark.parametrize("classed", [False, True])
+def test_peeled_hidden_layers_beside_faces_of_their_own(classed, output_dir):
     """A peeled mesh whose triangles are not all in multi-face regions: the
     flat grid's layers are peeled, the pillars' faces (regions of one face)
     still go through the direct hidden-line pass (a mesh with no such
-    triangle skips it)."""
+    triangle skips it), those with a classed edge too, which measure their
+    other edges themselves (edge_select.OWN_EDGES_MEASURED)."""
     from solidwire_addon.blender import runtime
     from solidwire_addon.core.view import DrawItem
 
-    scene = scenes.empty_scene(200, 150, use_cage_edges=False, edge_angle=math.radians(10.0), use_hidden_lines=True)
+    look = dict(use_sharp_edges=True, sharp_thickness=2.5, sharp_color=(0.0, 1.0, 0.0, 1.0)) if classed else {}
+    scene = scenes.empty_scene(
+        200, 150, use_cage_edges=False, edge_angle=math.radians(10.0), use_hidden_lines=True, **look
+    )
     # Seen from under the grid: the pillars lie behind it.
-    scenes.mesh_object(scene, "Pillars", _grid_with_pillars, rotation=(-1.1, 0.0, 0.4))
+    obj = scenes.mesh_object(scene, "Pillars", _grid_with_pillars, rotation=(-1.1, 0.0, 0.4))
+    if classed:  # one top edge of each of two thin pillars
+        edge_of_key = {key: index for index, key in enumerate(obj.data.edge_keys)}
+        tops = [
+            face
+            for face in obj.data.polygons
+            if all(abs(obj.data.vertices[v].co.z - 0.35) < 1e-4 for v in face.vertices)
+        ]
+        for top in tops[:2]:
+            obj.data.edges[edge_of_key[top.edge_keys[0]]].use_edge_sharp = True
     scenes.add_camera(scene, location=(0.0, -5.0, -0.5), target=(0.0, 0.0, 0.0))
-    report = accuracy.measure(scene, "regions_peeled_beside_own_faces", output_dir)
+    report = accuracy.measure(scene, f"regions_peeled_beside_own_faces{'_classed' if classed else ''}", output_dir)
     accuracy.assert_accurate(report)
     (mesh,) = runtime.mesh_cache.meshes()
     assert passes._peeled_items([DrawItem(mesh, np.eye(4))])
+    own = (mesh.edge_flags_cpu & edge_select.OWN_EDGES_MEASURED) == edge_select.OWN_EDGES_MEASURED
+    assert own.sum() == (2 * 2 * 2 if classed else 0)  # each marked edge's two faces, two triangles each
     # The thin pillars' faces, five each, two triangles each.
     assert mesh.region_sizes()[2] == 2 * 5 * len(PILLAR_FEET)
     assert mesh.region_sizes()[2] > edge_select.PLAIN_LISTED_SHARE * mesh.triangle_count

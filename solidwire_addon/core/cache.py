@@ -179,6 +179,7 @@ class GPUMesh:
         self._region_lines_cpu = arrays.region_lines
         self._region_line_runs_cpu = arrays.region_line_runs
         self.region_run_segments = arrays.region_run_segments
+        self.own_edges_measured = arrays.own_edges_measured
         # The runs of the wire (style 0): the first ones, as edge selection
         # writes the entries by style (draw.WIRE_RUNS).
         self.region_wire_runs = _wire_runs(arrays.region_line_runs, arrays.region_lines)

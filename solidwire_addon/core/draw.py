@@ -770,7 +770,10 @@ def _bind_mesh(shader, variant, mesh) -> None:
         # (A resolve whose lines all come from the region-lines image reads
         # no edge flags: the table is never made for it.)
         shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
-    if variant.ngons:
+    # (A face that measures its own edges reads its corners from its block,
+    # edge_select.OWN_EDGES_MEASURED, in every variant that sets up edges;
+    # a variant that reads no block does not have the sampler.)
+    if variant.ngons or (mesh.own_edges_measured and not (variant.no_edge_setup or variant.region_lines_pass)):
         shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
     if variant.uses_corners:
         shader.uniform_sampler("corner_table", mesh.corners)

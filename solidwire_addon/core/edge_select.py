@@ -94,6 +94,18 @@ PLAIN_LISTED_SHARE = 0.1
 # quad edges and n-gon outline are in its block, and its block's segment
 # count takes the bits from NGON_SHIFT up.
 LISTED_FACE_DROPS = HAS_QUAD_CORNER | IS_NGON | REGION_LINES | EDGE3_HIDDEN | EDGE4_HIDDEN | (-1 << NGON_SHIFT)
+# A listed triangle that keeps HAS_QUAD_CORNER measures its own edges as a
+# plain one does, all but those its block holds (_measures_own_edges: a
+# triangle or quad of its own with a classed edge, whose block holds the
+# classed edges alone; they are marked hidden but stay real,
+# _mark_edges_from_block). Its block starts with its face's corners, in the
+# texels of one segment (_face_corners: its quad's fourth corner is among
+# them, as the triangle's fourth column holds the block's start). Its
+# triangles' region is OWN_REGION_BASE - label, below NO_REGION: the
+# region-lines pass finds its classed lines there, and the hidden layers
+# leave it to the direct hidden-line pass, which walks its block.
+OWN_EDGES_MEASURED = IN_REGION | HAS_QUAD_CORNER
+OWN_REGION_BASE = -2.0
 
 
 @dataclass
@@ -422,23 +434,35 @@ def select_edges(
             np.concatenate(([0], np.cumsum(ngon_sizes)[:-1])),
         )
     styled_face = np.zeros(face_count, bool)
+    classed_corner = None
     if has_classes:
-        styled_face[corner_face[classes.take(corner_edge) != 0]] = True
+        classed_corner = classes.take(corner_edge) != 0
+        styled_face[corner_face[classed_corner]] = True
     walked = walked_region[label]
     # Faces listed on their own (a block of their own drawn edges, their
     # lines drawn by the region-lines pass): those with a classed edge, and
     # where nearly every face is listed anyway, the few plain ones too
-    # (_lists_plain_faces_too).
+    # (_lists_plain_faces_too). Otherwise the plain faces set up their own
+    # edges at every pixel anyway, and a triangle or quad with a classed
+    # edge measures its other edges itself (_measures_own_edges).
     alone = styled_face
     plain = ~walked & ~styled_face
+    measures_own = None
     if _lists_plain_faces_too(int(sizes.compress(plain).sum()) - 2 * int(plain.sum()), arrays.triangle_count):
         alone = styled_face | plain
+    elif has_classes and plain.any():
+        measures_own = _measures_own_edges(styled_face & ~walked, sizes)
+        if not measures_own.any():
+            measures_own = None
 
     # Drawn edges of each region whose lines are listed (unique (label,
     # edge) pairs, as one key, so sorted by region): those of multi-face
-    # regions and of the faces listed alone; a plain face needs none.
+    # regions and of the faces listed alone (of a face that measures its
+    # own, the classed ones alone); a plain face needs none.
     drawn_corner = drawn[corner_edge]
     lines_corner = drawn_corner & (walked | alone)[corner_face]
+    if measures_own is not None:
+        lines_corner &= classed_corner | ~measures_own[corner_face]
     keys = distinct(label[corner_face[lines_corner]] * edge_count + corner_edge[lines_corner])
     pairs = np.stack(np.divmod(keys, edge_count), axis=1)
     # A region too large to walk (see WALK_LIMIT): its faces' blocks hold
@@ -456,6 +480,11 @@ def select_edges(
     owner = np.where(own_block, face_count + faces, np.where(walked, label, -1))
 
     _mark_own_edges(arrays, verts, drawn, np.asarray(corner_vert), offsets, sizes, corner_edge)
+    if measures_own is not None:
+        own_rows = np.flatnonzero(measures_own[arrays.triangle_polygons])
+        _mark_edges_from_block(
+            arrays, own_rows, verts, drawn & (classes == 0), np.asarray(corner_vert), offsets, sizes, corner_edge
+        )
     listed_face = owner >= 0
     if not listed_face.any():
         return stats
@@ -482,6 +511,8 @@ def select_edges(
         face_owned = np.zeros(face_count, bool)
         face_owned[block_face[~from_region]] = True
         own_corner = face_owned[corner_face] & drawn_corner
+        if measures_own is not None:
+            own_corner &= classed_corner | ~measures_own[corner_face]
         # Unique (owner, edge) pairs, as one key: sorted by owner, then edge.
         own_keys = distinct((face_count + corner_face[own_corner]) * edge_count + corner_edge[own_corner])
         own = np.stack(np.divmod(own_keys, edge_count), axis=1)
@@ -505,10 +536,22 @@ def select_edges(
     chain_a = np.concatenate([chain_a, diag_a])
     chain_b = np.concatenate([chain_b, diag_b])
     seg_style = np.concatenate([seg_style, np.full(len(diag_a), DIAGONAL_STYLE)])
+    # A face that measures its own edges: its corners lead its block, in a
+    # slot of a segment's texels (written below).
+    corner_faces = np.zeros(0, np.int64) if measures_own is None else np.flatnonzero(measures_own)
+    head = np.zeros(len(seg_owner) + len(corner_faces), bool)
+    head[len(seg_owner) :] = True
+    seg_owner = np.concatenate([seg_owner, face_count + corner_faces])
+    seg_a, seg_b, chain_a, chain_b = (
+        np.append(x, np.zeros(len(corner_faces), np.int64)) for x in (seg_a, seg_b, chain_a, chain_b)
+    )
+    seg_style = np.append(seg_style, np.zeros(len(corner_faces), seg_style.dtype))
 
-    # Diagonals first in each block: a triangle whose lines come from the
-    # region-lines pass walks only that prefix (solidwire_frag.glsl).
-    order = np.lexsort((seg_style != DIAGONAL_STYLE, seg_owner))
+    # Diagonals first in each block (after a face's corners): a triangle
+    # whose lines come from the region-lines pass walks only that prefix
+    # (solidwire_frag.glsl).
+    order = np.lexsort((seg_style != DIAGONAL_STYLE, ~head, seg_owner))
+    head = head[order]
     seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style = (
         x[order] for x in (seg_owner, seg_a, seg_b, chain_a, chain_b, seg_style)
     )
@@ -523,6 +566,8 @@ def select_edges(
     table = np.zeros((TEXELS_PER_SEGMENT * len(seg_a), 4), dtype=np.float32)
     table[0::2, 0], table[0::2, 1], table[0::2, 2] = seg_a, seg_b, seg_style
     table[1::2, 0], table[1::2, 1] = chain_a, chain_b
+    if len(corner_faces):
+        table[0::2][head] = _face_corners(corner_faces, offsets, sizes, corner_vert)
     base = len(arrays.ngon_corners)  # region blocks follow the n-gon blocks in one table
     arrays.region_table = table
 
@@ -534,7 +579,9 @@ def select_edges(
     face_block = block_of_owner[owner]  # (meaningless where owner is -1: not listed)
     # Every listed face's lines can come from the region-lines pass
     # (REGION_LINES); its quad edges are in its block instead.
-    face_bits = (count[face_block].astype(np.int32) << NGON_SHIFT) | np.int32(IN_REGION | REGION_LINES)
+    # (A face that measures its own edges: its corners are no segment.)
+    segments = count[face_block] - (0 if measures_own is None else measures_own)
+    face_bits = (segments.astype(np.int32) << NGON_SHIFT) | np.int32(IN_REGION | REGION_LINES)
     face_start = (base + TEXELS_PER_SEGMENT * first[face_block]).astype(np.int32)
     polygons = arrays.triangle_polygons
     if listed_face.all():  # as with cage edges: plain slices, no mask to apply
@@ -544,13 +591,73 @@ def select_edges(
         listed_count = int(rows.sum())
         polygons = polygons[rows]
     flags = arrays.edge_flags
-    flags[rows] = (flags[rows] & ~LISTED_FACE_DROPS) | face_bits[polygons]
+    drops = np.int32(LISTED_FACE_DROPS)
+    if measures_own is None:
+        flags[rows] = (flags[rows] & ~drops) | face_bits[polygons]
+    else:
+        # Its own edges stay as marked; a triangle's two quad edges are none.
+        keeps = np.where(measures_own[polygons], np.int32(~(IS_NGON | REGION_LINES | (-1 << NGON_SHIFT))), ~drops)
+        own_bits = np.where(
+            measures_own[polygons] & (flags[rows] & HAS_QUAD_CORNER == 0), EDGE3_HIDDEN | EDGE4_HIDDEN, 0
+        )
+        flags[rows] = (
+            (flags[rows] & keeps)
+            | face_bits[polygons]
+            | own_bits
+            | np.where(measures_own[polygons], HAS_QUAD_CORNER, 0)
+        )
     arrays.triangles[rows, 3] = face_start[polygons]
+    arrays.own_edges_measured = measures_own is not None
     stats.regions = int(walked_region.sum())  # sizes are counted at each region's label only
     stats.listed_triangles = listed_count
-    stats.segments = len(seg_a)
-    _region_lines(arrays, verts, classes, ends, label, walked | alone, pairs, stats)
+    stats.segments = len(seg_a) - len(corner_faces)
+    _region_lines(arrays, verts, classes, ends, label, walked | alone, pairs, stats, measures_own)
     return stats
+
+
+def _measures_own_edges(styled_alone: np.ndarray, sizes: np.ndarray) -> np.ndarray:
+    """(F,) bool: the faces that measure their own edges (OWN_EDGES_MEASURED):
+    of ``styled_alone`` (faces of their own with a classed edge), the
+    triangles and quads. Their classed edges' lines come from their blocks
+    or, over the deferred surface, the region-lines pass; their other edges
+    they set up as a plain face does, which the resolve then does at every
+    pixel for the mesh's plain faces anyway, where drawing them as lines
+    of the pass cost more (the edge classes' F12 on llvmpipe). An n-gon's
+    outline stays in its block."""
+    return styled_alone & (sizes <= 4)
+
+
+def _face_corners(faces: np.ndarray, offsets: np.ndarray, sizes: np.ndarray, corner_vert) -> np.ndarray:
+    """(len(faces), 4) float32: the vertices of each triangle or quad of
+    ``faces`` in loop order (a triangle's second repeated last): what a
+    triangle of such a face reads its quad's fourth corner from, the one
+    corner that is not its own (solidwire_vert.glsl)."""
+    start = offsets[faces]
+    corner = np.stack([start, start + 1, start + 2, np.where(sizes[faces] == 4, start + 3, start + 1)], axis=1)
+    return np.asarray(corner_vert)[corner].astype(np.float32)
+
+
+def _mark_edges_from_block(
+    arrays: MeshArrays, rows: np.ndarray, verts, measured, corner_vert, offsets, sizes, corner_edge
+) -> None:
+    """For the triangle ``rows`` of faces that measure their own edges: the
+    edges whose lines their blocks hold (not ``measured``) marked hidden
+    as _mark_own_edges marks edges that are not drawn, but EDGEk_REAL kept:
+    they are polygon edges still (the silhouettes' candidates). The
+    fragment stage measures an own edge that is real and not hidden."""
+    if not len(rows):
+        return
+    part = replace(
+        arrays,
+        triangles=arrays.triangles[rows],
+        edge_flags=arrays.edge_flags[rows],
+        triangle_polygons=arrays.triangle_polygons[rows],
+        quad_flip=None,
+        ngon_corners=np.zeros(0, arrays.ngon_corners.dtype),
+    )
+    real = part.edge_flags & (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL)
+    _mark_rows_in_faces(part, verts, measured, corner_vert, offsets, sizes, corner_edge)
+    arrays.edge_flags[rows] = part.edge_flags | real
 
 
 def regions_from_layout(
@@ -1200,24 +1307,31 @@ def _one_per_class(bits: np.ndarray, *columns: np.ndarray):
     return style, tuple(column.take(row, axis=0) for column in columns)
 
 
-def _region_lines(arrays: MeshArrays, verts, classes, ends, label, lines_face, pairs, stats: SelectionStats) -> None:
+def _region_lines(
+    arrays: MeshArrays, verts, classes, ends, label, lines_face, pairs, stats: SelectionStats, measures_own=None
+) -> None:
     """The lines of the listed faces (``lines_face``: those of multi-face
     regions and faces with a classed edge) as a table of their own
     (``region_lines``, TEXELS_PER_REGION_LINE texels per entry) and each
-    triangle's region (``triangle_regions``, NO_REGION for a plain face). An
-    edge bounding two such regions is one entry naming both; a non-manifold
-    edge bounding more is one entry per pair; an edge in several classes is
-    one entry per class."""
-    region_of_face = np.where(lines_face, label, -1)
+    triangle's region (``triangle_regions``, NO_REGION for a plain face,
+    OWN_REGION_BASE - label for a face that measures its own edges,
+    ``measures_own``). An edge bounding two such regions is one entry naming
+    both; a non-manifold edge bounding more is one entry per pair; an edge
+    in several classes is one entry per class."""
+    value = label.astype(np.float32)
+    if measures_own is not None:
+        value[measures_own] = OWN_REGION_BASE - value[measures_own]
+    region_of_face = np.where(lines_face, value, NO_REGION)
     arrays.triangle_regions = region_of_face.astype(np.float32)[arrays.triangle_polygons]
     keep = lines_face[pairs[:, 0]] if len(pairs) else np.zeros(0, bool)
-    _region_line_table(arrays, verts, classes, ends, pairs[keep], stats)
+    _region_line_table(arrays, verts, classes, ends, pairs[keep], stats, None if measures_own is None else value)
 
 
-def _region_line_table(arrays: MeshArrays, verts, classes, ends, pairs, stats: SelectionStats) -> None:
+def _region_line_table(arrays: MeshArrays, verts, classes, ends, pairs, stats: SelectionStats, value=None) -> None:
     """``region_lines`` and its runs from the (region, drawn edge) pairs of
     the regions whose lines the region-lines pass draws (see _region_lines),
-    sorted by region. ``classes`` None: no edge has a class."""
+    sorted by region. ``classes`` None: no edge has a class. ``value``: what
+    the table names region k by (k itself where None)."""
     if not len(pairs):
         arrays.region_lines = arrays.region_line_runs = None
         return
@@ -1248,21 +1362,25 @@ def _region_line_table(arrays: MeshArrays, verts, classes, ends, pairs, stats: S
     # (_line_runs).
     order = np.argsort(style, kind="stable")
     style, edge, region, partner = style[order], edge[order], region[order], partner[order]
-    _write_region_lines(arrays, verts, ends, style, edge, region, partner, stats)
+    _write_region_lines(arrays, verts, ends, style, edge, region, partner, stats, value)
 
 
-def _write_region_lines(arrays: MeshArrays, verts, ends, style, edge, region, partner, stats: SelectionStats) -> None:
+def _write_region_lines(
+    arrays: MeshArrays, verts, ends, style, edge, region, partner, stats: SelectionStats, value=None
+) -> None:
     """``region_lines`` and its runs from its entries in table order: each
-    entry's style, edge, region and partner region (-1: none)."""
+    entry's style, edge, region and partner region (-1: none), each region
+    named by ``value`` (itself where None)."""
     table = np.zeros((TEXELS_PER_REGION_LINE * len(edge), 4), np.float32)
     edge_verts = np.take(verts, edge, axis=0)
     table[0::2, 0] = np.minimum(edge_verts[:, 0], edge_verts[:, 1])
     table[0::2, 1] = np.maximum(edge_verts[:, 0], edge_verts[:, 1])
     table[0::2, 2] = style
-    table[0::2, 3] = region
+    table[0::2, 3] = region if value is None else value.take(region)
     edge_ends = np.take(ends, edge, axis=0)
     table[1::2, 0], table[1::2, 1] = edge_ends[:, 0], edge_ends[:, 1]
-    table[1::2, 2] = np.where(partner >= 0, partner, NO_REGION)
+    named_partner = partner if value is None else value.take(np.maximum(partner, 0))
+    table[1::2, 2] = np.where(partner >= 0, named_partner, NO_REGION)
     arrays.region_lines = table
     arrays.region_line_runs, arrays.region_run_segments = _line_runs(edge_ends, style, region, partner)
     stats.region_lines = len(edge)
@@ -1335,6 +1453,21 @@ def _mark_own_edges(
         return
     if _mark_tri_and_quad_rows(arrays, drawn, offsets, sizes, corner_edge):
         return
+    _mark_rows_in_faces(arrays, verts, drawn, corner_vert, offsets, sizes, corner_edge)
+
+
+def _mark_rows_in_faces(
+    arrays: MeshArrays,
+    verts: np.ndarray,
+    drawn: np.ndarray,
+    corner_vert: np.ndarray,
+    offsets: np.ndarray,
+    sizes: np.ndarray,
+    corner_edge: np.ndarray,
+) -> None:
+    """_mark_own_edges for any rows: each row's corners found in its face
+    (or, where they are not its face's first four, its edges looked up by
+    vertex pair)."""
     vertex_count = np.int64(max(arrays.vertex_count, int(verts.max()) + 1))
     sorted_keys = []  # the hidden edges' vertex-pair keys, sorted on first use
 

@@ -90,6 +90,9 @@ class MeshArrays:
     # run holds (1, 2, 4 or 8).
     region_line_runs: np.ndarray = None
     region_run_segments: int = 1
+    # Some listed triangle measures its own edges and reads its quad's
+    # fourth corner from its block (edge_select.OWN_EDGES_MEASURED).
+    own_edges_measured: bool = False
     # Every n-gon is a region of its own (edge_select.select_edges): then,
     # where they are flat (ngons_flat), a triangle's own diagonals give its
     # n-gon's (draw._Part.variant). Their outlines: every n-gon's corner
