@@ -500,16 +500,21 @@ def test_cage_look_alike_on_every_path():
     _assert_matches_reference(scene, images[0][..., 3])
 
 
-def test_cage_look_with_classes_takes_each_lines_colour():
+@pytest.mark.parametrize("cage", [True, False])
+def test_cage_look_with_classes_takes_each_lines_colour(cage):
     """Edge classes on the cage look's regions in the viewport: the region
     lines carry each pixel's style beside its intensity (one packed depth
     value, shaders/edge_styles.glsl), so every solid sample takes the
     colour of the style the reference picks, drawn straight and from the
-    kept image alike."""
+    kept image alike. Without the cage look every face is its own region:
+    those with a classed edge measure their other edges themselves and the
+    region lines are the classed edges alone (edge_select.OWN_EDGES_MEASURED)."""
+    from solidwire_addon.core import edge_select
+
     scene = scenes.empty_scene(
         WIDTH,
         HEIGHT,
-        use_cage_edges=True,
+        use_cage_edges=cage,
         thickness=1.5,
         use_sharp_edges=True,
         sharp_thickness=3.0,
@@ -523,6 +528,9 @@ def test_cage_look_with_classes_takes_each_lines_colour():
     modifier.levels = modifier.render_levels = 3
     straight, stats = _draw(scene, [cube])
     assert _path(stats) == "surface_straight" and stats.get("region_line_entries", 0) > 0
+    (mesh,) = runtime.mesh_cache.meshes()
+    own = (mesh.edge_flags_cpu & edge_select.OWN_EDGES_MEASURED) == edge_select.OWN_EDGES_MEASURED
+    assert own.any() != cage
     kept, stats = _draw(scene, [cube])
     assert np.array_equal(straight, kept)
     _assert_matches_reference(scene, straight[..., 3])
