@@ -512,8 +512,10 @@ def test_faces_with_a_classed_edge_measure_their_other_edges(path, output_dir, m
     edge_of_key = {key: index for index, key in enumerate(obj.data.edge_keys)}
     faces_of_edge = np.bincount([edge_of_key[key] for face in obj.data.polygons for key in face.edge_keys])
     for edge in obj.data.edges:
-        edge.use_edge_sharp = edge.index % 7 == 0
-        edge.use_seam = edge.index % 11 == 3
+        if path == "hidden lines":  # two sharp edges and a seam, in front and behind
+            edge.use_edge_sharp, edge.use_seam = edge.index in (1, 6), edge.index == 9
+        else:
+            edge.use_edge_sharp, edge.use_seam = edge.index % 7 == 0, edge.index % 11 == 3
     classes_per_edge = [
         int(edge.use_edge_sharp) + int(edge.use_seam) + int(faces_of_edge[edge.index] == 1) for edge in obj.data.edges
     ]
@@ -534,8 +536,14 @@ def test_faces_with_a_classed_edge_measure_their_other_edges(path, output_dir, m
         assert np.abs(distance[near] - ref.d_real[near]).max() <= 2e-3
         assert (distance[covered & ~near] >= reach - 2e-3).all()
     else:
-        report = accuracy.measure(scene, f"classed_faces_{path.replace(' ', '_')}", output_dir)
+        name = f"classed_faces_{path.replace(' ', '_')}"
+        report = accuracy.measure(scene, name, output_dir)
         accuracy.assert_accurate(report)
+        rgba = scenes.load_png(output_dir / f"{name}.png")
+        solid = rgba[..., 3] > 0.5
+        green = solid & (rgba[..., 1] > 0.8) & (rgba[..., 0] < 0.2)
+        red = solid & (rgba[..., 0] > 0.8) & (rgba[..., 1] < 0.2)
+        assert green.sum() > 30 and red.sum() > 30  # both classes show
     (mesh,) = runtime.mesh_cache.meshes()
     # Every classed edge is drawn by the pass, once per class, and no other.
     assert mesh.region_line_count == sum(classes_per_edge) > (2 if path == "hidden lines" else 40)
