@@ -201,7 +201,9 @@ void own_edge_distances(vec2 p, out float d0, out float d1, out float d2, out fl
  * NO_EDGE unless it has them. */
 NearLines own_edge_lines(vec2 p, float half_thickness, bool listed)
 {
+#ifdef OWN_EDGES
   listed = listed && (triangle_flags & OWN_EDGES_MEASURED) != OWN_EDGES_MEASURED;
+#endif
   float d0, d1, d2, d3, d4;
   own_edge_distances(p, d0, d1, d2, d3, d4);
   NearLines found = no_lines();

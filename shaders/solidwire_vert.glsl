@@ -369,6 +369,7 @@ void main()
   bool is_quad = (edge_flags & HAS_QUAD_CORNER) != 0;
   bool is_ngon = (edge_flags & IS_NGON) != 0;
   ngon_corner_start = int(ids.w);
+#ifdef OWN_EDGES
   if ((edge_flags & OWN_EDGES_MEASURED) == OWN_EDGES_MEASURED) {
     /* Its face's corners lead its block: its quad's 4th corner is the one
      * that is not its own (a triangle face repeats one of its own, whose
@@ -386,6 +387,7 @@ void main()
     }
     ngon_corner_start += SEGMENT_TEXELS;
   }
+#endif
 #ifdef SETUP_TABLE
   bool simple = read_setup_table(triangle, ids, is_quad, is_ngon);
   vec3 local = fetch_texel(vertex_positions, int(vertex_id)).xyz;

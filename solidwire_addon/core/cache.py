@@ -186,7 +186,7 @@ class GPUMesh:
         # Every triangle takes its lines from the region-lines pass and
         # there is no n-gon (a cage look): a resolve that reads the pass's
         # image sets up no triangle edge (ShaderVariant.no_edge_setup).
-        self.lines_only_from_region_pass = every_triangle_region_lines
+        self.lines_only_from_region_pass = every_triangle_region_lines and not arrays.own_edges_measured
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
         self._region_sizes = None  # (region lines, region_sizes()), made on first use

@@ -612,6 +612,7 @@ class _Part:
     lines_from_image_only: bool = False  # every triangle's lines come from the region-lines pass
     ngon_diagonals: bool = False  # blocks hold listed n-gons' diagonals (walked where they show, see variant)
     flat_ngons_alone: bool = False  # every n-gon is a region of its own and flat (asked where diagonals show)
+    own_edges: bool = False  # some listed faces measure their own edges (edge_select.OWN_EDGES_MEASURED)
 
     def variant(self, variant):
         """``variant`` for this part. The visibility and region-lines passes
@@ -641,6 +642,7 @@ class _Part:
             in_front=self.in_front and not variant.visibility,
             attribute_colors=variant.attribute_colors and self.colored and not plain_stage,
             run_segments=self.run_segments if variant.region_lines_pass else 1,
+            own_edges=self.own_edges and not plain_stage,
         )
         if (
             self.lines_from_image_only
@@ -655,7 +657,7 @@ class _Part:
         if lines_elsewhere and variant.edge_classes:
             part_variant = replace(part_variant, edge_classes=False, style_colors=True)
         if variant.no_lines:
-            part_variant = replace(part_variant, ngons=False, setup_table=False, no_edge_setup=True)
+            part_variant = replace(part_variant, ngons=False, setup_table=False, no_edge_setup=True, own_edges=False)
         return part_variant
 
 
@@ -688,6 +690,7 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False) ->
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
             ngon_diagonals=getattr(mesh, "blocks_hold_ngon_diagonals", False),
             flat_ngons_alone=diagonals_shown and getattr(mesh, "ngons_alone", False) and mesh.ngons_flat(),
+            own_edges=getattr(mesh, "own_edges_measured", False),
         )
         parts.setdefault(part, []).append(g)
     return parts
@@ -770,10 +773,7 @@ def _bind_mesh(shader, variant, mesh) -> None:
         # (A resolve whose lines all come from the region-lines image reads
         # no edge flags: the table is never made for it.)
         shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
-    # (A face that measures its own edges reads its corners from its block,
-    # edge_select.OWN_EDGES_MEASURED, in every variant that sets up edges;
-    # a variant that reads no block does not have the sampler.)
-    if variant.ngons or (mesh.own_edges_measured and not (variant.no_edge_setup or variant.region_lines_pass)):
+    if variant.ngons or variant.own_edges:  # (OWN_EDGES: a quad's 4th corner is in its block)
         shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
     if variant.uses_corners:
         shader.uniform_sampler("corner_table", mesh.corners)

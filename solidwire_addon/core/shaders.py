@@ -161,6 +161,12 @@ class ShaderVariant:
     # line comes from the region-lines pass) but colours the winning style:
     # the class colours without the per-style distance code (STYLE_COLORS).
     style_colors: bool = False
+    # The mesh has faces that measure their own edges beside a block of
+    # classed ones (core/edge_select.py OWN_EDGES_MEASURED): the vertex
+    # stage reads such a quad's 4th corner from its block (OWN_EDGES);
+    # other meshes get a variant without that code, which a CPU rasteriser
+    # would run at every corner or resolved pixel, branch or not.
+    own_edges: bool = False
     # The ATTRIBUTE fill source for a mesh that has a colour attribute: the
     # fill is its colours, interpolated over each triangle (ATTRIBUTE_COLORS).
     attribute_colors: bool = False
@@ -437,6 +443,10 @@ def _create_info(variant: ShaderVariant):
     info.define("STYLE_COUNT", str(schema.STYLE_COUNT if variant.edge_classes else 1))
     if variant.style_colors:
         info.define("STYLE_COLORS", "1")
+    if variant.own_edges:
+        if variant.no_edge_setup:
+            raise ValueError("a variant that sets up no edge measures none of its own")
+        info.define("OWN_EDGES", "1")
     if variant.density_fade:
         info.define("USE_DENSITY_FADE", "1")
     if variant.write_aovs:
