@@ -596,16 +596,11 @@ def select_edges(
         flags[rows] = (flags[rows] & ~drops) | face_bits[polygons]
     else:
         # Its own edges stay as marked; a triangle's two quad edges are none.
-        keeps = np.where(measures_own[polygons], np.int32(~(IS_NGON | REGION_LINES | (-1 << NGON_SHIFT))), ~drops)
-        own_bits = np.where(
-            measures_own[polygons] & (flags[rows] & HAS_QUAD_CORNER == 0), EDGE3_HIDDEN | EDGE4_HIDDEN, 0
-        )
-        flags[rows] = (
-            (flags[rows] & keeps)
-            | face_bits[polygons]
-            | own_bits
-            | np.where(measures_own[polygons], HAS_QUAD_CORNER, 0)
-        )
+        own, before = measures_own[polygons], flags[rows]
+        keeps = np.where(own, np.int32(~(IS_NGON | REGION_LINES | (-1 << NGON_SHIFT))), ~drops)
+        triangle_face = own & (before & HAS_QUAD_CORNER == 0)
+        own_bits = np.where(own, HAS_QUAD_CORNER, 0) | np.where(triangle_face, EDGE3_HIDDEN | EDGE4_HIDDEN, 0)
+        flags[rows] = (before & keeps) | face_bits[polygons] | own_bits
     arrays.triangles[rows, 3] = face_start[polygons]
     arrays.own_edges_measured = measures_own is not None
     stats.regions = int(walked_region.sum())  # sizes are counted at each region's label only
