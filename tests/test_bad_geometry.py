@@ -65,6 +65,15 @@ def _all_nonfinite(scene, name, loc):
     return _mesh_object(scene, name, verts, [], faces, loc)
 
 
+def _nan_misleading_bound_box(scene, name, loc):
+    # Blender 5.0's bound box of this mesh is finite but wrong: x in [40, 40],
+    # out of view, while the healthy triangle at the origin is in view (4.2's
+    # is right). The box must not cull the object before extraction.
+    verts = [(-0.6, 0.0, -0.5), (0.6, 0.0, -0.5), (0.0, 0.0, 0.6), (NAN, 0.0, 0.0)]
+    verts += [(40.0, 0.0, 0.0), (40.0, 0.0, 1.0), (40.0, 0.0, 2.0)]
+    return _mesh_object(scene, name, verts, [], [(0, 1, 2), (3, 4, 5, 6)], loc)
+
+
 def _zero_area(scene, name, loc):
     # Distinct vertices on one line, and a quad whose corners coincide in
     # pairs: zero area, never visible (SPEC 1.2).
@@ -100,6 +109,7 @@ def _huge_far_away(scene, name, loc):
 CASES = {
     "nan_and_inf_vertices": (_nonfinite, "non-finite", True),
     "all_vertices_nan": (_all_nonfinite, "non-finite", False),
+    "nan_vertex_misleads_bound_box": (_nan_misleading_bound_box, "non-finite", True),
     "zero_area_faces": (_zero_area, None, False),
     "face_uses_vertex_twice": (_repeated_vertex, "uses one vertex twice", True),
     "loose_edges_and_vertices_only": (_loose_only, "no faces", False),
@@ -177,6 +187,25 @@ def test_overlay_with_every_bad_object(capfd):
     for case, (_build, message, _draws) in CASES.items():
         said = robustness.lines_of(err.out + err.err, f"'Overlay_{case}'")
         assert len(said) == (1 if message else len(said)) and len(said) <= 1, (case, said)
+
+
+def test_a_wrong_bound_box_does_not_cull_a_mesh_with_a_nan_vertex(output_dir, monkeypatch):
+    """Whatever box Blender reports for a mesh with a non-finite vertex (some
+    versions report a finite box that misses finite vertices), the object is
+    culled before extraction only by the box of its finite vertices."""
+    from solidwire_addon.blender import gather
+    from solidwire_addon.blender import runtime as addon_runtime
+
+    scene, location = _base_scene()
+    without = robustness.render_exr(scene, output_dir / "wrong_box_without.exr")
+    _nan_misleading_bound_box(scene, "Misleading", location)
+    out_of_view = (np.array([40.0, 0.0, -0.5]), np.array([40.0, 0.0, 2.0]))
+    monkeypatch.setattr(gather, "_bound_box", lambda obj: out_of_view if obj.name == "Misleading" else None)
+    image = robustness.render_exr(scene, output_dir / "wrong_box.exr")
+    assert addon_runtime.stats()["objects_culled"] == 0
+    assert (image[..., 3] > 0.5).sum() > (without[..., 3] > 0.5).sum() + 20, "the in-view triangle is missing"
+    report = reference.error_report(image[..., 3].astype(np.float64), reference.render_reference(scene))
+    accuracy.assert_accurate(report)
 
 
 def test_a_face_with_a_nan_corner_is_dropped_whole():
