@@ -208,6 +208,32 @@ def test_a_wrong_bound_box_does_not_cull_a_mesh_with_a_nan_vertex(output_dir, mo
     accuracy.assert_accurate(report)
 
 
+def test_the_viewport_culls_a_mesh_with_a_nan_vertex_by_its_finite_vertices():
+    """The viewport extracts every mesh and culls at draw time by the box of
+    the vertices it draws: out of view, a mesh with a NaN vertex is culled at
+    every redraw; once an edit moves its triangle into view (Blender's box
+    may still say otherwise), the next redraw draws it."""
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+
+    scene, location = _base_scene()
+    ensure_gpu()
+    viewport = robustness.Viewport(W, H)
+    _stats, without = viewport.draw(scene)
+    in_view = [(-0.6, 0.0, -0.5), (0.6, 0.0, -0.5), (0.0, 0.0, 0.6)]
+    away = [(x + 40.0, y, z) for x, y, z in in_view]
+    verts = [*away, (NAN, 0.0, 0.0), (40.0, 0.0, 0.0), (40.0, 0.0, 1.0), (40.0, 0.0, 2.0)]
+    obj = _mesh_object(scene, "Away", verts, [], [(0, 1, 2), (3, 4, 5, 6)], location)
+    for _redraw in range(2):
+        stats, image = viewport.draw(scene)
+        assert stats["objects_culled"] == 1 and np.array_equal(image, without)
+    for vertex, co in zip(obj.data.vertices, in_view):
+        vertex.co = co
+    obj.data.update()
+    stats, image = viewport.draw(scene)
+    assert stats["objects_culled"] == 0
+    assert (image > 0.5).sum() > (without > 0.5).sum() + 20, "the triangle moved into view is missing"
+
+
 def test_a_face_with_a_nan_corner_is_dropped_whole():
     """A quad with one NaN corner: both its triangles go (a kept half would
     draw edges to a corner that has no position)."""

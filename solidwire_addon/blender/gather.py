@@ -381,7 +381,7 @@ class _FrameGather:
                     if self.view_projection is not None and key not in self.cache:
                         box = _bound_box(obj)
                         if box is not None and _outside(self.view_projection, instance, box):
-                            box = self._checked_box(obj, data, pointer, key, uids, box)
+                            box = self._checked_box(obj, data, box)
                         if box is not None and _outside(self.view_projection, instance, box):
                             self.deferred[pointer] = (key, uids, box, 1)
                             return None
@@ -396,31 +396,26 @@ class _FrameGather:
             self.by_pointer[pointer] = mesh
         return self.by_pointer[pointer]
 
-    def _checked_box(self, obj, data, pointer, key, uids, box):
+    @staticmethod
+    def _checked_box(obj, data, box):
         """``box`` (Blender's bound box, which would cull the object unseen)
         checked against the vertices: with a non-finite vertex Blender's box
         can be finite and still miss the finite ones, which are drawn. Then
         the box of the finite vertices; None (do not cull) when there are
-        none, so extraction reports the object. The viewport checks a mesh
-        once per geometry update."""
-        token = _trust_token(self.trust, self.versions, pointer, uids)
-        if token is not None:
-            checked = runtime.checked_boxes.get(key)
-            if checked is not None and checked[0] == token:
-                return checked[1]
+        none, so extraction reports the object. Only renders cull before
+        extraction, and only an object off-screen is checked: one read of its
+        positions (about 2 ms per million vertices on the 2-core VM), a
+        small part of what extracting it would cost."""
         if obj.original.mode == "EDIT":
             return box  # the evaluated mesh can be an empty wrapper (see _mesh_for)
         try:
             positions = mesh_reading.read_positions(data)
         except (AttributeError, RuntimeError, ValueError):
             return None
-        finite = np.isfinite(positions).all(axis=1)
-        if not finite.all():
-            drawn = positions[finite].astype(np.float64)
-            box = (drawn.min(axis=0), drawn.max(axis=0)) if len(drawn) else None
-        if token is not None:
-            runtime.checked_boxes[key] = (token, box)
-        return box
+        if np.isfinite(positions).all():
+            return box
+        drawn = positions[np.isfinite(positions).all(axis=1)].astype(np.float64)
+        return (drawn.min(axis=0), drawn.max(axis=0)) if len(drawn) else None
 
     def _key(self, obj, pointer, parent):
         key, uids = _key_for(obj, pointer, parent, self.mode, self.key_pointer, self.instancer_meshes)
@@ -554,15 +549,6 @@ def _outside(view_projection, instance, box) -> bool:
     return bool(outside_frustum_many(object_to_clip[None], *box)[0])
 
 
-def _trust_token(trust, versions, pointer, uids):
-    """What a viewport mesh's cached state is valid for (None in renders,
-    which fingerprint content instead; see runtime.py): the depsgraph and
-    epoch, the evaluated mesh and the geometry updates of its IDs."""
-    if trust is None:
-        return None
-    return (*trust, pointer, *(versions.get(uid, 0) for uid in uids))
-
-
 def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):
     """(cache key, session_uids whose geometry updates invalidate it)."""
     obj_orig = obj.original
@@ -608,7 +594,9 @@ def _mesh_for(
     says a mask is passed), not the cage's; ``allow_reposition`` False
     extracts a mesh whose shape changed in full."""
     obj_orig = obj.original
-    fast = _trust_token(trust, versions, pointer, uids)
+    fast = None
+    if trust is not None:
+        fast = (*trust, pointer, *(versions.get(uid, 0) for uid in uids))
 
     in_edit_mode = obj_orig.mode == "EDIT"
     start = time.perf_counter()

@@ -38,9 +38,6 @@ _last_stats: dict = {}
 
 geometry_version: dict[int, int] = {}  # session_uid -> geometry updates seen
 epoch = 0  # bumped by frame changes, undo/redo and file loads
-# Cull boxes checked against the vertices (blender/gather.py): cache key ->
-# (the viewport's trust token it was checked under, the box).
-checked_boxes: dict[tuple, tuple] = {}
 # What the entry points Blender calls (the render engine, the overlay's draw
 # handler) draw with: they take no arguments of ours, so they read this once
 # per frame and hand it down (core/options.py). The shipped defaults;
@@ -74,7 +71,6 @@ def _on_load(*_args) -> None:
     epoch += 1
     mesh_cache.clear()
     geometry_version.clear()
-    checked_boxes.clear()
 
 
 _HANDLERS = (
@@ -161,7 +157,6 @@ def release() -> None:
     remove_handlers()
     mesh_cache.clear()
     geometry_version.clear()
-    checked_boxes.clear()
     _last_stats.clear()
 
 
