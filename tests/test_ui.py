@@ -306,6 +306,22 @@ def test_fade_range_from_visible_objects():
     assert (props.fade_start, props.fade_end) == pytest.approx((5.0, 17.0), abs=1e-4)
 
 
+def test_fade_range_takes_the_finite_vertices_of_a_mesh_with_a_nan_vertex():
+    """Blender's box of a mesh with a NaN vertex can be finite and miss
+    vertices (Blender 5.0 gives this one depth 16 alone); the fade range
+    spans its finite vertices."""
+    scene = scenes.empty_scene()
+    scenes.add_camera(scene, location=(0.0, -10.0, 0.0), target=(0.0, 0.0, 0.0))
+    nan = float("nan")
+    verts = [(-1.0, -4.0, -1.0), (1.0, -4.0, -1.0), (0.0, -4.0, 1.0), (0.0, nan, 0.0)]
+    verts += [(0.0, 6.0, 0.0), (1.0, 6.0, 0.0), (0.0, 6.0, 1.0)]
+    mesh = bpy.data.meshes.new("Broken")
+    mesh.from_pydata(verts, [], [(0, 1, 2), (3, 4, 5, 6)])
+    scene.collection.objects.link(bpy.data.objects.new("Broken", mesh))
+    assert bpy.ops.solidwire.fade_from_visible() == {"FINISHED"}
+    assert (scene.solidwire.fade_start, scene.solidwire.fade_end) == pytest.approx((6.0, 16.0), abs=1e-4)
+
+
 def _two_viewports():
     """A screen of the factory file with two 3D Views (Animation workspace)."""
     screen = bpy.data.screens["Animation"]

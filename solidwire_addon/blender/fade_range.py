@@ -7,6 +7,8 @@ from __future__ import annotations
 import bpy
 import numpy as np
 
+from . import mesh_reading
+
 
 def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
     """(nearest, farthest) view depth of the bounding boxes of the drawn mesh
@@ -16,6 +18,7 @@ def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
     (start, end) = extent fades from the nearest object to the farthest."""
     view = np.asarray(view_matrix, dtype=np.float64)
     depths = []
+    boxes = {}  # evaluated mesh -> the box of its drawn vertices
     for instance in depsgraph.object_instances:
         obj = instance.object
         if obj.type != "MESH":
@@ -23,8 +26,15 @@ def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
         owner = instance.parent if instance.is_instance and instance.parent is not None else obj
         if object_filter is not None and not object_filter(owner.original):
             continue
+        pointer = obj.data.as_pointer()
+        if pointer not in boxes:  # (read once per mesh, however many instances draw it)
+            box = np.array(obj.bound_box, dtype=np.float64)
+            boxes[pointer] = mesh_reading.finite_vertex_box(obj, (box.min(axis=0), box.max(axis=0)))
+        box = boxes[pointer]
+        if box is None:
+            continue
         corners = np.ones((8, 4))
-        corners[:, :3] = np.array(obj.bound_box, dtype=np.float64)
+        corners[:, :3] = [[box[(k >> axis) & 1][axis] for axis in range(3)] for k in range(8)]
         world = corners @ np.array(instance.matrix_world, dtype=np.float64).T
         depths.append(-(world @ view[2]))
     if not depths:

@@ -381,7 +381,9 @@ class _FrameGather:
                     if self.view_projection is not None and key not in self.cache:
                         box = _bound_box(obj)
                         if box is not None and _outside(self.view_projection, instance, box):
-                            box = self._checked_box(obj, data, box)
+                            # Only an off-screen object pays for the check: a
+                            # small part of what extracting it would cost.
+                            box = mesh_reading.finite_vertex_box(obj, box)
                         if box is not None and _outside(self.view_projection, instance, box):
                             self.deferred[pointer] = (key, uids, box, 1)
                             return None
@@ -395,27 +397,6 @@ class _FrameGather:
                 )
             self.by_pointer[pointer] = mesh
         return self.by_pointer[pointer]
-
-    @staticmethod
-    def _checked_box(obj, data, box):
-        """``box`` (Blender's bound box, which would cull the object unseen)
-        checked against the vertices: with a non-finite vertex Blender's box
-        can be finite and still miss the finite ones, which are drawn. Then
-        the box of the finite vertices; None (do not cull) when there are
-        none, so extraction reports the object. Only renders cull before
-        extraction, and only an object off-screen is checked: one read of its
-        positions (about 2 ms per million vertices on the 2-core VM), a
-        small part of what extracting it would cost."""
-        if obj.original.mode == "EDIT":
-            return box  # the evaluated mesh can be an empty wrapper (see _mesh_for)
-        try:
-            positions = mesh_reading.read_positions(data)
-        except (AttributeError, RuntimeError, ValueError):
-            return None
-        if np.isfinite(positions).all():
-            return box
-        drawn = positions[np.isfinite(positions).all(axis=1)].astype(np.float64)
-        return (drawn.min(axis=0), drawn.max(axis=0)) if len(drawn) else None
 
     def _key(self, obj, pointer, parent):
         key, uids = _key_for(obj, pointer, parent, self.mode, self.key_pointer, self.instancer_meshes)
