@@ -153,6 +153,45 @@ void write_linear_depth()
 #endif
 }
 
+#if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
+/* A hidden layer is a face behind the visible face F, never F itself
+ * (docs/image_model.md §5.4). A folded quad's two triangles can both cover
+ * a pixel: where the other one (solidwire_vert.glsl, partner_outputs) covers this
+ * pixel nearer than this one, this fragment takes its depth there, a hair
+ * nearer still, so the GREATER test drops it exactly where that triangle
+ * is the surface, and keeps it where something else hides both. */
+void leave_out_the_visible_face()
+{
+#  ifndef LINEAR_DEPTH
+  gl_FragDepth = gl_FragCoord.z;
+#  endif
+  if (partner0.z == 0.0) {
+    return; /* not a quad's triangle, or a corner behind the near plane */
+  }
+  vec2 p = gl_FragCoord.xy, a = partner0.xy, ab = partner2.xy - a, ac = partner3.xy - a;
+  float area = ab.x * ac.y - ab.y * ac.x;
+  if (area == 0.0) {
+    return;
+  }
+  vec2 ap = p - a;
+  float u = (ap.x * ac.y - ap.y * ac.x) / area, v = (ab.x * ap.y - ab.y * ap.x) / area;
+  if (u < 0.0 || v < 0.0 || u + v > 1.0) {
+    return; /* the other triangle does not cover this pixel */
+  }
+  vec3 weights = vec3(1.0 - u - v, u, v);
+  float depth = dot(weights, vec3(partner0.w, partner2.w, partner3.w)) /
+                dot(weights, vec3(partner0.z, partner2.z, partner3.z));
+  if (!(depth < view_depth)) {
+    return;
+  }
+#  ifdef LINEAR_DEPTH
+  gl_FragDepth = depth * params.inv_clip_end * (1.0 - PARTNER_DEPTH_HAIR);
+#  else
+  gl_FragDepth = min(dot(weights, partner_window_depth) - PARTNER_DEPTH_HAIR, gl_FragCoord.z);
+#  endif
+}
+#endif
+
 /* Squared distances from window point p to the five candidate edges. */
 void own_edge_distances(vec2 p, out float d0, out float d1, out float d2, out float d3, out float d4)
 {
@@ -502,6 +541,9 @@ void main()
 #endif
 {
   write_linear_depth();
+#if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
+  leave_out_the_visible_face();
+#endif
   if (outside_clip_region()) {
     discard;
   }

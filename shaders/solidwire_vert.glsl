@@ -344,6 +344,41 @@ vec4 biased(vec4 position)
   return position;
 }
 
+#if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
+/* A corner of the other triangle of this one's quad, for the fragment
+ * stage's test of whether that triangle is the surface (solidwire_frag.glsl,
+ * leave_out_the_visible_face): its window position, 1/w and view depth / w
+ * (both affine in window space, so interpolated there they give the view
+ * depth perspective-correctly, in either projection), and its window depth
+ * as the depth test sees it (with the overlay's bias). */
+vec4 partner_corner(vec4 clip, float id, out float window_depth)
+{
+  vec2 window = (clip.xy / clip.w) * (0.5 * params.viewport.zw) + params.viewport.xy + 0.5 * params.viewport.zw;
+  float depth = -dot(object_to_view_z, vec4(fetch_texel(vertex_positions, int(id)).xyz, 1.0));
+  window_depth = 0.5 * (biased(clip).z / clip.w) + 0.5;
+  return vec4(window, 1.0 / clip.w, depth / clip.w);
+}
+
+/* The other triangle of a quad (corners 0, 2 and the 4th: the diagonal is
+ * edge 2), where all three lie in front of the near plane; a zero 1/w marks
+ * none. Only a folded quad's two triangles can cover one pixel. */
+void partner_outputs(vec4 ids, bool is_quad)
+{
+  partner0 = partner2 = partner3 = vec4(0.0);
+  partner_window_depth = vec3(0.0);
+  if (!is_quad) {
+    return;
+  }
+  vec4 a = vertex_clip(ids.x), b = vertex_clip(ids.z), c = vertex_clip(ids.w);
+  if (min(min(a.z + a.w, b.z + b.w), c.z + c.w) < 0.0 || min(min(a.w, b.w), c.w) <= 0.0) {
+    return;
+  }
+  partner0 = partner_corner(a, ids.x, partner_window_depth.x);
+  partner2 = partner_corner(b, ids.z, partner_window_depth.y);
+  partner3 = partner_corner(c, ids.w, partner_window_depth.z);
+}
+#endif
+
 /* The per-corner work. The resolve pass (resolve_frag.glsl) runs it too,
  * for the provoking corner of the triangle a pixel shows, with
  * SW_VERTEX_ID standing for gl_VertexID and every output a plain global. */
@@ -412,6 +447,9 @@ void main()
   render_pass_outputs(triangle, ids);
 #endif
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
+#if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
+  partner_outputs(ids, is_quad);
+#endif
   fill_outputs(triangle, corner, vertex_id);
 #ifdef USE_CLIP_PLANES
   clip_distances(position); /* (before the depth bias, which moves only z) */

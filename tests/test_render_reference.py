@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+import bpy
 import numpy as np
 import pytest
 
@@ -289,6 +290,61 @@ def test_hidden_lines_match_reference(fill, output_dir):
     without = reference.render_reference(scene, settings=_Override(scene.solidwire, use_hidden_lines=False))
     extra = ref.intensity - without.intensity
     assert (extra > 0.2).sum() > 100
+
+
+def _folded_quad_scene(occluded: bool):
+    """One quad folded along its diagonal (0, 2) and seen from the side the
+    fold opens to: its nearer triangle hides part of its farther one.
+    ``occluded``: a card in front hides part of both."""
+    scene = scenes.empty_scene(120, 90, use_hidden_lines=True, hidden_alpha=0.5, hidden_period=6.0)
+    verts = [(-0.8, 0.0, 0.0), (0.0, -1.0, 0.0), (0.8, 0.0, 0.0), (0.0, 1.0, 0.5)]
+    obj = scenes.from_pydata(scene, "Fold", verts, [(0, 1, 2, 3)])
+    if occluded:
+        card = [(-0.15, 3.0, 0.45), (0.3, 3.0, 0.45), (0.3, 3.0, 0.8), (-0.15, 3.0, 0.8)]
+        scenes.from_pydata(scene, "Card", card, [(0, 1, 2, 3)])
+    scenes.add_camera(scene, location=(0.0, 6.0, 1.0), target=(0.0, 0.0, 0.1))
+    triangles = [
+        tuple(t.vertices) for t in obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles
+    ]
+    assert sorted(triangles) == [(0, 1, 2), (0, 2, 3)], triangles
+    # Folded on screen: corners 1 and 3 on the same side of the diagonal.
+    from bpy_extras.object_utils import world_to_camera_view
+
+    seen = [world_to_camera_view(scene, scene.camera, obj.matrix_world @ v.co).xy for v in obj.data.vertices]
+    side = [(seen[2] - seen[0]).cross(seen[k] - seen[0]) for k in (1, 3)]
+    assert side[0] * side[1] > 0.0
+    return scene
+
+
+@pytest.mark.parametrize("occluded", [False, True], ids=["open", "behind_a_card"])
+@pytest.mark.parametrize("path", ["deferred", "direct", "overlay"])
+def test_a_folded_quad_is_no_hidden_layer_of_itself(path, occluded, output_dir, monkeypatch):
+    """Under hidden lines a face behind the visible face is drawn as a
+    layer, never the visible face itself (image model §5.4): where a folded
+    quad's nearer triangle is the surface, its farther triangle draws
+    nothing (the open fold has no hidden line at all); where a card hides
+    both, both are layers."""
+    from solidwire_addon.blender import runtime
+    from solidwire_addon.core.options import DrawOptions
+
+    scene = _folded_quad_scene(occluded)
+    ref = reference.render_reference(scene)
+    without = reference.render_reference(scene, settings=_Override(scene.solidwire, use_hidden_lines=False))
+    hidden_pixels = int((np.abs(ref.intensity - without.intensity) > 0.05).sum())
+    assert hidden_pixels > 50 if occluded else hidden_pixels == 0
+    if path == "overlay":
+        from solidwire_addon.blender.gpu_context import ensure_gpu
+        from tests.support import robustness
+
+        ensure_gpu()
+        _stats, alpha = robustness.Viewport(120, 90).draw(scene)
+    else:
+        monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=path == "deferred"))
+        name = f"folded_quad_{path}_{'behind_a_card' if occluded else 'open'}"
+        alpha = scenes.render_to_file(scene, output_dir / f"{name}.png")[..., 3]
+    report = reference.error_report(alpha, ref)
+    print(report)
+    accuracy.assert_accurate(report)
 
 
 class _Override:

@@ -366,6 +366,11 @@ def _create_info(variant: ShaderVariant):
             iface.flat("VEC4", f"segment_line{i}")  # line xyz, span.x
             iface.flat("VEC4", f"segment_rest{i}")  # span.y, style, chain length, -
     iface.smooth("FLOAT", "view_depth")
+    if variant.hidden_pass and not variant.resolve:
+        # The other triangle of a quad's (solidwire_frag.glsl, leave_out_the_visible_face).
+        for name in ("partner0", "partner2", "partner3"):
+            iface.flat("VEC4", name)
+        iface.flat("VEC3", "partner_window_depth")
 
     info = pulling_info(push_matrices=not variant.instanced)
     if variant.instanced:
@@ -427,6 +432,14 @@ def _create_info(variant: ShaderVariant):
         info.define("ALL_IN_FRONT", "1")
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
+        # How much nearer than a quad's other triangle a fragment behind it
+        # writes its depth: relative in view depth, absolute in window depth
+        # (a few steps of a 24-bit buffer); far above the rounding of the two
+        # interpolations, far below any real gap.
+        info.define("PARTNER_DEPTH_HAIR", "1.0e-5" if variant.linear_depth else "2.0e-7")
+        if not variant.linear_depth:
+            # It only ever writes a nearer depth than its own.
+            compat.depth_write(info, "LESS")
     if variant.region_layers_peeled:
         if not variant.hidden_pass or variant.resolve:
             raise ValueError("only the direct hidden-line pass leaves the peeled region layers out")
