@@ -748,13 +748,22 @@ def _rays(inv_proj, proj, px, py, width, height):
 # A triangle whose facing |det| is within this fraction of its scale is seen
 # edge-on as far as float32 can tell (back-face culling may go either way).
 FACING_TOLERANCE = 1e-5
+# Barycentric slack of the near misses _hidden_edge_samples looks at: a
+# sample 0.01 px outside a triangle lies 0.01 / (its size in px) outside in
+# barycentrics, so this holds every such sample of a triangle 0.04 px across
+# or larger (smaller ones are slivers, flagged whole); each is then measured
+# in window space.
+NEAR_MISS_BARYCENTRIC = 0.25
 
 
-def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None, centre_hit=None):
+def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None, centre_hit=None, near_misses=None):
     """Nearest face for the sample of each pixel of ``rows`` and its 4 offsets.
 
     With a list as ``all_hits``, every hit of the centre sample is appended
-    to it as (pixel, depth, face) arrays (hidden-line style). With a dict as
+    to it as (pixel, depth, face, triangle) arrays (hidden-line style); with
+    a list as ``near_misses``, so is every triangle whose plane the centre
+    ray meets just outside it (barycentrics within NEAR_MISS_BARYCENTRIC;
+    _hidden_edge_samples measures how far in pixels). With a dict as
     ``centre_hit``, it receives the centre sample's triangle, barycentric
     (u, v) and whether its front side is seen ("tri", "u", "v", "front")."""
     inv_proj = np.linalg.inv(proj)
@@ -839,6 +848,11 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
             if s == 0 and all_hits is not None:
                 all_hits.append((h_pix, h_depth, h_face, pair_tri[hit]))
+            if s == 0 and near_misses is not None:
+                slack = NEAR_MISS_BARYCENTRIC
+                miss = ok & ~inside & (u >= -slack) & (v >= -slack) & (u + v <= 1 + slack)
+                miss &= (t >= t_near) & (t <= t_far)
+                near_misses.append((pixel[miss], depth[miss], geo.tri_face[pair_tri[miss]], pair_tri[miss]))
             h_tri, h_u, h_v, h_front = pair_tri[hit], u[hit], v[hit], det[hit] > 0.0
             # Nearest hit per pixel (ties: lowest face id, deterministic).
             order = np.lexsort((h_face, h_depth, h_pix))
@@ -1230,17 +1244,20 @@ def _fade(s, z):
     return (z <= fs).astype(np.float64)
 
 
-def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj) -> np.ndarray:
-    """Samples within 0.01 px of an edge of a triangle hit behind the visible
-    surface (§7: whether the rasteriser covers them is undecided — at a fold
-    seen edge-on, two triangles meet within 1e-4 px of the sample)."""
+def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj, near_misses=()) -> np.ndarray:
+    """Samples within 0.01 px of an edge of a triangle behind the visible
+    surface, hit or just missed (§7: whether the rasteriser covers them is
+    undecided — at a fold seen edge-on, two triangles meet within 1e-4 px of
+    the sample, on either side of it)."""
     flagged = np.zeros(len(face), bool)
-    if not all_hits:
+    found = list(all_hits or ()) + list(near_misses or ())
+    if not found:
         return flagged
-    pix = np.concatenate([h[0] for h in all_hits])
-    f = np.concatenate([h[2] for h in all_hits])
-    tri = np.concatenate([h[3] for h in all_hits])
-    behind = (face[pix] >= 0) & (f != face[pix])
+    pix = np.concatenate([h[0] for h in found])
+    z = np.concatenate([h[1] for h in found])
+    f = np.concatenate([h[2] for h in found])
+    tri = np.concatenate([h[3] for h in found])
+    behind = (face[pix] >= 0) & (f != face[pix]) & (z > depth[pix])
     pix, tri = pix[behind], tri[behind]
     if len(pix) == 0:
         return flagged
@@ -1323,8 +1340,11 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
     geo = _gather_geometry(depsgraph, view_matrix, s)
     hidden_lines = bool(getattr(s, "use_hidden_lines", False))
     all_hits = [] if hidden_lines else None
+    near_misses = [] if hidden_lines else None
     centre_hit = {}
-    faces, depths = _visibility(geo, proj, width, height, rows, bool(s.use_backface_culling), all_hits, centre_hit)
+    faces, depths = _visibility(
+        geo, proj, width, height, rows, bool(s.use_backface_culling), all_hits, centre_hit, near_misses
+    )
 
     face = faces[0]
     depth = depths[0]
@@ -1398,7 +1418,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
                 wire_alpha,
                 undecided=on_silhouette,
             )
-            on_silhouette |= _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj)
+            on_silhouette |= _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj, near_misses)
             hidden_all = hidden
             # The visible wire over the hidden lines ("over" with one colour),
             # expressed as an intensity relative to the wire alpha.
