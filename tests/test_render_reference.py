@@ -347,16 +347,18 @@ def test_a_folded_quad_is_no_hidden_layer_of_itself(path, occluded, output_dir, 
     accuracy.assert_accurate(report)
 
 
+@pytest.mark.parametrize("edge_angle", [0.0, 20.0], ids=["every_edge", "edge_angle"])
 @pytest.mark.parametrize("path", ["deferred", "direct", "overlay"])
-def test_hidden_lines_on_suzanne_match_reference(path, output_dir, monkeypatch):
+def test_hidden_lines_on_suzanne_match_reference(path, edge_angle, output_dir, monkeypatch):
     """Suzanne turned so that folded quads and folds seen edge-on lie in
     front of hidden faces: the hidden layers are those of the reference on
-    every path (the fold's own triangle is no layer; a sample on the edge of
-    a fold is undecided, image model §7.2)."""
+    every path (the fold's own triangle is no layer, also where its quad is
+    listed with a region of the edge angle; a sample on the edge of a fold
+    is undecided, image model §7.2)."""
     from solidwire_addon.blender import runtime
     from solidwire_addon.core.options import DrawOptions
 
-    scene = scenes.empty_scene(200, 150, use_hidden_lines=True)
+    scene = scenes.empty_scene(200, 150, use_hidden_lines=True, edge_angle=math.radians(edge_angle))
     scenes.monkey(scene, rotation=(1.2, 0.0, 0.5))
     scenes.add_camera(scene, location=(0.6, -4.2, 1.2))
     ref = reference.render_reference(scene)
@@ -370,7 +372,7 @@ def test_hidden_lines_on_suzanne_match_reference(path, output_dir, monkeypatch):
         _stats, alpha = robustness.Viewport(200, 150).draw(scene)
     else:
         monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=path == "deferred"))
-        alpha = scenes.render_to_file(scene, output_dir / f"hidden_suzanne_{path}.png")[..., 3]
+        alpha = scenes.render_to_file(scene, output_dir / f"hidden_suzanne_{path}_{edge_angle:.0f}.png")[..., 3]
     report = reference.error_report(alpha, ref)
     print(report)
     accuracy.assert_accurate(report)
