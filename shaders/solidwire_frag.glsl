@@ -573,8 +573,12 @@ void main()
 #ifdef REGION_DISTANCE_IMAGE
   /* The region-lines pass measured every line of the region within reach
    * (image model §2.6); beyond it d is what the triangle's own edges give,
-   * at least the reach. */
-  float coded_distance = texelFetch(region_distance_image, ivec2(gl_FragCoord.xy), 0).r;
+   * at least the reach. Only for a triangle whose lines the pass drew: drawn
+   * directly, a triangle of another mesh may cover a pixel whose record
+   * (of the meshes with regions alone) shows a region behind it. */
+  float coded_distance = lines_from_image ?
+                             texelFetch(region_distance_image, ivec2(gl_FragCoord.xy), 0).r :
+                             1.0;
   if (coded_distance < 1.0) { /* (1.0: no line within reach) */
     d_real = min(d_real, coded_distance / LINE_DISTANCE_SCALE);
   }

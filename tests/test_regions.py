@@ -493,10 +493,10 @@ def test_faces_with_a_classed_edge_measure_their_other_edges(path, output_dir, m
     """On a mesh with plain faces, a triangle or quad of its own with a
     classed edge sets up its other edges itself, as a plain face does
     (edge_select.OWN_EDGES_MEASURED): the region-lines pass draws the
-    classed edges alone, one entry per class of each, and the face's block
-    holds them for what has no such pass (a surface drawn directly, and the
-    faces behind it under hidden lines, drawn by the direct hidden-line
-    pass). Suzanne (triangles and quads) with a dashed sharp class, a wider
+    classed edges alone, one entry per class of each (also for a surface
+    drawn directly), and the face's block holds them for what has no such
+    pass (the faces behind the surface under hidden lines, drawn by the
+    direct hidden-line pass). Suzanne (triangles and quads) with a dashed sharp class, a wider
     seam class and its eye holes' boundary, against the reference, and the
     Edge Distance pass within a line's reach; under hidden lines a cube."""
     from solidwire_addon.blender import runtime
@@ -551,7 +551,7 @@ def test_faces_with_a_classed_edge_measure_their_other_edges(path, output_dir, m
     own = (flags & edge_select.OWN_EDGES_MEASURED) == edge_select.OWN_EDGES_MEASURED
     assert own.any() and (flags & edge_select.IN_REGION == 0).any()  # beside plain faces
     drawn_by_pass = solidwire_addon.stats().get("region_line_entries", 0)
-    assert drawn_by_pass == (0 if path == "direct" else mesh.region_line_count)
+    assert drawn_by_pass == mesh.region_line_count
 
 
 @pytest.mark.parametrize("level, hidden_lines", [(3, False), (6, False), (6, True)])
@@ -926,6 +926,63 @@ def test_the_overlay_peels_hidden_region_layers_as_the_render_does(output_dir):
     assert hidden_only.sum() > 100
     assert np.percentile(diff[off], 99.9) <= 2.0 / 255.0 + 1e-9
     assert diff[off].max() <= 0.1
+
+
+def _large_regions_under_the_angle(scene):
+    """Suzanne subdivided once under a 20 degree edge angle: regions of
+    more lines than a walk takes (edge_select.WALK_LIMIT)."""
+    monkey = scenes.monkey(scene, rotation=(1.2, 0.0, 0.5))
+    _subdivided(monkey, 1)
+    scenes.add_camera(scene, location=(0.6, -4.2, 1.2))
+
+
+def _a_cube_without_lines_in_front(scene):
+    """Under a 100 degree edge angle a cube is one region with no line
+    (every edge hidden), in front of Suzanne, whose eye holes' boundaries
+    are lines of its regions."""
+    scenes.monkey(scene, rotation=(1.3, 0.0, 0.4))
+    scenes.cube(scene, size=0.5, location=(0.35, -1.2, 0.2), rotation=(0.4, 0.3, 0.2))
+    scenes.add_camera(scene, location=(0.6, -4.2, 1.2))
+
+
+DIRECT_REGION_SCENES = {
+    "large regions": (_large_regions_under_the_angle, 20.0),
+    "a cube without lines in front": (_a_cube_without_lines_in_front, 100.0),
+}
+
+
+@pytest.mark.parametrize("hidden_lines", [False, True], ids=["visible lines", "hidden lines"])
+@pytest.mark.parametrize("path", ["render drawn directly", "overlay"])
+@pytest.mark.parametrize("name", sorted(DIRECT_REGION_SCENES))
+def test_meshes_drawn_directly_take_their_region_lines_from_the_pass(name, path, hidden_lines, output_dir, monkeypatch):
+    """A mesh drawn directly (the render with the deferred surface switched
+    off, the overlay under hidden lines and whenever it does not defer)
+    takes its regions' lines from the region-lines pass over a record of
+    its own, as a deferred one does: every region whole, however many lines
+    (no walk face by face past the walk's limit), and the record holds
+    every mesh whose triangles read the lines, also one whose regions have
+    none, so that no line of a region it hides shows through it."""
+    from solidwire_addon.blender import runtime
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+    from solidwire_addon.core.options import DrawOptions
+    from tests.support import robustness
+
+    build, edge_angle = DIRECT_REGION_SCENES[name]
+    scene = scenes.empty_scene(200, 150, use_hidden_lines=hidden_lines, edge_angle=math.radians(edge_angle))
+    build(scene)
+    ref = reference.render_reference(scene)
+    if path == "overlay":
+        ensure_gpu()
+        stats, alpha = robustness.Viewport(200, 150).draw(scene)
+    else:
+        monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=False))
+        file_name = f"regions_direct_{name}_{hidden_lines}.png".replace(" ", "_")
+        alpha = scenes.render_to_file(scene, output_dir / file_name)[..., 3]
+        stats = solidwire_addon.stats()
+    assert stats.get("region_line_entries", 0) > 0
+    report = reference.error_report(alpha, ref)
+    print(report)
+    accuracy.assert_accurate(report)
 
 
 def _overlay_redraw(scene, size, depth_of, alpha: bool = False):

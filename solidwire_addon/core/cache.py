@@ -187,6 +187,11 @@ class GPUMesh:
         # there is no n-gon (a cage look): a resolve that reads the pass's
         # image sets up no triangle edge (ShaderVariant.no_edge_setup).
         self.lines_only_from_region_pass = every_triangle_region_lines and not arrays.own_edges_measured
+        # Some triangle reads the region-lines image: also a mesh whose
+        # regions have no drawn line (a closed mesh under a wide edge angle),
+        # which the image's record must hold all the same, so that no line
+        # of a region behind it shows through it (passes.reads_region_lines).
+        self.reads_region_line_image = every_triangle_region_lines or bool(np.any(flags & REGION_LINES))
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
         self._region_sizes = None  # (region lines, region_sizes()), made on first use

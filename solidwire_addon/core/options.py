@@ -17,7 +17,8 @@ from dataclasses import dataclass
 class DrawOptions:
     # Meshes dense on screen draw their surface in two stages
     # (docs/image_model.md §2.5, draw.split_deferred); False draws every mesh
-    # directly, the same image.
+    # directly, the same image (a mesh's region lines still come from the
+    # region-lines pass, over a record of its own: §2.6).
     deferred_surface: bool = True
     # How the deferred surface's visibility stage numbers triangles: by their
     # provoking vertex (True) or with gl_PrimitiveID (False); None lets

@@ -506,10 +506,10 @@ def _wire_region_lines(frame: Frame, settings):
     visibility record of those meshes over the surface depth already drawn
     (only the nearest surface passes it), then the region-lines pass over
     it, so that the wire's pixels read their lines instead of walking their
-    regions (docs/image_model.md §2.6). Where the deferred stages are not
-    to be used the wire walks."""
-    items = [item for item in frame.items if item.mesh.region_line_count]
-    if not items or not (frame.options.deferred_surface and shaders.deferred_available()):
+    regions (docs/image_model.md §2.6). Where the record's stages do not
+    compile here the wire walks."""
+    items = _line_image_readers(frame.items)
+    if not _has_region_lines(items) or not shaders.deferred_available():
         return None
     stats = frame.stats if frame.stats is not None else DrawStats()
     try:
@@ -707,13 +707,21 @@ def draw_surface(
     if options.deferred_surface and shaders.deferred_available():
         no_lines = None if wire else draw_mod.DEFERRED_MIN_DENSITY_NO_LINES
         deferred, direct = draw_mod.split_deferred(items, view, no_lines)
+    # A mesh drawn directly takes its regions' lines from the region-lines
+    # pass too (docs/image_model.md §2.6), over a record of its own, as the
+    # viewport overlay's direct meshes do: no pixel walks a region's edges.
+    line_stats = DrawStats()
+    direct_lines = _direct_region_lines(targets, direct, view, settings, target, cull, options, line_stats)
     framebuffer = targets.framebuffer(aovs=aovs)
     with framebuffer.bind():
         _clear(framebuffer, width, height)
         targets.clear_view_depth()
-        stats = draw_mod.draw(direct, view, settings, target=replace(target, view_depth=True), cull=cull)
+        stats = draw_mod.draw(
+            direct, view, settings, target=replace(target, view_depth=True, **direct_lines), cull=cull
+        )
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
+    stats.extra.update(line_stats.extra)
     if deferred:
         try:
             stats.add(
@@ -754,15 +762,26 @@ def _deferred_surface(
         targets, items, view, settings, target, options, cull=cull, keep_depth=True, clear_record=after_direct
     )
     # The lines of multi-face regions as quads over the record, so that no
-    # pixel walks a region's edges (docs/image_model.md §2.6); a pass with
-    # the wire switched off needs none, unless it writes the render passes
-    # (the Wire pass is the visible lines' intensity whether or not the
-    # image shows them: the fill under hidden lines). The Edge Distance pass
-    # needs d itself: with the render passes' outputs a second run keeps
-    # each pixel's nearest line distance, which the resolve reads in place
-    # of a walk. The lines pass keeps ``aovs``: with it draw() groups and
-    # numbers the draws as the record and the resolve do; it writes no
-    # output of them.
+    # pixel walks a region's edges (docs/image_model.md §2.6).
+    images = _region_line_images(targets, items, view, settings, target, cull, stats)
+    with targets.resolve_framebuffer(aovs=target.aovs).bind():
+        gpu.state.viewport_set(0, 0, width, height)
+        resolve = replace(target, stage=draw_mod.RESOLVE, visibility=targets.visible, view_depth=True, **images)
+        draw_mod.draw(items, view, settings, target=resolve, cull=cull)
+    return stats
+
+
+def _region_line_images(targets, items, view: View, settings, target: DrawTarget, cull: bool, stats) -> dict:
+    """The region-lines images of ``items`` over their visibility record in
+    ``targets.visible``, as DrawTarget fields for the pass that reads them
+    (both None without multi-face regions). A pass with the wire switched
+    off needs no lines, unless it writes the render passes (the Wire pass
+    is the visible lines' intensity whether or not the image shows them:
+    the fill under hidden lines). The Edge Distance pass needs d itself:
+    with the render passes' outputs a second run keeps each pixel's nearest
+    line distance, which the reader takes in place of a walk. The lines
+    pass keeps ``aovs``: with it draw() groups and numbers the draws as the
+    record and the reader do; it writes no output of them."""
     lines = distances = None
     if _has_region_lines(items):
         if target.lines != draw_mod.NO_LINES or target.aovs:
@@ -771,18 +790,28 @@ def _deferred_surface(
             distances = _draw_region_lines(
                 targets, items, view, settings, replace(target, line_distance=True), cull, stats
             )
-    with targets.resolve_framebuffer(aovs=target.aovs).bind():
-        gpu.state.viewport_set(0, 0, width, height)
-        resolve = replace(
-            target,
-            stage=draw_mod.RESOLVE,
-            visibility=targets.visible,
-            view_depth=True,
-            region_lines=lines,
-            region_distance=distances,
-        )
-        draw_mod.draw(items, view, settings, target=resolve, cull=cull)
-    return stats
+    return {"region_lines": lines, "region_distance": distances}
+
+
+def _direct_region_lines(targets, direct, view: View, settings, target: DrawTarget, cull, options, stats) -> dict:
+    """_region_line_images for the meshes the surface pass draws directly
+    (with the deferred surface switched off, DrawOptions.deferred_surface):
+    a record of those that read the image alone (_line_image_readers),
+    then their lines over it. The direct pass's depth test lets only the
+    nearest surface through, and where that is a reader's triangle the
+    record holds it too, so the record needs no other mesh (as the viewport
+    overlay's, _overlay_region_lines). Nothing where the record cannot number them
+    exactly (draw.DEFERRED_MAX) or its stages do not compile here: those
+    pixels walk their regions."""
+    items = [item for item in _line_image_readers(direct) if item.mesh.triangle_count < draw_mod.DEFERRED_MAX]
+    if not _has_region_lines(items) or len(items) >= draw_mod.DEFERRED_MAX or not shaders.deferred_available():
+        return {}
+    try:
+        _record_visibility(targets, items, view, settings, target, options, cull=cull)
+        return _region_line_images(targets, items, view, settings, target, cull, stats)
+    except shaders.DeferredUnavailable as exc:
+        _refused(exc)
+        return {}
 
 
 def _record_visibility(
@@ -876,6 +905,15 @@ def _has_region_lines(items) -> bool:
     return any(item.mesh.region_line_count for item in items)
 
 
+def _line_image_readers(items) -> list:
+    """The items whose triangles read the region-lines image: those with
+    multi-face regions, whether or not a region has a line
+    (cache.GPUMesh.reads_region_line_image). A record for that image holds
+    them all: where such a triangle is the nearest surface, the record then
+    shows it, and no line of a region it hides is kept there."""
+    return [item for item in items if item.mesh.region_line_count or item.mesh.reads_region_line_image]
+
+
 def _draw_region_lines(targets, items, view: View, settings, target: DrawTarget, cull: bool, stats, scissor=None):
     """The region-lines pass over ``targets.visible`` (the visibility
     record of ``items``, numbered as draw() numbers them): the strongest
@@ -951,7 +989,7 @@ def _overlay_region_lines(items, view: View, settings, stats, options: DrawOptio
     settings, which meshes in which shape where) reuses the last image of
     that viewport size: a viewport redraws far more often than its scene
     changes."""
-    items = [item for item in items if item.mesh.region_line_count]
+    items = _line_image_readers(items)
     targets = overlay_targets_for(view.width, view.height)
     key = _overlay_lines_key(items, view, settings, clip_planes)
     if key is not None and targets.lines_key == key and targets.lines is not None:
@@ -1046,7 +1084,11 @@ def _sync_overlay_surface(frame: Frame) -> None:
 
 def _refused(exc: Exception) -> None:
     shaders.disable_deferred()
-    warn_once(("deferred",), f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly")
+    warn_once(
+        ("deferred",),
+        f"SolidWire: the deferred surface pass is not available here ({exc}); drawing directly "
+        f"(a region of more than {WALK_LIMIT} drawn edges is measured face by face)",
+    )
 
 
 def _overlay_defers(frame: Frame) -> bool:
@@ -1357,10 +1399,11 @@ def _peel_hidden_regions(
 
     Only the meshes that _peeled_items picks are peeled; returns them (the
     direct hidden-line pass leaves their region triangles out, and walks
-    the rest: _draw_hidden); none where the deferred stages are not to be
-    used."""
+    the rest: _draw_hidden); none where the record's stages do not compile
+    here. (A mesh drawn directly is peeled too: the layers are records of
+    their own, whichever way the surface was drawn.)"""
     items = _peeled_items(frame.items)
-    if not items or not (frame.options.deferred_surface and shaders.deferred_available()):
+    if not items or not shaders.deferred_available():
         return []
     view, base, options, cull = frame.view, frame.base, frame.options, frame.cull
     stats = stats if stats is not None else DrawStats()

@@ -415,8 +415,8 @@ def _create_info(variant: ShaderVariant):
         add_sampler(info, "region_line_image")
         info.define("REGION_LINE_IMAGE", "1")
     if variant.region_distance:
-        if not (variant.resolve and variant.write_aovs):
-            raise ValueError("only the render passes' resolve over region lines reads their distances")
+        if not variant.write_aovs:
+            raise ValueError("only the render passes' outputs over region lines read their distances")
         add_sampler(info, "region_distance_image")
         info.define("REGION_DISTANCE_IMAGE", "1")
     if variant.no_edge_setup:
@@ -845,7 +845,9 @@ def deferred_available() -> bool:
 
 def disable_deferred() -> None:
     """Never use the deferred surface again in this process (a stage failed
-    to compile): the direct surface pass draws the same image."""
+    to compile): the direct surface pass draws the same image, except that
+    without a visibility record the lines of a region are walked, face by
+    face past edge_select.WALK_LIMIT (docs/image_model.md §2.6)."""
     _deferred_support[0] = False
 
 
