@@ -4,7 +4,8 @@
  * DEPTH_BIAS (z/w - b in NDC is z - b/2 in window depth, solidwire_vert.glsl),
  * so that Blender's depth test keeps exactly the pixels it keeps of the
  * direct pass, and the colour blends as that pass's fragment would. Where
- * the record holds no surface (its cleared depth), nothing is drawn. */
+ * the record holds no surface (its cleared depth), nothing is drawn. A
+ * hidden layer (passes._peel_hidden_regions) is composited the same way. */
 
 void main()
 {
@@ -13,6 +14,14 @@ void main()
   if (depth >= 1.0) {
     discard;
   }
+#ifdef LINEAR_RECORD
+  /* A hidden layer's record holds view depth / clip end (linear: which of
+   * two layers is nearer never depends on the clip range); Blender's test
+   * needs window depth: 0.5 z/w + 0.5 of the same point. */
+  float z_clip = window_depth_rows.y - window_depth_rows.x * depth;
+  float w_clip = window_depth_rows.w - window_depth_rows.z * depth;
+  depth = 0.5 * (z_clip / w_clip) + 0.5;
+#endif
   gl_FragDepth = depth - 0.5 * DEPTH_BIAS;
   frag_color = texelFetch(surface_image, pixel, 0);
 }

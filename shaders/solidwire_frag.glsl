@@ -154,34 +154,19 @@ void write_linear_depth()
 }
 
 #if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
-/* A hidden layer is a face behind the visible face F, never F itself
- * (docs/image_model.md §5.4). A folded quad's two triangles can both cover
- * a pixel: where the other one (solidwire_vert.glsl, partner_outputs) covers this
- * pixel nearer than this one, this fragment takes its depth there, a hair
- * nearer still, so the GREATER test drops it exactly where that triangle
- * is the surface, and keeps it where something else hides both. */
+/* A hidden layer is never the visible face itself (quad_partner.glsl): where
+ * the quad's other triangle (solidwire_vert.glsl, partner_outputs) covers
+ * this pixel nearer than this one, this fragment takes its depth there, a
+ * hair nearer still, so the GREATER test drops it exactly where that
+ * triangle is the surface, and keeps it where something else hides both. */
 void leave_out_the_visible_face()
 {
 #  ifndef LINEAR_DEPTH
   gl_FragDepth = gl_FragCoord.z;
 #  endif
-  if (partner0.z == 0.0) {
-    return; /* not a quad's triangle, or a corner behind the near plane */
-  }
-  vec2 p = gl_FragCoord.xy, a = partner0.xy, ab = partner2.xy - a, ac = partner3.xy - a;
-  float area = ab.x * ac.y - ab.y * ac.x;
-  if (area == 0.0) {
-    return;
-  }
-  vec2 ap = p - a;
-  float u = (ap.x * ac.y - ap.y * ac.x) / area, v = (ab.x * ap.y - ab.y * ap.x) / area;
-  if (u < 0.0 || v < 0.0 || u + v > 1.0) {
-    return; /* the other triangle does not cover this pixel */
-  }
-  vec3 weights = vec3(1.0 - u - v, u, v);
-  float depth = dot(weights, vec3(partner0.w, partner2.w, partner3.w)) /
-                dot(weights, vec3(partner0.z, partner2.z, partner3.z));
-  if (!(depth < view_depth)) {
+  vec3 weights;
+  float depth;
+  if (!quad_partner_covers(gl_FragCoord.xy, partner0, partner2, partner3, weights, depth) || !(depth < view_depth)) {
     return;
   }
 #  ifdef LINEAR_DEPTH

@@ -345,77 +345,27 @@ vec4 biased(vec4 position)
 }
 
 #if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
-/* A corner of the other triangle of this one's quad, for the fragment
- * stage's test of whether that triangle is the surface (solidwire_frag.glsl,
- * leave_out_the_visible_face): its window position, 1/w and view depth / w
- * (both affine in window space, so interpolated there they give the view
- * depth perspective-correctly, in either projection), and its window depth
- * as the depth test sees it (with the overlay's bias). */
-vec4 partner_corner(vec4 clip, float id, out float window_depth)
-{
-  vec2 window = (clip.xy / clip.w) * (0.5 * params.viewport.zw) + params.viewport.xy + 0.5 * params.viewport.zw;
-  float depth = -dot(object_to_view_z, vec4(fetch_texel(vertex_positions, int(id)).xyz, 1.0));
-  window_depth = 0.5 * (biased(clip).z / clip.w) + 0.5;
-  return vec4(window, 1.0 / clip.w, depth / clip.w);
-}
-
-/* The other triangle of a quad, where all three of its corners lie in
- * front of the near plane; a zero 1/w marks none. Only a folded quad's two
- * triangles can cover one pixel. A plain quad's triangle has the 4th corner
- * (the diagonal is edge 2); one listed with its region has its block's
- * start there instead, and finds the other triangle beside it in the
- * triangle table: the one that also has its diagonal (its one edge that is
- * no polygon edge, which no other face has). An n-gon's triangles are
- * left as they are. */
-void partner_outputs(int triangle, vec4 ids, bool is_quad)
+/* The other triangle of this one's quad (quad_partner.glsl), where all three
+ * of its corners lie in front of the near plane, for the fragment stage's
+ * test of whether that triangle is the surface (solidwire_frag.glsl,
+ * leave_out_the_visible_face); a zero 1/w marks none. Its window depth as
+ * the depth test sees it, with the overlay's bias. */
+void partner_outputs(int triangle, vec4 ids)
 {
   partner0 = partner2 = partner3 = vec4(0.0);
   partner_window_depth = vec3(0.0);
-  vec3 corners = ids.xzw;
-  if (!is_quad) {
-    if ((edge_flags & IS_NGON) != 0 || (edge_flags & IN_REGION) == 0) {
-      return;
-    }
-    /* Its polygon's edges, drawn (real) or not (hidden); the diagonal is neither. */
-    int polygon_edges = (edge_flags | (edge_flags / EDGE0_HIDDEN)) & (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
-    vec2 diagonal;
-    if (polygon_edges == (EDGE0_REAL | EDGE1_REAL)) {
-      diagonal = ids.zx;
-    }
-    else if (polygon_edges == (EDGE1_REAL | EDGE2_REAL)) {
-      diagonal = ids.xy;
-    }
-    else if (polygon_edges == (EDGE2_REAL | EDGE0_REAL)) {
-      diagonal = ids.yz;
-    }
-    else {
-      return; /* a triangle face */
-    }
-    float fourth = -1.0;
-    for (int step = -1; step <= 1; step += 2) {
-      int beside = triangle + step;
-      if (beside < 0 || fourth >= 0.0) {
-        continue;
-      }
-      vec3 other = fetch_texel(triangle_vertices, beside).xyz;
-      bvec3 on_a = equal(other, vec3(diagonal.x)), on_b = equal(other, vec3(diagonal.y));
-      if (any(on_a) && any(on_b)) {
-        bvec3 rest = not(bvec3(on_a.x || on_b.x, on_a.y || on_b.y, on_a.z || on_b.z));
-        fourth = rest.x ? other.x : (rest.y ? other.y : other.z);
-      }
-    }
-    if (fourth < 0.0) {
-      return;
-    }
-    corners = vec3(diagonal, fourth);
+  vec3 corners;
+  if (!quad_partner_corners(triangle, ids, edge_flags, corners)) {
+    return;
   }
   vec4 a = vertex_clip(corners.x), b = vertex_clip(corners.y), c = vertex_clip(corners.z);
   if (min(min(a.z + a.w, b.z + b.w), c.z + c.w) < 0.0 || min(min(a.w, b.w), c.w) <= 0.0) {
     return;
   }
-  partner0 = partner_corner(a, corners.x, partner_window_depth.x);
-  partner2 = partner_corner(b, corners.y, partner_window_depth.y);
-  partner3 = partner_corner(c, corners.z, partner_window_depth.z);
+  partner0 = quad_partner_corner(a, corner_view_depth(corners.x));
+  partner2 = quad_partner_corner(b, corner_view_depth(corners.y));
+  partner3 = quad_partner_corner(c, corner_view_depth(corners.z));
+  partner_window_depth = 0.5 * vec3(biased(a).z / a.w, biased(b).z / b.w, biased(c).z / c.w) + 0.5;
 }
 #endif
 
@@ -488,7 +438,7 @@ void main()
 #endif
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
 #if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
-  partner_outputs(triangle, ids, is_quad);
+  partner_outputs(triangle, ids);
 #endif
   fill_outputs(triangle, corner, vertex_id);
 #ifdef USE_CLIP_PLANES

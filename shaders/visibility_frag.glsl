@@ -9,6 +9,44 @@
  * records the nearest of them strictly behind the depth in `peel_depth`
  * (the surface, or the layer recorded before), one layer per draw. */
 
+#ifdef REGION_LAYERS
+/* A layer is never the visible face itself (quad_partner.glsl): where the
+ * quad's other triangle covers this pixel nearer than this one, this
+ * fragment takes that depth, a hair nearer still, so the test against the
+ * layer before drops it exactly where that triangle is the surface (the
+ * render's first layer lies behind the surface; over the viewport the
+ * surface's own layer, peeled first from the front, is this one now, and
+ * Blender's depth test leaves it out). Where something else hides both it
+ * comes just before the other: each is a layer of their face. */
+float nearer_than_the_other_triangle(int triangle, float depth)
+{
+  vec2 flag_halves = fetch_texel(triangle_flag_table, triangle).xy;
+  int flags = int(flag_halves.x) | (int(flag_halves.y) << 12); /* cache.GPUMesh.flag_table */
+  vec3 corners;
+  if (!quad_partner_corners(triangle, fetch_texel(triangle_vertices, triangle), flags, corners)) {
+    return depth;
+  }
+  vec4 a = vertex_clip(corners.x), b = vertex_clip(corners.y), c = vertex_clip(corners.z);
+  if (min(min(a.z + a.w, b.z + b.w), c.z + c.w) < 0.0 || min(min(a.w, b.w), c.w) <= 0.0) {
+    return depth;
+  }
+  vec3 weights;
+  float partner_view_depth;
+  if (!quad_partner_covers(gl_FragCoord.xy,
+                           quad_partner_corner(a, corner_view_depth(corners.x)),
+                           quad_partner_corner(b, corner_view_depth(corners.y)),
+                           quad_partner_corner(c, corner_view_depth(corners.z)),
+                           weights,
+                           partner_view_depth) ||
+      !(partner_view_depth < view_depth))
+  {
+    return depth;
+  }
+  /* (The layers are recorded in linear depth: shaders.py.) */
+  return min(partner_view_depth * params.inv_clip_end * (1.0 - PARTNER_DEPTH_HAIR), depth);
+}
+#endif
+
 void main()
 {
   if (outside_clip_region()) {
@@ -37,6 +75,8 @@ void main()
   if (fetch_texel(triangle_regions, int(triangle_number) - 1).x < 0.0) {
     discard; /* a face that is its own region: the direct hidden-line pass draws it */
   }
+  depth = nearer_than_the_other_triangle(int(triangle_number) - 1, depth);
+  gl_FragDepth = depth;
 #endif
 #ifdef PEEL_LAYER
   /* Strictly behind: the depth in `peel_depth` was written by this same

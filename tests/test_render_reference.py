@@ -13,6 +13,7 @@ import bpy
 import numpy as np
 import pytest
 
+import solidwire_addon
 from tests.support import accuracy, reference, scenes
 
 
@@ -347,16 +348,25 @@ def test_a_folded_quad_is_no_hidden_layer_of_itself(path, occluded, output_dir, 
     accuracy.assert_accurate(report)
 
 
-@pytest.mark.parametrize("edge_angle", [0.0, 20.0], ids=["every_edge", "edge_angle"])
+@pytest.mark.parametrize(
+    "edge_angle, layers",
+    [(0.0, "walked"), (20.0, "walked"), (20.0, "peeled")],
+    ids=["every_edge", "edge_angle", "edge_angle_peeled"],
+)
 @pytest.mark.parametrize("path", ["deferred", "direct", "overlay"])
-def test_hidden_lines_on_suzanne_match_reference(path, edge_angle, output_dir, monkeypatch):
+def test_hidden_lines_on_suzanne_match_reference(path, edge_angle, layers, output_dir, monkeypatch):
     """Suzanne turned so that folded quads and folds seen edge-on lie in
     front of hidden faces: the hidden layers are those of the reference on
     every path (the fold's own triangle is no layer, also where its quad is
-    listed with a region of the edge angle; a sample on the edge of a fold
-    is undecided, image model §7.2)."""
+    listed with a region of the edge angle, and where the layers of the
+    regions are peeled; a sample on the edge of a fold is undecided, image
+    model §7.2)."""
     from solidwire_addon.blender import runtime
+    from solidwire_addon.core import passes
     from solidwire_addon.core.options import DrawOptions
+
+    if layers == "peeled":  # (every mesh with multi-face regions)
+        monkeypatch.setattr(passes, "PEEL_MIN_REGION_LINES", 1)
 
     scene = scenes.empty_scene(200, 150, use_hidden_lines=True, edge_angle=math.radians(edge_angle))
     scenes.monkey(scene, rotation=(1.2, 0.0, 0.5))
@@ -369,10 +379,13 @@ def test_hidden_lines_on_suzanne_match_reference(path, edge_angle, output_dir, m
         from tests.support import robustness
 
         ensure_gpu()
-        _stats, alpha = robustness.Viewport(200, 150).draw(scene)
+        stats, alpha = robustness.Viewport(200, 150).draw(scene)
     else:
         monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=path == "deferred"))
-        alpha = scenes.render_to_file(scene, output_dir / f"hidden_suzanne_{path}_{edge_angle:.0f}.png")[..., 3]
+        name = f"hidden_suzanne_{path}_{edge_angle:.0f}_{layers}.png"
+        alpha = scenes.render_to_file(scene, output_dir / name)[..., 3]
+        stats = solidwire_addon.stats()
+    assert (stats.get("hidden_region_layers", 0) > 0) == (layers == "peeled")
     report = reference.error_report(alpha, ref)
     print(report)
     accuracy.assert_accurate(report)

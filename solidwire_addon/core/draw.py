@@ -767,6 +767,8 @@ def _bind_mesh(shader, variant, mesh) -> None:
     if variant.visibility:
         if variant.region_layers:
             shader.uniform_sampler("triangle_regions", mesh.region_tables()[1])
+            shader.uniform_sampler("triangle_vertices", mesh.triangles)
+            shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
         return  # its batch holds the rest (cache.GPUMesh.visibility_batch)
     shader.uniform_sampler("triangle_vertices", mesh.triangles)
     if variant.resolve and not variant.no_edge_setup:

@@ -1407,9 +1407,11 @@ def _peel_hidden_regions(
         return []
     view, base, options, cull = frame.view, frame.base, frame.options, frame.cull
     stats = stats if stats is not None else DrawStats()
-    # The overlay's record holds window depth (Blender's depth test meets it
-    # in the composite, less the bias), the render's its linear depth.
-    record = DrawTarget(linear_depth=base.linear_depth, clip_planes=base.clip_planes, region_layers=True)
+    # The layers are recorded in linear depth, as the render's surface: which
+    # of two layers is nearer never depends on the clip range (float window
+    # depth near 1 cannot tell a face from one just behind it). Over the
+    # viewport the composite turns it into window depth for Blender's test.
+    record = DrawTarget(linear_depth=True, clip_planes=base.clip_planes, region_layers=True)
     lines = DrawTarget(linear_depth=True, lines=draw_mod.HIDDEN_LINES, display=base.display)
     # The state the caller's own passes draw with stays (over the viewport
     # they blend as the composite does).
@@ -1421,7 +1423,9 @@ def _peel_hidden_regions(
         # surface's own layer (peeled too, from the front) from passing
         # GREATER by a rounding of Blender's depth. The render's depth has
         # no bias and its first layer lies behind the surface already.
-        composite = shaders.get_overlay_composite(2.0 * base.depth_bias)
+        over_viewport = not base.linear_depth
+        composite = shaders.get_overlay_composite(2.0 * base.depth_bias, linear_record=over_viewport)
+        rows = _window_depth_rows(view.projection) if over_viewport else None
         box, layers = box or (0, 0, view.width, view.height), 0
         behind_tiles = None  # (the first layer lies behind ``behind``, or in front of everything)
         left_out = 0  # triangles the records left out (behind_tiles, and outside the box)
@@ -1439,7 +1443,7 @@ def _peel_hidden_regions(
                 framebuffer=targets.peel_framebuffer(layer),
             )
             left_out += recorded.extra.get("record_triangles_left_out", 0)
-            extent = _layer_extent(targets.peel_depths[layer % 2], box, view, base.linear_depth)
+            extent = _layer_extent(targets.peel_depths[layer % 2], box, view, True)
             if extent is None:
                 break
             box, behind_tiles = extent
@@ -1455,6 +1459,7 @@ def _peel_hidden_regions(
                     view,
                     framebuffer_of,
                     test=test,
+                    window_depth_rows=rows,
                 )
             layers = layer
         else:
@@ -1537,6 +1542,7 @@ def _composite_kept(
     *,
     test: str = "GREATER",
     write_depth: bool = False,
+    window_depth_rows=None,
 ) -> None:
     """Blend an image (``colour``, premultiplied, at the depth image
     ``depth``: a hidden layer's lines, a kept image) "over" into
@@ -1544,7 +1550,8 @@ def _composite_kept(
     at its depth less the bias ``shader`` moves it by
     (shaders.get_overlay_composite), tested ``test`` against the depth
     there (GREATER: a hidden layer, behind the surface) and written with
-    ``write_depth``."""
+    ``write_depth``; ``window_depth_rows`` (_window_depth_rows) for a
+    composite of a linear record."""
     x, y, w, h = scissor
     rect = (
         2.0 * x / view.width - 1.0,
@@ -1560,6 +1567,8 @@ def _composite_kept(
         shader.bind()
         shader.uniform_sampler("record_depth", depth)
         shader.uniform_sampler("surface_image", colour)
+        if window_depth_rows is not None:
+            shader.uniform_float("window_depth_rows", window_depth_rows)
         draw_mod.draw_rectangle(shader, rect)
 
     if into is None:
@@ -1568,6 +1577,17 @@ def _composite_kept(
     with into().bind():
         gpu.state.viewport_set(0, 0, view.width, view.height)
         draw()
+
+
+def _window_depth_rows(projection) -> tuple:
+    """The projection's depth rows for the composite of a linear record
+    (shaders.get_overlay_composite): clip z and w of the point at view
+    depth ``r * clip_end`` are ``y - x r`` and ``w - z r`` (Blender's
+    projections, perspective or orthographic, give z and w from view z
+    alone)."""
+    clip_end = clip_end_of(projection)
+    p = np.asarray(projection, dtype=np.float64)
+    return (float(p[2, 2] * clip_end), float(p[2, 3]), float(p[3, 2] * clip_end), float(p[3, 3]))
 
 
 def _hidden_wire(frame: Frame, settings) -> np.ndarray:

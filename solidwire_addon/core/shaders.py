@@ -432,13 +432,9 @@ def _create_info(variant: ShaderVariant):
         info.define("ALL_IN_FRONT", "1")
     if variant.hidden_pass:
         info.define("HIDDEN_PASS", "1")
-        # How much nearer than a quad's other triangle a fragment behind it
-        # writes its depth: relative in view depth, absolute in window depth
-        # (a few steps of a 24-bit buffer); far above the rounding of the two
-        # interpolations, far below any real gap.
-        info.define("PARTNER_DEPTH_HAIR", "1.0e-5" if variant.linear_depth else "2.0e-7")
+        _define_partner_depth_hair(info, variant.linear_depth)
         if not variant.linear_depth:
-            # It only ever writes a nearer depth than its own.
+            # (leave_out_the_visible_face: only ever a nearer depth than its own.)
             compat.depth_write(info, "LESS")
     if variant.region_layers_peeled:
         if not variant.hidden_pass or variant.resolve:
@@ -482,6 +478,14 @@ def _create_info(variant: ShaderVariant):
     return info
 
 
+def _define_partner_depth_hair(info, linear_depth: bool) -> None:
+    """How near a quad's other triangle (shaders/quad_partner.glsl) counts as
+    at a depth: relative in view depth, absolute in window depth (a few
+    steps of a 24-bit buffer); far above the rounding of two interpolations
+    of one depth, far below any real gap."""
+    info.define("PARTNER_DEPTH_HAIR", "1.0e-5" if linear_depth else "2.0e-7")
+
+
 def _add_clip_planes(info, iface) -> None:
     """The clipping region's planes and distances (shaders/clip_region.glsl).
     A block of their own, not push constants: those stay within the 128
@@ -518,8 +522,15 @@ def _visibility_create_info(variant: ShaderVariant):
         _add_clip_planes(info, iface)
         info.typedef_source(schema.param_block_glsl() + CLIP_BLOCK_GLSL)
     if variant.region_layers:
+        if not variant.linear_depth:
+            raise ValueError("the region layers are recorded in linear depth")
         add_sampler(info, "triangle_regions")
         info.define("REGION_LAYERS", "1")
+        # (A layer is never the visible face itself: its quad's other
+        # triangle, from the triangle table and the flags.)
+        add_sampler(info, "triangle_vertices")
+        add_sampler(info, "triangle_flag_table")
+        _define_partner_depth_hair(info, linear_depth=True)
     if variant.peel_layer:
         if not variant.region_layers:
             raise ValueError("only the region layers are peeled")
@@ -543,7 +554,16 @@ def _visibility_create_info(variant: ShaderVariant):
         )
     clip = read_source("clip_region.glsl")
     info.vertex_source(prologue + clip + read_source("visibility_vert.glsl"))
-    info.fragment_source(read_source("common.glsl") + _CLIP_DISTANCES_IN + clip + read_source("visibility_frag.glsl"))
+    fragment_head = read_source("common.glsl")
+    if variant.region_layers:
+        fragment_head += read_source("edge_geometry.glsl") + read_source("quad_partner.glsl")
+        if variant.instanced:
+            fragment_head = (
+                f"#define SW_INSTANCE_SLOT (instance_base + {INSTANCE_TEXELS} * int(visible_instance))\n"
+                + read_source("instancing.glsl")
+                + fragment_head
+            )
+    info.fragment_source(fragment_head + _CLIP_DISTANCES_IN + clip + read_source("visibility_frag.glsl"))
     return info
 
 
@@ -726,7 +746,7 @@ def _add_sources(info, variant: ShaderVariant, iface: _Interface) -> None:
     """The GLSL files of the exact path, in the order each stage needs them.
     The SW_ names stand for the builtins a stage reads (resolve_frag.glsl
     supplies its own)."""
-    common = read_source("common.glsl") + read_source("edge_geometry.glsl")
+    common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("quad_partner.glsl")
     styles = read_source("line_style.glsl") + edge_styles_source()
     fill = read_source("fill_shading.glsl")
     if variant.instanced:
@@ -913,11 +933,15 @@ def get_setup(in_front: bool = False):
     return shader
 
 
-def get_overlay_composite(depth_bias: float):
+def get_overlay_composite(depth_bias: float, linear_record: bool = False):
     """The viewport overlay's composite (shaders/overlay_composite_frag.glsl
     over resolve_vert.glsl's rectangle): the kept surface image into
-    Blender's buffer at the record's depth less ``depth_bias``."""
-    key = (_context, "overlay composite", float(depth_bias))
+    Blender's buffer at the record's depth less ``depth_bias``;
+    ``linear_record``: the record holds view depth / clip end (a hidden
+    layer's), turned into window depth by the projection's depth rows
+    (push constant ``window_depth_rows``: P22, P23, P32, P33 with the clip
+    end folded into the first and third)."""
+    key = (_context, "overlay composite", float(depth_bias), linear_record)
     shader = _cache.get(key)
     if shader is None:
         info = gpu.types.GPUShaderCreateInfo()
@@ -926,6 +950,9 @@ def get_overlay_composite(depth_bias: float):
         add_sampler(info, "record_depth")
         add_sampler(info, "surface_image")
         info.define("DEPTH_BIAS", repr(float(depth_bias)))
+        if linear_record:
+            info.push_constant("VEC4", "window_depth_rows")
+            info.define("LINEAR_RECORD", "1")
         info.fragment_out(0, "VEC4", "frag_color")
         compat.depth_write(info, "ANY")
         info.vertex_source(read_source("resolve_vert.glsl"))

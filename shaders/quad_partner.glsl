@@ -1,0 +1,101 @@
+/* The other triangle of a quad. A hidden layer is a face behind the visible
+ * face F, never F itself (docs/image_model.md §5.4), and only a folded
+ * quad's two triangles can both cover one pixel: a triangle behind the
+ * surface whose other triangle covers the same pixel nearer takes that
+ * triangle's depth there, a hair nearer still, so a test against the
+ * surface (the direct hidden-line pass, solidwire_frag.glsl) or against
+ * the layer before (the peeled layers' record, visibility_frag.glsl) drops
+ * it exactly where that triangle is the surface. Needs common.glsl and
+ * edge_geometry.glsl. */
+
+/* The corner ids of the other triangle of `triangle` (corner ids `ids`,
+ * edge flags `flags`), or false where it has none. A plain quad's triangle
+ * has the 4th corner in ids.w (the diagonal is edge 2); one listed with its
+ * region has its block's start there instead, and finds the other triangle
+ * beside it in the triangle table: the one that also has its diagonal (its
+ * one edge that is no polygon edge, which no other face has). An n-gon's
+ * triangles have none. */
+bool quad_partner_corners(int triangle, vec4 ids, int flags, out vec3 corners)
+{
+  corners = ids.xzw;
+  if ((flags & HAS_QUAD_CORNER) != 0) {
+    return true;
+  }
+  if ((flags & IS_NGON) != 0 || (flags & IN_REGION) == 0) {
+    return false;
+  }
+  /* Its polygon's edges, drawn (real) or not (hidden); the diagonal is neither. */
+  int polygon_edges = (flags | (flags / EDGE0_HIDDEN)) & (EDGE0_REAL | EDGE1_REAL | EDGE2_REAL);
+  vec2 diagonal;
+  if (polygon_edges == (EDGE0_REAL | EDGE1_REAL)) {
+    diagonal = ids.zx;
+  }
+  else if (polygon_edges == (EDGE1_REAL | EDGE2_REAL)) {
+    diagonal = ids.xy;
+  }
+  else if (polygon_edges == (EDGE2_REAL | EDGE0_REAL)) {
+    diagonal = ids.yz;
+  }
+  else {
+    return false; /* a triangle face */
+  }
+  float fourth = -1.0;
+  for (int step = -1; step <= 1; step += 2) {
+    int beside = triangle + step;
+    if (beside < 0 || fourth >= 0.0) {
+      continue;
+    }
+    vec3 other = fetch_texel(triangle_vertices, beside).xyz;
+    bvec3 on_a = equal(other, vec3(diagonal.x)), on_b = equal(other, vec3(diagonal.y));
+    if (any(on_a) && any(on_b)) {
+      bvec3 rest = not(bvec3(on_a.x || on_b.x, on_a.y || on_b.y, on_a.z || on_b.z));
+      fourth = rest.x ? other.x : (rest.y ? other.y : other.z);
+    }
+  }
+  if (fourth < 0.0) {
+    return false;
+  }
+  corners = vec3(diagonal, fourth);
+  return true;
+}
+
+/* The view depth of vertex `id` (as the vertex stage's own view_depth). */
+float corner_view_depth(float id)
+{
+  return -dot(object_to_view_z, vec4(fetch_texel(vertex_positions, int(id)).xyz, 1.0));
+}
+
+/* A corner of the other triangle as the depth test at a pixel needs it:
+ * its window position, 1/w and view depth / w (both affine in window
+ * space, so interpolated there they give the view depth perspective-
+ * correctly, in either projection). */
+vec4 quad_partner_corner(vec4 clip, float view_depth_of_corner)
+{
+  vec2 window = (clip.xy / clip.w) * (0.5 * params.viewport.zw) + params.viewport.xy + 0.5 * params.viewport.zw;
+  return vec4(window, 1.0 / clip.w, view_depth_of_corner / clip.w);
+}
+
+/* Whether the other triangle (corners a, b, c of quad_partner_corner; a
+ * zero 1/w in a marks none) covers window point p, and there its window
+ * barycentric weights and its view depth. */
+bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out float depth)
+{
+  weights = vec3(0.0);
+  depth = 0.0;
+  if (a.z == 0.0) {
+    return false; /* no other triangle, or a corner behind the near plane */
+  }
+  vec2 ab = b.xy - a.xy, ac = c.xy - a.xy;
+  float area = ab.x * ac.y - ab.y * ac.x;
+  if (area == 0.0) {
+    return false;
+  }
+  vec2 ap = p - a.xy;
+  float u = (ap.x * ac.y - ap.y * ac.x) / area, v = (ab.x * ap.y - ab.y * ap.x) / area;
+  if (u < 0.0 || v < 0.0 || u + v > 1.0) {
+    return false;
+  }
+  weights = vec3(1.0 - u - v, u, v);
+  depth = dot(weights, vec3(a.w, b.w, c.w)) / dot(weights, vec3(a.z, b.z, c.z));
+  return true;
+}
