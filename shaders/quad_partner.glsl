@@ -99,3 +99,30 @@ bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out f
   depth = dot(weights, vec3(a.w, b.w, c.w)) / dot(weights, vec3(a.z, b.z, c.z));
   return true;
 }
+
+#ifdef REGION_LAYERS
+/* The corners (quad_partner_corner) of the other triangle of `triangle`, a
+ * region triangle of a peeled layer's record (visibility_frag.glsl), where
+ * it has one and all three of its corners lie in front of the near plane;
+ * else a zero 1/w in `a`. Its flags from the flag table. */
+void quad_partner_window_corners(int triangle, out vec4 a, out vec4 b, out vec4 c)
+{
+  a = b = c = vec4(0.0);
+  if (triangle < 0) {
+    return; /* (a corner that provokes no triangle) */
+  }
+  vec2 flag_halves = fetch_texel(triangle_flag_table, triangle).xy;
+  int flags = int(flag_halves.x) | (int(flag_halves.y) << 12); /* cache.GPUMesh.flag_table */
+  vec3 corners;
+  if (!quad_partner_corners(triangle, fetch_texel(triangle_vertices, triangle), flags, corners)) {
+    return;
+  }
+  vec4 ca = vertex_clip(corners.x), cb = vertex_clip(corners.y), cc = vertex_clip(corners.z);
+  if (min(min(ca.z + ca.w, cb.z + cb.w), cc.z + cc.w) < 0.0 || min(min(ca.w, cb.w), cc.w) <= 0.0) {
+    return;
+  }
+  a = quad_partner_corner(ca, corner_view_depth(corners.x));
+  b = quad_partner_corner(cb, corner_view_depth(corners.y));
+  c = quad_partner_corner(cc, corner_view_depth(corners.z));
+}
+#endif

@@ -20,24 +20,18 @@
  * comes just before the other: each is a layer of their face. */
 float nearer_than_the_other_triangle(int triangle, float depth)
 {
-  vec2 flag_halves = fetch_texel(triangle_flag_table, triangle).xy;
-  int flags = int(flag_halves.x) | (int(flag_halves.y) << 12); /* cache.GPUMesh.flag_table */
-  vec3 corners;
-  if (!quad_partner_corners(triangle, fetch_texel(triangle_vertices, triangle), flags, corners)) {
-    return depth;
-  }
-  vec4 a = vertex_clip(corners.x), b = vertex_clip(corners.y), c = vertex_clip(corners.z);
-  if (min(min(a.z + a.w, b.z + b.w), c.z + c.w) < 0.0 || min(min(a.w, b.w), c.w) <= 0.0) {
-    return depth;
-  }
+  vec4 a, b, c;
+#  ifdef SW_TRIANGLE_BY_VERTEX
+  /* Set up once per triangle by its provoking corner (visibility_vert.glsl). */
+  a = partner0;
+  b = partner2;
+  c = partner3;
+#  else
+  quad_partner_window_corners(triangle, a, b, c);
+#  endif
   vec3 weights;
   float partner_view_depth;
-  if (!quad_partner_covers(gl_FragCoord.xy,
-                           quad_partner_corner(a, corner_view_depth(corners.x)),
-                           quad_partner_corner(b, corner_view_depth(corners.y)),
-                           quad_partner_corner(c, corner_view_depth(corners.z)),
-                           weights,
-                           partner_view_depth) ||
+  if (!quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, partner_view_depth) ||
       !(partner_view_depth < view_depth))
   {
     return depth;
@@ -75,16 +69,24 @@ void main()
   if (fetch_texel(triangle_regions, int(triangle_number) - 1).x < 0.0) {
     discard; /* a face that is its own region: the direct hidden-line pass draws it */
   }
-  depth = nearer_than_the_other_triangle(int(triangle_number) - 1, depth);
-  gl_FragDepth = depth;
-#endif
-#ifdef PEEL_LAYER
+#  ifdef PEEL_LAYER
   /* Strictly behind: the depth in `peel_depth` was written by this same
    * code for the layer before (or by the surface pass, for the first), so
-   * that layer itself never passes. */
-  if (depth <= texelFetch(peel_depth, ivec2(gl_FragCoord.xy), 0).r) {
+   * that layer itself never passes. Tested first with the fragment's own
+   * depth, which the other triangle only ever moves nearer: most fragments
+   * lie in front of the layer before and skip that triangle's set-up. */
+  float previous = texelFetch(peel_depth, ivec2(gl_FragCoord.xy), 0).r;
+  if (depth <= previous) {
     discard;
   }
+#  endif
+  depth = nearer_than_the_other_triangle(int(triangle_number) - 1, depth);
+  gl_FragDepth = depth;
+#  ifdef PEEL_LAYER
+  if (depth <= previous) {
+    discard;
+  }
+#  endif
 #endif
   frag_visible = vec4(triangle_number, instance, float(draw_number), view_depth);
 }

@@ -17,6 +17,11 @@ void main()
   /* Only the provoking (last) corner's value reaches the fragments: the
    * batch gives every triangle a last corner of its own. */
   visible_triangle = triangle;
+#  ifdef REGION_LAYERS
+  /* So the quad's other triangle (visibility_frag.glsl) is set up once per
+   * triangle, by that corner, not at every pixel. */
+  quad_partner_window_corners(int(triangle) - 1, partner0, partner2, partner3);
+#  endif
 #endif
 #ifdef SW_INSTANCED
   visible_instance = float(gl_InstanceID);

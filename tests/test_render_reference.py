@@ -350,8 +350,8 @@ def test_a_folded_quad_is_no_hidden_layer_of_itself(path, occluded, output_dir, 
 
 @pytest.mark.parametrize(
     "edge_angle, layers",
-    [(0.0, "walked"), (20.0, "walked"), (20.0, "peeled")],
-    ids=["every_edge", "edge_angle", "edge_angle_peeled"],
+    [(0.0, "walked"), (20.0, "walked"), (20.0, "peeled"), (20.0, "peeled, primitive ids")],
+    ids=["every_edge", "edge_angle", "edge_angle_peeled", "edge_angle_peeled_primitive_ids"],
 )
 @pytest.mark.parametrize("path", ["deferred", "direct", "overlay"])
 def test_hidden_lines_on_suzanne_match_reference(path, edge_angle, layers, output_dir, monkeypatch):
@@ -365,8 +365,12 @@ def test_hidden_lines_on_suzanne_match_reference(path, edge_angle, layers, outpu
     from solidwire_addon.core import passes
     from solidwire_addon.core.options import DrawOptions
 
-    if layers == "peeled":  # (every mesh with multi-face regions)
+    if layers != "walked":  # (every mesh with multi-face regions)
         monkeypatch.setattr(passes, "PEEL_MIN_REGION_LINES", 1)
+    # The layers' records number their triangles by a corner of each (where
+    # that corner sets up the quad's other triangle) or by primitive (each
+    # pixel sets it up): shaders.triangle_ids_by_vertex.
+    by_vertex = None if layers != "peeled, primitive ids" else False
 
     scene = scenes.empty_scene(200, 150, use_hidden_lines=True, edge_angle=math.radians(edge_angle))
     scenes.monkey(scene, rotation=(1.2, 0.0, 0.5))
@@ -379,13 +383,15 @@ def test_hidden_lines_on_suzanne_match_reference(path, edge_angle, layers, outpu
         from tests.support import robustness
 
         ensure_gpu()
+        monkeypatch.setattr(runtime, "options", DrawOptions(triangle_ids_by_vertex=by_vertex))
         stats, alpha = robustness.Viewport(200, 150).draw(scene)
     else:
-        monkeypatch.setattr(runtime, "options", DrawOptions(deferred_surface=path == "deferred"))
-        name = f"hidden_suzanne_{path}_{edge_angle:.0f}_{layers}.png"
+        options = DrawOptions(deferred_surface=path == "deferred", triangle_ids_by_vertex=by_vertex)
+        monkeypatch.setattr(runtime, "options", options)
+        name = f"hidden_suzanne_{path}_{edge_angle:.0f}_{layers.replace(', ', '_').replace(' ', '_')}.png"
         alpha = scenes.render_to_file(scene, output_dir / name)[..., 3]
         stats = solidwire_addon.stats()
-    assert (stats.get("hidden_region_layers", 0) > 0) == (layers == "peeled")
+    assert (stats.get("hidden_region_layers", 0) > 0) == (layers != "walked")
     report = reference.error_report(alpha, ref)
     print(report)
     accuracy.assert_accurate(report)

@@ -526,6 +526,9 @@ def _visibility_create_info(variant: ShaderVariant):
             raise ValueError("the region layers are recorded in linear depth")
         add_sampler(info, "triangle_regions")
         info.define("REGION_LAYERS", "1")
+        if variant.triangle_ids_by_vertex:
+            for name in ("partner0", "partner2", "partner3"):
+                iface.flat("VEC4", name)
         # (A layer is never the visible face itself: its quad's other
         # triangle, from the triangle table and the flags.)
         add_sampler(info, "triangle_vertices")
@@ -545,6 +548,8 @@ def _visibility_create_info(variant: ShaderVariant):
         compat.depth_write(info, "ANY")
     # (fetch_texel, common.glsl: the exact path reads positions so.)
     prologue = read_source("common.glsl") + read_source("edge_geometry.glsl")
+    if variant.region_layers:
+        prologue += read_source("quad_partner.glsl")
     if variant.instanced:
         info.define("SW_INSTANCED", "1")
         prologue = (
