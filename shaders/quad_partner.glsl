@@ -100,11 +100,36 @@ bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out f
   return true;
 }
 
+/* The corners (quad_partner_corner) of the other triangle of `triangle`
+ * (corner ids `ids`, edge flags `flags`) and their clip positions, where it
+ * has one and all three of its corners lie in front of the near plane;
+ * else false, with a zero 1/w in `a`. */
+bool quad_partner_set_up(
+    int triangle, vec4 ids, int flags, out vec4 a, out vec4 b, out vec4 c, out vec4 clip_a, out vec4 clip_b, out vec4 clip_c)
+{
+  a = b = c = vec4(0.0);
+  vec3 corners;
+  if (!quad_partner_corners(triangle, ids, flags, corners)) {
+    clip_a = clip_b = clip_c = vec4(0.0);
+    return false;
+  }
+  clip_a = vertex_clip(corners.x);
+  clip_b = vertex_clip(corners.y);
+  clip_c = vertex_clip(corners.z);
+  if (min(min(clip_a.z + clip_a.w, clip_b.z + clip_b.w), clip_c.z + clip_c.w) < 0.0 ||
+      min(min(clip_a.w, clip_b.w), clip_c.w) <= 0.0)
+  {
+    return false;
+  }
+  a = quad_partner_corner(clip_a, corner_view_depth(corners.x));
+  b = quad_partner_corner(clip_b, corner_view_depth(corners.y));
+  c = quad_partner_corner(clip_c, corner_view_depth(corners.z));
+  return true;
+}
+
 #ifdef REGION_LAYERS
-/* The corners (quad_partner_corner) of the other triangle of `triangle`, a
- * region triangle of a peeled layer's record (visibility_frag.glsl), where
- * it has one and all three of its corners lie in front of the near plane;
- * else a zero 1/w in `a`. Its flags from the flag table. */
+/* quad_partner_set_up for a region triangle of a peeled layer's record
+ * (visibility_frag.glsl), its flags from the flag table. */
 void quad_partner_window_corners(int triangle, out vec4 a, out vec4 b, out vec4 c)
 {
   a = b = c = vec4(0.0);
@@ -113,16 +138,7 @@ void quad_partner_window_corners(int triangle, out vec4 a, out vec4 b, out vec4 
   }
   vec2 flag_halves = fetch_texel(triangle_flag_table, triangle).xy;
   int flags = int(flag_halves.x) | (int(flag_halves.y) << 12); /* cache.GPUMesh.flag_table */
-  vec3 corners;
-  if (!quad_partner_corners(triangle, fetch_texel(triangle_vertices, triangle), flags, corners)) {
-    return;
-  }
-  vec4 ca = vertex_clip(corners.x), cb = vertex_clip(corners.y), cc = vertex_clip(corners.z);
-  if (min(min(ca.z + ca.w, cb.z + cb.w), cc.z + cc.w) < 0.0 || min(min(ca.w, cb.w), cc.w) <= 0.0) {
-    return;
-  }
-  a = quad_partner_corner(ca, corner_view_depth(corners.x));
-  b = quad_partner_corner(cb, corner_view_depth(corners.y));
-  c = quad_partner_corner(cc, corner_view_depth(corners.z));
+  vec4 clip_a, clip_b, clip_c;
+  quad_partner_set_up(triangle, fetch_texel(triangle_vertices, triangle), flags, a, b, c, clip_a, clip_b, clip_c);
 }
 #endif

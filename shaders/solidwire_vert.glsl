@@ -352,20 +352,11 @@ vec4 biased(vec4 position)
  * the depth test sees it, with the overlay's bias. */
 void partner_outputs(int triangle, vec4 ids)
 {
-  partner0 = partner2 = partner3 = vec4(0.0);
+  vec4 a, b, c;
   partner_window_depth = vec3(0.0);
-  vec3 corners;
-  if (!quad_partner_corners(triangle, ids, edge_flags, corners)) {
-    return;
+  if (quad_partner_set_up(triangle, ids, edge_flags, partner0, partner2, partner3, a, b, c)) {
+    partner_window_depth = 0.5 * vec3(biased(a).z / a.w, biased(b).z / b.w, biased(c).z / c.w) + 0.5;
   }
-  vec4 a = vertex_clip(corners.x), b = vertex_clip(corners.y), c = vertex_clip(corners.z);
-  if (min(min(a.z + a.w, b.z + b.w), c.z + c.w) < 0.0 || min(min(a.w, b.w), c.w) <= 0.0) {
-    return;
-  }
-  partner0 = quad_partner_corner(a, corner_view_depth(corners.x));
-  partner2 = quad_partner_corner(b, corner_view_depth(corners.y));
-  partner3 = quad_partner_corner(c, corner_view_depth(corners.z));
-  partner_window_depth = 0.5 * vec3(biased(a).z / a.w, biased(b).z / b.w, biased(c).z / c.w) + 0.5;
 }
 #endif
 
