@@ -800,11 +800,14 @@ def _direct_region_lines(targets, direct, view: View, settings, target: DrawTarg
     then their lines over it. The direct pass's depth test lets only the
     nearest surface through, and where that is a reader's triangle the
     record holds it too, so the record needs no other mesh (as the viewport
-    overlay's, _overlay_region_lines). Nothing where the record cannot number them
-    exactly (draw.DEFERRED_MAX) or its stages do not compile here: those
-    pixels walk their regions."""
-    items = [item for item in _line_image_readers(direct) if item.mesh.triangle_count < draw_mod.DEFERRED_MAX]
-    if not _has_region_lines(items) or len(items) >= draw_mod.DEFERRED_MAX or not shaders.deferred_available():
+    overlay's, _overlay_region_lines). Nothing where the record cannot
+    number them all exactly (draw.DEFERRED_MAX) or its stages do not
+    compile here: those pixels walk their regions."""
+    items = _line_image_readers(direct)
+    numbered = len(items) < draw_mod.DEFERRED_MAX and all(
+        item.mesh.triangle_count < draw_mod.DEFERRED_MAX for item in items
+    )
+    if not (_has_region_lines(items) and numbered and shaders.deferred_available()):
         return {}
     try:
         _record_visibility(targets, items, view, settings, target, options, cull=cull)
