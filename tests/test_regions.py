@@ -680,7 +680,7 @@ def test_depth_tiles_keep_every_block_that_may_lie_behind():
     ramp = 0.2 + 0.6 * np.arange(width) / width + 0.1 * np.arange(height)[:, None] / height
     depth = (ramp + rng.uniform(0.0, 0.02, (height, width))).astype(np.float32)
     depth[20:45, 30:70] = 1.0  # nothing recorded there
-    tiles = draw.DepthTiles(depth, origin, linear=False, inv_clip_end=1.0)
+    tiles = draw.DepthTiles(depth, origin, inv_clip_end=1.0)
     count = 4000
     x_low = rng.uniform(-20.0, 130.0, count)
     y_low = rng.uniform(-20.0, 90.0, count)

@@ -190,7 +190,7 @@ class GPUMesh:
         # Some triangle reads the region-lines image: also a mesh whose
         # regions have no drawn line (a closed mesh under a wide edge angle),
         # which the image's record must hold all the same, so that no line
-        # of a region behind it shows through it (passes.reads_region_lines).
+        # of a region behind it shows through it (passes._line_image_readers).
         self.reads_region_line_image = every_triangle_region_lines or bool(np.any(flags & REGION_LINES))
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None

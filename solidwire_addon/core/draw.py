@@ -984,7 +984,7 @@ def triangle_ranges_reaching(mesh, object_to_clip: np.ndarray, viewport, window,
     x, y, ahead = x.reshape(8, -1), y.reshape(8, -1), ahead.reshape(8, -1)
     kept = np.ones(x.shape[1], bool) if window is None else _boxes_reaching(x, y, ahead, window)
     if behind is not None:
-        deepest = behind.record_depth(points, object_to_clip, object_to_view_z).reshape(8, -1).max(axis=0)
+        deepest = behind.record_depth(points, object_to_view_z).reshape(8, -1).max(axis=0)
         kept &= behind.reached(x.min(axis=0), x.max(axis=0), y.min(axis=0), y.max(axis=0), deepest)
         kept |= ~ahead.all(axis=0)
     if kept.all():
@@ -1031,12 +1031,12 @@ class DepthTiles:
     tiles. A pixel where the image holds nothing counts as infinitely deep:
     a peeled layer can only lie where the layer before it does.
 
-    ``linear``: the depth is view depth / clip end (the render's record,
-    ``inv_clip_end``), else window depth (the overlay's)."""
+    The depth is view depth / clip end (``inv_clip_end``), as every layer's
+    record holds it."""
 
     TILE = 8
 
-    def __init__(self, depth: np.ndarray, origin, *, linear: bool, inv_clip_end: float):
+    def __init__(self, depth: np.ndarray, origin, *, inv_clip_end: float):
         tile = self.TILE
         height, width = depth.shape
         padded = np.full((-(-height // tile) * tile, -(-width // tile) * tile), np.inf, np.float32)
@@ -1050,19 +1050,14 @@ class DepthTiles:
             level = even.reshape(rows, 2, columns, 2).min(axis=(1, 3))
             self.levels.append(level)
         self.origin = origin
-        self.linear, self.inv_clip_end = linear, inv_clip_end
+        self.inv_clip_end = inv_clip_end
 
-    def record_depth(self, points: np.ndarray, object_to_clip: np.ndarray, object_to_view_z) -> np.ndarray:
+    def record_depth(self, points: np.ndarray, object_to_view_z) -> np.ndarray:
         """The depth the record writes at mesh-space ``points`` ((N, 4), w 0
         as _window_points'), in float64 (where a point is at or behind the
         camera plane the value means nothing: the caller keeps its box)."""
-        if self.linear:
-            row = np.asarray(object_to_view_z, np.float64)
-            return -(points[:, :3] @ row[:3] + row[3]) * self.inv_clip_end
-        to_clip = np.asarray(object_to_clip, np.float64)
-        z = points[:, :3] @ to_clip[2, :3] + to_clip[2, 3]
-        w = points[:, :3] @ to_clip[3, :3] + to_clip[3, 3]
-        return 0.5 * z / np.where(w > 0.0, w, 1.0) + 0.5
+        row = np.asarray(object_to_view_z, np.float64)
+        return -(points[:, :3] @ row[:3] + row[3]) * self.inv_clip_end
 
     def reached(self, x_low, x_high, y_low, y_high, deepest) -> np.ndarray:
         """Whether a box whose window extent is ``x_low``..``y_high`` (one

@@ -1446,7 +1446,7 @@ def _peel_hidden_regions(
                 framebuffer=targets.peel_framebuffer(layer),
             )
             left_out += recorded.extra.get("record_triangles_left_out", 0)
-            extent = _layer_extent(targets.peel_depths[layer % 2], box, view, True)
+            extent = _layer_extent(targets.peel_depths[layer % 2], box, view)
             if extent is None:
                 break
             box, behind_tiles = extent
@@ -1510,7 +1510,7 @@ def _peeled_items(items) -> list:
     return peeled
 
 
-def _layer_extent(depth_image, scissor, view: View, linear: bool):
+def _layer_extent(depth_image, scissor, view: View):
     """(the box (x, y, width, height) around the pixels inside ``scissor``
     where a layer was recorded into ``depth_image`` (cleared to 1.0 there),
     that depth by tiles (draw.DepthTiles) or None), or None where no pixel
@@ -1531,7 +1531,7 @@ def _layer_extent(depth_image, scissor, view: View, linear: bool):
     if shaders.software_rasteriser():
         x0, y0, bw, bh = box
         inside = depth[y0 - y : y0 - y + bh, x0 - x : x0 - x + bw]
-        tiles = draw_mod.DepthTiles(inside, (x0, y0), linear=linear, inv_clip_end=1.0 / clip_end_of(view.projection))
+        tiles = draw_mod.DepthTiles(inside, (x0, y0), inv_clip_end=1.0 / clip_end_of(view.projection))
     return box, tiles
 
 
