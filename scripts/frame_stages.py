@@ -36,6 +36,7 @@ UPLOAD = "upload"
 SETUP = "edge set-up (compute, direct draws)"
 DIRECT = "surface pass, drawn directly"
 VISIBILITY = "surface pass: visibility stage"
+REGION_LINES = "region-lines pass"
 RESOLVE = "surface pass: resolve stage"
 HIDDEN = "hidden lines"
 WIRE = "wire pass (blended)"
@@ -52,6 +53,7 @@ ORDER = (
     SETUP,
     DIRECT,
     VISIBILITY,
+    REGION_LINES,
     RESOLVE,
     HIDDEN,
     WIRE,
@@ -66,9 +68,14 @@ ORDER = (
 
 
 def _sync() -> None:
-    """Wait for the GPU: a read waits for every draw into the framebuffer."""
+    """Wait for the GPU: a read waits for every draw into the framebuffer.
+    Its depth is read too: the region-lines pass draws into a framebuffer of
+    a depth image alone, where a colour read waits for nothing (llvmpipe
+    then draws those lines when a later stage reads their image, and the
+    probe counted them there)."""
     framebuffer = gpu.state.active_framebuffer_get()
     framebuffer.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
+    framebuffer.read_depth(0, 0, 1, 1)
 
 
 def _draw_stage(kwargs) -> str:
@@ -77,6 +84,8 @@ def _draw_stage(kwargs) -> str:
         return VISIBILITY
     if target.stage == draw_mod.RESOLVE:
         return RESOLVE
+    if target.stage == draw_mod.LINES:
+        return HIDDEN if target.lines == draw_mod.HIDDEN_LINES else REGION_LINES
     if target.lines == draw_mod.HIDDEN_LINES:
         return HIDDEN
     if not target.depth_write:

@@ -32,6 +32,24 @@ def test_probe_times_every_stage_and_restores_the_add_on(tmp_path):
     assert rows[-1].startswith("| unprobed frame") and any(frame_stages.READBACK in row for row in rows)
 
 
+def test_probe_times_the_region_lines_pass_as_its_own_stage(tmp_path):
+    """The cage look draws its regions' lines in a pass of their own, into a
+    depth image alone: the probe names it and waits for it there, instead
+    of folding it into the surface drawn directly (and its time into the
+    stage that reads its image)."""
+    scene = scenes.empty_scene(96, 72, transparent=False, use_cage_edges=True)
+    obj = scenes.monkey(scene)
+    obj.modifiers.new("Subdivision", "SUBSURF").levels = 2
+    obj.modifiers["Subdivision"].render_levels = 2
+    scenes.add_camera(scene, location=(2.0, -4.0, 1.5), target=(0.0, 0.0, 0.0))
+    with frame_stages.StageProbe() as probe:
+        scenes.render_to_file(scene, tmp_path / "cage.png")
+        probe.end_frame(1000.0, solidwire_addon.stats())
+    (frame,) = probe.frames
+    assert frame.get(frame_stages.REGION_LINES, 0.0) > 0.0, frame
+    assert any(frame_stages.REGION_LINES in row for row in probe.table(900.0))
+
+
 def test_bare_draw_covers_what_solidwire_draws(tmp_path):
     """The benchmark's floor (frame_stages.bare_draw): the same triangles
     from the same camera, so the same pixels up to float32 rounding of the
