@@ -1,7 +1,8 @@
 /* The viewport overlay's deferred surface, composited into Blender's buffer
  * (passes.draw_over_viewport): the resolved colour the overlay keeps, at the
  * record's window depth moved towards the camera by the direct pass's
- * DEPTH_BIAS (z/w - b in NDC is z - b/2 in window depth, solidwire_vert.glsl),
+ * DEPTH_BIAS (z/w - b in NDC is z - b/2 in window depth, solidwire_vert.glsl)
+ * and by the allowance for Blender's rounding of the same surface,
  * so that Blender's depth test keeps exactly the pixels it keeps of the
  * direct pass, and the colour blends as that pass's fragment would. Where
  * the record holds no surface (its cleared depth), nothing is drawn. A
@@ -22,6 +23,10 @@ void main()
   float w_clip = window_depth_rows.w - window_depth_rows.z * depth;
   depth = 0.5 * (z_clip / w_clip) + 0.5;
 #endif
-  gl_FragDepth = depth - 0.5 * DEPTH_BIAS;
+  /* The allowance for Blender's rounding far from the origin (common.glsl),
+   * at the view depth of this window depth. */
+  float ndc = 2.0 * depth - 1.0;
+  float view_depth = (depth_rows.y - ndc * depth_rows.w) / (depth_rows.x - ndc * depth_rows.z);
+  gl_FragDepth = depth - 0.5 * DEPTH_BIAS + window_depth_shift(view_depth, blender_depth_allowance, depth_rows);
   frag_color = texelFetch(surface_image, pixel, 0);
 }

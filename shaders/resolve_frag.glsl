@@ -24,8 +24,10 @@ void main()
   }
 #ifdef RECORD_DEPTH
   /* Straight into Blender's buffer (viewport overlay): the record's window
-   * depth less the bias, as overlay_composite_frag.glsl writes it. */
-  gl_FragDepth = texelFetch(record_depth, ivec2(gl_FragCoord.xy), 0).r - 0.5 * DEPTH_BIAS;
+   * depth less the bias and Blender's allowance, as overlay_composite_frag.glsl
+   * writes it. */
+  gl_FragDepth = texelFetch(record_depth, ivec2(gl_FragCoord.xy), 0).r - 0.5 * DEPTH_BIAS +
+                 window_depth_shift(visible.w, params.blender_depth_allowance, params.depth_rows);
 #endif
   int triangle = int(visible.x) - 1;
   sw_instance_id = int(visible.y);

@@ -42,13 +42,14 @@ void main()
 #ifdef OVERLAY_FINS
   /* Viewport: the fixed-function depth test against the viewport's depth
    * (every object Blender drew) does the occlusion; q is moved towards the
-   * camera by the overlay's depth bias (draw.OVERLAY_DEPTH_BIAS, NDC, so half
+   * camera by the overlay's depth bias (view.OVERLAY_DEPTH_BIAS, NDC, so half
    * of it in window depth) so the surface beyond the outline never wins a
    * tie. Fins blend "over", so two fins meeting at a convex corner compound
    * slightly there; the render keeps the exact maximum. */
   float weight = intensity * params.wire_color.a;
   frag_color = vec4(params.wire_color.rgb * weight, weight);
-  gl_FragDepth = q_depth - 0.5 * OVERLAY_FINS;
+  gl_FragDepth = q_depth - 0.5 * OVERLAY_FINS +
+                 window_depth_shift(q_view_depth, params.blender_depth_allowance, params.depth_rows);
 #else
   frag_intensity = intensity;
   gl_FragDepth = 1.0 - intensity;

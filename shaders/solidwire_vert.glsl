@@ -334,11 +334,17 @@ void fill_outputs(int triangle, int corner, float vertex_id)
  * LESS_EQUAL test would stipple. Moving every vertex a constant DEPTH_BIAS
  * towards the camera in NDC (z - b*w, i.e. z/w - b after the divide) makes
  * our surface win that tie; NDC bias is the right unit because float32
- * rounding of z/w is relative to |z/w| <= 1. Window x/y and the edge
- * distances are untouched (only z changes). */
+ * rounding of z/w is relative to |z/w| <= 1. Far from the world origin
+ * Blender's rounding of the positions themselves dominates: the vertex
+ * moves towards the camera by that allowance too, in scene units
+ * (window_depth_shift, common.glsl). Window x/y and the edge distances are
+ * untouched (only z changes). */
 vec4 biased(vec4 position)
 {
 #ifdef DEPTH_BIAS
+  float view_depth_here = view_depth_of_clip_z(position.z, params.depth_rows);
+  position.z += 2.0 * window_depth_shift(view_depth_here, params.blender_depth_allowance, params.depth_rows) *
+                position.w;
   position.z -= DEPTH_BIAS * position.w;
 #endif
   return position;

@@ -115,9 +115,10 @@ vec4 strand_colour(vec2 p, float intensity, bool inside)
  * Blender drew; blended "over". */
 void write_overlay(vec4 color, float depth)
 {
-  float clip_z = -proj_z.x * depth + proj_z.y;
-  float clip_w = -proj_z.z * depth + proj_z.w;
-  gl_FragDepth = clamp(0.5 * (clip_z / clip_w) + 0.5 - 0.5 * STRAND_OVERLAY, 0.0, 1.0);
+  float clip_z = -params.depth_rows.x * depth + params.depth_rows.y;
+  float clip_w = -params.depth_rows.z * depth + params.depth_rows.w;
+  float shift = window_depth_shift(depth, params.blender_depth_allowance, params.depth_rows);
+  gl_FragDepth = clamp(0.5 * (clip_z / clip_w) + 0.5 - 0.5 * STRAND_OVERLAY + shift, 0.0, 1.0);
   frag_color = color;
 #  ifdef DISPLAY_TRANSFORM
   frag_color = display_transform(frag_color);

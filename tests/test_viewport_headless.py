@@ -186,6 +186,39 @@ def test_hidden_lines_stay_behind_another_blender_object(viewport):
     assert changed_bare[inner].sum() > 50, "control: without the occluder the lines are there"
 
 
+@pytest.mark.parametrize("hidden_lines", [False, True], ids=["wire", "hidden_lines"])
+@pytest.mark.parametrize("subdivisions", [0, 2], ids=["drawn_directly", "deferred"])
+def test_wire_far_from_the_origin_stays_in_front_of_blenders_depth(viewport, subdivisions, hidden_lines):
+    """Suzanne 2,000 units from the world origin: Blender's Solid shading
+    projects her through float32 matrices, so its depth of her slanted
+    faces strays by far more than the overlay's constant bias, and 4 % of
+    the wire's full-intensity pixels (those of the float64 reference) used
+    to fail Blender's depth test. The overlay moves its surface towards the
+    camera by that rounding too (view.blender_depth_allowance): the wire
+    is whole again, directly drawn or deferred, and still shows nothing
+    where the reference shows no line."""
+    from tests.support import reference
+
+    offset = 2000.0
+    scene = scenes.empty_scene(WIDTH, HEIGHT, wire_color=WIRE, use_hidden_lines=hidden_lines)
+    monkey = scenes.monkey(scene, location=(offset, offset, 0.0), subdivisions=subdivisions)
+    scenes.add_camera(scene, location=(offset + 3.0, offset - 3.0, 1.5), target=(offset, offset, 0.0))
+    monkey.select_set(False)
+    strong = reference.render_reference(scene).intensity
+    view = viewport(scene)
+    flat_solid_shading(view.space)
+    set_overlays(view.space, overlays=False)
+    view.draw_blender()
+    view.draw_solidwire()
+    rgba = view.rgba().astype(np.float64) / 255.0
+    green = rgba[..., 1] - rgba[..., 0] > 0.3  # the wire over Blender's red surface
+    full = strong > 0.9
+    assert full.sum() > 5000
+    missing = int((full & ~green).sum())
+    assert missing <= 0.001 * full.sum(), f"{missing} of {full.sum()} full-intensity wire pixels hidden"
+    assert int((green & (strong < 0.02)).sum()) <= 2, "no line where the reference has none"
+
+
 def flat_colours(view_transform: str):
     """(Blender's Solid colour, SolidWire's fill colour as the screen shows
     it, the scene's display transform of the colour), each (N, 3) in 0..1

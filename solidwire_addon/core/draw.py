@@ -20,8 +20,10 @@ from .edge_select import EDGE_CLASSES
 from .log import warn_once
 from .settings import pack_params
 from .view import (
+    NO_DEPTH_ALLOWANCE,
     DrawStats,
     View,
+    blender_depth_allowance,
     box_pixels,
     determinant3,
     inverse_transpose3,
@@ -63,7 +65,7 @@ class DrawTarget:
     target, from which its shader variant follows (:func:`shader_variant`).
 
     Depth: the test and whether the draw writes depth, an NDC bias towards
-    the camera (the viewport overlay, passes.OVERLAY_DEPTH_BIAS) and whether
+    the camera (the viewport overlay, view.OVERLAY_DEPTH_BIAS) and whether
     the depth written is view depth / clip end (the render's own targets,
     LINEAR_DEPTH in solidwire_frag.glsl). ``clip_planes`` ((6, 4)
     world-space planes of a viewport's clipping region): fragments outside
@@ -518,13 +520,13 @@ def draw(
     if variant.item_colors:
         table, bases = colors.color_table(items, settings, lambda style: styled(settings, style, show_wire))
         extras["item_colors"] = table_texture(table)
-    blocks = {None: gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))}
+    blocks = {None: gpu.types.GPUUniformBuf(params_block(settings, view, target))}
 
     def ubo(style):
         block = blocks.get(style)
         if block is None:
             block = blocks[style] = gpu.types.GPUUniformBuf(
-                pack_params(styled(settings, style, show_wire), view.viewport, view.projection)
+                params_block(styled(settings, style, show_wire), view, target)
             )
         return block
 
@@ -754,6 +756,15 @@ def _bind_extras(shader, variant, extras) -> None:
         shader.uniform_sampler("record_depth", extras["record_depth"])
     if variant.peel_layer:
         shader.uniform_sampler("peel_depth", extras["peel_depth"])
+
+
+def params_block(settings, view: View, target: DrawTarget) -> bytes:
+    """The parameter block of a draw of ``target`` in ``view``
+    (settings.pack_params): a viewport overlay's (``target.depth_bias``)
+    moves its surfaces towards the camera by Blender's depth allowance
+    (view.blender_depth_allowance)."""
+    allowance = blender_depth_allowance(view) if target.depth_bias else NO_DEPTH_ALLOWANCE
+    return pack_params(settings, view.viewport, view.projection, allowance)
 
 
 def bind_display_transform(shader, display) -> None:

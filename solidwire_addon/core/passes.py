@@ -56,19 +56,12 @@ from .schema import (
     OBJECT_INDEX_PASS,
     WIRE_PASS,
 )
-from .settings import clip_end_of, pack_params
+from .settings import clip_end_of, depth_rows, pack_params
 from .targets import BACKGROUND_DEPTH, overlay_targets_for, read_texture, release_kept_images, targets_for
-from .view import DrawStats, View, window_boxes
+from .view import NO_DEPTH_ALLOWANCE, OVERLAY_DEPTH_BIAS, DrawStats, View, blender_depth_allowance, window_boxes
 
 # Written by the surface pass's extra outputs (the rest has its own pass).
 _SURFACE_AOVS = frozenset((WIRE_PASS, EDGE_DISTANCE_PASS, NORMAL_PASS, OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS))
-
-# NDC depth bias of the viewport overlay (2^-18: 32 steps of a 24-bit depth
-# buffer, about 4 float32 ULPs of z/w near 1). Enough to win the tie with
-# Blender's own depth of the same surface (a few ULPs off, computed from other
-# float32 matrices); small enough that a surface more than a hair behind
-# another stays hidden. See DEPTH_BIAS in shaders/solidwire_vert.glsl.
-OVERLAY_DEPTH_BIAS = 2.0**-18
 
 # The overlay defers a mesh from this many triangles per pixel of its
 # window box on (draw.split_deferred). Higher than the render's threshold:
@@ -1348,7 +1341,7 @@ def _draw_overlay_surface(frame: Frame, target: DrawTarget) -> None:
     surface = frame.overlay_surface
     targets = surface.targets
     if surface.kept:
-        _composite_overlay_surface(targets, frame.base.depth_bias)
+        _composite_overlay_surface(targets, frame.base.depth_bias, frame.view)
         return
     resolve = DrawTarget(
         stage=draw_mod.RESOLVE,
@@ -1367,13 +1360,14 @@ def _draw_overlay_surface(frame: Frame, target: DrawTarget) -> None:
     frame.line_stats.add(stats)
 
 
-def _composite_overlay_surface(targets, depth_bias: float) -> None:
+def _composite_overlay_surface(targets, depth_bias: float, view: View) -> None:
     """Blend ``targets.surface`` into the bound framebuffer (Blender's)
     over the items' window boxes, each pixel at the record's depth less the
-    bias, with depth test LESS_EQUAL and write, blending as the caller set
-    (premultiplied "over")."""
+    bias and Blender's allowance, with depth test LESS_EQUAL and write,
+    blending as the caller set (premultiplied "over")."""
     shader = shaders.get_overlay_composite(depth_bias)
     shader.bind()
+    _bind_depth_allowance(shader, view, blender_depth_allowance(view))
     shader.uniform_sampler("record_depth", targets.depth)
     shader.uniform_sampler("surface_image", targets.surface)
     gpu.state.depth_test_set("LESS_EQUAL")
@@ -1429,6 +1423,8 @@ def _peel_hidden_regions(
         over_viewport = not base.linear_depth
         composite = shaders.get_overlay_composite(2.0 * base.depth_bias, linear_record=over_viewport)
         rows = _window_depth_rows(view.projection) if over_viewport else None
+        # (Twice Blender's allowance too, for the same reason.)
+        allowance = tuple(2.0 * a for a in blender_depth_allowance(view)) if over_viewport else NO_DEPTH_ALLOWANCE
         box, layers = box or (0, 0, view.width, view.height), 0
         behind_tiles = None  # (the first layer lies behind ``behind``, or in front of everything)
         left_out = 0  # triangles the records left out (behind_tiles, and outside the box)
@@ -1463,6 +1459,7 @@ def _peel_hidden_regions(
                     framebuffer_of,
                     test=test,
                     window_depth_rows=rows,
+                    allowance=allowance,
                 )
             layers = layer
         else:
@@ -1546,6 +1543,7 @@ def _composite_kept(
     test: str = "GREATER",
     write_depth: bool = False,
     window_depth_rows=None,
+    allowance=NO_DEPTH_ALLOWANCE,
 ) -> None:
     """Blend an image (``colour``, premultiplied, at the depth image
     ``depth``: a hidden layer's lines, a kept image) "over" into
@@ -1554,7 +1552,9 @@ def _composite_kept(
     (shaders.get_overlay_composite), tested ``test`` against the depth
     there (GREATER: a hidden layer, behind the surface) and written with
     ``write_depth``; ``window_depth_rows`` (_window_depth_rows) for a
-    composite of a linear record."""
+    composite of a linear record; ``allowance``: Blender's depth allowance
+    (view.blender_depth_allowance) it moves the pixels by too, where the
+    depth image has none of it yet."""
     x, y, w, h = scissor
     rect = (
         2.0 * x / view.width - 1.0,
@@ -1570,6 +1570,7 @@ def _composite_kept(
         shader.bind()
         shader.uniform_sampler("record_depth", depth)
         shader.uniform_sampler("surface_image", colour)
+        _bind_depth_allowance(shader, view, allowance)
         if window_depth_rows is not None:
             shader.uniform_float("window_depth_rows", window_depth_rows)
         draw_mod.draw_rectangle(shader, rect)
@@ -1580,6 +1581,14 @@ def _composite_kept(
     with into().bind():
         gpu.state.viewport_set(0, 0, view.width, view.height)
         draw()
+
+
+def _bind_depth_allowance(shader, view: View, allowance) -> None:
+    """The push constants of a bound composite shader
+    (shaders.get_overlay_composite) that move its pixels by Blender's depth
+    ``allowance`` (NO_DEPTH_ALLOWANCE: not at all)."""
+    shader.uniform_float("depth_rows", depth_rows(view.projection))
+    shader.uniform_float("blender_depth_allowance", (*allowance, 0.0, 0.0))
 
 
 def _window_depth_rows(projection) -> tuple:
@@ -1629,6 +1638,8 @@ def _blend_hidden_target(targets) -> None:
     is (no layer lies behind the background)."""
     shader = shaders.get_overlay_composite(0.0)
     shader.bind()
+    shader.uniform_float("depth_rows", (0.0,) * 4)  # (no allowance: its depth is never written)
+    shader.uniform_float("blender_depth_allowance", (0.0,) * 4)
     shader.uniform_sampler("record_depth", targets.depth)
     shader.uniform_sampler("surface_image", targets.hidden)
     gpu.state.depth_test_set("NONE")

@@ -61,6 +61,12 @@ DrawSettings = dataclasses.make_dataclass(
 DrawSettings.__doc__ = "A plain, immutable snapshot of the scene's SolidWire settings (see core/schema.py)."
 
 
+def depth_rows(projection) -> tuple:
+    """(P22, P23, P32, P33) of a GL projection: a point at view depth d has
+    clip z = P23 - P22 d and clip w = P33 - P32 d."""
+    return tuple(float(projection[row][column]) for row, column in ((2, 2), (2, 3), (3, 2), (3, 3)))
+
+
 def clip_end_of(projection) -> float:
     """The far clip distance of a GL projection matrix (perspective or
     orthographic), from its third row."""
@@ -72,17 +78,21 @@ def clip_end_of(projection) -> float:
     return far if math.isfinite(far) and far > 0.0 else 1.0e30
 
 
-def pack_params(settings, viewport, projection=None) -> bytes:
+def pack_params(settings, viewport, projection=None, blender_depth_allowance=(0.0, 0.0)) -> bytes:
     """The std140 parameter block (layout: schema.PARAM_BLOCK).
 
     ``projection`` (the view's) is needed for world-space thickness: window
     pixels per scene unit across the view at clip w = 1 are
-    0.5 * height * projection[1][1]; the shader divides by the fragment's w."""
+    0.5 * height * projection[1][1]; the shader divides by the fragment's w.
+    ``blender_depth_allowance``: the viewport overlay's (a, b) of
+    view.blender_depth_allowance, (0, 0) elsewhere."""
     px_per_unit = 0.0 if projection is None else 0.5 * float(viewport[3]) * abs(float(projection[1][1]))
     view_values = {
         "viewport": tuple(float(v) for v in viewport),
         "world_half_thickness_px": 0.5 * max(float(settings.world_thickness), 0.0) * px_per_unit,
         "inv_clip_end": 0.0 if projection is None else 1.0 / clip_end_of(projection),
+        "depth_rows": (0.0,) * 4 if projection is None else depth_rows(projection),
+        "blender_depth_allowance": (*(float(v) for v in blender_depth_allowance), 0.0, 0.0),
     }
     values: list[float] = []
     for member in schema.PARAM_BLOCK:

@@ -56,7 +56,7 @@ class ShaderVariant:
     use_fade: bool = False
     write_view_depth: bool = False
     # Viewport overlay: NDC depth bias towards the camera (0 = none); see
-    # DEPTH_BIAS in solidwire_vert.glsl and draw.OVERLAY_DEPTH_BIAS.
+    # DEPTH_BIAS in solidwire_vert.glsl and view.OVERLAY_DEPTH_BIAS.
     depth_bias: float = 0.0
     thickness_mode: int = THICKNESS_PIXELS
     # Hidden-line style (image model §5.4): the pass that draws faces behind the
@@ -941,11 +941,13 @@ def get_setup(in_front: bool = False):
 def get_overlay_composite(depth_bias: float, linear_record: bool = False):
     """The viewport overlay's composite (shaders/overlay_composite_frag.glsl
     over resolve_vert.glsl's rectangle): the kept surface image into
-    Blender's buffer at the record's depth less ``depth_bias``;
-    ``linear_record``: the record holds view depth / clip end (a hidden
-    layer's), turned into window depth by the projection's depth rows
-    (push constant ``window_depth_rows``: P22, P23, P32, P33 with the clip
-    end folded into the first and third)."""
+    Blender's buffer at the record's depth less ``depth_bias`` and
+    Blender's allowance (push constants ``depth_rows``, the projection's
+    P22, P23, P32, P33, and ``blender_depth_allowance``: window_depth_shift
+    in common.glsl); ``linear_record``: the record holds view depth / clip
+    end (a hidden layer's), turned into window depth by the projection's
+    depth rows (push constant ``window_depth_rows``: those rows with the
+    clip end folded into the first and third)."""
     key = (_context, "overlay composite", float(depth_bias), linear_record)
     shader = _cache.get(key)
     if shader is None:
@@ -954,6 +956,8 @@ def get_overlay_composite(depth_bias: float, linear_record: bool = False):
         info.push_constant("VEC4", "resolve_rect")
         add_sampler(info, "record_depth")
         add_sampler(info, "surface_image")
+        info.push_constant("VEC4", "depth_rows")
+        info.push_constant("VEC4", "blender_depth_allowance")
         info.define("DEPTH_BIAS", repr(float(depth_bias)))
         if linear_record:
             info.push_constant("VEC4", "window_depth_rows")
@@ -961,7 +965,7 @@ def get_overlay_composite(depth_bias: float, linear_record: bool = False):
         info.fragment_out(0, "VEC4", "frag_color")
         compat.depth_write(info, "ANY")
         info.vertex_source(read_source("resolve_vert.glsl"))
-        info.fragment_source(read_source("overlay_composite_frag.glsl"))
+        info.fragment_source(read_source("common.glsl") + read_source("overlay_composite_frag.glsl"))
         try:
             shader = _keep(_cache, key, gpu.shader.create_from_info(info))
         except Exception as exc:
@@ -1065,16 +1069,15 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             if overlay_bias:
                 iface.flat("VEC4", "seg_split")  # bisector normals at the two joints (overlay)
         info = pulling_info()
-        # Push constants: 120 of the 128 bytes every backend guarantees with
-        # the overlay's proj_z and display_shaper (draw_range draws exactly
-        # the primitives there are, so no count is needed).
+        # Push constants: 104 of the 128 bytes every backend guarantees with
+        # the overlay's display_shaper (draw_range draws exactly the
+        # primitives there are, so no count is needed).
         info.push_constant("VEC4", "strand_view")  # px per unit at w = 1, radius scale
         add_sampler(info, "strand_segments")
         info.vertex_in(0, "INT", "quad_corner")
         info.vertex_out(iface)
         info.fragment_out(0, "VEC4", "frag_color")
         if flags.depth_bias:
-            info.push_constant("VEC4", "proj_z")  # P[2][2], P[2][3], P[3][2], P[3][3]
             info.define("STRAND_OVERLAY", repr(float(flags.depth_bias)))
         else:
             add_sampler(info, "scene_depth")

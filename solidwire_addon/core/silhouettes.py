@@ -35,9 +35,8 @@ import numpy as np
 
 from . import shaders
 from .cache import table_texture, texture_bytes
-from .draw import DrawTarget, bind_display_transform, indexed_quad_batch, shader_variant
+from .draw import DrawTarget, bind_display_transform, indexed_quad_batch, params_block, shader_variant
 from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
-from .settings import pack_params
 from .view import translation
 
 NO_FACE = -1.0
@@ -111,7 +110,7 @@ def draw_silhouettes(items, view, settings, target: DrawTarget, scene_depth_text
     if not overlay_bias:
         variant = replace(variant, display_transform=False)
     shader = shaders.get_silhouette(variant, overlay_bias)
-    ubo = gpu.types.GPUUniformBuf(pack_params(settings, view.viewport, view.projection))
+    ubo = gpu.types.GPUUniformBuf(params_block(settings, view, target))
     shader.bind()
     shader.uniform_block("params", ubo)
     if variant.display_transform:

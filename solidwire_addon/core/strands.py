@@ -31,9 +31,16 @@ import numpy as np
 
 from . import colors, matcaps, shaders
 from .cache import table_texture
-from .draw import DrawTarget, bind_display_transform, clip_space_planes, indexed_quad_batch, shader_variant, styled
+from .draw import (
+    DrawTarget,
+    bind_display_transform,
+    clip_space_planes,
+    indexed_quad_batch,
+    params_block,
+    shader_variant,
+    styled,
+)
 from .log import one_line, warn_once
-from .settings import pack_params
 from .targets import read_texture
 from .view import determinant3, outside_frustum_many, translation
 
@@ -369,7 +376,6 @@ def _draw(items, view, settings, target: DrawTarget, scene_depth=None) -> int:
         rows = clip_space_planes(target.clip_planes, view)
         clip_block = gpu.types.GPUUniformBuf(np.asarray(rows, dtype=np.float32).tobytes())
     px_per_unit = 0.5 * float(view.viewport[3]) * abs(float(view.projection[1][1]))
-    proj = view.projection
     blocks: dict = {}
     drawn = 0
     for kind in (CURVES, POINTS):
@@ -386,9 +392,6 @@ def _draw(items, view, settings, target: DrawTarget, scene_depth=None) -> int:
                 shader = shaders.get_strand(kind == POINTS, variant, overlay_bias)
                 shader.bind()
                 if overlay_bias:
-                    shader.uniform_float(
-                        "proj_z", [float(proj[2][2]), float(proj[2][3]), float(proj[3][2]), float(proj[3][3])]
-                    )
                     if variant.display_transform:
                         bind_display_transform(shader, target.display)
                     if clip_block is not None:
@@ -405,7 +408,7 @@ def _draw(items, view, settings, target: DrawTarget, scene_depth=None) -> int:
                 item_settings = replace(
                     item_settings, wire_color=(*wire, item_settings.wire_color[3]), fill_color=tuple(fill)
                 )
-                block = blocks[key] = gpu.types.GPUUniformBuf(pack_params(item_settings, view.viewport, proj))
+                block = blocks[key] = gpu.types.GPUUniformBuf(params_block(item_settings, view, target))
             shader.uniform_block("params", block)
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())

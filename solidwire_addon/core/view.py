@@ -8,6 +8,7 @@ touches Blender or the GPU.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,6 +29,58 @@ class View:
     @property
     def height(self) -> int:
         return int(self.viewport[3])
+
+
+# NDC depth bias of the viewport overlay (2^-18: 32 steps of a 24-bit depth
+# buffer, about 4 float32 ULPs of z/w near 1). Enough to win the tie with
+# Blender's own depth of the same surface (a few ULPs off, computed from other
+# float32 matrices); small enough that a surface more than a hair behind
+# another stays hidden. See DEPTH_BIAS in shaders/solidwire_vert.glsl; far
+# from the world origin the overlay adds blender_depth_allowance.
+OVERLAY_DEPTH_BIAS = 2.0**-18
+
+# How far Blender's own depth of a surface may stray from ours, in float32
+# spacings (ULPs) of the largest coordinate involved: Blender projects each
+# vertex from its object's space through float32 matrices, so its depth of
+# a surface far from the world origin is off by a few of those spacings in
+# every direction, and a slanted surface's by that much over the cosine of
+# its slant (at 88 degrees about 30 times more). Measured in Blender's own
+# headless viewport (tests/test_viewport_headless.py): Suzanne 2,000 units
+# from the origin needs about 30; 64 leaves room for wider slants and other
+# backends while moving our surface no more than 64 / 2**24 of its distance
+# from the origin (1 cm at 2.6 km).
+BLENDER_DEPTH_ULPS = 64.0
+
+# No allowance: every draw that never meets Blender's depth (the render's).
+NO_DEPTH_ALLOWANCE = (0.0, 0.0)
+
+
+def blender_depth_allowance(view: View) -> tuple[float, float]:
+    """(a, b): the viewport overlay moves the point it draws at view depth
+    d towards the camera by a + b |d| scene units before Blender's depth
+    test meets it (docs/image_model.md §5.6; shaders/common.glsl,
+    window_depth_shift): BLENDER_DEPTH_ULPS float32 spacings of the largest
+    coordinate such a point can have, the camera's distance from the origin
+    plus the point's from the camera (at most d times the length of the
+    ray through the view's corner per unit of view depth; for an
+    orthographic view the view's half diagonal plus |d|)."""
+    view_matrix = np.asarray(view.view_matrix, dtype=np.float64)
+    p = np.asarray(view.projection, dtype=np.float64)
+    eye = -view_matrix[:3, :3].T @ view_matrix[:3, 3]  # the camera in world space
+    if p[0][0] == 0.0 or p[1][1] == 0.0:
+        return NO_DEPTH_ALLOWANCE
+    # The view's farthest corner from its axis (a lens shift moves the
+    # window off the axis): per unit of view depth, or in scene units.
+    perspective = p[3][3] != 1.0
+    shift_x, shift_y = (p[0][2], p[1][2]) if perspective else (p[0][3], p[1][3])
+    half_diagonal = math.hypot((1.0 + abs(shift_x)) / p[0][0], (1.0 + abs(shift_y)) / p[1][1])
+    eye_distance = math.sqrt(float(eye @ eye))
+    if perspective:  # the corner ray's length per unit of view depth
+        at_eye, per_unit = eye_distance, math.sqrt(1.0 + half_diagonal**2)
+    else:  # orthographic: a window of that half diagonal, moved |d| along the axis
+        at_eye, per_unit = eye_distance + half_diagonal, 1.0
+    spacing = BLENDER_DEPTH_ULPS * 2.0**-24
+    return (spacing * at_eye, spacing * per_unit)
 
 
 @dataclass(frozen=True)

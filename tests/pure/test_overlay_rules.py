@@ -5,6 +5,9 @@ for the table in docs/user/overlay.md ("Viewport states").
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 
 from solidwire_addon.core import overlay_state
@@ -61,3 +64,67 @@ def test_pixel_lengths_follow_the_ui_scale():
     assert scaled.fade_start == base.fade_start
     for bad in (0.0, -1.0, float("nan"), None):
         assert overlay_state.plan_overlay(ViewportState(pixel_size=bad)).pixel_scale == 1.0
+
+
+def _perspective(near=0.1, far=100.0, focal=2.0, aspect=4.0 / 3.0):
+    p = np.zeros((4, 4))
+    p[0, 0], p[1, 1] = focal / aspect, focal
+    p[2, 2], p[2, 3] = -(far + near) / (far - near), -2.0 * far * near / (far - near)
+    p[3, 2] = -1.0
+    return p
+
+
+def _looking_from(eye) -> np.ndarray:
+    """A view matrix of a camera at ``eye`` looking down -Z (no rotation)."""
+    view = np.eye(4)
+    view[:3, 3] = -np.asarray(eye, dtype=np.float64)
+    return view
+
+
+def _window_shift(view_depth, allowance, projection):
+    """What shaders/common.glsl's window_depth_shift gives, in float64."""
+    p22, p23, p32, p33 = projection[2, 2], projection[2, 3], projection[3, 2], projection[3, 3]
+    slack = allowance[0] + allowance[1] * abs(view_depth)
+    w_here, w_moved = p33 - p32 * view_depth, p33 - p32 * (view_depth - slack)
+    return 0.5 * slack * (p22 * p33 - p23 * p32) / (w_moved * w_here)
+
+
+def test_blender_depth_allowance_grows_with_the_distance_from_the_origin():
+    """The overlay's allowance for Blender's float32 depth
+    (view.blender_depth_allowance): BLENDER_DEPTH_ULPS spacings of the
+    largest coordinate a drawn point can have. Near the origin it moves a
+    surface less than the constant NDC bias does from 15 near-clip
+    distances on (the overlay's depth test is as before: closer, both move
+    it by hundred-thousandths of a unit); 2,000 units away, more than 2^-14
+    in NDC at 4 units from the camera, which Blender's own viewport needs
+    there (tests/test_viewport_headless.py)."""
+    from solidwire_addon.core.view import BLENDER_DEPTH_ULPS, OVERLAY_DEPTH_BIAS, View, blender_depth_allowance
+
+    projection = _perspective()
+    spacing = BLENDER_DEPTH_ULPS * 2.0**-24
+    corner_ray = math.sqrt(1.0 + (1.0 / projection[0, 0]) ** 2 + (1.0 / projection[1, 1]) ** 2)
+    for eye in ((3.0, -4.0, 0.0), (2003.0, 1997.0, 1.5)):
+        a, b = blender_depth_allowance(View(_looking_from(eye), projection, (0, 0, 640, 480)))
+        assert a == pytest.approx(spacing * math.dist(eye, (0.0, 0.0, 0.0)))
+        assert b == pytest.approx(spacing * corner_ray)
+    near = blender_depth_allowance(View(_looking_from((3.0, -4.0, 0.0)), projection, (0, 0, 640, 480)))
+    far = blender_depth_allowance(View(_looking_from((2003.0, 1997.0, 1.5)), projection, (0, 0, 640, 480)))
+    for depth in (1.5, 4.0, 50.0):
+        assert -2.0 * _window_shift(depth, near, projection) < OVERLAY_DEPTH_BIAS
+    assert near[0] + near[1] * 0.5 < 3e-5
+    assert -2.0 * _window_shift(4.0, far, projection) > 2.0**-14
+
+
+def test_blender_depth_allowance_of_an_orthographic_view():
+    """Orthographic: the window's half diagonal joins the camera's distance
+    (a point lies that far off the axis at any depth), one unit per unit of
+    depth; the shift in window depth is then the same at every depth."""
+    from solidwire_addon.core.view import BLENDER_DEPTH_ULPS, View, blender_depth_allowance
+
+    projection = np.eye(4)
+    projection[0, 0], projection[1, 1] = 1.0 / 8.0, 1.0 / 6.0  # a 16 x 12 window
+    projection[2, 2], projection[2, 3] = -2.0 / 99.9, -100.1 / 99.9
+    a, b = blender_depth_allowance(View(_looking_from((0.0, 0.0, 500.0)), projection, (0, 0, 640, 480)))
+    spacing = BLENDER_DEPTH_ULPS * 2.0**-24
+    assert a == pytest.approx(spacing * (500.0 + 10.0)) and b == pytest.approx(spacing)
+    assert _window_shift(1.0, (a, 0.0), projection) == pytest.approx(_window_shift(90.0, (a, 0.0), projection))
