@@ -61,21 +61,22 @@ vec4 fetch_texel(sampler2D table, int index)
 
 /* Viewport overlay (docs/image_model.md §5.6): the change of window depth
  * that moves the point at view depth `view_depth` towards the camera by
- * allowance.x + allowance.y |view_depth| scene units (core/view.py,
- * blender_depth_allowance: how far Blender's float32 depth of the same
- * surface may stray), for a projection whose depth `rows` are P22, P23,
+ * min(allowance.x + allowance.y |d|, allowance.z + allowance.w |d|) scene
+ * units (core/view.py, blender_depth_allowance: how far Blender's float32
+ * depth of the same surface may stray, and the most a point may move),
+ * for a projection whose depth `rows` are P22, P23,
  * P32, P33 (clip z = P23 - P22 d, clip w = P33 - P32 d). Exact for the
  * projection: window depth 0.5 z/w + 0.5 changes by
  * 0.5 s (P22 P33 - P23 P32) / (w(d - s) w(d)) when d becomes d - s. 0
- * where there is no allowance, or either point is not in front of the eye. */
+ * where there is no allowance or the point is not in front of the eye. */
 float window_depth_shift(float view_depth, vec4 allowance, vec4 rows)
 {
-  float slack = allowance.x + allowance.y * abs(view_depth);
+  float slack = min(allowance.x + allowance.y * abs(view_depth), allowance.z + allowance.w * abs(view_depth));
   if (!(slack > 0.0)) { /* (also where the view depth is not a number) */
     return 0.0;
   }
   float w_here = rows.w - rows.z * view_depth;
-  float w_moved = rows.w - rows.z * (view_depth - slack);
+  float w_moved = w_here + rows.z * slack;
   if (w_here <= 0.0 || w_moved <= 0.0) {
     return 0.0;
   }

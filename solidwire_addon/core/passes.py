@@ -1588,7 +1588,7 @@ def _bind_depth_allowance(shader, view: View, allowance) -> None:
     (shaders.get_overlay_composite) that move its pixels by Blender's depth
     ``allowance`` (NO_DEPTH_ALLOWANCE: not at all)."""
     shader.uniform_float("depth_rows", depth_rows(view.projection))
-    shader.uniform_float("blender_depth_allowance", (*allowance, 0.0, 0.0))
+    shader.uniform_float("blender_depth_allowance", allowance)
 
 
 def _window_depth_rows(projection) -> tuple:
@@ -1639,7 +1639,7 @@ def _blend_hidden_target(targets) -> None:
     shader = shaders.get_overlay_composite(0.0)
     shader.bind()
     shader.uniform_float("depth_rows", (0.0,) * 4)  # (no allowance: its depth is never written)
-    shader.uniform_float("blender_depth_allowance", (0.0,) * 4)
+    shader.uniform_float("blender_depth_allowance", NO_DEPTH_ALLOWANCE)
     shader.uniform_sampler("record_depth", targets.depth)
     shader.uniform_sampler("surface_image", targets.hidden)
     gpu.state.depth_test_set("NONE")

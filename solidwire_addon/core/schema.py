@@ -930,7 +930,7 @@ VIEW_PARAMS = (
     ("world_half_thickness_px", "float"),  # world_thickness / 2 in px at clip w = 1
     ("inv_clip_end", "float"),  # 1 / the view's clip end (linear depth of the render)
     ("depth_rows", "vec4"),  # the projection's P22, P23, P32, P33 (view depth <-> window depth)
-    # Viewport overlay: (a, b, 0, 0), its points moved a + b |view depth|
+    # Viewport overlay: (a, b, c, e), its points moved min(a + b |d|, c + e |d|)
     # towards the camera before Blender's depth test (view.blender_depth_allowance).
     ("blender_depth_allowance", "vec4"),
 )

@@ -78,21 +78,21 @@ def clip_end_of(projection) -> float:
     return far if math.isfinite(far) and far > 0.0 else 1.0e30
 
 
-def pack_params(settings, viewport, projection=None, blender_depth_allowance=(0.0, 0.0)) -> bytes:
+def pack_params(settings, viewport, projection=None, blender_depth_allowance=(0.0,) * 4) -> bytes:
     """The std140 parameter block (layout: schema.PARAM_BLOCK).
 
     ``projection`` (the view's) is needed for world-space thickness: window
     pixels per scene unit across the view at clip w = 1 are
     0.5 * height * projection[1][1]; the shader divides by the fragment's w.
-    ``blender_depth_allowance``: the viewport overlay's (a, b) of
-    view.blender_depth_allowance, (0, 0) elsewhere."""
+    ``blender_depth_allowance``: the viewport overlay's
+    view.blender_depth_allowance, none elsewhere."""
     px_per_unit = 0.0 if projection is None else 0.5 * float(viewport[3]) * abs(float(projection[1][1]))
     view_values = {
         "viewport": tuple(float(v) for v in viewport),
         "world_half_thickness_px": 0.5 * max(float(settings.world_thickness), 0.0) * px_per_unit,
         "inv_clip_end": 0.0 if projection is None else 1.0 / clip_end_of(projection),
         "depth_rows": (0.0,) * 4 if projection is None else depth_rows(projection),
-        "blender_depth_allowance": (*(float(v) for v in blender_depth_allowance), 0.0, 0.0),
+        "blender_depth_allowance": tuple(float(v) for v in blender_depth_allowance),
     }
     values: list[float] = []
     for member in schema.PARAM_BLOCK:

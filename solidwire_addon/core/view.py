@@ -51,19 +51,29 @@ OVERLAY_DEPTH_BIAS = 2.0**-18
 # from the origin (1 cm at 2.6 km).
 BLENDER_DEPTH_ULPS = 64.0
 
+# The most the allowance moves a point, as a fraction of its distance from
+# the camera (2^-8: 1.6 cm at 4 m). Kilometres from the origin, where
+# Blender's own depth strays by more than that, a surface hidden behind
+# another one of ours would otherwise show its wire through it where the
+# overlay lets Blender's depth hide our farther surfaces (Solid shading,
+# no depth pre-pass of our own).
+BLENDER_DEPTH_MOST = 2.0**-8
+
 # No allowance: every draw that never meets Blender's depth (the render's).
-NO_DEPTH_ALLOWANCE = (0.0, 0.0)
+NO_DEPTH_ALLOWANCE = (0.0, 0.0, 0.0, 0.0)
 
 
-def blender_depth_allowance(view: View) -> tuple[float, float]:
-    """(a, b): the viewport overlay moves the point it draws at view depth
-    d towards the camera by a + b |d| scene units before Blender's depth
-    test meets it (docs/image_model.md §5.6; shaders/common.glsl,
-    window_depth_shift): BLENDER_DEPTH_ULPS float32 spacings of the largest
-    coordinate such a point can have, the camera's distance from the origin
-    plus the point's from the camera (at most d times the length of the
-    ray through the view's corner per unit of view depth; for an
-    orthographic view the view's half diagonal plus |d|)."""
+def blender_depth_allowance(view: View) -> tuple[float, float, float, float]:
+    """(a, b, c, e): the viewport overlay moves the point it draws at view
+    depth d towards the camera by min(a + b |d|, c + e |d|) scene units
+    before Blender's depth test meets it (docs/image_model.md §5.6;
+    shaders/common.glsl, window_depth_shift). a + b |d|: BLENDER_DEPTH_ULPS
+    float32 spacings of the largest coordinate such a point can have, the
+    camera's distance from the origin plus the point's from the camera (at
+    most d times the length of the ray through the view's corner per unit
+    of view depth; for an orthographic view the view's half diagonal plus
+    |d|). c + e |d|: at most BLENDER_DEPTH_MOST of the point's distance
+    from the camera (orthographic: of the view's half diagonal plus |d|)."""
     view_matrix = np.asarray(view.view_matrix, dtype=np.float64)
     p = np.asarray(view.projection, dtype=np.float64)
     eye = -view_matrix[:3, :3].T @ view_matrix[:3, 3]  # the camera in world space
@@ -76,11 +86,11 @@ def blender_depth_allowance(view: View) -> tuple[float, float]:
     half_diagonal = math.hypot((1.0 + abs(shift_x)) / p[0][0], (1.0 + abs(shift_y)) / p[1][1])
     eye_distance = math.sqrt(float(eye @ eye))
     if perspective:  # the corner ray's length per unit of view depth
-        at_eye, per_unit = eye_distance, math.sqrt(1.0 + half_diagonal**2)
+        at_eye, per_unit, window = eye_distance, math.sqrt(1.0 + half_diagonal**2), 0.0
     else:  # orthographic: a window of that half diagonal, moved |d| along the axis
-        at_eye, per_unit = eye_distance + half_diagonal, 1.0
+        at_eye, per_unit, window = eye_distance + half_diagonal, 1.0, half_diagonal
     spacing = BLENDER_DEPTH_ULPS * 2.0**-24
-    return (spacing * at_eye, spacing * per_unit)
+    return (spacing * at_eye, spacing * per_unit, BLENDER_DEPTH_MOST * window, BLENDER_DEPTH_MOST)
 
 
 @dataclass(frozen=True)

@@ -84,47 +84,64 @@ def _looking_from(eye) -> np.ndarray:
 def _window_shift(view_depth, allowance, projection):
     """What shaders/common.glsl's window_depth_shift gives, in float64."""
     p22, p23, p32, p33 = projection[2, 2], projection[2, 3], projection[3, 2], projection[3, 3]
-    slack = allowance[0] + allowance[1] * abs(view_depth)
-    w_here, w_moved = p33 - p32 * view_depth, p33 - p32 * (view_depth - slack)
-    return 0.5 * slack * (p22 * p33 - p23 * p32) / (w_moved * w_here)
+    slack = min(allowance[0] + allowance[1] * abs(view_depth), allowance[2] + allowance[3] * abs(view_depth))
+    w_here = p33 - p32 * view_depth
+    return 0.5 * slack * (p22 * p33 - p23 * p32) / ((w_here + p32 * slack) * w_here)
 
 
 def test_blender_depth_allowance_grows_with_the_distance_from_the_origin():
     """The overlay's allowance for Blender's float32 depth
     (view.blender_depth_allowance): BLENDER_DEPTH_ULPS spacings of the
-    largest coordinate a drawn point can have. Near the origin it moves a
-    surface less than the constant NDC bias does from 15 near-clip
-    distances on (the overlay's depth test is as before: closer, both move
-    it by hundred-thousandths of a unit); 2,000 units away, more than 2^-14
-    in NDC at 4 units from the camera, which Blender's own viewport needs
-    there (tests/test_viewport_headless.py)."""
-    from solidwire_addon.core.view import BLENDER_DEPTH_ULPS, OVERLAY_DEPTH_BIAS, View, blender_depth_allowance
+    largest coordinate a drawn point can have, at most BLENDER_DEPTH_MOST
+    of the point's distance. Near the origin it moves a surface less than
+    the constant NDC bias does from 15 near-clip distances on (the
+    overlay's depth test is as before: closer, both move it by
+    hundred-thousandths of a unit); 2,000 units away, more than 2^-14 in
+    NDC at 4 units from the camera, which Blender's own viewport needs
+    there (tests/test_viewport_headless.py); 100,000 units away, no more
+    than the cap."""
+    from solidwire_addon.core.view import (
+        BLENDER_DEPTH_MOST,
+        BLENDER_DEPTH_ULPS,
+        OVERLAY_DEPTH_BIAS,
+        View,
+        blender_depth_allowance,
+    )
 
     projection = _perspective()
     spacing = BLENDER_DEPTH_ULPS * 2.0**-24
     corner_ray = math.sqrt(1.0 + (1.0 / projection[0, 0]) ** 2 + (1.0 / projection[1, 1]) ** 2)
+
+    def allowance(eye):
+        return blender_depth_allowance(View(_looking_from(eye), projection, (0, 0, 640, 480)))
+
     for eye in ((3.0, -4.0, 0.0), (2003.0, 1997.0, 1.5)):
-        a, b = blender_depth_allowance(View(_looking_from(eye), projection, (0, 0, 640, 480)))
+        a, b, c, e = allowance(eye)
         assert a == pytest.approx(spacing * math.dist(eye, (0.0, 0.0, 0.0)))
         assert b == pytest.approx(spacing * corner_ray)
-    near = blender_depth_allowance(View(_looking_from((3.0, -4.0, 0.0)), projection, (0, 0, 640, 480)))
-    far = blender_depth_allowance(View(_looking_from((2003.0, 1997.0, 1.5)), projection, (0, 0, 640, 480)))
+        assert (c, e) == (0.0, BLENDER_DEPTH_MOST)
+    near, far, farther = allowance((3.0, -4.0, 0.0)), allowance((2003.0, 1997.0, 1.5)), allowance((1e5, 1e5, 0.0))
     for depth in (1.5, 4.0, 50.0):
         assert -2.0 * _window_shift(depth, near, projection) < OVERLAY_DEPTH_BIAS
     assert near[0] + near[1] * 0.5 < 3e-5
     assert -2.0 * _window_shift(4.0, far, projection) > 2.0**-14
+    capped = (4.0 * BLENDER_DEPTH_MOST, 0.0, 4.0 * BLENDER_DEPTH_MOST, 0.0)
+    assert _window_shift(4.0, farther, projection) == pytest.approx(_window_shift(4.0, capped, projection))
 
 
 def test_blender_depth_allowance_of_an_orthographic_view():
     """Orthographic: the window's half diagonal joins the camera's distance
     (a point lies that far off the axis at any depth), one unit per unit of
-    depth; the shift in window depth is then the same at every depth."""
-    from solidwire_addon.core.view import BLENDER_DEPTH_ULPS, View, blender_depth_allowance
+    depth, and the cap is a fraction of that half diagonal plus the depth;
+    the shift in window depth for a given slack is the same at every depth."""
+    from solidwire_addon.core.view import BLENDER_DEPTH_MOST, BLENDER_DEPTH_ULPS, View, blender_depth_allowance
 
     projection = np.eye(4)
     projection[0, 0], projection[1, 1] = 1.0 / 8.0, 1.0 / 6.0  # a 16 x 12 window
     projection[2, 2], projection[2, 3] = -2.0 / 99.9, -100.1 / 99.9
-    a, b = blender_depth_allowance(View(_looking_from((0.0, 0.0, 500.0)), projection, (0, 0, 640, 480)))
+    a, b, c, e = blender_depth_allowance(View(_looking_from((0.0, 0.0, 500.0)), projection, (0, 0, 640, 480)))
     spacing = BLENDER_DEPTH_ULPS * 2.0**-24
     assert a == pytest.approx(spacing * (500.0 + 10.0)) and b == pytest.approx(spacing)
-    assert _window_shift(1.0, (a, 0.0), projection) == pytest.approx(_window_shift(90.0, (a, 0.0), projection))
+    assert c == pytest.approx(BLENDER_DEPTH_MOST * 10.0) and e == BLENDER_DEPTH_MOST
+    fixed = (a, 0.0, 1.0, 0.0)
+    assert _window_shift(1.0, fixed, projection) == pytest.approx(_window_shift(90.0, fixed, projection))
