@@ -64,9 +64,9 @@ vec4 fetch_texel(sampler2D table, int index)
  * min(allowance.x + allowance.y |d|, allowance.z + allowance.w |d|) scene
  * units (core/view.py, blender_depth_allowance: how far Blender's float32
  * depth of the same surface may stray, and the most a point may move),
- * for a projection whose depth `rows` are P22, P23,
- * P32, P33 (clip z = P23 - P22 d, clip w = P33 - P32 d). Exact for the
- * projection: window depth 0.5 z/w + 0.5 changes by
+ * for a projection whose depth `rows` are P22, P23, P32, P33 (clip
+ * z = P23 - P22 d, clip w = P33 - P32 d). Exact for the projection:
+ * window depth 0.5 z/w + 0.5 changes by
  * 0.5 s (P22 P33 - P23 P32) / (w(d - s) w(d)) when d becomes d - s. 0
  * where there is no allowance or the point is not in front of the eye. */
 float window_depth_shift(float view_depth, vec4 allowance, vec4 rows)

@@ -1598,8 +1598,8 @@ def _window_depth_rows(projection) -> tuple:
     projections, perspective or orthographic, give z and w from view z
     alone)."""
     clip_end = clip_end_of(projection)
-    p = np.asarray(projection, dtype=np.float64)
-    return (float(p[2, 2] * clip_end), float(p[2, 3]), float(p[3, 2] * clip_end), float(p[3, 3]))
+    p22, p23, p32, p33 = depth_rows(projection)
+    return (p22 * clip_end, p23, p32 * clip_end, p33)
 
 
 def _hidden_wire(frame: Frame, settings) -> np.ndarray:
