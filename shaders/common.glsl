@@ -88,3 +88,11 @@ float view_depth_of_clip_z(float clip_z, vec4 rows)
 {
   return (rows.y - clip_z) / rows.x;
 }
+
+/* The view depth of a point from its window depth (0.5 z/w + 0.5): with
+ * n = z/w, n (P33 - P32 d) = P23 - P22 d. */
+float view_depth_of_window_depth(float window_depth, vec4 rows)
+{
+  float ndc = 2.0 * window_depth - 1.0;
+  return (rows.y - ndc * rows.w) / (rows.x - ndc * rows.z);
+}

@@ -25,8 +25,7 @@ void main()
 #endif
   /* The allowance for Blender's rounding far from the origin (common.glsl),
    * at the view depth of this window depth. */
-  float ndc = 2.0 * depth - 1.0;
-  float view_depth = (depth_rows.y - ndc * depth_rows.w) / (depth_rows.x - ndc * depth_rows.z);
+  float view_depth = view_depth_of_window_depth(depth, depth_rows);
   gl_FragDepth = depth - 0.5 * DEPTH_BIAS + window_depth_shift(view_depth, blender_depth_allowance, depth_rows);
   frag_color = texelFetch(surface_image, pixel, 0);
 }
