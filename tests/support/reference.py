@@ -206,16 +206,21 @@ COPLANAR_ANGLE = 1.0e-3
 def _cage_masks(depsgraph, s) -> dict:
     """{object name: (drawn mask, chain id) per evaluated edge} for the
     meshes a subdivision modifier subdivides, found independently of the
-    add-on: a temporary integer edge attribute on the original mesh numbers
-    every edge from 1; Blender's subdivision carries it onto the child
-    edges of original edges only. An Array cap carries no Optimal Display
-    marks, so Blender's overlay shows every cap edge: the caps' meshes get
-    the attribute too, numbered past the object's edges, so each cap edge
-    is drawn and a chain of its own. Removed again before returning."""
+    add-on: a temporary integer edge attribute numbers every edge of the
+    last subdivision's input from 1; Blender's subdivision carries it onto
+    the child edges of those edges only. Where that input is the object's
+    own mesh (nothing but deform modifiers before the subdivision) the
+    attribute is written on the mesh; else (a Bevel, a Triangulate, a
+    Mirror... before it, whose new edges are cage edges too, each a chain
+    of its own) a temporary Geometry Nodes modifier just before the
+    subdivision stores it. An Array cap carries no Optimal Display marks,
+    so Blender's overlay shows every cap edge: the caps' meshes get the
+    attribute too, numbered past the object's edges, so each cap edge is
+    drawn and a chain of its own. Removed again before returning."""
     if s is None or not getattr(s, "use_cage_edges", False):
         return {}
     render = depsgraph.mode == "RENDER"
-    marked, caps = [], []
+    marked, caps, numbering = [], [], []
     for obj in bpy.context.scene.objects:
         if obj.type != "MESH" or obj.mode == "EDIT":
             continue
@@ -229,8 +234,11 @@ def _cage_masks(depsgraph, s) -> dict:
         if subdivides and not _keeps_optimal_display(obj, subdivides, render, depsgraph):
             continue  # Blender's overlay shows every edge
         if subdivides and "__reference_cage" not in obj.data.attributes:
-            attribute = obj.data.attributes.new("__reference_cage", "INT", "EDGE")
-            attribute.data.foreach_set("value", np.arange(1, len(obj.data.edges) + 1, dtype=np.int32))
+            if _input_is_own_mesh(obj, subdivides[-1], render):
+                attribute = obj.data.attributes.new("__reference_cage", "INT", "EDGE")
+                attribute.data.foreach_set("value", np.arange(1, len(obj.data.edges) + 1, dtype=np.int32))
+            else:
+                numbering.append(_number_input_edges(obj, subdivides[-1]))
             marked.append(obj)
             for cap in _array_caps(obj, subdivides[-1], render):
                 if "__reference_cage" not in cap.data.attributes:
@@ -254,10 +262,52 @@ def _cage_masks(depsgraph, s) -> dict:
             # edge attribute is copied to them); new inner edges get 0.
             masks[obj.name] = (values > 0, values - 1)
     finally:
+        for obj, modifier, tree in numbering:
+            obj.modifiers.remove(modifier)
+            bpy.data.node_groups.remove(tree)
         for obj in marked + caps:
-            obj.data.attributes.remove(obj.data.attributes["__reference_cage"])
+            attribute = obj.data.attributes.get("__reference_cage")
+            if attribute is not None:
+                obj.data.attributes.remove(attribute)
         depsgraph.update()
     return masks
+
+
+def _input_is_own_mesh(obj, last_subdivision, render) -> bool:
+    """Whether the last subdivision subdivides the object's own mesh, moved
+    at most: only deform modifiers (or none) are enabled before it."""
+    for m in obj.modifiers:
+        if m == last_subdivision:
+            return True
+        if (m.show_render if render else m.show_viewport) and m.type not in _REFERENCE_DEFORM:
+            return False
+    return True
+
+
+def _number_input_edges(obj, last_subdivision):
+    """(obj, modifier, node group): a Geometry Nodes modifier inserted just
+    before ``last_subdivision`` that stores each edge's index + 1 as the
+    integer edge attribute "__reference_cage" (an index below 2**24 is
+    exact through the float addition)."""
+    tree = bpy.data.node_groups.new("__reference_cage", "GeometryNodeTree")
+    tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    nodes, links = tree.nodes, tree.links
+    group_in, group_out = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    store = nodes.new("GeometryNodeStoreNamedAttribute")
+    store.data_type, store.domain = "INT", "EDGE"
+    store.inputs["Name"].default_value = "__reference_cage"
+    plus_one = nodes.new("ShaderNodeMath")
+    plus_one.operation = "ADD"
+    plus_one.inputs[1].default_value = 1.0
+    links.new(nodes.new("GeometryNodeInputIndex").outputs[0], plus_one.inputs[0])
+    links.new(plus_one.outputs[0], store.inputs["Value"])
+    links.new(group_in.outputs[0], store.inputs["Geometry"])
+    links.new(store.outputs[0], group_out.inputs[0])
+    modifier = obj.modifiers.new("__reference_cage", "NODES")
+    modifier.node_group = tree
+    obj.modifiers.move(len(obj.modifiers) - 1, list(obj.modifiers).index(last_subdivision))
+    return obj, modifier, tree
 
 
 # Where the caps' edge numbers start (cap k from (k + 1) times this): past
