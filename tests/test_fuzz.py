@@ -211,6 +211,7 @@ SHAPES = {
     "sphere": lambda scene: scenes.uv_sphere(scene, segments=8, rings=4),
     "monkey": lambda scene: scenes.monkey(scene),
 }
+SIZE = (80, 60)
 BEFORE_SUBDIVISION = ["BEVEL", "SOLIDIFY", "TRIANGULATE", "MIRROR", "SIMPLE_DEFORM"]
 AFTER_SUBDIVISION = ["MIRROR", "ARRAY", "WELD", "SIMPLE_DEFORM", "CAST", "DISPLACE", "TRIANGULATE"]
 
@@ -274,9 +275,7 @@ def orbits(draw):
 
 
 def build_stack(stack, line, camera):
-    scene = scenes.empty_scene(
-        80, 60, world_thickness=0.02, thickness_depth_start=5.0, thickness_depth_end=10.0, **line
-    )
+    scene = scenes.empty_scene(*SIZE, world_thickness=0.02, thickness_depth_start=5.0, thickness_depth_end=10.0, **line)
     obj = SHAPES[stack["shape"]](scene)
     if "MIRROR" in stack["before"] + stack["after"]:
         # Off the mirror planes: a mirrored copy never lies on the original
@@ -334,6 +333,26 @@ def test_random_modifier_stacks_under_cage_edges_match_reference(stack, line, ca
     scene = build_stack(stack, line, camera)
     try:
         check(scene, tmp_path_factory.getbasetemp() / "fuzz_cage.exr")
+    except Exception:
+        print(f"\n--- fuzz scene ---\nstack={stack!r}\nsettings={line!r}\ncamera={camera!r}")
+        raise
+
+
+@FUZZ
+@given(stack=cage_stacks(), line=cage_looks(), camera=orbits())
+def test_random_modifier_stacks_under_cage_edges_in_the_overlay(stack, line, camera):
+    """The same in the viewport overlay's first redraw over Blender's Solid
+    shading depth (drawn directly or deferred as the overlay decides; an
+    orbit redraws this way at every frame)."""
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+
+    log.forget()
+    ensure_gpu()
+    scene = build_stack(stack, line, camera)
+    try:
+        _stats, alpha = robustness.Viewport(*SIZE).draw(scene)
+        report = reference.error_report(alpha, reference.render_reference(scene))
+        accuracy.assert_accurate(report)
     except Exception:
         print(f"\n--- fuzz scene ---\nstack={stack!r}\nsettings={line!r}\ncamera={camera!r}")
         raise
