@@ -207,7 +207,7 @@ SHAPES = {
     "cube": lambda scene: scenes.cube(scene, size=1.6),
     "tube": lambda scene: scenes.tube(scene, segments=7, depth=1.4),
     "cone": lambda scene: scenes.tube(scene, segments=5, depth=1.4, top_radius=0.3),
-    "grid": lambda scene: scenes.grid(scene, x_segments=3, y_segments=2, size=2.0),
+    "grid": lambda scene: scenes.grid(scene, x_segments=3, y_segments=2, size=1.0),
     "sphere": lambda scene: scenes.uv_sphere(scene, segments=8, rings=4),
     "monkey": lambda scene: scenes.monkey(scene),
 }
@@ -221,6 +221,9 @@ def cage_stacks(draw):
     before = draw(st.sampled_from([None, *BEFORE_SUBDIVISION]))
     after = draw(st.lists(st.sampled_from(AFTER_SUBDIVISION), max_size=2))
     before = [] if before is None else [before]
+    # One Mirror at most: a second one on the same axis would lay the
+    # copies on one another.
+    after = [kind for k, kind in enumerate(after) if kind != "MIRROR" or "MIRROR" not in before + after[:k]]
     return {
         "shape": draw(st.sampled_from(sorted(SHAPES))),
         "before": before,
@@ -280,7 +283,7 @@ def build_stack(stack, line, camera):
     if "MIRROR" in stack["before"] + stack["after"]:
         # Off the mirror planes: a mirrored copy never lies on the original
         # (coplanar copies would leave which face shows to chance).
-        obj.data.transform(Matrix.Translation((1.2, 1.2, 0.3)))
+        obj.data.transform(Matrix.Translation((1.5, 1.5, 0.3)))
     marked = [bool((stack["marked"] >> (k % 16)) & 1) for k in range(len(obj.data.edges))]
     for k, edge in enumerate(obj.data.edges):
         edge.use_edge_sharp = marked[k] and k % 3 == 0
@@ -301,7 +304,7 @@ def build_stack(stack, line, camera):
 
 def _add_modifier(obj, kind, variant: bool, axes):
     """A modifier of ``kind``; ``variant``: a Mirror or Array that merges, a
-    Weld that welds (else its distance welds nothing), a twist (else a bend)."""
+    Weld of connected vertices (else of all), a twist (else a bend)."""
     modifier = obj.modifiers.new(kind, kind)
     if kind == "BEVEL":
         modifier.width = 0.1
@@ -315,7 +318,9 @@ def _add_modifier(obj, kind, variant: bool, axes):
         modifier.relative_offset_displace = (1.2, 0.0, 0.0)
         modifier.use_merge_vertices = variant
     elif kind == "WELD":
-        modifier.merge_threshold = 0.05 if variant else 1e-5
+        # Welding nothing (a weld that welds drops the cage: test_cage_edges_mask.py).
+        modifier.merge_threshold = 1e-5
+        modifier.mode = "CONNECTED" if variant else "ALL"
     elif kind == "SIMPLE_DEFORM":
         modifier.deform_method = "TWIST" if variant else "BEND"
         modifier.angle = 0.6

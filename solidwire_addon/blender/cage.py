@@ -357,7 +357,10 @@ def _carried_copies(after, edges, verts_num: int, faces_num: int):
             edges_num, verts_num, faces_num = edges_num // count, verts_num // count, faces_num // count
             steps.append((count, verts_num, tuple(caps)))
         # WELD: it kept its input only if nothing was welded, which the
-        # caller's check of the whole layout tells.
+        # caller's check of the whole layout tells, but for one case: a weld
+        # whose result still reads exactly as the subdivision of a smaller
+        # cage, which is then drawn where Blender shows every edge (image
+        # model §3.5).
     return steps[::-1], (edges_num, verts_num, faces_num)
 
 
