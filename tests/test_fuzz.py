@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import os
+from contextlib import contextmanager
 
 import bpy
 import numpy as np
@@ -170,10 +171,18 @@ def check_example(mesh, camera, line, transform, path):
     """Build, render and compare one example; print its recipe when it fails."""
     log.forget()
     scene = build(mesh, camera, line, transform)
-    try:
+    with recipe_on_failure(repro(mesh, camera, line, transform)):
         check(scene, path)
+
+
+@contextmanager
+def recipe_on_failure(recipe: str):
+    """Print how to rebuild the example when the block fails (hypothesis
+    shrinks no render: the recipe is what a person has to go on)."""
+    try:
+        yield
     except Exception:
-        print("\n--- fuzz scene ---\n" + repro(mesh, camera, line, transform))
+        print("\n--- fuzz scene ---\n" + recipe)
         raise
 
 
@@ -337,11 +346,8 @@ def test_random_modifier_stacks_under_cage_edges_match_reference(stack, line, ca
     the reference itself) and what the modifiers after it keep."""
     log.forget()
     scene = build_stack(stack, line, camera)
-    try:
+    with recipe_on_failure(f"stack={stack!r}\nsettings={line!r}\ncamera={camera!r}"):
         check(scene, tmp_path_factory.getbasetemp() / "fuzz_cage.exr")
-    except Exception:
-        print(f"\n--- fuzz scene ---\nstack={stack!r}\nsettings={line!r}\ncamera={camera!r}")
-        raise
 
 
 @FUZZ
@@ -355,10 +361,6 @@ def test_random_modifier_stacks_under_cage_edges_in_the_overlay(stack, line, cam
     log.forget()
     ensure_gpu()
     scene = build_stack(stack, line, camera)
-    try:
+    with recipe_on_failure(f"stack={stack!r}\nsettings={line!r}\ncamera={camera!r}"):
         _stats, alpha = robustness.Viewport(*SIZE).draw(scene)
-        report = reference.error_report(alpha, reference.render_reference(scene))
-        accuracy.assert_accurate(report)
-    except Exception:
-        print(f"\n--- fuzz scene ---\nstack={stack!r}\nsettings={line!r}\ncamera={camera!r}")
-        raise
+        accuracy.assert_accurate(reference.error_report(alpha, reference.render_reference(scene)))
