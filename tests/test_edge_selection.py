@@ -124,6 +124,26 @@ def test_density_fade_matches_the_reference(diagonals, output_dir):
     assert ref.intensity[: len(ref.rows) // 4].max() > 0.99
 
 
+@pytest.mark.parametrize("folded", [False, True])
+def test_a_fade_below_zero_pixels_fades_nothing(folded, output_dir):
+    """Density fade on with a length of 0: the image the fade switched off
+    gives, where dotted diagonals meet too (with the fade on, a style takes
+    its strongest faded line, and the dots of two diagonals that meet at a
+    corner differ from the nearest one's alone)."""
+    look = dict(diagonal_mode="DOTTED", pattern_period=3.0, pattern_duty=0.3, thickness=2.0)
+    scene = scenes.empty_scene(160, 120, use_density_fade=True, density_fade_length=0.0, **look)
+    cylinder = scenes.tube(scene, segments=12, depth=1.0, rotation=(0.9, 0.0, 0.3))
+    if folded:  # an n-gon that is not flat takes another path (image model §4.3)
+        cylinder.data.vertices[1].co.z += 0.3
+    scenes.add_camera(scene, location=(0.0, -3.2, 2.2), target=(0.0, 0.0, 0.1))
+    report = accuracy.measure(scene, f"fade_below_zero_{folded}", output_dir)
+    accuracy.assert_accurate(report)
+    faded = scenes.render_to_file(scene, output_dir / f"fade_below_zero_{folded}.png")
+    scene.solidwire.use_density_fade = False
+    plain = scenes.render_to_file(scene, output_dir / f"fade_below_zero_{folded}_off.png")
+    assert np.array_equal(faded, plain)
+
+
 # ---------------------------------------------------------------- cage edges
 
 

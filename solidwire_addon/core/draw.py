@@ -175,7 +175,7 @@ def shader_variant(settings, target: DrawTarget | None = None) -> shaders.Shader
         material_colors=colors.needs_material_colors(settings),
         attribute_colors=colors.needs_attribute_colors(settings),
         edge_classes=bool(edge_classes_of(settings)),
-        density_fade=bool(settings.use_density_fade),
+        density_fade=density_fade_of(settings),
     )
     if target.lines == HIDDEN_LINES:
         variant = replace(
@@ -238,6 +238,15 @@ def shader_variant(settings, target: DrawTarget | None = None) -> shaders.Shader
 def edge_classes_of(settings) -> tuple:
     """The edge classes switched on (image model §3.6), in style order."""
     return tuple(name for name in EDGE_CLASSES if getattr(settings, f"use_{name}_edges"))
+
+
+def density_fade_of(settings) -> bool:
+    """Whether each line fades with its chain's length (image model §3.7):
+    on, with a length to fade below. A length of 0 fades nothing, and the
+    image is then the one the fade switched off gives (each style the
+    nearest line's, not the strongest faded one's: the two differ where
+    patterned lines meet)."""
+    return bool(settings.use_density_fade) and float(settings.density_fade_length) > 0.0
 
 
 def fill_shading(settings) -> int:

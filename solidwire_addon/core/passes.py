@@ -1320,7 +1320,7 @@ def _line_reach_px(settings, items) -> float | None:
     ``settings`` (the widest half width of every style, class widths
     included, plus 2s, and 2 px to spare), or None where it is not a
     fixed number of pixels."""
-    if settings.thickness_mode != "PIXELS" or settings.use_density_fade:
+    if settings.thickness_mode != "PIXELS" or draw_mod.density_fade_of(settings):
         return None
     reach = 0.0
     for style in {item.style for item in items} | {None}:
