@@ -9,17 +9,26 @@
 # beyond the C library are carried along (not OpenGL's: the other machine
 # needs its own, libEGL.so.1 and libGL.so.1 from glvnd).
 #
-#   scripts/portable_bench.sh build/portable-bench.tar.xz
+#   scripts/portable_bench.sh build/portable-bench.tar.xz [PART_MB]
 #
 # On the other machine, from a checkout of the same commit:
 #
 #   mkdir -p ../portable && tar xf portable-bench.tar.xz -C ../portable && . ../portable/env.sh
 #   PYTHONPATH=$PWD:$PYTHONPATH $PY -m scripts.bench_regions
 #
-# (About 230 MB with xz -9; packing takes several minutes on two cores.)
+# (About 220 MB with xz -9; packing takes several minutes on two cores.)
+# With PART_MB, the tarball is also cut into OUT.part00, OUT.part01, ... of
+# at most that many MiB each, for a transfer that limits what one copy may
+# carry (a remote machine lent with, say, 64 MiB a call: the parts already
+# sent stay there between calls). OUT.sha256 holds the whole tarball's
+# checksum; there, join and check before unpacking:
+#
+#   cat portable-bench.tar.xz.part* > portable-bench.tar.xz && sha256sum -c portable-bench.tar.xz.sha256
 set -euo pipefail
 cd "$(dirname "$0")/.."
-out=${1:?usage: scripts/portable_bench.sh OUT.tar.xz}
+out=${1:?usage: scripts/portable_bench.sh OUT.tar.xz [PART_MB]}
+part_mb=${2:-}
+[[ -z $part_mb || $part_mb =~ ^[1-9][0-9]*$ ]] || { echo "error: PART_MB must be a whole number of MiB, not '$part_mb'" >&2; exit 1; }
 site=.venv/lib/python3.11/site-packages
 [ -d "$site/bpy" ] || { echo "error: no bpy in .venv (run: make venv)" >&2; exit 1; }
 python=$(.venv/bin/python -c 'import sys; print(sys.base_prefix)')
@@ -63,4 +72,10 @@ EOF
   { echo "error: the packed runtime does not import bpy" >&2; exit 1; }
 mkdir -p "$(dirname "$out")"
 tar cf - -C "$stage" env.sh py xlib site | xz -9 -T0 > "$out"
+(cd "$(dirname "$out")" && sha256sum "$(basename "$out")" > "$(basename "$out").sha256")
 echo "$out: $(du -h "$out" | cut -f1)"
+if [[ -n $part_mb ]]; then
+  rm -f "$out".part[0-9]*
+  split -b "${part_mb}M" -d -a 2 "$out" "$out.part"
+  echo "$(ls "$out".part[0-9]* | wc -l) parts of at most $part_mb MiB: $out.part00 ..."
+fi
