@@ -439,6 +439,25 @@ def test_full_width_silhouettes_match_reference(case, output_dir):
     assert ((ref.intensity - without.intensity) > 0.5).sum() > 30  # outer halves really drawn
 
 
+def test_faces_lying_on_one_another_are_undecided(output_dir):
+    """Two quads of one plane that overlap (z-fighting): which one a sample
+    of the overlap shows is the rasteriser's rounding, so the reference
+    reports those samples apart (image model §7.2) and measures the rest."""
+    scene = scenes.empty_scene(120, 90, thickness=1.0)
+    scenes.grid(scene, "Under", x_segments=1, y_segments=1, size=2.0)
+    scenes.grid(scene, "Over", x_segments=1, y_segments=1, size=1.2, location=(0.5, 0.3, 0.0), rotation=(0, 0, 0.5))
+    scenes.add_camera(scene, location=(0.4, -4.2, 4.2), target=(0.2, 0.1, 0.0))
+    report = accuracy.measure(scene, "faces_on_one_another", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    covered = ref.face >= 0
+    # The smaller quad lies wholly on the larger: its samples are undecided,
+    # the rest of the larger quad's are measured.
+    undecided = ref.on_silhouette & covered
+    assert undecided.sum() > 0.2 * covered.sum()
+    assert (covered & ~ref.on_silhouette).sum() > 0.4 * covered.sum()
+
+
 def test_silhouette_candidates_are_every_real_edge_of_one_or_two_triangles():
     """The silhouette pass's edge table (silhouettes.candidate_edges) on a
     random triangle soup with random real edges: every real edge used by

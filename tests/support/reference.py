@@ -832,6 +832,9 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
     undecided_hits: list = []
     if centre_hit is not None:
         centre_hit["undecided"] = np.zeros(n_rows * width, bool)
+        # The nearest hit of another face than the centre's visible one, to
+        # find faces that lie on one another (§7.2).
+        runner_up = _RunnerUp(n_rows * width)
     x0, x1, y0, y1 = _triangle_pixel_bounds(proj, geo.tri_view, width, height)
     tri_ids = np.nonzero(x1 >= x0)[0]
     if len(tri_ids) == 0:
@@ -910,6 +913,8 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
             h_tri, h_u, h_v, h_front = h_tri[order], h_u[order], h_v[order], h_front[order]
             first = np.ones(len(h_pix), bool)
             first[1:] = h_pix[1:] != h_pix[:-1]
+            if s == 0 and centre_hit is not None:
+                runner_up.add(h_pix, h_depth, h_face, first)
             h_pix, h_depth, h_face = h_pix[first], h_depth[first], h_face[first]
             h_tri, h_u, h_v, h_front = h_tri[first], h_u[first], h_v[first], h_front[first]
             closer = h_depth < best_depth[s, h_pix]
@@ -923,13 +928,61 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
                 centre_hit["front"][px_c] = h_front[closer]
         start = stop
     if centre_hit is not None:
-        # Samples whose nearest surface may be an undecided triangle.
-        flagged = np.zeros(n_rows * width, bool)
+        # Samples whose nearest surface may be an undecided triangle, or
+        # another face at the visible one's depth.
+        flagged = np.isfinite(runner_up.depth) & (runner_up.depth <= best_depth[0] * (1.0 + UNDECIDED_DEPTH))
         for pix, depth in undecided_hits + _sliver_samples(geo, proj, width, height, rows, row_of):
-            near = depth <= best_depth[0, pix] * (1.0 + 1e-6)
+            near = depth <= best_depth[0, pix] * (1.0 + UNDECIDED_DEPTH)
             flagged[pix[near]] = True
         centre_hit["undecided"] = flagged
     return best_face, best_depth
+
+
+# Relative depth within which which of two surfaces the engine's float32
+# depth shows is rounding's choice (§7.2).
+UNDECIDED_DEPTH = 1e-6
+
+
+class _RunnerUp:
+    """Per sample, the nearest depth of a face other than the nearest face
+    over every hit added so far (inf where none): where it equals the
+    visible face's depth, two faces lie on one another there (coplanar
+    overlapping faces) and which one the engine shows is rounding's choice
+    (§7.2). Fed the chunks of _visibility's centre hits."""
+
+    def __init__(self, samples: int):
+        self.nearest = np.full(samples, np.inf)
+        self.nearest_face = np.full(samples, -1, np.int64)
+        self.depth = np.full(samples, np.inf)
+        self.face = np.full(samples, -1, np.int64)
+
+    def add(self, pix, depth, face, first):
+        """Hits sorted by (pixel, depth, face); ``first`` marks each pixel's
+        nearest."""
+        if not len(pix):
+            return
+        group = np.cumsum(first) - 1
+        top_face = face[first]
+        # The chunk's own runner-up: the first hit of another face in each
+        # pixel's sorted hits.
+        index = np.flatnonzero(face != top_face[group])
+        index = index[np.r_[True, group[index[1:]] != group[index[:-1]]]] if len(index) else index
+        chunk_second = np.full(len(top_face), np.inf)
+        chunk_second_face = np.full(len(top_face), -1, np.int64)
+        chunk_second[group[index]] = depth[index]
+        chunk_second_face[group[index]] = face[index]
+        p = pix[first]
+        # Four candidates per sample: the kept nearest and runner-up, the
+        # chunk's; the new nearest, then the nearest of the others' faces.
+        depths = np.stack([self.nearest[p], self.depth[p], depth[first], chunk_second])
+        faces = np.stack([self.nearest_face[p], self.face[p], top_face, chunk_second_face])
+        best = np.argmin(depths, axis=0)
+        columns = np.arange(len(p))
+        best_face = faces[best, columns]
+        others = np.where((faces != best_face) & (faces >= 0), depths, np.inf)
+        second = np.argmin(others, axis=0)
+        self.nearest[p], self.nearest_face[p] = depths[best, columns], best_face
+        self.depth[p], self.face[p] = others[second, columns], faces[second, columns]
 
 
 # A triangle thinner than this (its smallest window-space altitude, px) is a
