@@ -22,6 +22,30 @@ vec2 window_point(vec4 clip)
   return h.xy / h.z;
 }
 
+/* The clip w of every point of the near plane (z + w = 0): its view depth
+ * n for a perspective projection, 1 for an orthographic one (from the
+ * projection's rows P22, P23, P32, P33 in params.depth_rows). */
+float near_plane_w()
+{
+  vec4 rows = params.depth_rows;
+  float depth = (rows.y + rows.w) / (rows.x + rows.z);
+  return rows.w - rows.z * depth;
+}
+
+/* The point a fraction `t` of the way from a to b (clip space) where the
+ * segment crosses the near plane, with the near plane's own w rather than
+ * the interpolated one: where a lies far behind the camera, the
+ * interpolated w (about n) is the small difference of large numbers, and
+ * an end that projects thousands of pixels off-screen carried that
+ * rounding (a relative 1e-5) into its window point: into the span, and so
+ * into the phase of a dashed line's pattern. */
+vec4 near_clipped(vec4 a, vec4 b, float t)
+{
+  vec4 point = mix(a, b, t);
+  float w = near_plane_w();
+  return vec4(point.xyz, (w > 0.0) ? w : point.w);
+}
+
 /* Lines and spans are stored relative to the viewport centre: the fragment
  * stage evaluates them at gl_FragCoord.xy - viewport_centre(), an exact
  * subtraction that halves the size of the numbers it rounds. */
@@ -107,8 +131,8 @@ void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
   vec2 centre = viewport_centre();
   line = l * inversesqrt(len2);
   line.z += dot(line.xy, centre); /* relative to the viewport centre, like line_through */
-  vec4 a_front = (depth_a < 0.0) ? mix(a, b, depth_a / (depth_a - depth_b)) : a;
-  vec4 b_front = (depth_b < 0.0) ? mix(b, a, depth_b / (depth_b - depth_a)) : b;
+  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a / (depth_a - depth_b)) : a;
+  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b / (depth_b - depth_a)) : b;
   vec2 wa = window_point(a_front) - centre, wb = window_point(b_front) - centre;
   vec2 dir = vec2(-line.y, line.x);
   if (dot(dir, wb - wa) < 0.0) {
