@@ -458,6 +458,29 @@ def test_faces_lying_on_one_another_are_undecided(output_dir):
     assert (covered & ~ref.on_silhouette).sum() > 0.4 * covered.sum()
 
 
+def test_an_edge_that_projects_to_a_point_draws_no_line(output_dir):
+    """A pentagon two of whose corners coincide: the edge between them is a
+    single point on screen and draws nothing (image model §3.2), also under
+    a dotted style wide enough that every pixel near it takes its
+    strongest dot (where a point would have a dot of its own)."""
+    scene = scenes.empty_scene(
+        120,
+        90,
+        thickness=1.0,
+        softness=12.0,
+        use_boundary_edges=True,
+        boundary_thickness=2.0,
+        boundary_pattern="DOTTED",
+    )
+    data = bpy.data.meshes.new("Pinched")
+    corners = [(-1.0, -1.0, 0.0), (1.0, -1.0, 0.0), (1.2, 0.6, 0.0), (0.0, 1.0, 0.0), (0.0, 1.0, 0.0)]
+    data.from_pydata(corners, [], [(0, 1, 2, 3, 4)])
+    scene.collection.objects.link(bpy.data.objects.new("Pinched", data))
+    scenes.add_camera(scene, location=(0.3, -0.4, 3.2), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, "edge_projects_to_a_point", output_dir)
+    accuracy.assert_accurate(report)
+
+
 def test_silhouette_candidates_are_every_real_edge_of_one_or_two_triangles():
     """The silhouette pass's edge table (silhouettes.candidate_edges) on a
     random triangle soup with random real edges: every real edge used by
