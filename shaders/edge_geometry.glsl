@@ -32,16 +32,18 @@ float near_plane_w()
   return rows.w - rows.z * depth;
 }
 
-/* The point a fraction `t` of the way from a to b (clip space) where the
- * segment crosses the near plane, with the near plane's own w rather than
- * the interpolated one: where a lies far behind the camera, the
- * interpolated w (about n) is the small difference of large numbers, and
- * an end that projects thousands of pixels off-screen carried that
- * rounding (a relative 1e-5) into its window point: into the span, and so
- * into the phase of a dashed line's pattern. */
-vec4 near_clipped(vec4 a, vec4 b, float t)
+/* Where the segment from `behind` (depth, z + w, below 0) to `front`
+ * (depth at least 0) crosses the near plane. Measured from the front end:
+ * the behind end can lie far away, and its clip coordinates carry a
+ * rounding error in proportion, which a step from the front end scales
+ * down by the fraction it takes. Its w is the near plane's own, not an
+ * interpolated one: that w (about n) would be the small difference of large
+ * numbers, and an end that projects thousands of pixels off-screen carried
+ * its relative error into its window point, so into the span and the phase
+ * of a dashed line's pattern. */
+vec4 near_clipped(vec4 behind, vec4 front, float depth_behind, float depth_front)
 {
-  vec4 point = mix(a, b, t);
+  vec4 point = front + (depth_front / (depth_front - depth_behind)) * (behind - front);
   float w = near_plane_w();
   return vec4(point.xyz, (w > 0.0) ? w : point.w);
 }
@@ -131,8 +133,8 @@ void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
   vec2 centre = viewport_centre();
   line = l * inversesqrt(len2);
   line.z += dot(line.xy, centre); /* relative to the viewport centre, like line_through */
-  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a / (depth_a - depth_b)) : a;
-  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b / (depth_b - depth_a)) : b;
+  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a, depth_b) : a;
+  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b, depth_a) : b;
   vec2 wa = window_point(a_front) - centre, wb = window_point(b_front) - centre;
   vec2 dir = vec2(-line.y, line.x);
   if (dot(dir, wb - wa) < 0.0) {

@@ -65,8 +65,8 @@ void run_segment(int texel, bool used, float half_width, inout RunBox box, out v
    * sample the profile reaches lies inside the quad. */
 #if THICKNESS_MODE == 1
   float depth_a = a.z + a.w, depth_b = b.z + b.w;
-  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a / (depth_a - depth_b)) : a;
-  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b / (depth_b - depth_a)) : b;
+  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a, depth_b) : a;
+  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b, depth_a) : b;
   half_width = style_half_thickness(line_style, params.world_half_thickness_px / max(min(a_front.w, b_front.w), 1e-6));
 #endif
   box.reach = max(box.reach, half_width + 2.0 * params.softness + 0.01);

@@ -31,8 +31,8 @@ void main()
     return;
   }
   /* The part in front of the near plane, in clip and window space. */
-  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a / (depth_a - depth_b)) : a;
-  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b / (depth_b - depth_a)) : b;
+  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a, depth_b) : a;
+  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b, depth_a) : b;
   fin_a = a_front;
   fin_b = b_front;
   fin_line = l * inversesqrt(dot(l.xy, l.xy));

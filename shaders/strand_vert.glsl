@@ -99,8 +99,8 @@ void main()
    * view depths and radii cut at the same parameters. */
   float ta = (depth_a < 0.0) ? depth_a / (depth_a - depth_b) : 0.0;
   float tb = (depth_b < 0.0) ? depth_b / (depth_b - depth_a) : 0.0;
-  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, ta) : a;
-  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, tb) : b;
+  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a, depth_b) : a;
+  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b, depth_a) : b;
   float za = view_depth_of(pa.xyz), zb = view_depth_of(pb.xyz);
   float ra = max(pa.w, 0.0) * RADIUS_SCALE, rb = max(pb.w, 0.0) * RADIUS_SCALE;
   seg_a = a_front;

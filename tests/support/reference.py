@@ -1126,6 +1126,10 @@ def _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select):
 # far from one as from the other, and a dash pattern's phase there depends
 # on which one is taken.
 TIE_PX = 1e-3
+# A sample this far (px) along a patterned line from the line's pattern
+# origin has an undecided phase (§7.2): float32 holds positions that far
+# to about 1e-3 px, and the dash mask moves with them.
+FAR_PHASE_PX = 8192.0
 
 
 def _min_distance_per_pixel(
@@ -1157,16 +1161,22 @@ def _min_distance_per_pixel(
                 np.abs(np.abs(along[runner_up]) - np.abs(along[runner_up - 1])) > TIE_PX
             )
             ties["tied"][pair_pix[runner_up[tied]]] = True
+            ties["tied"] |= np.abs(best_along) > FAR_PHASE_PX
     return (best, best_along, best_index) if want_index else (best, best_along)
 
 
-def _max_value_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, value_of):
+def _max_value_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, value_of, far_phase=None):
     """For every pixel: the largest value_of(pair_pix, pair_edge, d, along)
-    over the selected edges of its own face (0 without any)."""
+    over the selected edges of its own face (0 without any). With a bool
+    array as ``far_phase``, it marks the pixels a line reaches (a value
+    above 0) FAR_PHASE_PX or more from its pattern origin."""
     best = np.zeros(len(pix_face))
     pair_pix, pair_edge, d, along = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
     if len(pair_pix):
-        np.maximum.at(best, pair_pix, value_of(pair_pix, pair_edge, d, along))
+        values = value_of(pair_pix, pair_edge, d, along)
+        np.maximum.at(best, pair_pix, values)
+        if far_phase is not None:
+            far_phase[pair_pix[(values > 0.0) & (np.abs(along) > FAR_PHASE_PX)]] = True
     return best
 
 
@@ -1212,7 +1222,9 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
                 v = profile(d_pair, w, softness) * density(pair_edge)
                 return v * pattern_mask(np.abs(along_pair), float(s.pattern_period), duty) if duty < 1.0 else v
 
-            v = _max_value_per_pixel(keys, pix_xy, geo, wa, wb, valid, select, faded)
+            v = _max_value_per_pixel(
+                keys, pix_xy, geo, wa, wb, valid, select, faded, far_phase=tied if duty < 1.0 else None
+            )
         else:
             v = profile(d, width_px, softness)
         wins = v > value
@@ -1500,7 +1512,11 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
                     v = profile(d_pair, w, softness) * density(pair_edge)
                     return v * pattern_mask(np.abs(along_pair), float(s.pattern_period), duty) if duty < 1.0 else v
 
-                diag_value = _max_value_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, faded)
+                far = np.zeros(len(pix_face), bool)
+                diag_value = _max_value_per_pixel(
+                    pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, faded, far_phase=far if duty < 1.0 else None
+                )
+                on_silhouette[covered[far]] = True
             wins = diag_value > value
             winner_all[covered[wins]] = 0
             value = np.maximum(value, diag_value)
