@@ -1093,11 +1093,12 @@ def pattern_mask(t, period, duty):
 
 def _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select):
     """Every (pixel, selected edge of the pixel's own face) pair with the
-    distance and the position along the edge from its pattern origin
-    (unclamped): (pair_pix, pair_edge, d, along)."""
+    distance, the position along the edge from its pattern origin
+    (unclamped) and how far the engine's float32 may put that position
+    (_phase_error): (pair_pix, pair_edge, d, along, phase_error)."""
     n = len(pix_face)
     idx = np.nonzero(select & valid)[0]
-    empty = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0)
+    empty = np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0), np.zeros(0)
     if len(idx) == 0 or n == 0:
         return empty
     order = idx[np.argsort(geo.edge_face[idx], kind="stable")]
@@ -1118,7 +1119,25 @@ def _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select):
     len_ab = np.linalg.norm(ab, axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         along = np.where(len_ab > 0, np.einsum("ij,ij->i", pix_xy[pair_pix] - a, ab) / len_ab, 0.0)
-    return pair_pix, pair_edge, d, along
+    return pair_pix, pair_edge, d, along, _phase_error(pix_xy[pair_pix], a, b, len_ab)
+
+
+# A dash phase that the engine's float32 may put farther off than this (px)
+# is undecided (§7.2): the mask moves with it, up to 1 per px.
+PHASE_TOLERANCE_PX = 4e-3
+# The error of a window position in float32, relative to its size (a few
+# units in the last place).
+WINDOW_ROUNDING = 2.0**-21
+
+
+def _phase_error(p, a, b, len_ab):
+    """How far float32 may put the position of window point p along a -> b
+    from a: the ends' own rounding (in proportion to how far from the
+    window's origin they lie), plus the direction's, which p's distance from
+    a multiplies and the segment's length divides."""
+    scale = np.maximum(np.maximum(np.abs(a).max(axis=1), np.abs(b).max(axis=1)), np.abs(p).max(axis=1))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return WINDOW_ROUNDING * scale * (1.0 + 2.0 * np.linalg.norm(p - a, axis=1) / len_ab)
 
 
 # Two lines whose distances to a sample differ by less than this (px) are
@@ -1126,10 +1145,6 @@ def _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select):
 # far from one as from the other, and a dash pattern's phase there depends
 # on which one is taken.
 TIE_PX = 1e-3
-# A sample this far (px) along a patterned line from the line's pattern
-# origin has an undecided phase (§7.2): float32 holds positions that far
-# to about 1e-3 px, and the dash mask moves with them.
-FAR_PHASE_PX = 8192.0
 
 
 def _min_distance_per_pixel(
@@ -1145,23 +1160,24 @@ def _min_distance_per_pixel(
     best_index = np.full(n, -1)
     if ties is not None:
         ties["tied"] = np.zeros(n, bool)
-    pair_pix, pair_edge, d, along = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
+    pair_pix, pair_edge, d, along, phase_error = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
     if len(pair_pix):
         order2 = np.lexsort((d, pair_pix))
         pair_pix, d, along, pair_edge = pair_pix[order2], d[order2], along[order2], pair_edge[order2]
+        phase_error = phase_error[order2]
         keep = np.ones(len(pair_pix), bool)
         keep[1:] = pair_pix[1:] != pair_pix[:-1]
         best[pair_pix[keep]] = d[keep]
         best_along[pair_pix[keep]] = along[keep]
         best_index[pair_pix[keep]] = pair_edge[keep]
         if ties is not None:
+            ties["tied"][pair_pix[keep & (phase_error > PHASE_TOLERANCE_PX)]] = True
             runner_up = np.flatnonzero(~keep)  # a second (or later) line of the same pixel
             runner_up = runner_up[keep[runner_up - 1]]  # the second one only
             tied = (d[runner_up] - d[runner_up - 1] <= TIE_PX) & (
                 np.abs(np.abs(along[runner_up]) - np.abs(along[runner_up - 1])) > TIE_PX
             )
             ties["tied"][pair_pix[runner_up[tied]]] = True
-            ties["tied"] |= np.abs(best_along) > FAR_PHASE_PX
     return (best, best_along, best_index) if want_index else (best, best_along)
 
 
@@ -1169,14 +1185,14 @@ def _max_value_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, value_of,
     """For every pixel: the largest value_of(pair_pix, pair_edge, d, along)
     over the selected edges of its own face (0 without any). With a bool
     array as ``far_phase``, it marks the pixels a line reaches (a value
-    above 0) FAR_PHASE_PX or more from its pattern origin."""
+    above 0) where its dash phase is undecided (PHASE_TOLERANCE_PX)."""
     best = np.zeros(len(pix_face))
-    pair_pix, pair_edge, d, along = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
+    pair_pix, pair_edge, d, along, phase_error = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
     if len(pair_pix):
         values = value_of(pair_pix, pair_edge, d, along)
         np.maximum.at(best, pair_pix, values)
         if far_phase is not None:
-            far_phase[pair_pix[(values > 0.0) & (np.abs(along) > FAR_PHASE_PX)]] = True
+            far_phase[pair_pix[(values > 0.0) & (phase_error > PHASE_TOLERANCE_PX)]] = True
     return best
 
 
