@@ -30,11 +30,11 @@ float style_half_thickness(int style, float wire_half_thickness)
 #ifdef USE_DENSITY_FADE
 /* Density fade: full above the length L, nothing below L / 2, linear in
  * between; `length` is the window length of the near-clipped projection of
- * the straight line between the ends of the line's edge chain. */
+ * the straight line between the ends of the line's edge chain. Compiled
+ * only with L > 0 (draw.density_fade_of: 0 px is the fade switched off). */
 float density_fade(float length)
 {
-  float full = params.density_fade_length;
-  return (full > 0.0) ? clamp(2.0 * length / full - 1.0, 0.0, 1.0) : 1.0;
+  return clamp(2.0 * length / params.density_fade_length - 1.0, 0.0, 1.0);
 }
 
 /* That length for a line whose chain ends are in texel `chain_texel` of the
