@@ -27,8 +27,11 @@ void main()
 #endif
 #ifndef OVERLAY_FINS
   float scene = texelFetch(scene_depth, ivec2(p), 0).r;
-  if (scene < q_depth) {
-    discard; /* a nearer surface hides this part of the outer half */
+  /* A nearer surface hides this part of the outer half; the background
+   * (the depth's clear value, 1) hides nothing, also where q lies beyond
+   * the far clip (image model §5.5: z_vis is infinite there). */
+  if (scene < 1.0 && scene < q_depth) {
+    discard;
   }
 #endif
 

@@ -2,12 +2,22 @@
  * (two triangles over four shared corners, draw.indexed_quad_batch) per
  * candidate edge, pulled from `silhouette_edges` by gl_VertexID / 4 (an
  * indexed draw: gl_VertexID is the corner's index). See
- * solidwire_addon/silhouettes.py for the definition. Fins of edges that are
+ * solidwire_addon/core/silhouettes.py for the definition. Fins of edges that are
  * not silhouettes in this view collapse to nothing here: most fins, whose
  * four corners a software rasteriser shades once each (not six). */
 
 /* Outside the clip volume: the rasteriser drops the triangle. */
 const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
+
+/* The side of the window line l = ha x hb that the point ho lies on (no
+ * division by w: the sign of l . ho is the side of the face's interior
+ * next to the edge). 0 where ho is one of the edge's own ends (a face's
+ * corner folded onto the edge, whose sigma is exactly 0 in the image
+ * model, §5.5), where l . ho would leave rounding's sign. */
+float line_side(vec3 l, vec3 ha, vec3 hb, vec3 ho)
+{
+  return (ho == ha || ho == hb) ? 0.0 : dot(l, ho);
+}
 
 void main()
 {
@@ -16,12 +26,11 @@ void main()
   vec4 ids = fetch_texel(silhouette_edges, edge);
   vec4 a = vertex_clip(ids.x);
   vec4 b = vertex_clip(ids.y);
-  vec3 l = cross(window_homogeneous(a), window_homogeneous(b));
-  /* Side of the line each adjacent face lies on (no division by w: the
-   * sign of l . o_h is the side of the face's interior next to the edge). */
-  float side_f = dot(l, window_homogeneous(vertex_clip(ids.z)));
+  vec3 ha = window_homogeneous(a), hb = window_homogeneous(b);
+  vec3 l = cross(ha, hb);
+  float side_f = line_side(l, ha, hb, window_homogeneous(vertex_clip(ids.z)));
   bool boundary = ids.w < 0.0;
-  float side_g = boundary ? 0.0 : dot(l, window_homogeneous(vertex_clip(ids.w)));
+  float side_g = boundary ? 0.0 : line_side(l, ha, hb, window_homogeneous(vertex_clip(ids.w)));
   bool contour = !boundary && side_f * side_g > 0.0;
   float depth_a = a.z + a.w, depth_b = b.z + b.w;
   if (edge >= edge_count || !(boundary || contour) || side_f == 0.0 || (depth_a < 0.0 && depth_b < 0.0) ||

@@ -506,3 +506,111 @@ def test_silhouette_candidates_are_every_real_edge_of_one_or_two_triangles():
     assert any(len(o) > 2 for o in expected.values()) and any(len(o) == 1 for o in expected.values())
     np.testing.assert_array_equal(silhouettes.candidate_edges(triangles, flags), np.array(rows, np.float32))
     assert silhouettes.candidate_edges(triangles[:0], flags[:0]).shape == (0, 4)
+
+
+def test_a_face_with_a_non_finite_corner_makes_no_silhouette(output_dir):
+    """A face with a NaN corner is dropped whole (image model §2.1), its
+    edges too: the finite triangles Blender still makes of it give no
+    silhouette candidate, and the edge it shared with a drawn face is that
+    face's boundary, whose outer half shows where the dropped face was (a
+    random mesh of the fuzz found the reference keeping those triangles)."""
+    scene = scenes.empty_scene(120, 90, use_silhouettes=True, thickness=2.0)
+    data = bpy.data.meshes.new("Dropped")
+    corners = [
+        (-1.0, -0.5, 0.0),
+        (0.0, -0.5, 0.0),
+        (0.6, -0.8, 0.0),
+        (-1.0, 0.5, 0.0),
+        (0.0, 0.5, 0.0),
+        (0.6, 0.8, 0.0),
+        (1.2, float("nan"), 0.0),
+        (1.2, 0.4, 0.0),
+    ]
+    data.from_pydata(corners, [], [(0, 1, 4, 3), (1, 2, 6, 7, 5, 4)])
+    scene.collection.objects.link(bpy.data.objects.new("Dropped", data))
+    scenes.add_camera(scene, location=(0.2, -1.5, 3.5), target=(0.1, 0.0, 0.0))
+    report = accuracy.measure(scene, "non_finite_face_silhouettes", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    drawn = ref.face >= 0
+    # Outer halves on the background: the drawn quad's four boundary edges,
+    # the shared one included, and nothing of the dropped face's edges.
+    outer = (ref.intensity > 0.5) & ~drawn
+    columns = np.flatnonzero(outer.any(axis=0))
+    right_of_quad = np.flatnonzero(drawn.any(axis=0)).max()
+    assert outer.sum() > 60
+    assert columns.max() <= right_of_quad + 4  # (2 px core, 1 px fall-off)
+
+
+@pytest.mark.parametrize(
+    "corners, seed, softness",
+    [
+        ((0, 1, 2, 0), 1, 1.0),
+        ((0, 1, 2, 0), 8, 1.0),
+        ((0, 1, 2, 0), 9, 1.0),
+        ((0, 1, 2, 1), 1, 20.0),
+        ((0, 1, 1, 1), 4, 20.0),
+    ],
+)
+def test_corners_folded_onto_their_edges_make_no_silhouette(corners, seed, softness, output_dir):
+    """A quad some of whose corners lie on one another (``corners``: which
+    of three random points each corner takes). A triangle whose third
+    corner lies on an end of its edge, or an edge whose ends coincide, has
+    a side sigma of exactly 0 (image model §5.5): no silhouette, whatever
+    float32 rounding (the engine) or an LU determinant (the reference)
+    make of it. The fuzz found outer halves drawn along such edges on the
+    background (a wide softness draws them over the whole frame)."""
+    rng = np.random.default_rng(seed)
+    scene = scenes.empty_scene(120, 90, use_silhouettes=True, thickness=1.5, softness=softness)
+    data = bpy.data.meshes.new("Folded")
+    points = [tuple(rng.uniform(-1.0, 1.0, 3)) for _ in range(3)]
+    data.from_pydata([points[k] for k in corners], [], [(0, 1, 2, 3)])
+    scene.collection.objects.link(bpy.data.objects.new("Folded", data))
+    scenes.add_camera(scene, location=tuple(rng.uniform(-1.0, 1.0, 3) + [0.0, -1.0, 3.5]), target=(0.0, 0.0, 0.0))
+    name = "corners_folded_" + "".join(map(str, corners)) + f"_{seed}"
+    report = accuracy.measure(scene, name, output_dir)
+    accuracy.assert_accurate(report)
+
+
+def test_outer_halves_beyond_the_far_clip_show_on_the_background(output_dir):
+    """A strip running past the far clip: the surface stops at the far
+    plane, but its sides' outer halves lie on the background, which hides
+    nothing (image model §5.5), so they run on to the strip's end."""
+    scene = scenes.empty_scene(120, 90, use_silhouettes=True, thickness=2.0)
+    scenes.grid(scene, "Strip", x_segments=1, y_segments=1, size=1.0, location=(0.0, 6.0, 0.0), scale=(0.6, 12.0, 1.0))
+    scenes.add_camera(scene, location=(0.0, -4.0, 1.2), target=(0.0, 4.0, 0.0), clip=(0.1, 9.0))
+    report = accuracy.measure(scene, "outer_halves_beyond_the_far_clip", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    # Rows above the strip's far-clipped end still hold its sides' outer halves.
+    surface_rows = np.flatnonzero((ref.face >= 0).any(axis=1))
+    beyond = ref.intensity[surface_rows.max() + 3 :]
+    assert (beyond > 0.5).sum() >= 4
+
+
+def test_a_degenerate_face_s_silhouettes_are_undecided(output_dir):
+    """A triangle whose corners lie on one line (as meshes from imports and
+    welds have them) beside a plain quad: the side sigma of each of its
+    edges is 0 but for rounding, whose sign neither the engine's float32
+    nor the reference's float64 decides, so the samples its outer halves
+    could reach are reported apart (image model §7.2) and the quad's
+    outline is measured."""
+    scene = scenes.empty_scene(120, 90, use_silhouettes=True, thickness=1.5, softness=3.0)
+    data = bpy.data.meshes.new("Degenerate")
+    corners = [
+        (-1.5, -0.4, 0.0),
+        (-0.3, -0.4, 0.0),
+        (-0.3, 0.6, 0.0),
+        (-1.5, 0.6, 0.0),
+        (0.2, 0.0, 0.0),
+        (0.9, 0.0, 0.0),
+        (1.6, 0.0, 0.0),
+    ]
+    data.from_pydata(corners, [], [(0, 1, 2, 3), (4, 5, 6)])
+    scene.collection.objects.link(bpy.data.objects.new("Degenerate", data))
+    scenes.add_camera(scene, location=(0.3, -2.5, 3.0), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, "degenerate_face_silhouettes", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    assert ref.on_silhouette.sum() > 100  # the line's surroundings
+    assert ((ref.intensity > 0.5) & ~ref.on_silhouette).sum() > 100  # the quad's outline, measured

@@ -601,9 +601,16 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             zip(loop_poly.tolist(), np.minimum(real_a, real_b).tolist(), np.maximum(real_a, real_b).tolist())
         )
         diag = set()
-        half_edges: dict = {}  # real edge -> third vertices of its triangles
+        # A face with a non-finite (NaN/Inf) corner is not drawn at all
+        # (§2.1): it has no edges either, so it makes no silhouette
+        # candidate and leaves its neighbours' shared edges boundaries.
+        finite = np.isfinite(vco).all(axis=1)
+        poly_ok = np.bincount(loop_poly, weights=~finite[loop_vert], minlength=npoly) == 0
+        half_edges: dict = {}  # real edge -> third vertices of its drawn triangles
         for t in range(ntri):  # small meshes only (reference)
             p = int(tri_p[t])
+            if not poly_ok[p]:
+                continue
             for k in range(3):
                 a, b = int(tri_v[t, k]), int(tri_v[t, (k + 1) % 3])
                 key = (p, min(a, b), max(a, b))
@@ -613,8 +620,6 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
                     half_edges.setdefault((min(a, b), max(a, b)), []).append(int(tri_v[t, (k + 2) % 3]))
         diag = np.array(sorted(diag), dtype=np.int64).reshape(-1, 3)
 
-        # A face with a non-finite (NaN/Inf) corner is not drawn at all.
-        finite = np.isfinite(vco).all(axis=1)
         # Edge angle (image model §3.4): an edge of exactly two distinct
         # faces whose face normals differ by less than the angle is not
         # drawn (neither a line nor a diagonal).
@@ -639,7 +644,6 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             sil_edges.append(np.stack([vco[sa], vco[sb]], axis=1))
             third_g = np.where((og >= 0)[:, None], vco[np.maximum(og, 0)], np.nan)
             sil_third.append(np.stack([vco[of], third_g], axis=1))
-        poly_ok = np.bincount(loop_poly, weights=~finite[loop_vert], minlength=npoly) == 0
         tri_ok = poly_ok[tri_p]
         # The front side is the side the (transformed) normal points to: a
         # mirroring object or camera matrix reverses view-space winding, so
@@ -1288,14 +1292,27 @@ def _eye(proj):
     return vt[-1]
 
 
+# Image model §7.2: a silhouette side sigma (§5.5) within this share of
+# Hadamard's bound of its determinant's rows is rounding alone (a
+# triangle's third corner on its edge's line, as a degenerate face has
+# it), whose sign neither float64 nor float32 decides; a face merely
+# close to edge-on stays far above it.
+SIDE_TOLERANCE = 2.0**-30
+
+
 def _outer_half(s, geo, proj, width, height, rows, depth):
     """Outer-half intensity per pixel of ``rows`` (image model §5.5; see
     solidwire_addon/core/silhouettes.py): max over silhouette edges whose outer
     side holds the sample and whose nearest point q is not behind the
-    visible surface there, of P(d) * fade with thickness and fade at q."""
+    visible surface there, of P(d) * fade with thickness and fade at q;
+    and the pixels an undecided edge's outer half could reach (image model
+    §7.2: a side sigma that float32 cannot tell from 0, such as a
+    triangle's third corner on its edge's line, decides by rounding whether
+    the edge is a silhouette at all)."""
     out = np.zeros(len(rows) * width)
+    unsure = np.zeros(len(rows) * width, bool)
     if geo.sil_edges is None or len(geo.sil_edges) == 0:
-        return out
+        return out, unsure
     eye = _eye(proj)
     a, b = geo.sil_edges[:, 0], geo.sil_edges[:, 1]
     ones = np.ones((len(a), 1))
@@ -1304,22 +1321,33 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
         m = np.stack(
             [np.hstack([a, ones]), np.hstack([b, ones]), np.hstack([o, ones]), np.tile(eye, (len(a), 1))], axis=1
         )
-        return np.linalg.det(m)
+        # Two equal rows make it exactly 0, which LU's rounding need not
+        # give: a third corner at one of the edge's ends (a face folded
+        # onto the edge), or an edge whose ends coincide.
+        equal_rows = (o == a).all(axis=1) | (o == b).all(axis=1) | (a == b).all(axis=1)
+        value = np.where(equal_rows, 0.0, np.linalg.det(m))
+        # Against Hadamard's bound of the rows: a sigma that is only rounding.
+        unsure = ~equal_rows & (np.abs(value) <= SIDE_TOLERANCE * np.prod(np.linalg.norm(m, axis=2), axis=1))
+        return value, unsure
 
-    side_f = side(geo.sil_third[:, 0])
+    side_f, unsure_f = side(geo.sil_third[:, 0])
     boundary = ~np.isfinite(geo.sil_third[:, 1]).all(axis=1)
-    side_g = np.where(boundary, 0.0, side(np.nan_to_num(geo.sil_third[:, 1])))
+    side_g, unsure_g = side(np.nan_to_num(geo.sil_third[:, 1]))
+    side_g = np.where(boundary, 0.0, side_g)
     silhouette = (boundary | (side_f * side_g > 0)) & (side_f != 0)
-    a, b, third = a[silhouette], b[silhouette], geo.sil_third[silhouette, 0]
+    undecided = unsure_f | (~boundary & unsure_g)
+    drawn = silhouette | undecided
+    a, b, third, undecided = a[drawn], b[drawn], geo.sil_third[drawn, 0], undecided[drawn]
     wa, wb, valid = _clip_edges_to_window(proj, np.stack([a, b], axis=1), width, height)
-    a, b, third, wa, wb = a[valid], b[valid], third[valid], wa[valid], wb[valid]
+    a, b, third, wa, wb, undecided = a[valid], b[valid], third[valid], wa[valid], wb[valid], undecided[valid]
     if len(a) == 0:
-        return out
+        return out, unsure
     # Clipped 3D endpoints (for q's depth) and their clip w.
     xyz, w = _to_clip(proj, np.stack([a, b], axis=1))
     fa, fb = xyz[:, 0, 2] + w[:, 0], xyz[:, 1, 2] + w[:, 1]
-    ta = np.where(fa < 0, fa / (fa - fb), 0.0)
-    tb = np.where(fb < 0, fb / (fb - fa), 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):  # (the branch not taken where fa == fb)
+        ta = np.where(fa < 0, fa / (fa - fb), 0.0)
+        tb = np.where(fb < 0, fb / (fb - fa), 0.0)
     a3 = a + ta[:, None] * (b - a)
     b3 = b + tb[:, None] * (a - b)
     _x, wa_clip = _to_clip(proj, a3)
@@ -1357,13 +1385,16 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
         len2 = ab[e] @ ab[e]
         sp = np.clip(rel @ ab[e] / len2, 0.0, 1.0) if len2 > 0 else np.zeros(len(px))
         d = np.linalg.norm(rel - sp[:, None] * ab[e], axis=1)
+        if undecided[e]:
+            unsure[pixel[d <= reach[e]]] = True
+            continue
         u = sp * wa_clip[e] / (sp * wa_clip[e] + (1.0 - sp) * wb_clip[e])
         zq = -(a3[e, 2] + u * (b3[e, 2] - a3[e, 2]))
         seen = depth[pixel] >= zq
         value = profile(d, _thickness_at(s, zq, proj, height), softness) * _fade(s, zq)
         value = np.where(outer & seen, value, 0.0)
         np.maximum.at(out, pixel, value)
-    return out
+    return out, unsure
 
 
 def _fade(s, z):
@@ -1565,7 +1596,9 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
 
     if getattr(s, "use_silhouettes", False):
         wire_alpha = float(s.wire_color[3])
-        a_out = _outer_half(s, geo, proj, width, height, rows, depth) * wire_alpha
+        a_out, unsure = _outer_half(s, geo, proj, width, height, rows, depth)
+        a_out *= wire_alpha
+        on_silhouette |= unsure
         a_base = intensity * wire_alpha
         intensity = (a_out + (1.0 - a_out) * a_base) / max(wire_alpha, 1e-12)
 
