@@ -6,12 +6,14 @@
 void main()
 {
   vec2 p = gl_FragCoord.xy;
-  /* Only the side away from the face: the face draws its own inner half. */
-  if (dot(fin_line, vec3(p, 1.0)) * fin_inner_sign > 0.0) {
-    discard;
-  }
   vec2 wa = window_point(fin_a), wb = window_point(fin_b);
   vec2 ab = wb - wa;
+  /* Only the side away from the face: the face draws its own inner half.
+   * (The near-clipped ends keep the edge's line and its direction.) */
+  vec2 ap = p - wa;
+  if ((ab.x * ap.y - ab.y * ap.x) * fin_inner_sign > 0.0) {
+    discard;
+  }
   float len2 = dot(ab, ab);
   float s = (len2 > 0.0) ? clamp(dot(p - wa, ab) / len2, 0.0, 1.0) : 0.0;
   float d = length(p - (wa + s * ab));

@@ -998,7 +998,6 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
         iface.flat("VEC4", "fin_a")
         iface.flat("VEC4", "fin_b")
-        iface.flat("VEC3", "fin_line")
         iface.flat("FLOAT", "fin_inner_sign")
         iface.flat("VEC2", "fin_view_depth")
         info = pulling_info()

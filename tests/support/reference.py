@@ -998,14 +998,17 @@ SLIVER_REACH_PX = 0.01
 
 def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
     """[(pixels, depth)]: samples within SLIVER_REACH_PX of a sliver triangle
-    wholly in front of the camera (§7: their visible face is undecided), with
-    the sliver's nearest depth."""
+    (§7: their visible face is undecided), with the sliver's nearest depth.
+    A triangle through the near plane is a sliver where its front part is
+    (a triangle whose plane nearly holds the eye): the polygon clipped to
+    the near plane, as thin across as SLIVER_PX."""
     tri = geo.tri_view
     if len(tri) == 0:
         return []
     h = np.concatenate([tri, np.ones(tri.shape[:2] + (1,))], axis=2) @ proj.T  # (T, 3, 4)
     with np.errstate(all="ignore"):
-        front = ((h[..., 2] + h[..., 3]) >= 0).all(axis=1) & (h[..., 3] > 0).all(axis=1)
+        ahead = h[..., 2] + h[..., 3] >= 0
+        front = ahead.all(axis=1) & (h[..., 3] > 0).all(axis=1)
         win = (h[..., :2] / h[..., 3:4] + 1.0) * 0.5 * np.array([width, height])
         a, b, c = win[:, 0], win[:, 1], win[:, 2]
         area2 = np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
@@ -1015,12 +1018,21 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
         )
         altitude = np.where(longest > 0, area2 / np.maximum(longest, 1e-300), 0.0)
     thin = np.flatnonzero(front & np.isfinite(win).all(axis=(1, 2)) & (altitude < SLIVER_PX) & (longest > 0))
+    polygons = [(win[k], -tri[k, :, 2].max()) for k in thin]
+    crossing = np.flatnonzero(ahead.any(axis=1) & ~ahead.all(axis=1) & np.isfinite(h).all(axis=(1, 2)))
+    for k in crossing:  # few
+        clipped = _near_clipped_polygon(tri[k], h[k], width, height)
+        if clipped is None:
+            continue
+        points, depth = clipped
+        if 0.0 < _polygon_width(points) < SLIVER_PX:
+            polygons.append((points, depth))
     out = []
     evaluated = np.zeros(height, bool)
     evaluated[rows] = True
-    for k in thin:  # few, and each covers few pixels
-        lo = np.floor(win[k].min(axis=0) - 1.0).astype(int)
-        hi = np.ceil(win[k].max(axis=0) + 1.0).astype(int)
+    for points, depth in polygons:  # few, and each covers few pixels
+        lo = np.floor(points.min(axis=0) - 1.0).astype(int)
+        hi = np.ceil(points.max(axis=0) + 1.0).astype(int)
         xs = np.arange(max(lo[0], 0), min(hi[0], width))
         ys = np.arange(max(lo[1], 0), min(hi[1], height))
         ys = ys[evaluated[ys]]
@@ -1028,13 +1040,14 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
             continue
         gx, gy = np.meshgrid(xs + 0.5, ys + 0.5)
         pts = np.stack([gx.ravel(), gy.ravel()], axis=1)
+        n = len(points)
         dist = np.min(
             np.stack(
                 [
                     _segment_distance(
-                        pts, np.broadcast_to(win[k, i], pts.shape), np.broadcast_to(win[k, (i + 1) % 3], pts.shape)
+                        pts, np.broadcast_to(points[i], pts.shape), np.broadcast_to(points[(i + 1) % n], pts.shape)
                     )[0]
-                    for i in range(3)
+                    for i in range(n)
                 ]
             ),
             axis=0,
@@ -1042,8 +1055,45 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
         near = dist <= SLIVER_REACH_PX
         if near.any():
             pix = row_of[gy.ravel()[near].astype(int)] * width + gx.ravel()[near].astype(int)
-            out.append((pix, np.full(len(pix), -tri[k, :, 2].max())))
+            out.append((pix, np.full(len(pix), depth)))
     return out
+
+
+def _near_clipped_polygon(view, clip, width, height):
+    """The window polygon (N, 2) of the part of a triangle (view-space
+    corners ``view``, clip ``clip``) in front of the near plane, and its
+    nearest view depth; None where nothing of it is."""
+    ahead = clip[:, 2] + clip[:, 3]
+    kept_clip, kept_view = [], []
+    for i in range(3):
+        j = (i + 1) % 3
+        if ahead[i] >= 0:
+            kept_clip.append(clip[i])
+            kept_view.append(view[i])
+        if (ahead[i] >= 0) != (ahead[j] >= 0):
+            t = ahead[i] / (ahead[i] - ahead[j])  # (the projection is linear: one t for both)
+            kept_clip.append(clip[i] + t * (clip[j] - clip[i]))
+            kept_view.append(view[i] + t * (view[j] - view[i]))
+    kept_clip, kept_view = np.array(kept_clip), np.array(kept_view)
+    if len(kept_clip) < 3 or (kept_clip[:, 3] <= 0).any():
+        return None
+    points = (kept_clip[:, :2] / kept_clip[:, 3:4] + 1.0) * 0.5 * np.array([width, height])
+    return points, float(-kept_view[:, 2].max())
+
+
+def _polygon_width(points) -> float:
+    """The smallest width of a convex polygon across: over its sides, the
+    farthest corner from that side's line (0 where a side has no length)."""
+    widths = []
+    n = len(points)
+    for i in range(n):
+        edge = points[(i + 1) % n] - points[i]
+        length = np.hypot(*edge)
+        if length == 0.0:
+            continue
+        rel = points - points[i]
+        widths.append(np.abs(edge[0] * rel[:, 1] - edge[1] * rel[:, 0]).max() / length)
+    return min(widths) if widths else 0.0
 
 
 # ---------------------------------------------------------------- distances
@@ -1292,12 +1342,21 @@ def _eye(proj):
     return vt[-1]
 
 
-# Image model §7.2: a silhouette side sigma (§5.5) within this share of
-# Hadamard's bound of its determinant's rows is rounding alone (a
-# triangle's third corner on its edge's line, as a degenerate face has
-# it), whose sign neither float64 nor float32 decides; a face merely
-# close to edge-on stays far above it.
-SIDE_TOLERANCE = 2.0**-30
+# Image model §7.2: a silhouette side sigma (§5.5) whose window
+# orientation lies within this share of its float32 slack (the window
+# coordinates' size times the triangle's two sides there) is one float32
+# cannot tell from 0: a face that edge-on, or a triangle whose corners lie
+# on one line, is a silhouette or not by rounding's sign.
+SIDE_TOLERANCE = 2.0**-20
+SIDE_REACH_PX = 0.01
+
+
+def _window_points(proj, points, width, height):
+    """(N, 2) window points of view-space ``points`` (x / w, y / w, also for
+    a point behind the eye, as the engine divides)."""
+    clip = np.hstack([points, np.ones((len(points), 1))]) @ proj.T
+    with np.errstate(all="ignore"):
+        return (clip[:, :2] / clip[:, 3:4] + 1.0) * 0.5 * np.array([width, height])
 
 
 def _outer_half(s, geo, proj, width, height, rows, depth):
@@ -1326,8 +1385,18 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
         # onto the edge), or an edge whose ends coincide.
         equal_rows = (o == a).all(axis=1) | (o == b).all(axis=1) | (a == b).all(axis=1)
         value = np.where(equal_rows, 0.0, np.linalg.det(m))
-        # Against Hadamard's bound of the rows: a sigma that is only rounding.
-        unsure = ~equal_rows & (np.abs(value) <= SIDE_TOLERANCE * np.prod(np.linalg.norm(m, axis=2), axis=1))
+        # What float32 resolves of it: the engine takes sigma's sign from
+        # the orientation of the window points (line_side in
+        # shaders/silhouette_vert.glsl), cross2(b - a, o - a), which the
+        # rounding of window coordinates of size M moves by about
+        # 2^-23 M (|b - a| + |o - a|).
+        pa, pb, po = (_window_points(proj, p, width, height) for p in (a, b, o))
+        ab, ao = pb - pa, po - pa
+        with np.errstate(all="ignore"):  # (a point on the eye's plane: unsure)
+            orientation = ab[:, 0] * ao[:, 1] - ab[:, 1] * ao[:, 0]
+            size = np.abs(np.stack([pa, pb, po])).max(axis=(0, 2))
+            slack = SIDE_TOLERANCE * size * (np.hypot(*ab.T) + np.hypot(*ao.T))
+            unsure = ~equal_rows & ~(np.abs(orientation) > slack)
         return value, unsure
 
     side_f, unsure_f = side(geo.sil_third[:, 0])
@@ -1362,6 +1431,11 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
     z_ends = -np.stack([a3[:, 2], b3[:, 2]], axis=1)
     t_max = np.max(_thickness_at(s, z_ends.ravel(), proj, height).reshape(-1, 2), axis=1)
     reach = 0.5 * t_max + 2.0 * softness + 1.0
+    # A segment too short for float32 to fix its direction to 0.01 px over
+    # its reach (its ends' window coordinates carry about 2^-22 of their
+    # size): which side of it a sample lies on is rounding's choice.
+    size = np.maximum(np.abs(wa).max(axis=1), np.abs(wb).max(axis=1))
+    undecided |= np.hypot(*(wb - wa).T) * SIDE_REACH_PX < reach * size * 2.0**-22
     x0 = np.clip(np.floor(np.minimum(wa[:, 0], wb[:, 0]) - reach), 0, width).astype(np.int64)
     x1 = np.clip(np.ceil(np.maximum(wa[:, 0], wb[:, 0]) + reach), -1, width - 1).astype(np.int64)
     y0 = np.clip(np.floor(np.minimum(wa[:, 1], wb[:, 1]) - reach), 0, height).astype(np.int64)
