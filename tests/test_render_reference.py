@@ -638,3 +638,21 @@ def test_a_triangle_through_the_near_plane_seen_edge_on_is_a_sliver(output_dir):
     report = accuracy.measure(scene, "edge_on_through_the_near_plane", output_dir)
     accuracy.assert_accurate(report)
     assert report["silhouette_pixels"] > 0
+
+
+@pytest.mark.parametrize("mode", ["PIXELS", "WORLD"])
+def test_outer_halves_of_a_mesh_outside_the_frame_reach_into_it(mode, output_dir):
+    """A quad just past the frame's right border: its outer halves (wide and
+    soft) reach into the frame, so the render must not cull it as off-screen
+    (gather's view cull widened by silhouettes.outer_reach; the fuzz found
+    a frame left empty)."""
+    scene = scenes.empty_scene(
+        120, 90, use_silhouettes=True, thickness=4.0, softness=6.0, thickness_mode=mode, world_thickness=0.3
+    )
+    scenes.grid(scene, "Beyond", x_segments=1, y_segments=1, size=0.5, location=(2.75, 0.0, 0.0))
+    scenes.add_camera(scene, location=(0.0, 0.0, 6.0), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, f"outer_halves_from_outside_{mode.lower()}", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    assert not (ref.face >= 0).any()  # the quad itself lies outside the frame
+    assert (ref.intensity > 0.3).sum() > 20  # its outer halves reach in

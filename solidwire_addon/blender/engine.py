@@ -14,7 +14,7 @@ import time
 import bpy
 import numpy as np
 
-from ..core import colors, compositing, passes, schema, shaders
+from ..core import colors, compositing, passes, schema, shaders, silhouettes
 from ..core.ids import ENGINE_ID
 from ..core.log import one_line, warn_once
 from ..core.view import DrawStats, View
@@ -109,6 +109,7 @@ class PreparedFrame:
             depsgraph,
             runtime.mesh_cache,
             view=self.view,
+            view_reach=silhouettes.outer_reach(self.settings, self.view),
             should_stop=should_stop,
             object_settings=object_settings,
             materials=passes.MATERIAL_INDEX_PASS in self.extra_passes,

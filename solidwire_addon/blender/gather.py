@@ -198,6 +198,7 @@ def gather(
     object_filter=None,
     trust_updates: bool | None = None,
     view=None,
+    view_reach=None,
     should_stop=None,
     corners: bool = False,
     colors: bool = False,
@@ -219,7 +220,8 @@ def gather(
     With ``view`` (a core.view.View), a mesh the cache does not hold yet is not
     extracted at all while every instance of it lies outside the view
     frustum (its evaluated bound box against the clip planes); those
-    instances count as culled. ``should_stop()`` (a render's Esc) is asked
+    instances count as culled; ``view_reach`` widens that view by how far
+    drawing reaches past a mesh (silhouettes.outer_reach). ``should_stop()`` (a render's Esc) is asked
     before each object's work; when it says True, gathering ends there.
     ``corners``: meshes carry their corner table (shaded fill, material
     colours; a separate cache entry, so FLAT draws never pay for it).
@@ -249,6 +251,7 @@ def gather(
         cache,
         trust_updates=trust_updates,
         view=view,
+        view_reach=view_reach,
         corners=corners,
         edges=edges,
         outlines=not tessellation,
@@ -324,6 +327,7 @@ class _FrameGather:
         *,
         trust_updates: bool,
         view,
+        view_reach=None,
         corners: bool,
         edges: edge_select.Selection,
         outlines: bool = True,
@@ -338,6 +342,7 @@ class _FrameGather:
         self.corners, self.edges, self.outlines = corners, edges, outlines
         self.attribute_colors = attribute_colors
         self.view_projection = None if view is None else view.projection @ view.view_matrix
+        self.view_reach = view_reach
         self.seen = SeenKeys()
         self.seen.scope = (self.mode,)
         self.ms_extract = 0.0
@@ -355,7 +360,7 @@ class _FrameGather:
         pointer = data.as_pointer()
         if pointer in self.deferred:
             key, uids, box, culled = self.deferred[pointer]
-            if _outside(self.view_projection, instance, box):
+            if _outside(self.view_projection, instance, box, self.view_reach):
                 self.deferred[pointer] = (key, uids, box, culled + 1)
                 return None
             # A visible instance after all: extract now (the earlier ones are
@@ -380,11 +385,11 @@ class _FrameGather:
                 if key is not None:
                     if self.view_projection is not None and key not in self.cache:
                         box = _bound_box(obj)
-                        if box is not None and _outside(self.view_projection, instance, box):
+                        if box is not None and _outside(self.view_projection, instance, box, self.view_reach):
                             # Only an off-screen object pays for the check: a
                             # small part of what extracting it would cost.
                             box = mesh_reading.finite_vertex_box(obj, box)
-                        if box is not None and _outside(self.view_projection, instance, box):
+                        if box is not None and _outside(self.view_projection, instance, box, self.view_reach):
                             self.deferred[pointer] = (key, uids, box, 1)
                             return None
                     self.seen.add(key)
@@ -525,9 +530,9 @@ def _bound_box(obj):
     return corners.min(axis=0), corners.max(axis=0)
 
 
-def _outside(view_projection, instance, box) -> bool:
+def _outside(view_projection, instance, box, reach=None) -> bool:
     object_to_clip = view_projection @ np.array(instance.matrix_world, dtype=np.float64)
-    return bool(outside_frustum_many(object_to_clip[None], *box)[0])
+    return bool(outside_frustum_many(object_to_clip[None], *box, reach)[0])
 
 
 def _key_for(obj, pointer, parent, mode, key_pointer, instancer_meshes):

@@ -45,6 +45,22 @@ _NEXT_CORNER = np.array([1, 2, 0], np.intp)
 _THIRD_CORNER = np.array([2, 0, 1], np.intp)
 
 
+def outer_reach(settings, view) -> tuple | None:
+    """How far past its mesh's own projection an outer half can reach, as
+    view.outside_frustum_many's ``reach`` (pixels, pixels times clip w,
+    window width, height), or None with silhouettes off: the fin's reach of
+    shaders/silhouette_vert.glsl (the widest core, its fall-off and a pixel;
+    in world widths the core's pixels at clip w = 1 over w)."""
+    if not settings.use_silhouettes:
+        return None
+    pixels = 0.5 * max(float(settings.thickness), float(settings.thickness_far)) + 2.0 * float(settings.softness) + 1.0
+    per_w = 0.0
+    if settings.thickness_mode == "WORLD":
+        per_w = 0.5 * max(float(settings.world_thickness), 0.0) * 0.5 * view.height * abs(float(view.projection[1][1]))
+        pixels = max(pixels, 2.0 * float(settings.softness) + 1.0)
+    return (pixels, per_w, view.width, view.height)
+
+
 def candidate_edges(triangles: np.ndarray, edge_flags: np.ndarray) -> np.ndarray:
     """(E, 4) float32 rows (a, b, o_f, o_g): the real edges with one or two
     adjacent faces, ascending by (a, b), a < b; o_f / o_g are the third

@@ -214,13 +214,22 @@ def box_clip_corners(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.n
     return np.einsum("kj,nij->nki", corners, np.asarray(object_to_clip).reshape(-1, 4, 4))
 
 
-def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max) -> np.ndarray:
+def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max, reach=None) -> np.ndarray:
     """(N,) bool: the box lies wholly outside one clip plane (conservative),
-    for (N, 4, 4) matrices at once."""
+    for (N, 4, 4) matrices at once. ``reach`` (pixels, pixels times clip w,
+    window width, height; silhouettes.outer_reach): drawing that reaches
+    that far past the box's projection (the outer halves of silhouettes,
+    image model §5.5), so the side planes move out by it (a half-space in
+    clip space still: x > w (1 + 2 px / W) + 2 px_w / W), and a box beyond
+    the far plane stays in (the background hides no outer half)."""
     clip = box_clip_corners(object_to_clip, bounds_min, bounds_max)
     x, y, z, w = np.moveaxis(clip, 2, 0)
-    outside = (x > w).all(1) | (x < -w).all(1) | (y > w).all(1) | (y < -w).all(1) | (z > w).all(1) | (z < -w).all(1)
-    return outside
+    if reach is None:
+        return (x > w).all(1) | (x < -w).all(1) | (y > w).all(1) | (y < -w).all(1) | (z > w).all(1) | (z < -w).all(1)
+    pixels, per_w, width, height = reach
+    wx = w * (1.0 + 2.0 * pixels / width) + 2.0 * per_w / width
+    wy = w * (1.0 + 2.0 * pixels / height) + 2.0 * per_w / height
+    return (x > wx).all(1) | (x < -wx).all(1) | (y > wy).all(1) | (y < -wy).all(1) | (z < -w).all(1)
 
 
 def wholly_in_front(object_to_clip: np.ndarray, bounds_min, bounds_max) -> bool:
