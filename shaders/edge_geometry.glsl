@@ -22,14 +22,20 @@ vec2 window_point(vec4 clip)
   return h.xy / h.z;
 }
 
-/* The clip w of every point of the near plane (z + w = 0): its view depth
- * n for a perspective projection, 1 for an orthographic one (from the
- * projection's rows P22, P23, P32, P33 in params.depth_rows). */
+/* The view depth of the near plane (z + w = 0), from the projection's rows
+ * P22, P23, P32, P33 in params.depth_rows. */
+float near_plane_depth()
+{
+  vec4 rows = params.depth_rows;
+  return (rows.y + rows.w) / (rows.x + rows.z);
+}
+
+/* The clip w of every point of the near plane: its view depth n for a
+ * perspective projection, 1 for an orthographic one. */
 float near_plane_w()
 {
   vec4 rows = params.depth_rows;
-  float depth = (rows.y + rows.w) / (rows.x + rows.z);
-  return rows.w - rows.z * depth;
+  return rows.w - rows.z * near_plane_depth();
 }
 
 /* Where the segment from `behind` (depth, z + w, below 0) to `front`

@@ -65,45 +65,65 @@ float corner_view_depth(float id)
   return -dot(object_to_view_z, vec4(fetch_texel(vertex_positions, int(id)).xyz, 1.0));
 }
 
-/* A corner of the other triangle as the depth test at a pixel needs it:
- * its window position, 1/w and view depth / w (both affine in window
- * space, so interpolated there they give the view depth perspective-
- * correctly, in either projection). */
+/* A corner of the other triangle as the test at a pixel needs it: its
+ * homogeneous window point (x_win w, y_win w, w), finite also behind the
+ * eye, and its view depth. */
 vec4 quad_partner_corner(vec4 clip, float view_depth_of_corner)
 {
-  vec2 window = (clip.xy / clip.w) * (0.5 * params.viewport.zw) + params.viewport.xy + 0.5 * params.viewport.zw;
-  return vec4(window, 1.0 / clip.w, view_depth_of_corner / clip.w);
+  return vec4(window_homogeneous(clip), view_depth_of_corner);
 }
 
-/* Whether the other triangle (corners a, b, c of quad_partner_corner; a
- * zero 1/w in a marks none) covers window point p, and there its window
- * barycentric weights and its view depth. */
+/* Whether the part of the other triangle (corners a, b, c of
+ * quad_partner_corner; all zero for none) in front of the near plane
+ * covers window point p, and there the weights of its corners in the
+ * triangle itself (perspective-correct barycentrics) and its view depth.
+ * A triangle wholly in front of the near plane is tested in window space;
+ * one through it (a corner behind the camera, as a quad that crosses the
+ * near plane has) by its edge functions in homogeneous window space,
+ * (h_j x h_k) . (p, 1), which share det[h_a; h_b; h_c]'s sign exactly
+ * where a point of the triangle in front of the eye projects to p. */
 bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out float depth)
 {
   weights = vec3(0.0);
   depth = 0.0;
-  if (a.z == 0.0) {
-    return false; /* no other triangle, or a corner behind the near plane */
+  vec3 w = vec3(a.z, b.z, c.z);
+  float near = near_plane_depth();
+  if (min(min(a.w, b.w), c.w) >= near && min(min(w.x, w.y), w.z) > 0.0) {
+    vec2 pa = a.xy / w.x, pb = b.xy / w.y, pc = c.xy / w.z;
+    vec2 ab = pb - pa, ac = pc - pa;
+    float area = ab.x * ac.y - ab.y * ac.x;
+    if (area == 0.0) {
+      return false;
+    }
+    vec2 ap = p - pa;
+    float u = (ap.x * ac.y - ap.y * ac.x) / area, v = (ab.x * ap.y - ab.y * ap.x) / area;
+    if (u < 0.0 || v < 0.0 || u + v > 1.0) {
+      return false;
+    }
+    vec3 window_weights = vec3(1.0 - u - v, u, v) / w;
+    weights = window_weights / (window_weights.x + window_weights.y + window_weights.z);
   }
-  vec2 ab = b.xy - a.xy, ac = c.xy - a.xy;
-  float area = ab.x * ac.y - ab.y * ac.x;
-  if (area == 0.0) {
-    return false;
+  else {
+    vec3 q = vec3(p, 1.0);
+    vec3 bc = cross(b.xyz, c.xyz), ca = cross(c.xyz, a.xyz), ab = cross(a.xyz, b.xyz);
+    float det = dot(a.xyz, bc);
+    if (det == 0.0) {
+      return false; /* none, or a triangle seen edge-on */
+    }
+    vec3 e = vec3(dot(bc, q), dot(ca, q), dot(ab, q)) * sign(det);
+    float sum = e.x + e.y + e.z;
+    if (min(min(e.x, e.y), e.z) < 0.0 || !(sum > 0.0)) {
+      return false;
+    }
+    weights = e / sum;
   }
-  vec2 ap = p - a.xy;
-  float u = (ap.x * ac.y - ap.y * ac.x) / area, v = (ab.x * ap.y - ab.y * ap.x) / area;
-  if (u < 0.0 || v < 0.0 || u + v > 1.0) {
-    return false;
-  }
-  weights = vec3(1.0 - u - v, u, v);
-  depth = dot(weights, vec3(a.w, b.w, c.w)) / dot(weights, vec3(a.z, b.z, c.z));
-  return true;
+  depth = dot(weights, vec3(a.w, b.w, c.w));
+  return depth >= near; /* (a part the near plane clips is no surface) */
 }
 
 /* The corners (quad_partner_corner) of the other triangle of `triangle`
  * (corner ids `ids`, edge flags `flags`) and their clip positions, where it
- * has one and all three of its corners lie in front of the near plane;
- * else false, with a zero 1/w in `a`. */
+ * has one; else false, with every corner zero. */
 bool quad_partner_set_up(
     int triangle, vec4 ids, int flags, out vec4 a, out vec4 b, out vec4 c, out vec4 clip_a, out vec4 clip_b, out vec4 clip_c)
 {
@@ -116,11 +136,6 @@ bool quad_partner_set_up(
   clip_a = vertex_clip(corners.x);
   clip_b = vertex_clip(corners.y);
   clip_c = vertex_clip(corners.z);
-  if (min(min(clip_a.z + clip_a.w, clip_b.z + clip_b.w), clip_c.z + clip_c.w) < 0.0 ||
-      min(min(clip_a.w, clip_b.w), clip_c.w) <= 0.0)
-  {
-    return false;
-  }
   a = quad_partner_corner(clip_a, corner_view_depth(corners.x));
   b = quad_partner_corner(clip_b, corner_view_depth(corners.y));
   c = quad_partner_corner(clip_c, corner_view_depth(corners.z));

@@ -172,7 +172,8 @@ void leave_out_the_visible_face()
 #  ifdef LINEAR_DEPTH
   gl_FragDepth = depth * params.inv_clip_end * (1.0 - PARTNER_DEPTH_HAIR);
 #  else
-  gl_FragDepth = min(dot(weights, partner_window_depth) - PARTNER_DEPTH_HAIR, gl_FragCoord.z);
+  vec3 partner_w = vec3(partner0.z, partner2.z, partner3.z);
+  gl_FragDepth = min(dot(weights, partner_window_depth) / dot(weights, partner_w) - PARTNER_DEPTH_HAIR, gl_FragCoord.z);
 #  endif
 }
 #endif

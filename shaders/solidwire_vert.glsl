@@ -351,17 +351,19 @@ vec4 biased(vec4 position)
 }
 
 #if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
-/* The other triangle of this one's quad (quad_partner.glsl), where all three
- * of its corners lie in front of the near plane, for the fragment stage's
- * test of whether that triangle is the surface (solidwire_frag.glsl,
- * leave_out_the_visible_face); a zero 1/w marks none. Its window depth as
- * the depth test sees it, with the overlay's bias. */
+/* The other triangle of this one's quad (quad_partner.glsl), for the
+ * fragment stage's test of whether that triangle is the surface
+ * (solidwire_frag.glsl, leave_out_the_visible_face); all zero for none.
+ * Its window depth as the depth test sees it, with the overlay's bias,
+ * times w: 0.5 (z + w) of each corner, which weighted by the corners'
+ * barycentrics and divided by their w gives the window depth at a pixel
+ * (also where a corner lies behind the camera). */
 void partner_outputs(int triangle, vec4 ids)
 {
   vec4 a, b, c;
   partner_window_depth = vec3(0.0);
   if (quad_partner_set_up(triangle, ids, edge_flags, partner0, partner2, partner3, a, b, c)) {
-    partner_window_depth = 0.5 * vec3(biased(a).z / a.w, biased(b).z / b.w, biased(c).z / c.w) + 0.5;
+    partner_window_depth = 0.5 * (vec3(biased(a).z, biased(b).z, biased(c).z) + vec3(a.w, b.w, c.w));
   }
 }
 #endif

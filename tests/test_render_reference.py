@@ -656,3 +656,27 @@ def test_outer_halves_of_a_mesh_outside_the_frame_reach_into_it(mode, output_dir
     ref = reference.render_reference(scene)
     assert not (ref.face >= 0).any()  # the quad itself lies outside the frame
     assert (ref.intensity > 0.3).sum() > 20  # its outer halves reach in
+
+
+def test_a_folded_quad_through_the_near_plane_is_no_hidden_layer_of_itself(output_dir):
+    """A folded quad with a corner behind the camera, whose two triangles
+    overlap on screen: where one is the surface the other is the visible
+    face too, never a hidden layer (image model §5.4). Its other triangle
+    crosses the near plane, so the test of whether it covers a pixel works
+    in homogeneous window space (quad_partner_covers), where a window-space
+    one has no projected triangle to test (the fuzz found 68 pixels of the
+    quad's own edges drawn as hidden lines through it)."""
+    scene = scenes.empty_scene(48, 36, thickness=3.0, use_hidden_lines=True, hidden_alpha=1.0, hidden_duty=1.0)
+    data = bpy.data.meshes.new("Folded")
+    corners = [(1.085, 1.4696, -0.1884), (-1.0768, 0.0, -1.8831), (0.0, 1.3581, -1.8650), (0.0, -0.8138, 0.0)]
+    data.from_pydata(corners, [], [(0, 1, 2, 3)])
+    obj = bpy.data.objects.new("Folded", data)
+    obj.location, obj.rotation_euler, obj.scale = (0.0, 0.0, -0.1884), (0.0, -2.1416, -1.9681), (0.5, 0.3172, 0.7698)
+    scene.collection.objects.link(obj)
+    scenes.add_camera(
+        scene, location=(0.2978, -0.8138, 0.0366), target=(0.0, -0.8138, 0.0), lens=13.58, sensor_fit="HORIZONTAL"
+    )
+    report = accuracy.measure(scene, "folded_quad_through_the_near_plane", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    assert (ref.face >= 0).sum() > 200 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
