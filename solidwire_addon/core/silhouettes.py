@@ -55,9 +55,8 @@ def outer_reach(settings, view) -> tuple | None:
         return None
     pixels = 0.5 * max(float(settings.thickness), float(settings.thickness_far)) + 2.0 * float(settings.softness) + 1.0
     per_w = 0.0
-    if settings.thickness_mode == "WORLD":
+    if settings.thickness_mode == "WORLD":  # (settings.pack_params' world_half_thickness_px)
         per_w = 0.5 * max(float(settings.world_thickness), 0.0) * 0.5 * view.height * abs(float(view.projection[1][1]))
-        pixels = max(pixels, 2.0 * float(settings.softness) + 1.0)
     return (pixels, per_w, view.width, view.height)
 
 
