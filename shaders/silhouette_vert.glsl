@@ -9,27 +9,26 @@
 /* Outside the clip volume: the rasteriser drops the triangle. */
 const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
 
-/* Which side of the window line through the edge's ends a, b (clip) the
- * point o lies on: the sign of det[ha; hb; ho] (homogeneous window points),
- * which is sigma's (docs/image_model.md §5.5). Taken as w_a w_b w_o times
- * the orientation of the window points, cross2(b - a, o - a): the same
- * sign, but measured against the triangle's own size in window space
- * rather than against |ha| |hb| |ho| of three nearly parallel vectors,
- * whose float32 rounding decides faces a hair off edge-on. 0 where o is
- * one of the ends (a corner folded onto the edge: sigma is exactly 0
- * there); the homogeneous form where a point lies on the eye's plane. */
-float line_side(vec4 a, vec4 b, vec4 o)
+/* Which side of the window line through the edge's ends (homogeneous window
+ * points ha, hb) the point ho lies on: the sign of det[ha; hb; ho], which
+ * is sigma's (docs/image_model.md §5.5). Taken as w_a w_b w_o times the
+ * orientation of the window points, cross2(b - a, o - a): the same sign,
+ * but measured against the triangle's own size in window space rather
+ * than against |ha| |hb| |ho| of three nearly parallel vectors, whose
+ * float32 rounding decides faces a hair off edge-on. 0 where o is one of
+ * the ends (a corner folded onto the edge: sigma is exactly 0 there); the
+ * homogeneous form where a point lies on the eye's plane (w = 0). */
+float line_side(vec3 ha, vec3 hb, vec3 ho)
 {
-  vec3 ha = window_homogeneous(a), hb = window_homogeneous(b), ho = window_homogeneous(o);
   if (ho == ha || ho == hb) {
     return 0.0;
   }
-  if (a.w == 0.0 || b.w == 0.0 || o.w == 0.0) {
+  if (ha.z == 0.0 || hb.z == 0.0 || ho.z == 0.0) {
     return dot(cross(ha, hb), ho);
   }
   vec2 pa = ha.xy / ha.z, pb = hb.xy / hb.z, po = ho.xy / ho.z;
   vec2 ab = pb - pa, ao = po - pa;
-  return sign(a.w * b.w * o.w) * (ab.x * ao.y - ab.y * ao.x);
+  return sign(ha.z * hb.z * ho.z) * (ab.x * ao.y - ab.y * ao.x);
 }
 
 void main()
@@ -39,10 +38,11 @@ void main()
   vec4 ids = fetch_texel(silhouette_edges, edge);
   vec4 a = vertex_clip(ids.x);
   vec4 b = vertex_clip(ids.y);
-  vec3 l = cross(window_homogeneous(a), window_homogeneous(b));
-  float side_f = line_side(a, b, vertex_clip(ids.z));
+  vec3 ha = window_homogeneous(a), hb = window_homogeneous(b);
+  vec3 l = cross(ha, hb);
+  float side_f = line_side(ha, hb, window_homogeneous(vertex_clip(ids.z)));
   bool boundary = ids.w < 0.0;
-  float side_g = boundary ? 0.0 : line_side(a, b, vertex_clip(ids.w));
+  float side_g = boundary ? 0.0 : line_side(ha, hb, window_homogeneous(vertex_clip(ids.w)));
   bool contour = !boundary && side_f * side_g > 0.0;
   float depth_a = a.z + a.w, depth_b = b.z + b.w;
   if (edge >= edge_count || !(boundary || contour) || side_f == 0.0 || (depth_a < 0.0 && depth_b < 0.0) ||
