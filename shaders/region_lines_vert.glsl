@@ -160,6 +160,18 @@ void main()
   /* The box around every segment's window points, widened by the reach,
    * holds every segment's reach. */
   vec2 low = box.low - box.reach, high = box.high + box.reach;
+  /* The window lies within its half diagonal of the centre, in this frame
+   * as in any: past that the box covers no more of it. So a reach beyond
+   * any rasteriser's range (a class thousands of times the wire's width,
+   * image model §3.6, at a Thickness near 0) stays drawable, and a box
+   * wholly outside draws nothing. */
+  float window_radius = 0.5 * length(params.viewport.zw) + 1.0;
+  low = max(low, vec2(-window_radius));
+  high = min(high, vec2(window_radius));
+  if (low.x > high.x || low.y > high.y) {
+    gl_Position = COLLAPSED;
+    return;
+  }
   /* corners 0..3: (low,low), (high,low), (high,high), (low,high) */
   bool at_high = (corner == 1 || corner == 2);
   bool plus = (corner >= 2);

@@ -680,3 +680,30 @@ def test_a_folded_quad_through_the_near_plane_is_no_hidden_layer_of_itself(outpu
     accuracy.assert_accurate(report)
     ref = reference.render_reference(scene)
     assert (ref.face >= 0).sum() > 200 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
+
+
+def test_a_class_far_wider_than_the_wire_stays_drawable(output_dir):
+    """In world widths a class keeps its ratio to the wire's width (image
+    model §3.6), so a Thickness near 0 makes a boundary line 10^12 px wide:
+    every pixel of the face takes it. Its region lines' quads are clipped
+    to the window's half diagonal in their own frame, covering the same
+    pixels, where quads that size fell outside the rasteriser's range and
+    dropped pixels (found by the fuzz)."""
+    scene = scenes.empty_scene(
+        48,
+        36,
+        thickness=1e-12,
+        thickness_mode="WORLD",
+        world_thickness=0.01,
+        use_boundary_edges=True,
+        boundary_thickness=4.8,
+    )
+    data = bpy.data.meshes.new("Thin")
+    data.from_pydata([(-1.0, -0.9, 0.0), (1.1, -0.7, 0.2), (-0.1, 1.0, -0.3)], [], [(0, 1, 2)])
+    scene.collection.objects.link(bpy.data.objects.new("Thin", data))
+    scenes.add_camera(scene, location=(0.3, -1.0, 5.0), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, "class_far_wider_than_the_wire", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    covered = ref.face >= 0
+    assert covered.sum() > 20 and (ref.intensity[covered] > 0.99).all()
