@@ -472,10 +472,8 @@ def test_an_edge_that_projects_to_a_point_draws_no_line(output_dir):
         boundary_thickness=2.0,
         boundary_pattern="DOTTED",
     )
-    data = bpy.data.meshes.new("Pinched")
     corners = [(-1.0, -1.0, 0.0), (1.0, -1.0, 0.0), (1.2, 0.6, 0.0), (0.0, 1.0, 0.0), (0.0, 1.0, 0.0)]
-    data.from_pydata(corners, [], [(0, 1, 2, 3, 4)])
-    scene.collection.objects.link(bpy.data.objects.new("Pinched", data))
+    scenes.from_pydata(scene, "Pinched", corners, [(0, 1, 2, 3, 4)])
     scenes.add_camera(scene, location=(0.3, -0.4, 3.2), target=(0.0, 0.0, 0.0))
     report = accuracy.measure(scene, "edge_projects_to_a_point", output_dir)
     accuracy.assert_accurate(report)
@@ -515,7 +513,6 @@ def test_a_face_with_a_non_finite_corner_makes_no_silhouette(output_dir):
     face's boundary, whose outer half shows where the dropped face was (a
     random mesh of the fuzz found the reference keeping those triangles)."""
     scene = scenes.empty_scene(120, 90, use_silhouettes=True, thickness=2.0)
-    data = bpy.data.meshes.new("Dropped")
     corners = [
         (-1.0, -0.5, 0.0),
         (0.0, -0.5, 0.0),
@@ -526,8 +523,7 @@ def test_a_face_with_a_non_finite_corner_makes_no_silhouette(output_dir):
         (1.2, float("nan"), 0.0),
         (1.2, 0.4, 0.0),
     ]
-    data.from_pydata(corners, [], [(0, 1, 4, 3), (1, 2, 6, 7, 5, 4)])
-    scene.collection.objects.link(bpy.data.objects.new("Dropped", data))
+    scenes.from_pydata(scene, "Dropped", corners, [(0, 1, 4, 3), (1, 2, 6, 7, 5, 4)])
     scenes.add_camera(scene, location=(0.2, -1.5, 3.5), target=(0.1, 0.0, 0.0))
     report = accuracy.measure(scene, "non_finite_face_silhouettes", output_dir)
     accuracy.assert_accurate(report)
@@ -562,10 +558,8 @@ def test_corners_folded_onto_their_edges_make_no_silhouette(corners, seed, softn
     background (a wide softness draws them over the whole frame)."""
     rng = np.random.default_rng(seed)
     scene = scenes.empty_scene(120, 90, use_silhouettes=True, thickness=1.5, softness=softness)
-    data = bpy.data.meshes.new("Folded")
     points = [tuple(rng.uniform(-1.0, 1.0, 3)) for _ in range(3)]
-    data.from_pydata([points[k] for k in corners], [], [(0, 1, 2, 3)])
-    scene.collection.objects.link(bpy.data.objects.new("Folded", data))
+    scenes.from_pydata(scene, "Folded", [points[k] for k in corners], [(0, 1, 2, 3)])
     scenes.add_camera(scene, location=tuple(rng.uniform(-1.0, 1.0, 3) + [0.0, -1.0, 3.5]), target=(0.0, 0.0, 0.0))
     name = "corners_folded_" + "".join(map(str, corners)) + f"_{seed}"
     report = accuracy.measure(scene, name, output_dir)
@@ -596,7 +590,6 @@ def test_a_degenerate_face_s_silhouettes_are_undecided(output_dir):
     could reach are reported apart (image model §7.2) and the quad's
     outline is measured."""
     scene = scenes.empty_scene(120, 90, use_silhouettes=True, thickness=1.5, softness=3.0)
-    data = bpy.data.meshes.new("Degenerate")
     corners = [
         (-1.5, -0.4, 0.0),
         (-0.3, -0.4, 0.0),
@@ -606,8 +599,7 @@ def test_a_degenerate_face_s_silhouettes_are_undecided(output_dir):
         (0.9, 0.0, 0.0),
         (1.6, 0.0, 0.0),
     ]
-    data.from_pydata(corners, [], [(0, 1, 2, 3), (4, 5, 6)])
-    scene.collection.objects.link(bpy.data.objects.new("Degenerate", data))
+    scenes.from_pydata(scene, "Degenerate", corners, [(0, 1, 2, 3), (4, 5, 6)])
     scenes.add_camera(scene, location=(0.3, -2.5, 3.0), target=(0.0, 0.0, 0.0))
     report = accuracy.measure(scene, "degenerate_face_silhouettes", output_dir)
     accuracy.assert_accurate(report)
@@ -623,15 +615,15 @@ def test_a_triangle_through_the_near_plane_seen_edge_on_is_a_sliver(output_dir):
     (image model §7.2), as for a sliver wholly in front (the fuzz found a
     sample the engine covers with a line of 0.999 and the reference not)."""
     scene = scenes.empty_scene(48, 36, thickness=0.0, softness=0.01)
-    data = bpy.data.meshes.new("EdgeOn")
-    data.from_pydata(
+    scenes.from_pydata(
+        scene,
+        "EdgeOn",
         [(1.8601929298902666, 0.0, 0.0), (0.0, -1.5, 0.0), (-1.3657131893118066, 1.888580167212086, 0.0)],
-        [],
         [(0, 1, 2)],
+        location=(0.3, 0.0, 0.0),
+        rotation_euler=(0.0, 0.3, 0.3),
+        scale=(0.3, 0.3, 0.3),
     )
-    obj = bpy.data.objects.new("EdgeOn", data)
-    obj.location, obj.rotation_euler, obj.scale = (0.3, 0.0, 0.0), (0.0, 0.3, 0.3), (0.3, 0.3, 0.3)
-    scene.collection.objects.link(obj)
     scenes.add_camera(
         scene, location=(0.3, 5.235987755982963e-08, 0.0), target=(0.0, 0.0, 0.0), lens=12.0, clip=(0.01, 20.0)
     )
@@ -667,12 +659,16 @@ def test_a_folded_quad_through_the_near_plane_is_no_hidden_layer_of_itself(outpu
     one has no projected triangle to test (the fuzz found 68 pixels of the
     quad's own edges drawn as hidden lines through it)."""
     scene = scenes.empty_scene(48, 36, thickness=3.0, use_hidden_lines=True, hidden_alpha=1.0, hidden_duty=1.0)
-    data = bpy.data.meshes.new("Folded")
     corners = [(1.085, 1.4696, -0.1884), (-1.0768, 0.0, -1.8831), (0.0, 1.3581, -1.8650), (0.0, -0.8138, 0.0)]
-    data.from_pydata(corners, [], [(0, 1, 2, 3)])
-    obj = bpy.data.objects.new("Folded", data)
-    obj.location, obj.rotation_euler, obj.scale = (0.0, 0.0, -0.1884), (0.0, -2.1416, -1.9681), (0.5, 0.3172, 0.7698)
-    scene.collection.objects.link(obj)
+    scenes.from_pydata(
+        scene,
+        "Folded",
+        corners,
+        [(0, 1, 2, 3)],
+        location=(0.0, 0.0, -0.1884),
+        rotation_euler=(0.0, -2.1416, -1.9681),
+        scale=(0.5, 0.3172, 0.7698),
+    )
     scenes.add_camera(
         scene, location=(0.2978, -0.8138, 0.0366), target=(0.0, -0.8138, 0.0), lens=13.58, sensor_fit="HORIZONTAL"
     )
@@ -698,9 +694,7 @@ def test_a_class_far_wider_than_the_wire_stays_drawable(output_dir):
         use_boundary_edges=True,
         boundary_thickness=4.8,
     )
-    data = bpy.data.meshes.new("Thin")
-    data.from_pydata([(-1.0, -0.9, 0.0), (1.1, -0.7, 0.2), (-0.1, 1.0, -0.3)], [], [(0, 1, 2)])
-    scene.collection.objects.link(bpy.data.objects.new("Thin", data))
+    scenes.from_pydata(scene, "Thin", [(-1.0, -0.9, 0.0), (1.1, -0.7, 0.2), (-0.1, 1.0, -0.3)], [(0, 1, 2)])
     scenes.add_camera(scene, location=(0.3, -1.0, 5.0), target=(0.0, 0.0, 0.0))
     report = accuracy.measure(scene, "class_far_wider_than_the_wire", output_dir)
     accuracy.assert_accurate(report)
