@@ -1351,14 +1351,6 @@ SIDE_TOLERANCE = 2.0**-20
 SIDE_REACH_PX = 0.01
 
 
-def _window_points(proj, points, width, height):
-    """(N, 2) window points of view-space ``points`` (x / w, y / w, also for
-    a point behind the eye, as the engine divides)."""
-    clip = np.hstack([points, np.ones((len(points), 1))]) @ proj.T
-    with np.errstate(all="ignore"):
-        return (clip[:, :2] / clip[:, 3:4] + 1.0) * 0.5 * np.array([width, height])
-
-
 def _outer_half(s, geo, proj, width, height, rows, depth):
     """Outer-half intensity per pixel of ``rows`` (image model §5.5; see
     solidwire_addon/core/silhouettes.py): max over silhouette edges whose outer
@@ -1390,9 +1382,10 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
         # shaders/silhouette_vert.glsl), cross2(b - a, o - a), which the
         # rounding of window coordinates of size M moves by about
         # 2^-23 M (|b - a| + |o - a|).
-        pa, pb, po = (_window_points(proj, p, width, height) for p in (a, b, o))
-        ab, ao = pb - pa, po - pa
         with np.errstate(all="ignore"):  # (a point on the eye's plane: unsure)
+            # (x / w, y / w also behind the eye, as the engine divides)
+            pa, pb, po = (_window(proj, p, width, height) for p in (a, b, o))
+            ab, ao = pb - pa, po - pa
             orientation = ab[:, 0] * ao[:, 1] - ab[:, 1] * ao[:, 0]
             size = np.abs(np.stack([pa, pb, po])).max(axis=(0, 2))
             slack = SIDE_TOLERANCE * size * (np.hypot(*ab.T) + np.hypot(*ao.T))
