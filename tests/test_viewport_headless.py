@@ -225,6 +225,41 @@ def test_wire_far_from_the_origin_stays_in_front_of_blenders_depth(
     assert int((green & (strong < 0.02)).sum()) <= 2, "no line where the reference has none"
 
 
+@pytest.mark.parametrize("subdivisions", [0, 3], ids=["drawn_directly", "deferred"])
+def test_wire_of_a_ground_reaching_far_behind_the_camera(viewport, subdivisions):
+    """A ground 400 units long seen from 5 cm above it, near clip 1 cm (as
+    walking over a terrain in the viewport). Its positions used to be
+    re-centred on the middle of its bounds, 200 units away: the corners
+    near the camera rounded by the spacing of that size, and the surface
+    the overlay drew strayed from Blender's depth of the same corners by
+    more than its bias wherever the near plane cuts the quads steeply, so
+    the wire vanished there. Positions now keep Blender's float32 values
+    (extract._centre_of): the wire shows wherever the reference has it."""
+    from tests.support import reference
+
+    scene = scenes.empty_scene(WIDTH, HEIGHT, wire_color=WIRE, thickness=1.5, diagonal_mode="SOLID")
+    corners = [(-1.0123457, -400.0, 0.0137), (0.9876543, -404.0, 0.00731), (1.1234567, 2.3456789, -0.0123)]
+    ground = scenes.from_pydata(scene, "Ground", [*corners, (-0.9345678, 2.1234567, 0.00987)], [(0, 1, 2, 3)])
+    if subdivisions:
+        modifier = ground.modifiers.new("Subdivision", "SUBSURF")
+        modifier.subdivision_type, modifier.levels = "SIMPLE", subdivisions
+    scenes.add_camera(scene, location=(0.0, 0.0, 0.05), target=(0.2, 2.0, 0.0), lens=24.0, clip=(0.01, 100.0))
+    ground.select_set(False)
+    strong = reference.render_reference(scene).intensity
+    view = viewport(scene)
+    flat_solid_shading(view.space)
+    set_overlays(view.space, overlays=False)
+    view.draw_blender()
+    view.draw_solidwire()
+    rgba = view.rgba().astype(np.float64) / 255.0
+    green = rgba[..., 1] - rgba[..., 0] > 0.3
+    full = strong > 0.9
+    assert full.sum() > 200
+    missing = int((full & ~green).sum())
+    assert missing == 0, f"{missing} of {full.sum()} full-intensity wire pixels hidden"
+    assert int((green & (strong < 0.02)).sum()) <= 2, "no line where the reference has none"
+
+
 def flat_colours(view_transform: str):
     """(Blender's Solid colour, SolidWire's fill colour as the screen shows
     it, the scene's display transform of the colour), each (N, 3) in 0..1

@@ -312,14 +312,34 @@ def _recentre(
 
 
 def _centre_of(bounds_min: np.ndarray, bounds_max: np.ndarray) -> np.ndarray:
-    """(3,) float64: the middle of the bounds, rounded to float32. Each
-    position (float32) less a float32 centre is one correctly rounded
-    float32 subtraction, exact near the centre: as precise as a float64
-    subtraction rounded to float32, at a fraction of its cost (a float64
-    centre made every vertex a cast, a subtraction and a cast back: 10 of
-    60 ms of a 1M-triangle extraction). The bounds are exact in float32:
-    min and max round nothing."""
-    return (0.5 * (bounds_min + bounds_max)).astype(np.float32).astype(np.float64)
+    """(3,) float64, a float32 value per axis: where the positions are
+    re-centred, chosen so that no position rounds.
+
+    Re-centring wins precision where a mesh lies far from its origin: the
+    float64 matrix takes the large offset, and the float32 products on the
+    GPU see only the small local coordinates. But a position less the
+    centre is a float32 subtraction, exact only where the position lies
+    within a factor of two of the centre (Sterbenz's lemma); elsewhere it
+    rounds to the spacing of the centre's size. That moved the surface of
+    a mesh whose bounds reach far past its origin (one vertex 40 units
+    away, the rest near the camera) by more than the viewport overlay's
+    depth bias from Blender's own depth of the same float32 positions, and
+    the overlay hid its wire there. So on each axis the centre is the
+    middle of the bounds where that middle keeps every position within a
+    factor of two of it (the bounds on one side of 0, the far end at most
+    three times the near one), and 0 otherwise: the bounds then reach the
+    origin or nearly, so the positions themselves are no larger than the
+    mesh and re-centring had nothing to win. The positions are then
+    Blender's own, exactly, on every axis. A float32 centre keeps the
+    subtraction one float32 operation (a float64 one made every vertex a
+    cast, a subtraction and a cast back: 10 of 60 ms of a 1M-triangle
+    extraction). The bounds are exact in float32: min and max round
+    nothing."""
+    middle = (0.5 * (bounds_min + bounds_max)).astype(np.float32).astype(np.float64)
+    # Sterbenz on [lo, hi] (both of the middle's sign): |middle| / 2 <= |p| <= 2 |middle|.
+    near, far = np.minimum(np.abs(bounds_min), np.abs(bounds_max)), np.maximum(np.abs(bounds_min), np.abs(bounds_max))
+    exact = (bounds_min * bounds_max > 0.0) & (0.5 * np.abs(middle) <= near) & (far <= 2.0 * np.abs(middle))
+    return np.where(exact, middle, 0.0)
 
 
 def _finite_vertices(positions: np.ndarray) -> np.ndarray | None:
