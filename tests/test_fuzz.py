@@ -266,6 +266,42 @@ def test_random_meshes_with_every_line_option_match_reference(mesh, camera, line
         check(scene, tmp_path_factory.getbasetemp() / "fuzz_rich.exr")
 
 
+@FUZZ
+@given(mesh=polygons(), camera=cameras(), line=rich_settings(), transform=transforms())
+def test_random_meshes_with_every_line_option_in_the_overlay(mesh, camera, line, transform):
+    """The same scenes in the viewport overlay's first redraw over
+    Blender's Solid shading depth of them (image model §5.6), compared with
+    the reference wherever that depth agrees with the model. Where Blender
+    draws a surface nearer than the model's visible one (a face with a
+    non-finite corner, which the model drops; a sliver seen edge-on, which
+    it never hits) nothing of ours can show, and the picture there is
+    Blender's. Outer halves of silhouettes blend "over" one another in the
+    overlay (§5.5): where they reach, the overlay may be darker than the
+    reference, never lighter."""
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+
+    line = dict(line)
+    marked = line.pop("marked")
+    log.forget()
+    ensure_gpu()
+    scene = build(mesh, camera, line, transform)
+    mark_edges(scene.objects["Fuzz"].data, marked)
+    with recipe_on_failure(repro(mesh, camera, line, transform) + f"\nmarked={marked!r}"):
+        viewport = robustness.Viewport(W, H)
+        _stats, alpha = viewport.draw(scene)
+        assert np.isfinite(alpha).all(), "NaN/Inf pixels"
+        ref = reference.render_reference(scene)
+        blender_in_front = viewport.hides(ref.depth)
+        outer = np.zeros_like(blender_in_front)
+        if line.get("use_silhouettes"):
+            without = reference.SettingsWith(scene.solidwire, use_silhouettes=False)
+            outer = ref.intensity != reference.render_reference(scene, settings=without).intensity
+            lighter = (alpha < ref.intensity - 0.1) & outer & ~blender_in_front & ~ref.on_silhouette
+            assert not lighter.any(), f"{int(lighter.sum())} pixels lack outer halves"
+        ref.on_silhouette = ref.on_silhouette | blender_in_front | outer
+        accuracy.assert_accurate(reference.error_report(alpha, ref))
+
+
 # Modifier stacks under cage edges (image model §3.5): a primitive, what
 # comes before its Subdivision Surface (nothing, a deform, or modifiers
 # that make new edges, which are cage edges too), the subdivision, and what

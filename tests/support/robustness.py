@@ -130,7 +130,9 @@ class Viewport:
 
     def draw(self, scene, depsgraph=None) -> tuple[dict, np.ndarray]:
         """The overlay over Blender's Solid shading depth of the scene's
-        visible objects (viewport.draw_scene_depth): (stats, alpha)."""
+        visible objects (viewport.draw_scene_depth): (stats, alpha).
+        ``scene_depth`` keeps the view depth of that Solid shading depth
+        (+inf where it holds nothing), read before the overlay draws."""
         import gpu
 
         from tests.support.viewport import draw_scene_depth
@@ -141,6 +143,8 @@ class Viewport:
             self.framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0), depth=1.0)
         visible = [obj for obj in scene.objects if obj.visible_get()]
         draw_scene_depth(self.framebuffer, self.size, depsgraph, view, visible)
+        self.view = view
+        self.scene_depth = self._view_depth(view)
         with self.framebuffer.bind():
             gpu.state.viewport_set(0, 0, *self.size)
             stats = overlay.draw_scene_overlay(depsgraph, view, scene.solidwire.snapshot())
@@ -148,3 +152,31 @@ class Viewport:
         buf.dimensions = self.size[0] * self.size[1] * 4
         alpha = np.array(buf, dtype=np.float64).reshape(self.size[1], self.size[0], 4)[..., 3] / 255.0
         return stats, alpha
+
+    def hides(self, depth: np.ndarray) -> np.ndarray:
+        """(H, W) bool: where the Solid shading depth of the last draw lies
+        nearer than view depth ``depth`` (+inf: none) by more than half the
+        overlay's depth bias (OVERLAY_DEPTH_BIAS in NDC), so that a surface
+        of the overlay's at ``depth`` cannot show there."""
+        from solidwire_addon.core.view import OVERLAY_DEPTH_BIAS
+
+        p = np.asarray(self.view.projection, dtype=np.float64)
+        finite = np.isfinite(depth)
+        w = np.where(finite, p[3, 3] - p[3, 2] * np.where(finite, depth, 0.0), 1.0)
+        slope = abs(p[3, 2] * p[2, 3] - p[2, 2] * p[3, 3]) / (w * w)  # d(NDC) / d(view depth)
+        return self.scene_depth < np.where(finite, depth - 0.5 * OVERLAY_DEPTH_BIAS / slope, np.inf)
+
+    def _view_depth(self, view) -> np.ndarray:
+        """(H, W) float64 view depth of what the depth buffer holds now
+        (+inf where it is clear), through the view's projection: window
+        depth n = z/w with clip z = P22 (-d) + P23, clip w = P32 (-d) + P33."""
+        width, height = self.size
+        with self.framebuffer.bind():
+            buf = self.framebuffer.read_depth(0, 0, width, height)
+        buf.dimensions = width * height
+        window = np.array(buf, dtype=np.float64).reshape(height, width)
+        p = np.asarray(view.projection, dtype=np.float64)
+        ndc = 2.0 * window - 1.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            depth = (ndc * p[3, 3] - p[2, 3]) / (ndc * p[3, 2] - p[2, 2])
+        return np.where(window < 1.0, depth, np.inf)
