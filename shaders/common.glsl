@@ -59,6 +59,10 @@ vec4 fetch_texel(sampler2D table, int index)
   return texelFetch(table, ivec2(index & ((1 << TABLE_ROW_SHIFT) - 1), index >> TABLE_ROW_SHIFT), 0);
 }
 
+/* A triangle's edge flags from its texel of the flag table, which holds
+ * them as two 12-bit halves (core/cache.py, GPUMesh.flag_table). */
+#define TABLE_FLAGS(texel) (int((texel).x) | (int((texel).y) << 12))
+
 /* Viewport overlay (docs/image_model.md §5.6): the change of window depth
  * that moves the point at view depth `view_depth` towards the camera by
  * min(allowance.x + allowance.y |d|, allowance.z + allowance.w |d|) scene

@@ -10,6 +10,28 @@ vec4 vertex_clip(float vertex_index)
   return object_to_clip * vec4(p, 1.0);
 }
 
+/* Viewport overlay only: Blender's own Solid shading has already written
+ * (nearly) the same depth for the same surface, but from its own float32
+ * matrices and positions, so ours differs by a few ULPs either way and a
+ * LESS_EQUAL test would stipple. Moving every vertex a constant DEPTH_BIAS
+ * towards the camera in NDC (z - b*w, i.e. z/w - b after the divide) makes
+ * our surface win that tie; NDC bias is the right unit because float32
+ * rounding of z/w is relative to |z/w| <= 1. Far from the world origin
+ * Blender's rounding of the positions themselves dominates: the vertex
+ * moves towards the camera by that allowance too, in scene units
+ * (window_depth_shift, common.glsl). Window x/y and the edge distances are
+ * untouched (only z changes). */
+vec4 biased(vec4 position)
+{
+#ifdef DEPTH_BIAS
+  float view_depth_here = view_depth_of_clip_z(position.z, params.depth_rows);
+  position.z += 2.0 * window_depth_shift(view_depth_here, params.blender_depth_allowance, params.depth_rows) *
+                position.w;
+  position.z -= DEPTH_BIAS * position.w;
+#endif
+  return position;
+}
+
 /* Homogeneous window coordinates: (x_win * w, y_win * w, w). */
 vec3 window_homogeneous(vec4 clip)
 {

@@ -1,7 +1,7 @@
 /* The viewport overlay's deferred surface, composited into Blender's buffer
  * (passes.draw_over_viewport): the resolved colour the overlay keeps, at the
  * record's window depth moved towards the camera by the direct pass's
- * DEPTH_BIAS (z/w - b in NDC is z - b/2 in window depth, solidwire_vert.glsl)
+ * DEPTH_BIAS (z/w - b in NDC is z - b/2 in window depth, biased() in edge_geometry.glsl)
  * and by the allowance for Blender's rounding of the same surface,
  * so that Blender's depth test keeps exactly the pixels it keeps of the
  * direct pass, and the colour blends as that pass's fragment would. Where

@@ -59,6 +59,16 @@ bool quad_partner_corners(int triangle, vec4 ids, int flags, out vec3 corners)
   return true;
 }
 
+/* Whether the face's other triangle, at view depth `other` where it covers
+ * a pixel, lies in front of this one there (view depth `depth`), or level
+ * with it within float32's reach: a face that is flat but overlaps itself
+ * on screen (a self-intersecting outline) has two triangles at one depth,
+ * and the rasteriser's choice between them is the surface. */
+bool nearer_or_level(float other, float depth)
+{
+  return other < depth * (1.0 + 1.0e-5);
+}
+
 /* The view depth of vertex `id` (as the vertex stage's own view_depth). */
 float corner_view_depth(float id)
 {
@@ -151,9 +161,81 @@ void quad_partner_window_corners(int triangle, out vec4 a, out vec4 b, out vec4 
   if (triangle < 0) {
     return; /* (a corner that provokes no triangle) */
   }
-  vec2 flag_halves = fetch_texel(triangle_flag_table, triangle).xy;
-  int flags = int(flag_halves.x) | (int(flag_halves.y) << 12); /* cache.GPUMesh.flag_table */
+  int flags = TABLE_FLAGS(fetch_texel(triangle_flag_table, triangle));
   vec4 clip_a, clip_b, clip_c;
   quad_partner_set_up(triangle, fetch_texel(triangle_vertices, triangle), flags, a, b, c, clip_a, clip_b, clip_c);
+}
+#endif
+
+#ifdef NGON_SIBLINGS
+/* The other triangles of an n-gon. Its triangles can overlap on screen as
+ * a folded quad's two can (a face that is not flat), and a hidden layer is
+ * never the visible face itself, so a triangle of an n-gon behind the
+ * surface takes the depth of the nearest of its face's other triangles
+ * that covers the pixel nearer than it, a hair nearer still, as a quad's
+ * triangle takes its other triangle's: dropped exactly where that
+ * triangle is the surface. An n-gon's triangles are consecutive in the
+ * triangle table (Blender's order), and the face table
+ * (cache.GPUMesh.face_table) names each triangle's polygon; the walk from
+ * a triangle stops at the first of another face. It goes at most
+ * NGON_SIBLINGS_MOST triangles each way: past that (an n-gon of more
+ * corners whose far triangles fold back over this one) the layer shows. */
+const int NGON_SIBLINGS_MOST = 64;
+
+bool is_same_face(int other, float face)
+{
+  ivec2 size = textureSize(triangle_faces, 0);
+  return other >= 0 && other < size.x * size.y && fetch_texel(triangle_faces, other).x == face;
+}
+
+/* Of the other triangles of `triangle`'s face, the nearest that covers
+ * window point p in front of view depth `depth` (or level with it,
+ * nearer_or_level): its corners
+ * (quad_partner_corner), their clip positions, the weights of
+ * quad_partner_covers and that view depth; false where none does. */
+bool nearest_ngon_sibling(int triangle,
+                          vec2 p,
+                          float depth,
+                          out vec4 a,
+                          out vec4 b,
+                          out vec4 c,
+                          out vec4 clip_a,
+                          out vec4 clip_b,
+                          out vec4 clip_c,
+                          out vec3 weights,
+                          out float sibling_depth)
+{
+  a = b = c = clip_a = clip_b = clip_c = vec4(0.0);
+  weights = vec3(0.0);
+  sibling_depth = 0.0;
+  bool found = false;
+  float face = fetch_texel(triangle_faces, triangle).x;
+  for (int step = -1; step <= 1; step += 2) {
+    for (int k = 1; k <= NGON_SIBLINGS_MOST; k++) {
+      int other = triangle + step * k;
+      if (!is_same_face(other, face)) {
+        break;
+      }
+      vec3 ids = fetch_texel(triangle_vertices, other).xyz;
+      vec4 ca = vertex_clip(ids.x), cb = vertex_clip(ids.y), cc = vertex_clip(ids.z);
+      vec4 qa = quad_partner_corner(ca, corner_view_depth(ids.x));
+      vec4 qb = quad_partner_corner(cb, corner_view_depth(ids.y));
+      vec4 qc = quad_partner_corner(cc, corner_view_depth(ids.z));
+      vec3 w;
+      float d;
+      if (quad_partner_covers(p, qa, qb, qc, w, d) && nearer_or_level(d, depth) && (!found || d < sibling_depth)) {
+        found = true;
+        sibling_depth = d;
+        a = qa;
+        b = qb;
+        c = qc;
+        clip_a = ca;
+        clip_b = cb;
+        clip_c = cc;
+        weights = w;
+      }
+    }
+  }
+  return found;
 }
 #endif

@@ -37,8 +37,7 @@ void main()
    * (the rest describe its own edges, which are not set up). */
   edge_flags = IN_REGION | REGION_LINES;
 #else
-  vec2 flag_halves = fetch_texel(triangle_flag_table, triangle).xy;
-  edge_flags = int(flag_halves.x) | (int(flag_halves.y) << 12); /* cache.GPUMesh.flag_table */
+  edge_flags = TABLE_FLAGS(fetch_texel(triangle_flag_table, triangle));
 #endif
   sw_vertex_id = 3 * triangle + 2;
   solidwire_corner();

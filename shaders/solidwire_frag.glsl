@@ -155,10 +155,11 @@ void write_linear_depth()
 
 #if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
 /* A hidden layer is never the visible face itself (quad_partner.glsl): where
- * the quad's other triangle (solidwire_vert.glsl, partner_outputs) covers
- * this pixel nearer than this one, this fragment takes its depth there, a
- * hair nearer still, so the GREATER test drops it exactly where that
- * triangle is the surface, and keeps it where something else hides both. */
+ * the quad's other triangle (solidwire_vert.glsl, partner_outputs), or the
+ * nearest of a folded n-gon's other triangles (NGON_SIBLINGS), covers this
+ * pixel nearer than this one, this fragment takes its depth there, a hair
+ * nearer still, so the GREATER test drops it exactly where that triangle is
+ * the surface, and keeps it where something else hides both. */
 void leave_out_the_visible_face()
 {
 #  ifndef LINEAR_DEPTH
@@ -166,14 +167,27 @@ void leave_out_the_visible_face()
 #  endif
   vec3 weights;
   float depth;
-  if (!quad_partner_covers(gl_FragCoord.xy, partner0, partner2, partner3, weights, depth) || !(depth < view_depth)) {
+  vec4 a = partner0, b = partner2, c = partner3;
+  vec3 window_depth_w = partner_window_depth;
+  bool covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, depth) && nearer_or_level(depth, view_depth);
+#  ifdef NGON_SIBLINGS
+  if (!covered && a == vec4(0.0)) { /* no quad's triangle: an n-gon's, or a triangle face */
+    vec4 clip_a, clip_b, clip_c;
+    covered = nearest_ngon_sibling(
+        hidden_triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, depth);
+    /* (As partner_outputs sets a quad's other triangle up.) */
+    window_depth_w = 0.5 * (vec3(biased(clip_a).z, biased(clip_b).z, biased(clip_c).z) +
+                            vec3(clip_a.w, clip_b.w, clip_c.w));
+  }
+#  endif
+  if (!covered) {
     return;
   }
 #  ifdef LINEAR_DEPTH
   gl_FragDepth = depth * params.inv_clip_end * (1.0 - PARTNER_DEPTH_HAIR);
 #  else
-  vec3 partner_w = vec3(partner0.z, partner2.z, partner3.z);
-  gl_FragDepth = min(dot(weights, partner_window_depth) / dot(weights, partner_w) - PARTNER_DEPTH_HAIR, gl_FragCoord.z);
+  vec3 partner_w = vec3(a.z, b.z, c.z);
+  gl_FragDepth = min(dot(weights, window_depth_w) / dot(weights, partner_w) - PARTNER_DEPTH_HAIR, gl_FragCoord.z);
 #  endif
 }
 #endif

@@ -328,28 +328,6 @@ void fill_outputs(int triangle, int corner, float vertex_id)
 #endif
 }
 
-/* Viewport overlay only: Blender's own Solid shading has already written
- * (nearly) the same depth for the same surface, but from its own float32
- * matrices and positions, so ours differs by a few ULPs either way and a
- * LESS_EQUAL test would stipple. Moving every vertex a constant DEPTH_BIAS
- * towards the camera in NDC (z - b*w, i.e. z/w - b after the divide) makes
- * our surface win that tie; NDC bias is the right unit because float32
- * rounding of z/w is relative to |z/w| <= 1. Far from the world origin
- * Blender's rounding of the positions themselves dominates: the vertex
- * moves towards the camera by that allowance too, in scene units
- * (window_depth_shift, common.glsl). Window x/y and the edge distances are
- * untouched (only z changes). */
-vec4 biased(vec4 position)
-{
-#ifdef DEPTH_BIAS
-  float view_depth_here = view_depth_of_clip_z(position.z, params.depth_rows);
-  position.z += 2.0 * window_depth_shift(view_depth_here, params.blender_depth_allowance, params.depth_rows) *
-                position.w;
-  position.z -= DEPTH_BIAS * position.w;
-#endif
-  return position;
-}
-
 #if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
 /* The other triangle of this one's quad (quad_partner.glsl), for the
  * fragment stage's test of whether that triangle is the surface
@@ -438,6 +416,9 @@ void main()
   view_depth = -dot(object_to_view_z, vec4(local, 1.0));
 #if defined(HIDDEN_PASS) && !defined(RESOLVE_PASS)
   partner_outputs(triangle, ids);
+#  ifdef NGON_SIBLINGS
+  hidden_triangle = triangle;
+#  endif
 #endif
   fill_outputs(triangle, corner, vertex_id);
 #ifdef USE_CLIP_PLANES

@@ -11,7 +11,8 @@
 
 #ifdef REGION_LAYERS
 /* A layer is never the visible face itself (quad_partner.glsl): where the
- * quad's other triangle covers this pixel nearer than this one, this
+ * quad's other triangle (or the nearest of a folded n-gon's other
+ * triangles, NGON_SIBLINGS) covers this pixel nearer than this one, this
  * fragment takes that depth, a hair nearer still, so the test against the
  * layer before drops it exactly where that triangle is the surface (the
  * render's first layer lies behind the surface; over the viewport the
@@ -31,9 +32,16 @@ float nearer_than_the_other_triangle(int triangle, float depth)
 #  endif
   vec3 weights;
   float partner_view_depth;
-  if (!quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, partner_view_depth) ||
-      !(partner_view_depth < view_depth))
-  {
+  bool covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, partner_view_depth) &&
+                 nearer_or_level(partner_view_depth, view_depth);
+#  ifdef NGON_SIBLINGS
+  if (!covered && a == vec4(0.0)) { /* no quad's triangle: an n-gon's, or a triangle face */
+    vec4 clip_a, clip_b, clip_c;
+    covered = nearest_ngon_sibling(
+        triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, partner_view_depth);
+  }
+#  endif
+  if (!covered) {
     return depth;
   }
   /* (The layers are recorded in linear depth: shaders.py.) */

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import solidwire_addon
-from tests.support import accuracy, reference, scenes
+from tests.support import accuracy, reference, robustness, scenes
 
 
 def _floor_and_wall(scene):
@@ -676,6 +676,63 @@ def test_a_folded_quad_through_the_near_plane_is_no_hidden_layer_of_itself(outpu
     accuracy.assert_accurate(report)
     ref = reference.render_reference(scene)
     assert (ref.face >= 0).sum() > 200 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
+
+
+@pytest.mark.parametrize("layers", ["walked", "peeled"])
+def test_a_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir, monkeypatch):
+    """A hexagon that is not flat, whose triangles overlap on screen, two of
+    them level with each other where they cross (found by the fuzz): where
+    one is the surface, the others are the visible face too, never a hidden
+    layer (image model §5.4). Density Fade hides its short outline, so a
+    layer of itself would show. Each triangle tests its face's other
+    triangles (quad_partner.glsl, NGON_SIBLINGS) in the direct hidden-line
+    pass and in the peeled layers' record; the render and the overlay, where
+    14 pixels showed the hexagon's outline through itself."""
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+    from solidwire_addon.core import passes
+
+    if layers == "peeled":
+        monkeypatch.setattr(passes, "PEEL_MIN_REGION_LINES", 0.0)
+    scene = scenes.empty_scene(
+        48,
+        36,
+        thickness=8.0,
+        softness=0.25,
+        diagonal_mode="SOLID",
+        use_density_fade=True,
+        density_fade_length=38.0,
+        use_hidden_lines=True,
+        hidden_alpha=0.87,
+        hidden_duty=1.0,
+    )
+    scene.render.pixel_aspect_x = 2.0
+    corners = [(0.1457, 1.0947, 1.5), (-0.3333, 0.0, 0.0), (0.8134, -1.4138, 0.5061), (0.0, 1.087, 0.0)]
+    scenes.from_pydata(
+        scene,
+        "Folded",
+        [*corners, (0.0, 0.1, 0.0), (1.0, 1.441, 0.0)],
+        [(0, 1, 2, 3, 4, 5)],
+        location=(0.0, 0.0, -0.361),
+        rotation_euler=(-2.9102, 1.2839, -0.4081),
+        scale=(-1.6107, 0.5, 2.0),
+    )
+    scenes.add_camera(
+        scene,
+        location=(0.7718, 0.5829, 3.0426),
+        target=(0.3955, 0.0, 0.2187),
+        ortho_scale=10.2,
+        shift=(0.0, 0.141),
+        clip=(0.5, 20.0),
+        sensor_fit="HORIZONTAL",
+    )
+    report = accuracy.measure(scene, f"folded_ngon_{layers}", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    assert (ref.face >= 0).sum() > 80 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
+    ensure_gpu()
+    stats, alpha = robustness.Viewport(48, 36).draw(scene)
+    assert stats.get("hidden_region_layers", 0) == (2 if layers == "peeled" else 0)
+    accuracy.assert_accurate(reference.error_report(alpha, ref))
 
 
 def test_a_class_far_wider_than_the_wire_stays_drawable(output_dir):

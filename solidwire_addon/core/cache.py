@@ -206,6 +206,7 @@ class GPUMesh:
         self.setup_table = None
         self.setup_key = None
         self._flag_table = None  # flag_table(), made on first use
+        self._face_table = None  # face_table(), made on first use
         self._visibility = None  # (by_vertex, visibility_batch(), its bytes), made on first use, kept across moves
         self._position_rows = positions  # (N, 4), w 0: as uploaded (_local_positions, run_points)
         # What reposition() needs to tell a move of vertices from a new shape.
@@ -257,6 +258,19 @@ class GPUMesh:
             self._flag_table = gpu.types.GPUTexture((width, height), format="RG32F", data=buf)
             self.gpu_bytes += texture_bytes(self._flag_table)
         return self._flag_table
+
+    def face_table(self):
+        """The polygon of every triangle, as an R32F texture (table_shape;
+        the low 24 bits of its index, which float32 holds exactly: the
+        triangles compared lie a few dozen rows apart, so their polygons
+        never differ by 2^24): what tells a folded n-gon's other triangles
+        apart (shaders/quad_partner.glsl, NGON_SIBLINGS), as the flags do
+        not once the n-gon walks a block. Made on first use."""
+        if self._face_table is None:
+            faces = np.bitwise_and(np.asarray(self.triangle_polygons_cpu, dtype=np.int64), 0xFFFFFF)
+            self._face_table = value_table_texture(faces.astype(np.float32))
+            self.gpu_bytes += texture_bytes(self._face_table)
+        return self._face_table
 
     def ngons_flat(self) -> bool:
         """Whether every n-gon of the mesh lies in one plane at its current

@@ -623,6 +623,7 @@ class _Part:
     lines_from_image_only: bool = False  # every triangle's lines come from the region-lines pass
     ngon_diagonals: bool = False  # blocks hold listed n-gons' diagonals (walked where they show, see variant)
     flat_ngons_alone: bool = False  # every n-gon is a region of its own and flat (asked where diagonals show)
+    ngons_may_fold: bool = False  # an n-gon may not be flat: its triangles can overlap on screen
     own_edges: bool = False  # some listed faces measure their own edges (edge_select.OWN_EDGES_MEASURED)
 
     def variant(self, variant):
@@ -654,6 +655,15 @@ class _Part:
             attribute_colors=variant.attribute_colors and self.colored and not plain_stage,
             run_segments=self.run_segments if variant.region_lines_pass else 1,
             own_edges=self.own_edges and not plain_stage,
+            # A hidden layer is never the visible face itself: a triangle
+            # of a folded n-gon tests its face's other triangles
+            # (quad_partner.glsl, NGON_SIBLINGS) in the direct hidden-line
+            # pass and in the peeled layers' record.
+            ngon_siblings=self.ngons_may_fold
+            and (
+                (variant.hidden_pass and not (variant.resolve or variant.region_lines_pass or variant.no_lines))
+                or (variant.visibility and variant.region_layers)
+            ),
         )
         if (
             self.lines_from_image_only
@@ -701,6 +711,7 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False) ->
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
             ngon_diagonals=getattr(mesh, "blocks_hold_ngon_diagonals", False),
             flat_ngons_alone=diagonals_shown and getattr(mesh, "ngons_alone", False) and mesh.ngons_flat(),
+            ngons_may_fold=mesh.has_ngons and not (getattr(mesh, "ngons_alone", False) and mesh.ngons_flat()),
             own_edges=getattr(mesh, "own_edges_measured", False),
         )
         parts.setdefault(part, []).append(g)
@@ -789,12 +800,16 @@ def _bind_mesh(shader, variant, mesh) -> None:
             shader.uniform_sampler("triangle_regions", mesh.region_tables()[1])
             shader.uniform_sampler("triangle_vertices", mesh.triangles)
             shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
+            if variant.ngon_siblings:
+                shader.uniform_sampler("triangle_faces", mesh.face_table())
         return  # its batch holds the rest (cache.GPUMesh.visibility_batch)
     shader.uniform_sampler("triangle_vertices", mesh.triangles)
     if variant.resolve and not variant.no_edge_setup:
         # (A resolve whose lines all come from the region-lines image reads
         # no edge flags: the table is never made for it.)
         shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
+    if variant.ngon_siblings:
+        shader.uniform_sampler("triangle_faces", mesh.face_table())
     if variant.ngons or variant.own_edges:  # (OWN_EDGES: a quad's 4th corner is in its block)
         shader.uniform_sampler("ngon_corners", mesh.ngon_corners)
     if variant.uses_corners:

@@ -56,7 +56,7 @@ class ShaderVariant:
     use_fade: bool = False
     write_view_depth: bool = False
     # Viewport overlay: NDC depth bias towards the camera (0 = none); see
-    # DEPTH_BIAS in solidwire_vert.glsl and view.OVERLAY_DEPTH_BIAS.
+    # DEPTH_BIAS in edge_geometry.glsl (biased) and view.OVERLAY_DEPTH_BIAS.
     depth_bias: float = 0.0
     thickness_mode: int = THICKNESS_PIXELS
     # Hidden-line style (image model §5.4): the pass that draws faces behind the
@@ -145,6 +145,11 @@ class ShaderVariant:
     region_layers: bool = False
     peel_layer: bool = False
     region_layers_peeled: bool = False
+    # The direct hidden-line pass, or the region layers' record, of a mesh
+    # whose n-gons may not be flat: a triangle of an n-gon also tests its
+    # face's other triangles, as a quad's tests its other one
+    # (quad_partner.glsl, NGON_SIBLINGS; docs/image_model.md §5.4).
+    ngon_siblings: bool = False
     # Resolve only: every triangle of the draw takes its lines from the
     # region-lines image and no diagonal is drawn (a cage look), so no
     # triangle edge is set up per pixel (NO_EDGE_SETUP).
@@ -259,7 +264,8 @@ def uses_uniform(shader, name: str) -> bool:
 # never declared in one program: a mesh table and the fin / strand tables
 # (slot 1), the outline table, the region-lines table and the scene depth
 # (2), the instanced and per-object item tables (3), the corner table and
-# the per-triangle regions (4).
+# the per-triangle regions (4), the attribute colours and the per-triangle
+# faces (13: a hidden-line pass draws no attribute colour).
 SAMPLERS = {
     "vertex_positions": (0, "FLOAT_2D"),
     "triangle_vertices": (1, "FLOAT_2D"),
@@ -281,6 +287,7 @@ SAMPLERS = {
     "triangle_flag_table": (11, "FLOAT_2D"),
     "region_line_image": (12, "DEPTH_2D"),
     "attribute_colors": (13, "FLOAT_2D"),
+    "triangle_faces": (13, "FLOAT_2D"),
     "record_depth": (14, "DEPTH_2D"),
     "peel_depth": (14, "DEPTH_2D"),
     "surface_image": (15, "FLOAT_2D"),
@@ -371,6 +378,8 @@ def _create_info(variant: ShaderVariant):
         for name in ("partner0", "partner2", "partner3"):
             iface.flat("VEC4", name)
         iface.flat("VEC3", "partner_window_depth")
+        if variant.ngon_siblings:
+            iface.flat("INT", "hidden_triangle")  # (its n-gon's other triangles lie beside it)
 
     info = pulling_info(push_matrices=not variant.instanced)
     if variant.instanced:
@@ -440,6 +449,11 @@ def _create_info(variant: ShaderVariant):
         if not variant.hidden_pass or variant.resolve:
             raise ValueError("only the direct hidden-line pass leaves the peeled region layers out")
         info.define("REGION_LAYERS_PEELED", "1")
+    if variant.ngon_siblings:
+        if not variant.hidden_pass or variant.resolve or variant.attribute_colors:
+            raise ValueError("only the direct hidden-line pass tests an n-gon's other triangles")
+        add_sampler(info, "triangle_faces")
+        info.define("NGON_SIBLINGS", "1")
     if variant.linear_depth:
         if variant.resolve:
             raise ValueError("the resolve pass writes no depth (the visibility pass did)")
@@ -534,6 +548,11 @@ def _visibility_create_info(variant: ShaderVariant):
         add_sampler(info, "triangle_vertices")
         add_sampler(info, "triangle_flag_table")
         _define_partner_depth_hair(info, linear_depth=True)
+        if variant.ngon_siblings:
+            add_sampler(info, "triangle_faces")
+            info.define("NGON_SIBLINGS", "1")
+    elif variant.ngon_siblings:
+        raise ValueError("only the region layers' record tests an n-gon's other triangles")
     if variant.peel_layer:
         if not variant.region_layers:
             raise ValueError("only the region layers are peeled")

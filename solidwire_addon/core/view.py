@@ -35,7 +35,7 @@ class View:
 # buffer, about 4 float32 ULPs of z/w near 1). Enough to win the tie with
 # Blender's own depth of the same surface (a few ULPs off, computed from other
 # float32 matrices); small enough that a surface more than a hair behind
-# another stays hidden. See DEPTH_BIAS in shaders/solidwire_vert.glsl; far
+# another stays hidden. See DEPTH_BIAS in shaders/edge_geometry.glsl (biased); far
 # from the world origin the overlay adds blender_depth_allowance.
 OVERLAY_DEPTH_BIAS = 2.0**-18
 
