@@ -177,7 +177,11 @@ void quad_partner_window_corners(int triangle, out vec4 a, out vec4 b, out vec4 
  * triangle is the surface. An n-gon's triangles are consecutive in the
  * triangle table (Blender's order), and the face table
  * (cache.GPUMesh.face_table) names each triangle's polygon; the walk from
- * a triangle stops at the first of another face. It goes at most
+ * a triangle stops at the first of another face. In such a mesh this
+ * takes the place of the quad test: the walk finds a quad's one other
+ * triangle too, and a listed n-gon's ear finds a "quad partner" beside it
+ * (the triangle sharing its one diagonal), which need not be the nearest.
+ * It goes at most
  * NGON_SIBLINGS_MOST triangles each way: past that (an n-gon of more
  * corners whose far triangles fold back over this one) the layer shows. */
 const int NGON_SIBLINGS_MOST = 64;

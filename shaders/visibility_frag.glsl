@@ -22,24 +22,24 @@
 float nearer_than_the_other_triangle(int triangle, float depth)
 {
   vec4 a, b, c;
-#  ifdef SW_TRIANGLE_BY_VERTEX
+  vec3 weights;
+  float partner_view_depth;
+#  ifdef NGON_SIBLINGS
+  /* Every other triangle of its face (quad_partner.glsl). */
+  vec4 clip_a, clip_b, clip_c;
+  bool covered = nearest_ngon_sibling(
+      triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, partner_view_depth);
+#  else
+#    ifdef SW_TRIANGLE_BY_VERTEX
   /* Set up once per triangle by its provoking corner (visibility_vert.glsl). */
   a = partner0;
   b = partner2;
   c = partner3;
-#  else
+#    else
   quad_partner_window_corners(triangle, a, b, c);
-#  endif
-  vec3 weights;
-  float partner_view_depth;
+#    endif
   bool covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, partner_view_depth) &&
                  nearer_or_level(partner_view_depth, view_depth);
-#  ifdef NGON_SIBLINGS
-  if (!covered && a == vec4(0.0)) { /* no quad's triangle: an n-gon's, or a triangle face */
-    vec4 clip_a, clip_b, clip_c;
-    covered = nearest_ngon_sibling(
-        triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, partner_view_depth);
-  }
 #  endif
   if (!covered) {
     return depth;

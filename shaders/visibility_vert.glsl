@@ -17,9 +17,10 @@ void main()
   /* Only the provoking (last) corner's value reaches the fragments: the
    * batch gives every triangle a last corner of its own. */
   visible_triangle = triangle;
-#  ifdef REGION_LAYERS
+#  if defined(REGION_LAYERS) && !defined(NGON_SIBLINGS)
   /* So the quad's other triangle (visibility_frag.glsl) is set up once per
-   * triangle, by that corner, not at every pixel. */
+   * triangle, by that corner, not at every pixel. (A mesh whose n-gons may
+   * fold walks its face's triangles per pixel instead.) */
   quad_partner_window_corners(int(triangle) - 1, partner0, partner2, partner3);
 #  endif
 #endif

@@ -24,6 +24,7 @@ from .extract import (
     NORMALS_BY_VERTEX,
     REGION_LINES,
     MeshArrays,
+    ngon_triangles_overlap,
     ngons_flat,
 )
 
@@ -207,6 +208,7 @@ class GPUMesh:
         self.setup_key = None
         self._flag_table = None  # flag_table(), made on first use
         self._face_table = None  # face_table(), made on first use
+        self._ngons_fold = None  # (version, ngons_may_fold())
         self._visibility = None  # (by_vertex, visibility_batch(), its bytes), made on first use, kept across moves
         self._position_rows = positions  # (N, 4), w 0: as uploaded (_local_positions, run_points)
         # What reposition() needs to tell a move of vertices from a new shape.
@@ -271,6 +273,19 @@ class GPUMesh:
             self._face_table = value_table_texture(faces.astype(np.float32))
             self.gpu_bytes += texture_bytes(self._face_table)
         return self._face_table
+
+    def ngons_may_fold(self) -> bool:
+        """Whether the triangles of some n-gon can overlap on screen at the
+        mesh's current positions (extract.ngon_triangles_overlap): where
+        they can, a hidden-line pass tests each triangle's face's other
+        triangles (shaders/quad_partner.glsl, NGON_SIBLINGS)."""
+        known = self._ngons_fold
+        if known is None or known[0] != self.version:
+            fold = self.has_ngons and ngon_triangles_overlap(
+                self._position_rows, self.triangles_cpu, self.triangle_polygons_cpu
+            )
+            known = self._ngons_fold = (self.version, fold)
+        return known[1]
 
     def ngons_flat(self) -> bool:
         """Whether every n-gon of the mesh lies in one plane at its current

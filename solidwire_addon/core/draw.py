@@ -711,7 +711,7 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False) ->
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
             ngon_diagonals=getattr(mesh, "blocks_hold_ngon_diagonals", False),
             flat_ngons_alone=diagonals_shown and getattr(mesh, "ngons_alone", False) and mesh.ngons_flat(),
-            ngons_may_fold=mesh.has_ngons and not (getattr(mesh, "ngons_alone", False) and mesh.ngons_flat()),
+            ngons_may_fold=mesh.has_ngons and mesh.ngons_may_fold(),
             own_edges=getattr(mesh, "own_edges_measured", False),
         )
         parts.setdefault(part, []).append(g)

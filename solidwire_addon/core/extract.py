@@ -530,6 +530,36 @@ def ngons_flat(positions: np.ndarray, outlines) -> bool:
     return bool((np.maximum.reduceat(distance, starts) <= 1e-6 * scale).all())
 
 
+def ngon_triangles_overlap(positions: np.ndarray, triangles: np.ndarray, triangle_polygons: np.ndarray) -> bool:
+    """Whether the triangles of some n-gon can overlap on screen: they do
+    not all face one way in one plane, so that the sum of their areas
+    exceeds the area of their sum (a face that is not flat, or a flat one
+    whose outline crosses itself, which Blender still splits into triangles
+    that lie on one another). ``triangles``: (T, >= 3) corner vertex ids in
+    Blender's order, where each polygon's triangles are consecutive;
+    ``triangle_polygons``: (T,) their polygons. An n-gon whose triangles
+    all face one way in one plane projects without folding (a plane seen
+    edge-on is no wider than rounding)."""
+    polygons = np.asarray(triangle_polygons, np.int64)
+    if not len(polygons):
+        return False
+    starts = np.flatnonzero(np.r_[True, polygons[1:] != polygons[:-1]])
+    counts = np.diff(np.r_[starts, len(polygons)])
+    ngon = counts >= 3
+    if not ngon.any():
+        return False
+    sizes = counts[ngon]
+    firsts = np.r_[0, np.cumsum(sizes)[:-1]]
+    rows = np.repeat(starts[ngon] - firsts, sizes) + np.arange(int(sizes.sum()))
+    corners = np.asarray(triangles)[rows, :3].astype(np.int64)
+    points = np.asarray(positions, np.float64)[:, :3]
+    a, b, c = points[corners[:, 0]], points[corners[:, 1]], points[corners[:, 2]]
+    area = np.cross(b - a, c - a)
+    apart = np.add.reduceat(np.linalg.norm(area, axis=1), firsts)
+    together = np.linalg.norm(np.add.reduceat(area, firsts, axis=0), axis=1)
+    return bool((apart > together * (1.0 + 1e-6) + 1e-30).any())
+
+
 def build_arrays_fast(
     positions: np.ndarray,
     corner_vert: np.ndarray,
