@@ -169,16 +169,18 @@ void leave_out_the_visible_face()
   float depth;
   vec4 a = partner0, b = partner2, c = partner3;
   vec3 window_depth_w = partner_window_depth;
-#  ifdef NGON_SIBLINGS
-  /* Every other triangle of its face (quad_partner.glsl). */
-  vec4 clip_a, clip_b, clip_c;
-  bool covered = nearest_ngon_sibling(
-      hidden_triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, depth);
-  /* (As partner_outputs sets a quad's other triangle up.) */
-  window_depth_w = 0.5 * (vec3(biased(clip_a).z, biased(clip_b).z, biased(clip_c).z) +
-                          vec3(clip_a.w, clip_b.w, clip_c.w));
-#  else
   bool covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, depth) && nearer_or_level(depth, view_depth);
+#  ifdef NGON_SIBLINGS
+  /* Every other triangle of its face (quad_partner.glsl), but for a plain
+   * quad's triangle, whose one other triangle came from the vertex stage. */
+  if ((triangle_flags & (HAS_QUAD_CORNER | IN_REGION)) != HAS_QUAD_CORNER) {
+    vec4 clip_a, clip_b, clip_c;
+    covered = nearest_ngon_sibling(
+        hidden_triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, depth);
+    /* (As partner_outputs sets a quad's other triangle up.) */
+    window_depth_w = 0.5 * (vec3(biased(clip_a).z, biased(clip_b).z, biased(clip_c).z) +
+                            vec3(clip_a.w, clip_b.w, clip_c.w));
+  }
 #  endif
   if (!covered) {
     return;
