@@ -196,7 +196,9 @@ bool is_same_face(int other, float face)
  * window point p in front of view depth `depth` (or level with it,
  * nearer_or_level): its corners
  * (quad_partner_corner), their clip positions, the weights of
- * quad_partner_covers and that view depth; false where none does. */
+ * quad_partner_covers and that view depth; false where none does.
+ * `level_before`: one of them that comes before `triangle` in the table
+ * lies level with it there (then this one is no layer of its own). */
 bool nearest_ngon_sibling(int triangle,
                           vec2 p,
                           float depth,
@@ -207,11 +209,13 @@ bool nearest_ngon_sibling(int triangle,
                           out vec4 clip_b,
                           out vec4 clip_c,
                           out vec3 weights,
-                          out float sibling_depth)
+                          out float sibling_depth,
+                          out bool level_before)
 {
   a = b = c = clip_a = clip_b = clip_c = vec4(0.0);
   weights = vec3(0.0);
   sibling_depth = 0.0;
+  level_before = false;
   bool found = false;
   float face = fetch_texel(triangle_faces, triangle).x;
   for (int step = -1; step <= 1; step += 2) {
@@ -227,7 +231,14 @@ bool nearest_ngon_sibling(int triangle,
       vec4 qc = quad_partner_corner(cc, corner_view_depth(ids.z));
       vec3 w;
       float d;
-      if (quad_partner_covers(p, qa, qb, qc, w, d) && nearer_or_level(d, depth) && (!found || d < sibling_depth)) {
+      if (!quad_partner_covers(p, qa, qb, qc, w, d) || !nearer_or_level(d, depth)) {
+        continue;
+      }
+      /* Two triangles of the face level with each other at the pixel are
+       * one layer (image model §5.4): the one later in the table leaves it
+       * to the earlier. */
+      level_before = level_before || (step < 0 && abs(d - depth) <= depth * 1.0e-5);
+      if (!found || d < sibling_depth) {
         found = true;
         sibling_depth = d;
         a = qa;

@@ -175,8 +175,12 @@ void leave_out_the_visible_face()
    * quad's triangle, whose one other triangle came from the vertex stage. */
   if ((triangle_flags & (HAS_QUAD_CORNER | IN_REGION)) != HAS_QUAD_CORNER) {
     vec4 clip_a, clip_b, clip_c;
+    bool level_before;
     covered = nearest_ngon_sibling(
-        hidden_triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, depth);
+        hidden_triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, depth, level_before);
+    if (level_before) {
+      discard;
+    }
     /* (As partner_outputs sets a quad's other triangle up.) */
     window_depth_w = 0.5 * (vec3(biased(clip_a).z, biased(clip_b).z, biased(clip_c).z) +
                             vec3(clip_a.w, clip_b.w, clip_c.w));

@@ -27,8 +27,12 @@ float nearer_than_the_other_triangle(int triangle, float depth)
 #  ifdef NGON_SIBLINGS
   /* Every other triangle of its face (quad_partner.glsl). */
   vec4 clip_a, clip_b, clip_c;
+  bool level_before;
   bool covered = nearest_ngon_sibling(
-      triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, partner_view_depth);
+      triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, partner_view_depth, level_before);
+  if (level_before) {
+    discard;
+  }
 #  else
 #    ifdef SW_TRIANGLE_BY_VERTEX
   /* Set up once per triangle by its provoking corner (visibility_vert.glsl). */

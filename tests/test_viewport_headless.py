@@ -186,6 +186,22 @@ def test_hidden_lines_stay_behind_another_blender_object(viewport):
     assert changed_bare[inner].sum() > 50, "control: without the occluder the lines are there"
 
 
+def wire_over_flat_solid(viewport, scene) -> tuple[np.ndarray, np.ndarray]:
+    """(the float64 reference's intensity, where SolidWire's green wire
+    shows over Blender's flat red Solid shading) of ``scene`` in the
+    headless viewport, Blender's overlays off."""
+    from tests.support import reference
+
+    strong = reference.render_reference(scene).intensity
+    view = viewport(scene)
+    flat_solid_shading(view.space)
+    set_overlays(view.space, overlays=False)
+    view.draw_blender()
+    view.draw_solidwire()
+    rgba = view.rgba().astype(np.float64) / 255.0
+    return strong, rgba[..., 1] - rgba[..., 0] > 0.3
+
+
 @pytest.mark.parametrize("hidden_lines", [False, True], ids=["wire", "hidden_lines"])
 @pytest.mark.parametrize("subdivisions", [0, 2], ids=["drawn_directly", "deferred"])
 @pytest.mark.parametrize("offset, most_hidden", [(2000.0, 0.001), (1e5, 0.05)], ids=["2_km", "100_km"])
@@ -204,20 +220,11 @@ def test_wire_far_from_the_origin_stays_in_front_of_blenders_depth(
     keeps her far side, which only Blender's depth hides where Suzanne is
     drawn directly, from showing its wire through her: nowhere does a line
     show where the reference has none."""
-    from tests.support import reference
-
     scene = scenes.empty_scene(WIDTH, HEIGHT, wire_color=WIRE, use_hidden_lines=hidden_lines)
     monkey = scenes.monkey(scene, location=(offset, offset, 0.0), subdivisions=subdivisions)
     scenes.add_camera(scene, location=(offset + 3.0, offset - 3.0, 1.5), target=(offset, offset, 0.0))
     monkey.select_set(False)
-    strong = reference.render_reference(scene).intensity
-    view = viewport(scene)
-    flat_solid_shading(view.space)
-    set_overlays(view.space, overlays=False)
-    view.draw_blender()
-    view.draw_solidwire()
-    rgba = view.rgba().astype(np.float64) / 255.0
-    green = rgba[..., 1] - rgba[..., 0] > 0.3  # the wire over Blender's red surface
+    strong, green = wire_over_flat_solid(viewport, scene)
     full = strong > 0.9
     assert full.sum() > 5000
     missing = int((full & ~green).sum())
@@ -235,8 +242,6 @@ def test_wire_of_a_ground_reaching_far_behind_the_camera(viewport, subdivisions)
     more than its bias wherever the near plane cuts the quads steeply, so
     the wire vanished there. Positions now keep Blender's float32 values
     (extract._centre_of): the wire shows wherever the reference has it."""
-    from tests.support import reference
-
     scene = scenes.empty_scene(WIDTH, HEIGHT, wire_color=WIRE, thickness=1.5, diagonal_mode="SOLID")
     corners = [(-1.0123457, -400.0, 0.0137), (0.9876543, -404.0, 0.00731), (1.1234567, 2.3456789, -0.0123)]
     ground = scenes.from_pydata(scene, "Ground", [*corners, (-0.9345678, 2.1234567, 0.00987)], [(0, 1, 2, 3)])
@@ -245,14 +250,7 @@ def test_wire_of_a_ground_reaching_far_behind_the_camera(viewport, subdivisions)
         modifier.subdivision_type, modifier.levels = "SIMPLE", subdivisions
     scenes.add_camera(scene, location=(0.0, 0.0, 0.05), target=(0.2, 2.0, 0.0), lens=24.0, clip=(0.01, 100.0))
     ground.select_set(False)
-    strong = reference.render_reference(scene).intensity
-    view = viewport(scene)
-    flat_solid_shading(view.space)
-    set_overlays(view.space, overlays=False)
-    view.draw_blender()
-    view.draw_solidwire()
-    rgba = view.rgba().astype(np.float64) / 255.0
-    green = rgba[..., 1] - rgba[..., 0] > 0.3
+    strong, green = wire_over_flat_solid(viewport, scene)
     full = strong > 0.9
     assert full.sum() > 200
     missing = int((full & ~green).sum())
