@@ -64,9 +64,11 @@ bool quad_partner_corners(int triangle, vec4 ids, int flags, out vec3 corners)
  * with it within float32's reach: a face that is flat but overlaps itself
  * on screen (a self-intersecting outline) has two triangles at one depth,
  * and the rasteriser's choice between them is the surface. */
+const float LEVEL_DEPTH = 1.0e-5; /* relative: far above float32's rounding of one depth */
+
 bool nearer_or_level(float other, float depth)
 {
-  return other < depth * (1.0 + 1.0e-5);
+  return other < depth * (1.0 + LEVEL_DEPTH);
 }
 
 /* The view depth of vertex `id` (as the vertex stage's own view_depth). */
@@ -237,7 +239,7 @@ bool nearest_ngon_sibling(int triangle,
       /* Two triangles of the face level with each other at the pixel are
        * one layer (image model §5.4): the one later in the table leaves it
        * to the earlier. */
-      level_before = level_before || (step < 0 && abs(d - depth) <= depth * 1.0e-5);
+      level_before = level_before || (step < 0 && abs(d - depth) <= depth * LEVEL_DEPTH);
       if (!found || d < sibling_depth) {
         found = true;
         sibling_depth = d;

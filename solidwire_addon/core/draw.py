@@ -577,7 +577,9 @@ def draw(
             ),
         )
         # (Diagonals from the settings, not the variant: every stage must part alike.)
-        parts = _parts(groups, program, stage, view, settings.diagonal_mode != "HIDDEN")
+        parts = _parts(
+            groups, program, stage, view, settings.diagonal_mode != "HIDDEN", bool(settings.use_hidden_lines)
+        )
         # One variant per part; parts in a fixed order (both deferred stages
         # must draw, and so number, alike).
         for part in sorted(parts):
@@ -682,7 +684,7 @@ class _Part:
         return part_variant
 
 
-def _parts(groups, program, stage, view: View, diagonals_shown: bool = False) -> dict:
+def _parts(groups, program, stage, view: View, diagonals_shown: bool = False, hidden_lines: bool = False) -> dict:
     """DrawGroups by _Part.
 
     Meshes with n-gons need the fragment stage's outline walk; the rest use
@@ -711,7 +713,8 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False) ->
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
             ngon_diagonals=getattr(mesh, "blocks_hold_ngon_diagonals", False),
             flat_ngons_alone=diagonals_shown and getattr(mesh, "ngons_alone", False) and mesh.ngons_flat(),
-            ngons_may_fold=mesh.has_ngons and mesh.ngons_may_fold(),
+            # (Asked only where hidden lines read it: an edit re-asks.)
+            ngons_may_fold=hidden_lines and mesh.has_ngons and mesh.ngons_may_fold(),
             own_edges=getattr(mesh, "own_edges_measured", False),
         )
         parts.setdefault(part, []).append(g)
