@@ -1,8 +1,10 @@
 """Property-based tests: random small meshes, cameras and settings, and
 random modifier stacks under cage edges. Every example renders through the
-real engine to a float EXR (the stacks also through the viewport overlay)
-and must raise nothing, hold no NaN/Inf and agree with the float64
-reference on non-silhouette pixels (p99.9 <= 2/255, max <= 0.1).
+real engine to a float EXR (the stacks, and the meshes with every line
+option, also through the viewport overlay) and must raise nothing, hold no
+NaN/Inf and agree with the float64 reference on non-silhouette pixels
+(p99.9 <= 2/255, max <= 0.1). docs/dev/robustness.md (Fuzzing) says what
+each set draws and what its hunts found.
 
 Default CI runs a fixed, derandomised set of examples; a long random hunt:
 ``SOLIDWIRE_FUZZ_EXAMPLES=500 pytest tests/test_fuzz.py`` (make fuzz).
