@@ -169,7 +169,7 @@ void leave_out_the_visible_face()
   float depth;
   vec4 a = partner0, b = partner2, c = partner3;
   vec3 window_depth_w = partner_window_depth;
-  bool covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, depth) && nearer_or_level(depth, view_depth);
+  bool covered;
 #  ifdef NGON_SIBLINGS
   /* Every other triangle of its face (quad_partner.glsl), but for a plain
    * quad's triangle, whose one other triangle came from the vertex stage. */
@@ -185,7 +185,11 @@ void leave_out_the_visible_face()
     window_depth_w = 0.5 * (vec3(biased(clip_a).z, biased(clip_b).z, biased(clip_c).z) +
                             vec3(clip_a.w, clip_b.w, clip_c.w));
   }
+  else
 #  endif
+  {
+    covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, depth) && nearer_or_level(depth, view_depth);
+  }
   if (!covered) {
     return;
   }
