@@ -59,13 +59,15 @@ bool quad_partner_corners(int triangle, vec4 ids, int flags, out vec3 corners)
   return true;
 }
 
+/* How near two depths count as level: relative, far above float32's
+ * rounding of one depth. */
+const float LEVEL_DEPTH = 1.0e-5;
+
 /* Whether the face's other triangle, at view depth `other` where it covers
  * a pixel, lies in front of this one there (view depth `depth`), or level
- * with it within float32's reach: a face that is flat but overlaps itself
- * on screen (a self-intersecting outline) has two triangles at one depth,
- * and the rasteriser's choice between them is the surface. */
-const float LEVEL_DEPTH = 1.0e-5; /* relative: far above float32's rounding of one depth */
-
+ * with it: a face that is flat but overlaps itself on screen (a
+ * self-intersecting outline) has two triangles at one depth, and the
+ * rasteriser's choice between them is the surface. */
 bool nearer_or_level(float other, float depth)
 {
   return other < depth * (1.0 + LEVEL_DEPTH);
@@ -183,15 +185,15 @@ void quad_partner_window_corners(int triangle, out vec4 a, out vec4 b, out vec4 
  * takes the place of the quad test: the walk finds a quad's one other
  * triangle too, and a listed n-gon's ear finds a "quad partner" beside it
  * (the triangle sharing its one diagonal), which need not be the nearest.
- * It goes at most
- * NGON_SIBLINGS_MOST triangles each way: past that (an n-gon of more
- * corners whose far triangles fold back over this one) the layer shows. */
+ * It goes at most NGON_SIBLINGS_MOST triangles each way: past that (an
+ * n-gon of more corners whose far triangles fold back over this one) the
+ * layer shows. */
 const int NGON_SIBLINGS_MOST = 64;
 
-bool is_same_face(int other, float face)
+/* Whether triangle `other` (of a table of `rows` texels) is of `face`. */
+bool is_same_face(int other, int rows, float face)
 {
-  ivec2 size = textureSize(triangle_faces, 0);
-  return other >= 0 && other < size.x * size.y && fetch_texel(triangle_faces, other).x == face;
+  return other >= 0 && other < rows && fetch_texel(triangle_faces, other).x == face;
 }
 
 /* Of the other triangles of `triangle`'s face, the nearest that covers
@@ -220,10 +222,12 @@ bool nearest_ngon_sibling(int triangle,
   level_before = false;
   bool found = false;
   float face = fetch_texel(triangle_faces, triangle).x;
+  ivec2 size = textureSize(triangle_faces, 0);
+  int rows = size.x * size.y;
   for (int step = -1; step <= 1; step += 2) {
     for (int k = 1; k <= NGON_SIBLINGS_MOST; k++) {
       int other = triangle + step * k;
-      if (!is_same_face(other, face)) {
+      if (!is_same_face(other, rows, face)) {
         break;
       }
       vec3 ids = fetch_texel(triangle_vertices, other).xyz;
