@@ -27,6 +27,25 @@ float projected_length(float id_a, float id_b)
   return span.y - span.x;
 }
 
+#if THICKNESS_MODE == 1
+/* The least clip w of a point of run `run`'s regions in front of the near
+ * plane: a line in world widths is as wide as the visible point it lies on
+ * is near (image model §4.2), and that point may be any point of its
+ * regions, not just of its edge. From the sphere around them
+ * (core/edge_select.py run_bounds): clip w is linear in the position, so
+ * it falls from the centre's by the radius times the length of its
+ * gradient. */
+float regions_nearest_w(int run)
+{
+  vec4 sphere = fetch_texel(run_bounds, run);
+  mat4 to_clip = object_to_clip;
+  vec4 w_row = vec4(to_clip[0][3], to_clip[1][3], to_clip[2][3], to_clip[3][3]);
+  return max(dot(w_row, vec4(sphere.xyz, 1.0)) - sphere.w * length(w_row.xyz), near_plane_w());
+}
+
+float run_nearest_w; /* regions_nearest_w of the run, set by main() */
+#endif
+
 /* What the quad of a run is built from, segment by segment. */
 struct RunBox {
   vec2 along;    /* the frame: the run's chord (or its first drawn segment) ... */
@@ -64,10 +83,13 @@ void run_segment(int texel, bool used, float half_width, inout RunBox box, out v
    * profile is 0 beyond it) and a hundredth of a pixel for rounding: every
    * sample the profile reaches lies inside the quad. */
 #if THICKNESS_MODE == 1
+  /* (The segment's own nearer end too: its regions' spheres hold it, but
+   * not through float32 rounding.) */
   float depth_a = a.z + a.w, depth_b = b.z + b.w;
   vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a, depth_b) : a;
   vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b, depth_a) : b;
-  half_width = style_half_thickness(line_style, params.world_half_thickness_px / max(min(a_front.w, b_front.w), 1e-6));
+  float nearest_w = min(min(a_front.w, b_front.w), run_nearest_w);
+  half_width = style_half_thickness(line_style, params.world_half_thickness_px / max(nearest_w, 1e-6));
 #endif
   box.reach = max(box.reach, half_width + 2.0 * params.softness + 0.01);
   vec2 dir = vec2(-line.y, line.x);
@@ -118,6 +140,9 @@ void main()
   run_length = count;
 
   float half_width = style_half_thickness(line_style, max(params.half_thickness, params.half_thickness_far));
+#if THICKNESS_MODE == 1
+  run_nearest_w = regions_nearest_w(run);
+#endif
   RunBox box = RunBox(vec2(1.0, 0.0), vec2(0.0, 1.0), vec2(1e30), vec2(-1e30), 0.0, false, false);
   /* The frame along the chord from the first segment's middle to the
    * last's: a chain's box is then as narrow as its bend (the first

@@ -240,15 +240,20 @@ def test_rows_that_do_not_apply_are_greyed_not_hidden(context):
     greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
     assert {name for name, g in greyed.items() if g} == {"world_thickness"}
 
-    # World-space width: the pixel widths do not apply, the world width does.
+    # World-space width: the pixel widths do not apply, the world width
+    # does; Thickness stays live while a class is on, since each class's
+    # width keeps its ratio to it (image model §3.6).
     props.thickness_mode = "WORLD"
     greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
     assert {name for name, g in greyed.items() if g} == {
-        "thickness",
         "thickness_far",
         "thickness_depth_start",
         "thickness_depth_end",
     }
+    for name, *_rest in schema.EDGE_CLASS_STYLES:
+        setattr(props, f"use_{name}_edges", False)
+    greyed = draw_with(ui.VIEW3D_PT_solidwire.draw, context).greyed_props()
+    assert greyed["thickness"] and not greyed["world_thickness"]
     props.use_hidden_lines, props.thickness_mode = False, "PIXELS"
     props.use_density_fade = False
     for name, *_rest in schema.EDGE_CLASS_STYLES:

@@ -16,7 +16,7 @@ import time
 import gpu
 import numpy as np
 
-from .edge_select import TEXELS_PER_REGION_LINE
+from .edge_select import TEXELS_PER_REGION_LINE, region_listing, run_bounds
 from .extract import (
     IN_REGION,
     IS_NGON,
@@ -24,6 +24,7 @@ from .extract import (
     NORMALS_BY_VERTEX,
     REGION_LINES,
     MeshArrays,
+    boxes_of_triangle_runs,
     ngon_triangles_overlap,
     ngons_flat,
 )
@@ -195,6 +196,8 @@ class GPUMesh:
         self.reads_region_line_image = every_triangle_region_lines or bool(np.any(flags & REGION_LINES))
         self._triangle_regions_cpu = arrays.triangle_regions
         self._region_tables = None
+        self._run_bounds = None  # (version, run_bounds_table()), made on first use after each move
+        self._region_listing = None  # edge_select.region_listing, made with the first run_bounds_table()
         self._region_sizes = None  # (region lines, region_sizes()), made on first use
         self._run_vertices = None  # run_points(), made on first use
         self._block_boxes = None  # (version, low, high) of triangle_block_corners(), made on first use
@@ -348,6 +351,24 @@ class GPUMesh:
             self.gpu_bytes += sum(texture_bytes(t) for t in self._region_tables)
         return self._region_tables
 
+    def run_bounds_table(self):
+        """The sphere around each region-lines run's regions at the mesh's
+        current positions (edge_select.run_bounds) as an RGBA32F table,
+        a texel per run: what sizes the region-lines pass's quads in world
+        widths. Made on first use after each move (a move of any vertex
+        can change any sphere)."""
+        known = self._run_bounds
+        if known is None or known[0] != self.version:
+            if self._region_listing is None:
+                self._region_listing = region_listing(self._triangle_regions_cpu, self._corner_vertices())
+            bounds = run_bounds(
+                self._region_listing, self._position_rows, self._region_lines_cpu, self._region_line_runs_cpu
+            )
+            texture = table_texture(bounds)
+            self.gpu_bytes += texture_bytes(texture) - (0 if known is None else texture_bytes(known[1]))
+            known = self._run_bounds = (self.version, texture)
+        return known[1]
+
     @property
     def _local_positions(self) -> np.ndarray:
         """(N, 3) mesh-space positions as uploaded (a view)."""
@@ -431,16 +452,7 @@ class GPUMesh:
         if corner_vertices is None:
             corner_vertices = _corner_vertex_rows(self.triangles_cpu)
         starts = np.arange(0, self.triangle_count, RECORD_BLOCK_TRIANGLES)
-        low = np.empty((len(starts), 3), np.float32)
-        high = np.empty((len(starts), 3), np.float32)
-        for axis in range(3 if len(starts) else 0):
-            # (Gathers from a contiguous copy of the column: numpy would
-            # copy the strided column for every gather anyway.)
-            column = np.ascontiguousarray(self._position_rows[:, axis])
-            values = [column.take(vertices) for vertices in corner_vertices]
-            low[:, axis] = np.minimum.reduce([np.minimum.reduceat(v, starts) for v in values])
-            high[:, axis] = np.maximum.reduce([np.maximum.reduceat(v, starts) for v in values])
-        return low, high
+        return boxes_of_triangle_runs(self._position_rows, corner_vertices, starts)
 
     def _measure_blocks_again(self, moved: np.ndarray, low: np.ndarray, high: np.ndarray) -> None:
         """Measure again, in place, the blocks of ``low`` / ``high`` that

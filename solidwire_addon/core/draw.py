@@ -798,6 +798,8 @@ def bind_display_transform(shader, display) -> None:
 
 def _bind_mesh(shader, variant, mesh) -> None:
     shader.uniform_sampler("vertex_positions", mesh.positions)
+    if variant.region_lines_pass and variant.thickness_mode == shaders.THICKNESS_WORLD and mesh.region_run_count:
+        shader.uniform_sampler("run_bounds", mesh.run_bounds_table())  # (a mesh with no run draws no quad)
     if variant.visibility:
         if variant.region_layers:
             shader.uniform_sampler("triangle_regions", mesh.region_tables()[1])

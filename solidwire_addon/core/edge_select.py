@@ -48,6 +48,7 @@ from .extract import (
     NGON_SHIFT,
     REGION_LINES,
     MeshArrays,
+    boxes_of_triangle_runs,
     distinct,
 )
 
@@ -1379,6 +1380,73 @@ def _write_region_lines(
     arrays.region_lines = table
     arrays.region_line_runs, arrays.region_run_segments = _line_runs(edge_ends, style, region, partner)
     stats.region_lines = len(edge)
+
+
+@dataclass
+class RegionListing:
+    """The triangles of the regions whose lines the region-lines pass
+    draws, region by region: fixed with the topology (cache.GPUMesh keeps
+    it), so that measuring every region after a move is a gather and a
+    reduction (run_bounds)."""
+
+    corner_vertices: np.ndarray  # (3, K) intp: the corners of the listed triangles, region by region
+    starts: np.ndarray  # (R,) where each region's triangles start among them
+    names: np.ndarray  # (R,) each region's name as the tables name it, ascending
+
+
+def region_listing(triangle_regions: np.ndarray, corner_vertices: np.ndarray) -> RegionListing:
+    """The RegionListing of ``triangle_regions`` (T,) (each triangle's
+    region name, NO_REGION for none), ``corner_vertices`` (3, T) intp each
+    triangle's corners. A cage look lists every triangle region by region
+    already: its listing is ``corner_vertices`` itself."""
+    values = np.asarray(triangle_regions)
+    listed = values != NO_REGION
+    at = None if listed.all() else np.flatnonzero(listed)
+    names = values if at is None else values[at]
+    if len(names) > 1 and np.any(names[1:] < names[:-1]):
+        order = np.argsort(names, kind="stable")
+        at = order if at is None else at[order]
+        names = names[order]
+    corners = corner_vertices if at is None else corner_vertices.take(at, axis=1)
+    starts = np.flatnonzero(np.diff(names, prepend=names[0] - 1)) if len(names) else np.zeros(0, np.intp)
+    return RegionListing(corners, starts, names[starts])
+
+
+def run_bounds(listing: RegionListing, positions: np.ndarray, region_lines, region_line_runs) -> np.ndarray:
+    """(R, 4) float32: for each run of the region-lines table
+    (``region_lines``, ``region_line_runs``) a sphere (centre x, y, z,
+    radius) holding every triangle of the run's one or two regions at
+    ``positions`` ((N, >= 3) as uploaded; the regions as ``listing`` lists
+    them).
+
+    In world widths (image model §4.2) a line is as wide as the visible
+    point it lies on is near, and that point can be any point of the
+    line's regions, much nearer the camera than the line's own edge. The
+    region-lines pass sizes each run's quad by the nearest clip w its
+    sphere reaches in the current view (shaders/region_lines_vert.glsl),
+    so that no sample the line reaches lies outside the quad. The centre
+    is rounded to float32 before the radius is measured, which is then
+    rounded up: the float32 sphere holds the regions."""
+    first = TEXELS_PER_REGION_LINE * np.asarray(region_line_runs)[:, 0].astype(np.intp)
+    bounds = np.zeros((len(first), 4), np.float32)
+    names = listing.names
+    if not len(names):  # (no triangle in a region: no line shows)
+        return bounds
+    low, high = boxes_of_triangle_runs(positions, listing.corner_vertices, listing.starts)
+    run_low = np.full((len(first), 3), np.inf)
+    run_high = np.full((len(first), 3), -np.inf)
+    for side in (region_lines[first, 3], region_lines[first + 1, 2]):  # (the entry's region, its partner)
+        row = np.minimum(np.searchsorted(names, side), len(names) - 1)
+        known = ((side != NO_REGION) & (names[row] == side))[:, None]
+        np.minimum(run_low, np.where(known, low[row], np.inf), out=run_low)
+        np.maximum(run_high, np.where(known, high[row], -np.inf), out=run_high)
+    found = np.isfinite(run_low).all(axis=1)
+    centre = (0.5 * (run_low[found] + run_high[found])).astype(np.float32)
+    reach = np.maximum(run_high[found] - centre, centre - run_low[found])
+    radius = np.sqrt((reach * reach).sum(axis=1)).astype(np.float32)
+    bounds[found, :3] = centre
+    bounds[found, 3] = np.nextafter(radius, np.float32(np.inf))
+    return bounds
 
 
 def _line_runs(chain_ends: np.ndarray, style: np.ndarray, region: np.ndarray, partner: np.ndarray):

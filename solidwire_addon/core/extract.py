@@ -796,6 +796,23 @@ def reposition(
     return local, centre, bounds_min, bounds_max, positions
 
 
+def boxes_of_triangle_runs(positions: np.ndarray, corner_vertices: np.ndarray, starts: np.ndarray):
+    """(low, high) (R, 3) float32: the box of the corners of each run of
+    consecutive triangles, ``corner_vertices`` (3, T) intp a contiguous row
+    per corner, the runs starting at ``starts`` (ascending, from 0), at
+    ``positions`` (N, >= 3)."""
+    low = np.empty((len(starts), 3), np.float32)
+    high = np.empty((len(starts), 3), np.float32)
+    for axis in range(3 if len(starts) else 0):
+        # (Gathers from a contiguous copy of the column: numpy would copy
+        # the strided column for every gather anyway.)
+        column = np.ascontiguousarray(positions[:, axis])
+        values = [column.take(vertices) for vertices in corner_vertices]
+        low[:, axis] = np.minimum.reduce([np.minimum.reduceat(v, starts) for v in values])
+        high[:, axis] = np.maximum.reduce([np.maximum.reduceat(v, starts) for v in values])
+    return low, high
+
+
 def distinct(keys: np.ndarray) -> np.ndarray:
     """np.unique(keys) by a stable sort: timsort finds the ascending runs
     already there, and keys grouped by face or region mostly ascend (a

@@ -196,6 +196,11 @@ LINE_PATTERNS = (
 PATTERN_DUTY = {"SOLID": 1.0, "DOTTED": 0.25, "DASHED": 0.5}
 
 
+def _classes_on(props) -> bool:
+    """Whether some edge class is switched on in ``props``."""
+    return any(getattr(props, f"use_{edge_class[0]}_edges", False) for edge_class in EDGE_CLASS_STYLES)
+
+
 def edge_class_settings(name, label, what, color, width, pattern) -> tuple:
     """The four settings of one edge class: on/off, colour, width, pattern."""
     active = lambda p, flag=f"use_{name}_edges": getattr(p, flag)
@@ -228,7 +233,8 @@ def edge_class_settings(name, label, what, color, width, pattern) -> tuple:
             FLOAT,
             width,
             "Thickness",
-            f"Core width of {what}, in pixels (in every thickness mode)",
+            f"Core width of {what} in pixels, beside the wire's Thickness: every thickness mode and an "
+            "object's own Thickness keep that ratio to the wire",
             minimum=0.0,
             maximum=1000.0,
             soft_max=20.0,
@@ -283,13 +289,15 @@ SETTINGS: tuple[Setting, ...] = (
         FLOAT,
         1.5,
         "Thickness",
-        "Full width of an interior edge's opaque core, in pixels",
+        "Full width of an interior edge's opaque core, in pixels (World mode: what the edge classes' "
+        "widths are measured against)",
         minimum=0.0,
         maximum=1000.0,
         soft_max=20.0,
         subtype="PIXEL",
         section="line",
-        active_if=lambda p: p.thickness_mode != "WORLD",
+        # (In World mode it still sets the ratio of each class's width to the wire's.)
+        active_if=lambda p: p.thickness_mode != "WORLD" or _classes_on(p),
         param=Param("half_thickness", _half),
     ),
     Setting(

@@ -264,8 +264,10 @@ def uses_uniform(shader, name: str) -> bool:
 # never declared in one program: a mesh table and the fin / strand tables
 # (slot 1), the outline table, the region-lines table and the scene depth
 # (2), the instanced and per-object item tables (3), the corner table and
-# the per-triangle regions (4), the attribute colours and the per-triangle
-# faces (13: a hidden-line pass draws no attribute colour).
+# the per-triangle regions (4), the matcap and the region-lines runs'
+# bounds (6: the region-lines pass shades nothing), the attribute colours
+# and the per-triangle faces (13: a hidden-line pass draws no attribute
+# colour).
 SAMPLERS = {
     "vertex_positions": (0, "FLOAT_2D"),
     "triangle_vertices": (1, "FLOAT_2D"),
@@ -280,6 +282,7 @@ SAMPLERS = {
     "triangle_regions": (4, "FLOAT_2D"),
     "item_colors": (5, "FLOAT_2D"),
     "matcap_image": (6, "FLOAT_2D"),
+    "run_bounds": (6, "FLOAT_2D"),
     "triangle_material": (7, "FLOAT_2D"),
     "display_lut": (8, "FLOAT_3D"),
     "setup_table": (9, "FLOAT_2D"),
@@ -613,6 +616,8 @@ def _region_lines_create_info(variant: ShaderVariant):
     add_sampler(info, "region_lines")
     add_sampler(info, "triangle_regions")
     add_sampler(info, "visibility")
+    if variant.thickness_mode == THICKNESS_WORLD:  # (quads sized by their regions' nearest point)
+        add_sampler(info, "run_bounds")
     info.push_constant("INT", "draw_number")
     info.push_constant("INT", "line_first")
     info.push_constant("INT", "line_count")

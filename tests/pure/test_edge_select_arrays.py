@@ -1,13 +1,15 @@
 """Edge selection on plain arrays, without Blender (image model
 §3.4-§3.6): which edges a region walks, its block and its lines (a region
 past the walk limit included), the segments of an edge of several classes,
-the ends of a chain, the runs of the region-lines pass.
+the ends of a chain, the runs of the region-lines pass and the spheres
+around their regions.
 (tests/test_edge_selection.py renders the same rules against the float64
 reference.)"""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from solidwire_addon.core import edge_select, extract
 
@@ -484,3 +486,42 @@ def test_rows_of_triangles_and_quads_are_marked_as_the_general_path_marks_them(m
         assert hidden.any() and not hidden.all()
     assert taken == [True, False] * trials
     assert 0 < np.mean(flips) < 0.5  # quads split along either diagonal
+
+
+@pytest.mark.parametrize("listing", ["scattered", "region by region"])
+def test_each_runs_sphere_holds_every_triangle_of_its_regions(listing):
+    """edge_select.run_bounds: the sphere of each run of region lines holds
+    every corner of the triangles of the run's one or two regions (named
+    as the tables name them: faces measuring their own edges below
+    NO_REGION) as float32 stores it, and is no larger than the box of those
+    corners needs; with triangles scattered, some in no region, and with
+    every triangle listed region by region (a cage look)."""
+    rng = np.random.default_rng(7)
+    positions = np.zeros((400, 4), np.float32)
+    positions[:, :3] = rng.normal(size=(400, 3)) * np.array([3.0, 0.5, 80.0]) + np.array([1e3, -20.0, 0.0])
+    triangles = rng.integers(0, 400, size=(300, 4)).astype(np.int32)
+    label = rng.integers(0, 9, size=300)
+    names = np.where(label % 3 == 0, edge_select.OWN_REGION_BASE - label, label).astype(np.float32)
+    if listing == "scattered":
+        names[rng.random(300) < 0.2] = edge_select.NO_REGION
+    else:
+        names.sort()
+    carried = sorted(set(names[names != edge_select.NO_REGION].tolist()))
+    # Runs of one entry each: every pair of regions, and each with none.
+    pairs = [(a, b) for a in carried for b in carried if a < b] + [(a, edge_select.NO_REGION) for a in carried]
+    lines = np.zeros((2 * len(pairs), 4), np.float32)
+    lines[0::2, 3] = [a for a, _ in pairs]
+    lines[1::2, 2] = [b for _, b in pairs]
+    runs = np.zeros((len(pairs), 4), np.float32)
+    runs[:, 0], runs[:, 1] = np.arange(len(pairs)), 1
+    corner_vertices = np.ascontiguousarray(triangles[:, :3].T, dtype=np.intp)
+    listing = edge_select.region_listing(names, corner_vertices)
+    bounds = edge_select.run_bounds(listing, positions, lines, runs)
+    assert bounds.shape == (len(pairs), 4) and bounds.dtype == np.float32
+    for (a, b), sphere in zip(pairs, bounds):
+        of_run = (names == a) | ((names == b) & (b != edge_select.NO_REGION))
+        corners = positions[triangles[of_run, :3].ravel(), :3].astype(np.float64)
+        centre, radius = sphere[:3].astype(np.float64), float(sphere[3])
+        assert np.linalg.norm(corners - centre, axis=1).max() <= radius
+        half_diagonal = 0.5 * np.linalg.norm(corners.max(axis=0) - corners.min(axis=0))
+        assert radius <= half_diagonal * (1.0 + 1e-5) + 1e-3
