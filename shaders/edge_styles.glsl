@@ -17,8 +17,8 @@ float style_half_thickness(int style, float wire_half_thickness)
   }
   float own = style_own_half_thickness(style);
 #  if THICKNESS_MODE != 0
-  if (params.half_thickness > 0.0) {
-    own *= wire_half_thickness / params.half_thickness;
+  if (params.class_width_scale > 0.0) {
+    own *= wire_half_thickness * params.class_width_scale;
   }
 #  endif
   return own;

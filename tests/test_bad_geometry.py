@@ -252,6 +252,25 @@ def test_a_face_with_a_nan_corner_is_dropped_whole():
     assert np.isfinite(arrays.positions).all() and np.isfinite(arrays.centre).all()
 
 
+@pytest.mark.parametrize("bad", [-INF, INF], ids=["-inf", "inf"])
+def test_an_edge_beside_a_dropped_face_stays_drawn_under_the_edge_angle(bad, output_dir):
+    """A dropped face has no normal (image model §2.1, §3.4), whatever
+    Blender gives it (+Z for a triangle with an infinite corner): under an
+    edge angle the edge it shares with a drawn quad stays drawn, and no
+    region joins the quad to it. Before, the quad lying flat under +Z lost
+    that edge and drew the dropped face's other edges across itself
+    instead (a random-mesh test: 110 pixels up to 1.0)."""
+    scene = scenes.empty_scene(W, H, edge_angle=math.radians(30.0), thickness=1.5)
+    verts = [(-1.0, -0.8, 0.0), (0.6, -0.8, 0.0), (0.6, 0.8, 0.0), (-1.0, 0.8, 0.0), (bad, 0.2, 0.0)]
+    _mesh_object(scene, "Dropped", verts, [], [(0, 1, 2, 3), (1, 4, 2)], (0.0, 0.0, 0.0))
+    scenes.add_camera(scene, location=(0.3, -1.0, 4.0), target=(0, 0, 0))
+    report = accuracy.measure(scene, f"dropped_face_beside_edge_angle_{'minus' if bad < 0 else 'plus'}_inf", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    x_right = np.flatnonzero((ref.intensity > 0.9).any(axis=0)).max()
+    assert x_right > W // 2, "the quad's right edge, shared with the dropped face, is drawn"
+
+
 def test_degenerate_triangles_are_counted():
     arrays = extract.build_arrays(
         positions=np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0)], np.float32),

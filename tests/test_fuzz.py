@@ -256,9 +256,8 @@ def mark_edges(mesh, marked: int):
 @given(mesh=polygons(), camera=cameras(), line=rich_settings(), transform=transforms())
 def test_random_meshes_with_every_line_option_match_reference(mesh, camera, line, transform, tmp_path_factory):
     """Random meshes under every line option at once. A long hunt also
-    reports the differences image model §4.2 (world widths of region lines)
-    and §5.4 (folded faces' own hidden layers) name as SolidWire's own;
-    anything else it finds is new."""
+    reports the difference image model §5.4 (an n-gon folded three deep)
+    names as SolidWire's own; anything else it finds is new."""
     line = dict(line)
     marked = line.pop("marked")
     log.forget()

@@ -11,7 +11,7 @@ import pytest
 
 from solidwire_addon.blender.views import camera_view
 from solidwire_addon.core import overlay_state
-from tests.support import accuracy, scenes
+from tests.support import accuracy, reference, scenes
 
 
 def _classed_cube(scene, name="Cube", **kwargs):
@@ -44,6 +44,32 @@ def test_class_widths_follow_the_wire(mode, override, output_dir):
     scenes.add_camera(scene, location=(3.5, -5.0, 2.8), target=(0, 0.6, 0))
     report = accuracy.measure(scene, f"class_width_{mode.lower()}_{'override' if override else 'scene'}", output_dir)
     accuracy.assert_accurate(report)
+
+
+@pytest.mark.parametrize("thickness", [1e-30, 1.1754943508222875e-38])
+def test_a_class_beside_a_vanishing_thickness(thickness, output_dir):
+    """In World widths a class is T_k / T times the wire's width: beside a
+    Thickness of 1e-30 or float32's smallest normal number it covers the
+    faces it bounds. The ratio is taken in float64 (2 / T is still a
+    float32 there), not on a GPU, which reads half that Thickness as a
+    denormal and flushes it to 0, and then drew the class at its own pixel
+    width (a random-mesh test found 467 pixels up to 1.0 too dark)."""
+    scene = scenes.empty_scene(
+        120,
+        90,
+        thickness=thickness,
+        use_sharp_edges=True,
+        sharp_thickness=2.0,
+        sharp_pattern="DASHED",
+        thickness_mode="WORLD",
+        world_thickness=0.002,
+    )
+    _classed_cube(scene)
+    scenes.add_camera(scene, location=(3.5, -5.0, 2.8), target=(0, 0, 0))
+    report = accuracy.measure(scene, f"class_width_beside_thickness_{thickness:.0e}", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    assert (ref.intensity > 0.99).sum() > 0.2 * (ref.face >= 0).sum()  # the dashes cross whole faces
 
 
 def test_an_override_thickness_takes_the_ui_scale(output_dir):

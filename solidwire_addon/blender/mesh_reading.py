@@ -384,8 +384,12 @@ def apply_edge_selection(
     joined = None
     if selection.edge_angle > 0.0:
         # Beside a mask only its edges can be hidden by the angle: only they are tested.
+        normals = read_face_normals(mesh)
+        if arrays.dropped_triangles:
+            positions = arrays.source_positions if arrays.source_positions is not None else read_positions(mesh)
+            normals = extract.without_dropped_faces(normals, positions, corner_vert, face_offsets[:-1])
         state = edge_select.EdgeAngleState(
-            corner_edge, face_offsets, read_face_normals(mesh), len(verts), selection.edge_angle, candidates=drawn
+            corner_edge, face_offsets, normals, len(verts), selection.edge_angle, candidates=drawn
         )
         arrays.edge_angle_state = state  # a move of vertices is checked against it
         drawn = ~state.flat if drawn is None else drawn & ~state.flat

@@ -367,6 +367,19 @@ def _finite_faces(finite_vertex: np.ndarray, corner_vert: np.ndarray, loop_start
     return ok
 
 
+def without_dropped_faces(face_normals: np.ndarray, positions: np.ndarray, corner_vert, face_starts) -> np.ndarray:
+    """``face_normals`` (F, 3) with NaN rows for the faces with a
+    non-finite corner: such a face is not drawn (image model §2.1), so it
+    has no normal, and the edge angle hides no edge beside it (§3.4).
+    ``face_normals`` itself where every vertex is finite."""
+    finite_vertex = _finite_vertices(positions)
+    if finite_vertex is None:
+        return face_normals
+    normals = np.array(face_normals, np.float32)
+    normals[~_finite_faces(finite_vertex, np.asarray(corner_vert), np.asarray(face_starts))] = np.nan
+    return normals
+
+
 def _degenerate_count(triangles: np.ndarray) -> int:
     """Triangles that use one vertex twice (corrupt faces such as (0, 1, 1, 2))."""
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]

@@ -78,6 +78,13 @@ def clip_end_of(projection) -> float:
     return far if math.isfinite(far) and far > 0.0 else 1.0e30
 
 
+def _class_width_scale(thickness: float) -> float:
+    """schema.VIEW_PARAMS' class_width_scale: 1 / (thickness / 2)."""
+    if not thickness > 0.0:
+        return 0.0
+    return min(2.0 / thickness, float(np.finfo(np.float32).max))
+
+
 def pack_params(settings, viewport, projection=None, blender_depth_allowance=(0.0,) * 4) -> bytes:
     """The std140 parameter block (layout: schema.PARAM_BLOCK).
 
@@ -90,6 +97,7 @@ def pack_params(settings, viewport, projection=None, blender_depth_allowance=(0.
     view_values = {
         "viewport": tuple(float(v) for v in viewport),
         "world_half_thickness_px": 0.5 * max(float(settings.world_thickness), 0.0) * px_per_unit,
+        "class_width_scale": _class_width_scale(float(settings.thickness)),
         "inv_clip_end": 0.0 if projection is None else 1.0 / clip_end_of(projection),
         "depth_rows": (0.0,) * 4 if projection is None else depth_rows(projection),
         "blender_depth_allowance": tuple(float(v) for v in blender_depth_allowance),

@@ -168,13 +168,16 @@ def _corner_colors(mesh, tri_loops, tri_vertices) -> np.ndarray:
     return values[index]
 
 
-def _flat_edges(mesh, loop_poly, real_a, real_b, angle) -> set:
-    """{(lo, hi)} vertex pairs of the edges that the edge angle hides."""
+def _flat_edges(mesh, loop_poly, real_a, real_b, angle, poly_ok) -> set:
+    """{(lo, hi)} vertex pairs of the edges that the edge angle hides. A
+    dropped face (``poly_ok`` False: a non-finite corner, §2.1) has no
+    normal: no edge beside it is hidden by the angle."""
     if not angle > 0.0:
         return set()
     normals = np.empty(len(mesh.polygons) * 3, np.float32)
     mesh.polygon_normals.foreach_get("vector", normals)
     normals = normals.reshape(-1, 3).astype(np.float64)
+    normals[~poly_ok] = np.nan
     faces: dict = {}
     for f, a, b in zip(loop_poly.tolist(), real_a.tolist(), real_b.tolist()):
         faces.setdefault((min(a, b), max(a, b)), []).append(f)
@@ -630,7 +633,7 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             # hides edges between coplanar faces (the angle rule at a tiny
             # angle, for these types only).
             angle = max(angle, COPLANAR_ANGLE)
-        not_drawn = _flat_edges(mesh, loop_poly, real_a, real_b, angle)
+        not_drawn = _flat_edges(mesh, loop_poly, real_a, real_b, angle, poly_ok)
         cage = None if tessellated else cage_masks.get(source.name)  # (§3.9: no cage of their own)
         sel = _edge_selection(obj, mesh, s, npoly, total, loop_poly, not_drawn, cage)
         sil = [(a, b, th) for (a, b), th in half_edges.items() if len(th) <= 2 and (a, b) not in sel["hidden"]]
