@@ -14,7 +14,9 @@
  * region has its block's start there instead, and finds the other triangle
  * beside it in the triangle table: the one that also has its diagonal (its
  * one edge that is no polygon edge, which no other face has). An n-gon's
- * triangles have none. */
+ * triangles have none. The corners come in the face's winding (the other
+ * triangle runs along the shared diagonal the other way), as
+ * culled_partner needs. */
 bool quad_partner_corners(int triangle, vec4 ids, int flags, out vec3 corners)
 {
   corners = ids.xzw;
@@ -55,8 +57,21 @@ bool quad_partner_corners(int triangle, vec4 ids, int flags, out vec3 corners)
   if (fourth < 0.0) {
     return false;
   }
-  corners = vec3(diagonal, fourth);
+  corners = vec3(diagonal.y, diagonal.x, fourth);
   return true;
+}
+
+/* Whether the other triangle (corners a, b, c of quad_partner_corner, in
+ * the face's winding) is culled: with back faces culled a triangle seen
+ * from behind is no surface (image model §2.3) and hides nothing, so a
+ * folded face's triangle behind the surface is a layer of its own there.
+ * The sign of det[h_a; h_b; h_c] is its window orientation (also for a
+ * triangle through the near plane, for the part in front of the eye), and
+ * `drawn_front` (gl_FrontFacing of the triangle being drawn, which the
+ * culling kept) the orientation the culling keeps. */
+bool culled_partner(vec4 a, vec4 b, vec4 c, bool drawn_front)
+{
+  return params.backface_culling != 0.0 && (dot(a.xyz, cross(b.xyz, c.xyz)) > 0.0) != drawn_front;
 }
 
 /* How near two depths count as level: relative, far above float32's
@@ -202,10 +217,12 @@ bool is_same_face(int other, int rows, float face)
  * (quad_partner_corner), their clip positions, the weights of
  * quad_partner_covers and that view depth; false where none does.
  * `level_before`: one of them that comes before `triangle` in the table
- * lies level with it there (then this one is no layer of its own). */
+ * lies level with it there (then this one is no layer of its own).
+ * `drawn_front`: as culled_partner's (a culled one covers nothing). */
 bool nearest_ngon_sibling(int triangle,
                           vec2 p,
                           float depth,
+                          bool drawn_front,
                           out vec4 a,
                           out vec4 b,
                           out vec4 c,
@@ -237,7 +254,8 @@ bool nearest_ngon_sibling(int triangle,
       vec4 qc = quad_partner_corner(cc, corner_view_depth(ids.z));
       vec3 w;
       float d;
-      if (!quad_partner_covers(p, qa, qb, qc, w, d) || !nearer_or_level(d, depth)) {
+      if (!quad_partner_covers(p, qa, qb, qc, w, d) || !nearer_or_level(d, depth) ||
+          culled_partner(qa, qb, qc, drawn_front)) {
         continue;
       }
       /* Two triangles of the face level with each other at the pixel are

@@ -176,8 +176,8 @@ void leave_out_the_visible_face()
   if ((triangle_flags & (HAS_QUAD_CORNER | IN_REGION)) != HAS_QUAD_CORNER) {
     vec4 clip_a, clip_b, clip_c;
     bool level_before;
-    covered = nearest_ngon_sibling(
-        hidden_triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, depth, level_before);
+    covered = nearest_ngon_sibling(hidden_triangle, gl_FragCoord.xy, view_depth, gl_FrontFacing, a, b, c, clip_a,
+                                   clip_b, clip_c, weights, depth, level_before);
     if (level_before) {
       discard;
     }
@@ -188,7 +188,8 @@ void leave_out_the_visible_face()
   else
 #  endif
   {
-    covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, depth) && nearer_or_level(depth, view_depth);
+    covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, depth) && nearer_or_level(depth, view_depth) &&
+              !culled_partner(a, b, c, gl_FrontFacing);
   }
   if (!covered) {
     return;

@@ -28,8 +28,8 @@ float nearer_than_the_other_triangle(int triangle, float depth)
   /* Every other triangle of its face (quad_partner.glsl). */
   vec4 clip_a, clip_b, clip_c;
   bool level_before;
-  bool covered = nearest_ngon_sibling(
-      triangle, gl_FragCoord.xy, view_depth, a, b, c, clip_a, clip_b, clip_c, weights, partner_view_depth, level_before);
+  bool covered = nearest_ngon_sibling(triangle, gl_FragCoord.xy, view_depth, gl_FrontFacing, a, b, c, clip_a, clip_b,
+                                      clip_c, weights, partner_view_depth, level_before);
   if (level_before) {
     discard;
   }
@@ -43,7 +43,7 @@ float nearer_than_the_other_triangle(int triangle, float depth)
   quad_partner_window_corners(triangle, a, b, c);
 #    endif
   bool covered = quad_partner_covers(gl_FragCoord.xy, a, b, c, weights, partner_view_depth) &&
-                 nearer_or_level(partner_view_depth, view_depth);
+                 nearer_or_level(partner_view_depth, view_depth) && !culled_partner(a, b, c, gl_FrontFacing);
 #  endif
   if (!covered) {
     return depth;

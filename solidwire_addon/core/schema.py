@@ -684,6 +684,8 @@ SETTINGS: tuple[Setting, ...] = (
         "Faces seen from behind neither draw nor hide what is behind them",
         section="culling",
         cli="--backface-culling",
+        # (The hidden-line passes ask whether a folded face's other triangle is culled: quad_partner.glsl.)
+        param=Param("backface_culling", float),
     ),
     # -- viewport overlay only (the render draws every renderable mesh) --------
     Setting(
