@@ -1330,6 +1330,21 @@ def test_diagonals_of_a_folded_ngon(diagonals, output_dir):
     accuracy.assert_accurate(report)
 
 
+@pytest.mark.parametrize("diagonals", ["SOLID", "DASHED"])
+def test_diagonals_of_a_flat_ngon_whose_outline_crosses_itself(diagonals, output_dir):
+    """A flat hexagon whose outline crosses itself (found by the fuzz):
+    Blender's triangles of it lie on one another on screen as a folded
+    face's do, so its diagonals are walked although it is flat
+    (extract.ngon_triangles_overlap). Taking each triangle's own missed
+    lines over whole diagonals (381 pixels up to 1.0 here)."""
+    scene = scenes.empty_scene(160, 120, thickness=1.5, diagonal_mode=diagonals)
+    outline = [(0.0, 0.0), (-1.46, 1.43), (0.0, -0.87), (0.0, -1.81), (-1.14, -1.96), (-0.43, 0.0)]
+    scenes.from_pydata(scene, "Crossed", [(x, y, 0.0) for x, y in outline], [tuple(range(6))], location=(0.6, 0.2, 0.0))
+    scenes.add_camera(scene, location=(0.3, -0.9, 4.5), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, f"regions_crossed_ngon_{diagonals.lower()}", output_dir)
+    accuracy.assert_accurate(report)
+
+
 def test_a_moved_ngon_is_asked_again_whether_it_is_flat(output_dir):
     """A cap corner lifted out of the cap's plane moves the mesh without
     extracting it again, and the cap, no longer flat, walks its diagonals

@@ -712,7 +712,12 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False, hi
             run_segments=getattr(mesh, "region_run_segments", 1),
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
             ngon_diagonals=getattr(mesh, "blocks_hold_ngon_diagonals", False),
-            flat_ngons_alone=diagonals_shown and getattr(mesh, "ngons_alone", False) and mesh.ngons_flat(),
+            # (Flat alone is not enough: a flat outline that crosses itself
+            # has triangles lying on one another, as a folded one has.)
+            flat_ngons_alone=diagonals_shown
+            and getattr(mesh, "ngons_alone", False)
+            and mesh.ngons_flat()
+            and not mesh.ngons_may_fold(),
             # (Asked only where hidden lines read it: an edit re-asks.)
             ngons_may_fold=hidden_lines and mesh.has_ngons and mesh.ngons_may_fold(),
             own_edges=getattr(mesh, "own_edges_measured", False),

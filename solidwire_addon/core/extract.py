@@ -520,8 +520,9 @@ def ngons_flat(positions: np.ndarray, outlines) -> bool:
     within a millionth of the n-gon's size and distance from the origin of
     the plane through its centroid normal to its Newell normal. The
     projection of such a face folds nowhere (only a plane seen edge-on,
-    where it is no wider than that rounding), so its triangles' windows
-    never overlap. A face with no area is not flat."""
+    where it is no wider than that rounding); its triangles' windows still
+    overlap where its outline crosses itself (ngon_triangles_overlap). A
+    face with no area is not flat."""
     corners, starts = outlines
     if not len(starts):
         return True
