@@ -5,18 +5,21 @@
 
 void main()
 {
-  vec2 p = gl_FragCoord.xy;
-  vec2 wa = window_point(fin_a), wb = window_point(fin_b);
-  vec2 ab = wb - wa;
-  /* Only the side away from the face: the face draws its own inner half.
-   * (The near-clipped ends keep the edge's line and its direction.) */
-  vec2 ap = p - wa;
-  if ((ab.x * ap.y - ab.y * ap.x) * fin_inner_sign > 0.0) {
+  /* The distance from the edge's window line and span (edge_setup): a
+   * near-clipped end can lie 10^5 px off-screen, and measuring from that
+   * window point would carry its float32 rounding (about 0.01 px there)
+   * into every pixel's distance. */
+  vec2 p = gl_FragCoord.xy - viewport_centre();
+  float across = dot(fin_line, vec3(p, 1.0));
+  /* Only the side away from the face: the face draws its own inner half. */
+  if (across * fin_inner_sign < 0.0) {
     discard;
   }
-  float len2 = dot(ab, ab);
-  float s = (len2 > 0.0) ? clamp(dot(p - wa, ab) / len2, 0.0, 1.0) : 0.0;
-  float d = length(p - (wa + s * ab));
+  float along = dot(vec2(-fin_line.y, fin_line.x), p);
+  float beyond = max(max(fin_span.x - along, along - fin_span.y), 0.0);
+  float d = sqrt(across * across + beyond * beyond);
+  float span_length = fin_span.y - fin_span.x;
+  float s = (span_length > 0.0) ? clamp((along - fin_span.x) / span_length, 0.0, 1.0) : 0.0;
   /* Window parameter s -> parameter u along the clip-space segment
    * (perspective-correct), then q's depth in NDC and view space. */
   float u = s * fin_a.w / (s * fin_a.w + (1.0 - s) * fin_b.w);
@@ -28,7 +31,7 @@ void main()
   float q_depth = 0.5 * (q.z / q.w) + 0.5;
 #endif
 #ifndef OVERLAY_FINS
-  float scene = texelFetch(scene_depth, ivec2(p), 0).r;
+  float scene = texelFetch(scene_depth, ivec2(gl_FragCoord.xy), 0).r;
   /* A nearer surface hides this part of the outer half; the background
    * (the depth's clear value, 1) hides nothing, also where q lies beyond
    * the far clip (image model §5.5: z_vis is infinite there). */

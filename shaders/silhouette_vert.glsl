@@ -56,6 +56,7 @@ void main()
   vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b, depth_a) : b;
   fin_a = a_front;
   fin_b = b_front;
+  edge_setup(a, b, fin_line, fin_span);
   fin_inner_sign = sign(side_f);
   vec3 pa = vec3(fetch_texel(vertex_positions, int(ids.x)).xyz);
   vec3 pb = vec3(fetch_texel(vertex_positions, int(ids.y)).xyz);

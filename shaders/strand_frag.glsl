@@ -52,10 +52,24 @@ float segment_sample(vec2 p, out float depth, out vec4 clip_position)
     discard;
   }
 #  endif
-  vec2 ab = wb - wa;
-  float len2 = dot(ab, ab);
-  float s = (len2 > 0.0) ? clamp(dot(p - wa, ab) / len2, 0.0, 1.0) : 0.0;
-  float d = length(p - (wa + s * ab));
+  /* The distance from the segment's window line and span (edge_setup):
+   * a near-clipped end can lie 10^5 px off-screen, and measuring from that
+   * window point would carry its float32 rounding (about 0.01 px there)
+   * into every pixel's distance. A segment along a view ray has no line:
+   * it is the disc around its window point. */
+  float d, s = 0.0;
+  if (seg_line.z == NO_EDGE) {
+    d = length(p - wa);
+  }
+  else {
+    vec2 pc = p - viewport_centre();
+    float across = dot(seg_line, vec3(pc, 1.0));
+    float along = dot(vec2(-seg_line.y, seg_line.x), pc);
+    float beyond = max(max(seg_span.x - along, along - seg_span.y), 0.0);
+    d = sqrt(across * across + beyond * beyond);
+    float span_length = seg_span.y - seg_span.x;
+    s = (span_length > 0.0) ? clamp((along - seg_span.x) / span_length, 0.0, 1.0) : 0.0;
+  }
   /* Window parameter s -> parameter u along the clip-space segment
    * (perspective-correct). */
   float u = s * seg_a.w / (s * seg_a.w + (1.0 - s) * seg_b.w);

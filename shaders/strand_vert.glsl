@@ -105,6 +105,7 @@ void main()
   float ra = max(pa.w, 0.0) * RADIUS_SCALE, rb = max(pb.w, 0.0) * RADIUS_SCALE;
   seg_a = a_front;
   seg_b = b_front;
+  edge_setup(a, b, seg_line, seg_span);
   seg_depth = vec2(mix(za, zb, ta), mix(zb, za, tb));
   seg_radius = vec2(mix(ra, rb, ta), mix(rb, ra, tb));
   /* The widest half-width is at an end: r / w is monotonic along a segment. */

@@ -410,3 +410,33 @@ def test_bezier_curves_match_reference(output_dir):
     _rgba, ref, report = _measure(scene, "hair_bezier", output_dir)
     accuracy.assert_accurate(report)
     assert (ref.strand > 0.99).sum() > 300
+
+
+@pytest.mark.parametrize("path", ["render", "overlay"])
+def test_a_strand_through_the_near_plane_keeps_its_distance(path, output_dir):
+    """A strand from behind the camera into view, at a near clip of 0.01:
+    its first segment's clipped end lies some 10^5 px off-screen. Measured
+    from that end's window point, whose float32 rounding is about 0.01 px
+    there, a sharp strand (softness 0.25) was off by up to 0.057; it now
+    takes the window line and span of the meshes' edges (edge_setup in
+    shaders/edge_geometry.glsl), anchored near the screen."""
+    scene = scenes.empty_scene(160, 120, thickness=3.0, softness=0.25)
+    corners = [(-27.54, -0.19, 27.06), (1.297, -0.0365, -0.5913), (0.6522, -0.1639, 1.5426)]
+    strand_scenes.hair(scene, "Hair", [corners], [0.0])
+    scenes.add_camera(
+        scene, location=(-0.119, -1.123, 0.960), target=(0.0, 0.0, 0.915), lens=84.5, shift=(-0.09, -0.18), clip=(0.01, 100.0)
+    )
+    ref = strand_reference.render_strand_reference(scene)
+    if path == "overlay":
+        from solidwire_addon.blender.gpu_context import ensure_gpu
+        from tests.support import robustness
+
+        ensure_gpu()
+        _stats, alpha = robustness.Viewport(160, 120).draw(scene)
+    else:
+        alpha = scenes.render_to_file(scene, output_dir / "strand_through_the_near_plane.png")[..., 3]
+    report = strand_reference.error_report(alpha, ref)
+    print(report)
+    accuracy.assert_accurate(report)
+    assert report["max"] < 0.01
+    assert (ref.strand > 0.99).sum() > 150  # the strand really crosses the frame

@@ -169,3 +169,37 @@ def test_a_dashed_line_through_the_near_plane_keeps_its_phase(output_dir):
     report = accuracy.measure(scene, "dashes_through_the_near_plane", output_dir)
     accuracy.assert_accurate(report)
     assert report["max"] < 0.01
+
+
+@pytest.mark.parametrize("path", ["render", "overlay"])
+def test_a_silhouette_through_the_near_plane_keeps_its_distance(path, output_dir):
+    """A triangle with a corner behind the camera, seen at a near clip of
+    0.01: two of its boundary edges cross the near plane and end some 10^5
+    px off-screen. Their outer halves measured the distance from that
+    clipped end's window point, whose float32 rounding (about 0.01 px there)
+    moved the whole fall-off of a sharp line (softness 0.25) by up to 0.05;
+    they now take the line and span of the main pass (edge_setup in
+    shaders/edge_geometry.glsl), anchored near the screen. Found by the
+    fuzz of every line option."""
+    scene = scenes.empty_scene(
+        160, 120, thickness=3.0, softness=0.25, use_silhouettes=True, use_boundary_edges=True, boundary_thickness=2.0
+    )
+    corners = [(-27.54, -0.19, 27.06), (1.297, -0.0365, -0.5913), (0.6522, -0.1639, 1.5426)]
+    scenes.from_pydata(scene, "Behind", corners, [(0, 1, 2)])
+    scenes.add_camera(
+        scene, location=(-0.119, -1.123, 0.960), target=(0.0, 0.0, 0.915), lens=84.5, shift=(-0.09, -0.18), clip=(0.01, 100.0)
+    )
+    ref = reference.render_reference(scene)
+    if path == "overlay":
+        from tests.support import robustness
+
+        ensure_gpu()
+        _stats, alpha = robustness.Viewport(160, 120).draw(scene)
+    else:
+        alpha = scenes.render_to_file(scene, output_dir / "silhouette_through_the_near_plane.png")[..., 3]
+    report = reference.error_report(alpha, ref)
+    print(report)
+    accuracy.assert_accurate(report)
+    assert report["max"] < 0.01
+    without = reference.render_reference(scene, settings=reference.SettingsWith(scene.solidwire, use_silhouettes=False))
+    assert ((ref.intensity - without.intensity) > 0.5).sum() > 30  # outer halves really drawn

@@ -1022,6 +1022,8 @@ def get_silhouette(variant: ShaderVariant, overlay_bias: float = 0.0):
         iface = gpu.types.GPUStageInterfaceInfo("solidwire_fin_iface")
         iface.flat("VEC4", "fin_a")
         iface.flat("VEC4", "fin_b")
+        iface.flat("VEC3", "fin_line")
+        iface.flat("VEC2", "fin_span")
         iface.flat("FLOAT", "fin_inner_sign")
         iface.flat("VEC2", "fin_view_depth")
         info = pulling_info()
@@ -1087,6 +1089,8 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
         else:
             iface.flat("VEC4", "seg_a")
             iface.flat("VEC4", "seg_b")
+            iface.flat("VEC3", "seg_line")  # edge_setup's window line and span, from the viewport centre
+            iface.flat("VEC2", "seg_span")
             iface.flat("VEC2", "seg_depth")
             iface.flat("VEC2", "seg_radius")
             if overlay_bias:

@@ -1238,19 +1238,33 @@ def _min_distance_per_pixel(
     return (best, best_along, best_index) if want_index else (best, best_along)
 
 
-def _max_value_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, value_of, far_phase=None):
-    """For every pixel: the largest value_of(pair_pix, pair_edge, d, along)
-    over the selected edges of its own face (0 without any). With a bool
-    array as ``far_phase``, it marks the pixels a line reaches (a value
-    above 0) where its dash phase is undecided (PHASE_TOLERANCE_PX)."""
+def _max_value_per_pixel(pix_face, pix_xy, geo, wa, wb, valid, select, value_of, far_phase=None, mask_of=None):
+    """For every pixel: the largest value_of(pair_pix, pair_edge, d) times
+    mask_of(along) (a dash pattern; none: 1) over the selected edges of its
+    own face (0 without any). With a bool array as ``far_phase``, it marks
+    the pixels a line reaches (value_of above 0, whatever its dashes) where
+    its dash phase is undecided (PHASE_TOLERANCE_PX): a pixel in a gap
+    between dashes is undecided too where the phase may move a dash onto it."""
     best = np.zeros(len(pix_face))
     pair_pix, pair_edge, d, along, phase_error = _pixel_edge_pairs(pix_face, pix_xy, geo, wa, wb, valid, select)
     if len(pair_pix):
-        values = value_of(pair_pix, pair_edge, d, along)
+        values = value_of(pair_pix, pair_edge, d)
+        reaches = values > 0.0
+        if mask_of is not None:
+            values = values * mask_of(along)
         np.maximum.at(best, pair_pix, values)
         if far_phase is not None:
-            far_phase[pair_pix[(values > 0.0) & (phase_error > PHASE_TOLERANCE_PX)]] = True
+            far_phase[pair_pix[reaches & (phase_error > PHASE_TOLERANCE_PX)]] = True
     return best
+
+
+def _dashes(far_phase, period, duty):
+    """(far_phase, mask_of) for _max_value_per_pixel: a line of ``duty``
+    below 1 is dashed (pattern_mask along it) and marks its undecided
+    phases in ``far_phase``; a solid one neither."""
+    if duty >= 1.0:
+        return None, None
+    return far_phase, lambda along: pattern_mask(np.abs(along), period, duty)
 
 
 def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height, thickness, softness):
@@ -1290,13 +1304,12 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
             # The style's intensity is its strongest line (§3.6-§3.7), not
             # its nearest line's: each line fades on its own, and each
             # edge's pattern runs along that edge.
-            def faded(pair_pix, pair_edge, d_pair, along_pair, width_px=width_px, duty=duty):
+            def faded(pair_pix, pair_edge, d_pair, width_px=width_px):
                 w = width_px if np.isscalar(width_px) else width_px[pair_pix]
-                v = profile(d_pair, w, softness) * density(pair_edge)
-                return v * pattern_mask(np.abs(along_pair), float(s.pattern_period), duty) if duty < 1.0 else v
+                return profile(d_pair, w, softness) * density(pair_edge)
 
             v = _max_value_per_pixel(
-                keys, pix_xy, geo, wa, wb, valid, select, faded, far_phase=tied if duty < 1.0 else None
+                keys, pix_xy, geo, wa, wb, valid, select, faded, *_dashes(tied, float(s.pattern_period), duty)
             )
         else:
             v = profile(d, width_px, softness)
@@ -1624,14 +1637,13 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
             if getattr(s, "use_density_fade", False) and float(getattr(s, "density_fade_length", 0.0)) > 0.0:
                 duty = float(s.pattern_duty) if mode in ("DOTTED", "DASHED") else 1.0
 
-                def faded(pair_pix, pair_edge, d_pair, along_pair):
+                def faded(pair_pix, pair_edge, d_pair):
                     w = thickness if np.isscalar(thickness) else thickness[pair_pix]
-                    v = profile(d_pair, w, softness) * density(pair_edge)
-                    return v * pattern_mask(np.abs(along_pair), float(s.pattern_period), duty) if duty < 1.0 else v
+                    return profile(d_pair, w, softness) * density(pair_edge)
 
                 far = np.zeros(len(pix_face), bool)
                 diag_value = _max_value_per_pixel(
-                    pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, faded, far_phase=far if duty < 1.0 else None
+                    pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, faded, *_dashes(far, float(s.pattern_period), duty)
                 )
                 on_silhouette[covered[far]] = True
             wins = diag_value > value
