@@ -1345,6 +1345,22 @@ def test_diagonals_of_a_flat_ngon_whose_outline_crosses_itself(diagonals, output
     accuracy.assert_accurate(report)
 
 
+def test_a_flat_ngon_whose_outline_crosses_itself_counts_its_lines_once_under_hidden_lines(output_dir):
+    """The same hexagon with hidden lines on: where two of its triangles
+    lie on one another, both pass the visible wire's depth test at the
+    surface's very depth. Blended straight over the hidden lines, its line
+    there read 1 - (1 - I)^2; the wire is now drawn into a layer of its own
+    and blended once (passes.WirePass; found by the fuzz)."""
+    scene = scenes.empty_scene(160, 120, thickness=1.5, softness=1.5, use_hidden_lines=True)
+    outline = [(0.0, 0.0), (-1.46, 1.43), (0.0, -0.87), (0.0, -1.81), (-1.14, -1.96), (-0.43, 0.0)]
+    scenes.from_pydata(scene, "Crossed", [(x, y, 0.0) for x, y in outline], [tuple(range(6))], location=(0.6, 0.2, 0.0))
+    scenes.add_camera(scene, location=(0.3, -0.9, 4.5), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, "regions_crossed_ngon_hidden_lines", output_dir)
+    print(report)
+    accuracy.assert_accurate(report)
+    assert report["over_2_255"] == 0
+
+
 def test_a_moved_ngon_is_asked_again_whether_it_is_flat(output_dir):
     """A cap corner lifted out of the cap's plane moves the mesh without
     extracting it again, and the cap, no longer flat, walks its diagonals

@@ -241,7 +241,7 @@ class HiddenLinesPass(RenderPass):
             # into its target and blended over the image from there ("over"
             # is associative), not drawn twice.
             frame.extra[HIDDEN_WIRE_PASS] = _hidden_wire(frame, self.settings)
-            _blended(frame, lambda: _blend_hidden_target(targets))
+            _blended(frame, lambda: _blend_own_layer(targets))
             return
         peeled = _peel_hidden_regions(
             frame,
@@ -486,7 +486,21 @@ class WirePass(RenderPass):
 
     def render(self, frame: Frame) -> None:
         lines = _wire_region_lines(frame, self.settings)
-        _blended(frame, lambda: _draw(frame, self.settings, replace(frame.base, depth_write=False, region_lines=lines)))
+        # Into a layer of its own, unblended, then "over" the image: where
+        # two triangles lie at the surface's very depth (a flat n-gon whose
+        # outline crosses itself has triangles on one another) both pass
+        # the depth test, and blended straight over the hidden lines the
+        # line would count twice (1 - (1 - I)^2); here the last one stays,
+        # as in the surface pass without hidden lines.
+        targets, view = frame.targets, frame.view
+        framebuffer = targets.own_layer_framebuffer()
+        with framebuffer.bind():
+            _clear(framebuffer, view.width, view.height, depth=False)
+            try:
+                _draw(frame, self.settings, replace(frame.base, depth_write=False, region_lines=lines))
+            finally:
+                gpu.state.depth_test_set("NONE")
+        _blended(frame, lambda: _blend_own_layer(targets))
 
     def over_viewport(self, frame: Frame) -> None:
         if not frame.frame_kept:
@@ -1609,7 +1623,7 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
     surface depth: "over" blending of the a_k on 0 leaves 1 - prod(1 - a_k)
     in alpha."""
     targets, view = frame.targets, frame.view
-    framebuffer = targets.hidden_framebuffer()
+    framebuffer = targets.own_layer_framebuffer()
     with framebuffer.bind():
         _clear(framebuffer, view.width, view.height, depth=False)  # the surface depth stays
     settings = replace(settings, use_fill=False)
@@ -1617,7 +1631,7 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
         frame,
         settings,
         targets,
-        into=((targets.hidden_framebuffer, "GREATER"),),
+        into=((targets.own_layer_framebuffer, "GREATER"),),
         behind=targets.depth,
         stats=frame.stats,
     )
@@ -1629,19 +1643,19 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
         finally:
             gpu.state.blend_set("NONE")
             gpu.state.depth_test_set("NONE")
-    return read_texture(targets.hidden, 4)[..., 3:4]
+    return read_texture(targets.own_layer, 4)[..., 3:4]
 
 
-def _blend_hidden_target(targets) -> None:
-    """``targets.hidden`` (the hidden layers "over" each other on nothing)
-    blended as the caller set over the bound colour target, where a surface
-    is (no layer lies behind the background)."""
+def _blend_own_layer(targets) -> None:
+    """``targets.own_layer`` (premultiplied colour on nothing) blended as
+    the caller set over the bound colour target, where a surface is (no
+    line lies over the background)."""
     shader = shaders.get_overlay_composite(0.0)
     shader.bind()
     shader.uniform_float("depth_rows", (0.0,) * 4)  # (no allowance: its depth is never written)
     shader.uniform_float("blender_depth_allowance", NO_DEPTH_ALLOWANCE)
     shader.uniform_sampler("record_depth", targets.depth)
-    shader.uniform_sampler("surface_image", targets.hidden)
+    shader.uniform_sampler("surface_image", targets.own_layer)
     gpu.state.depth_test_set("NONE")
     gpu.state.depth_mask_set(False)
     draw_mod.draw_rectangle(shader, (-1.0, -1.0, 1.0, 1.0))

@@ -46,7 +46,8 @@ class Targets:
         self.lines = None  # the region lines' strongest line per pixel, made on first use
         self.line_distances = None  # their nearest line's distance per pixel (Edge Distance), likewise
         self.lines_key = None  # what the overlay's lines were drawn for (passes._overlay_lines_key)
-        self.aov = self.normal = self.hidden = None  # render-pass targets, made on first use
+        self.aov = self.normal = None  # render-pass targets, made on first use
+        self.own_layer = None  # a colour layer drawn apart (own_layer_framebuffer), made on first use
         self.visible = None  # the deferred surface's visibility record, made on first use
         # The hidden layers of multi-face regions (passes._peel_hidden_regions),
         # made on first use: two depth images the layers alternate between,
@@ -111,11 +112,13 @@ class Targets:
             slots += (self.aov, self.normal)
         return slots
 
-    def hidden_framebuffer(self):
-        """The Hidden Wire pass's own colour target over the surface depth."""
-        if self.hidden is None:
-            self.hidden = gpu.types.GPUTexture(self.size, format="RGBA32F")
-        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.hidden,))
+    def own_layer_framebuffer(self):
+        """A colour layer of its own over the surface depth, blended over the
+        image afterwards (passes._blend_own_layer): the Hidden Wire pass's
+        layers, or the visible wire under hidden lines."""
+        if self.own_layer is None:
+            self.own_layer = gpu.types.GPUTexture(self.size, format="RGBA32F")
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.own_layer,))
 
     def color_framebuffer(self):
         """Colour and depth only, for blended passes that must leave the
