@@ -424,7 +424,12 @@ def test_a_strand_through_the_near_plane_keeps_its_distance(path, output_dir):
     corners = [(-27.54, -0.19, 27.06), (1.297, -0.0365, -0.5913), (0.6522, -0.1639, 1.5426)]
     strand_scenes.hair(scene, "Hair", [corners], [0.0])
     scenes.add_camera(
-        scene, location=(-0.119, -1.123, 0.960), target=(0.0, 0.0, 0.915), lens=84.5, shift=(-0.09, -0.18), clip=(0.01, 100.0)
+        scene,
+        location=(-0.119, -1.123, 0.960),
+        target=(0.0, 0.0, 0.915),
+        lens=84.5,
+        shift=(-0.09, -0.18),
+        clip=(0.01, 100.0),
     )
     ref = strand_reference.render_strand_reference(scene)
     if path == "overlay":

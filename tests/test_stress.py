@@ -187,7 +187,12 @@ def test_a_silhouette_through_the_near_plane_keeps_its_distance(path, output_dir
     corners = [(-27.54, -0.19, 27.06), (1.297, -0.0365, -0.5913), (0.6522, -0.1639, 1.5426)]
     scenes.from_pydata(scene, "Behind", corners, [(0, 1, 2)])
     scenes.add_camera(
-        scene, location=(-0.119, -1.123, 0.960), target=(0.0, 0.0, 0.915), lens=84.5, shift=(-0.09, -0.18), clip=(0.01, 100.0)
+        scene,
+        location=(-0.119, -1.123, 0.960),
+        target=(0.0, 0.0, 0.915),
+        lens=84.5,
+        shift=(-0.09, -0.18),
+        clip=(0.01, 100.0),
     )
     ref = reference.render_reference(scene)
     if path == "overlay":

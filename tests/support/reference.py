@@ -1643,7 +1643,15 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
 
                 far = np.zeros(len(pix_face), bool)
                 diag_value = _max_value_per_pixel(
-                    pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real, faded, *_dashes(far, float(s.pattern_period), duty)
+                    pix_face,
+                    pix_xy,
+                    geo,
+                    wa,
+                    wb,
+                    valid,
+                    ~geo.edge_real,
+                    faded,
+                    *_dashes(far, float(s.pattern_period), duty),
                 )
                 on_silhouette[covered[far]] = True
             wins = diag_value > value
