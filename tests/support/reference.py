@@ -71,6 +71,10 @@ class ReferenceResult:
     objects: list = None  # names of the objects whose settings style each face
     object_face_offsets: list = None  # first face id of each entry of objects
     hidden: np.ndarray = None  # (H, W) H of image model §5.4 (hidden lines on only)
+    # (H, W) view depth of the nearest surface behind the visible one at the
+    # sample (another face, or a triangle of its own face folded behind it;
+    # +inf: none), with hidden lines on or ``depth_layers`` asked for.
+    next_depth: np.ndarray = None
 
 
 @dataclass
@@ -1566,12 +1570,15 @@ def _hidden_line_coverage(
 # ---------------------------------------------------------------- entry point
 
 
-def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None) -> ReferenceResult:
+def render_reference(
+    scene, depsgraph=None, size=None, rows=None, settings=None, depth_layers=False
+) -> ReferenceResult:
     """Evaluate SPEC section 1 in float64 for ``scene``'s camera.
 
     ``size`` overrides the render size (the camera projection is computed for
     it); ``rows`` restricts evaluation to some window rows (bottom = 0).
-    ``settings`` defaults to ``scene.solidwire``."""
+    ``settings`` defaults to ``scene.solidwire``. ``depth_layers``: report
+    ``next_depth`` also with hidden lines off."""
     if depsgraph is None:
         depsgraph = bpy.context.evaluated_depsgraph_get()
     s = settings if settings is not None else scene.solidwire
@@ -1584,7 +1591,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
     view_matrix, proj = _camera(scene, depsgraph, width, height)
     geo = _gather_geometry(depsgraph, view_matrix, s)
     hidden_lines = bool(getattr(s, "use_hidden_lines", False))
-    all_hits = [] if hidden_lines else None
+    all_hits = [] if hidden_lines or depth_layers else None
     near_misses = [] if hidden_lines else None
     centre_hit = {}
     faces, depths = _visibility(
@@ -1711,7 +1718,21 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None)
         geo.objects,
         geo.offsets,
         hidden_all.reshape(shape),
+        None if all_hits is None else _next_depth(all_hits, depth).reshape(shape),
     )
+
+
+def _next_depth(all_hits, depth) -> np.ndarray:
+    """Per sample, the view depth of the nearest hit behind the visible
+    surface (+inf: none): a hit level with it (a face's two triangles on
+    their shared diagonal) is the surface itself."""
+    behind = np.full(len(depth), np.inf)
+    if all_hits:
+        pix = np.concatenate([h[0] for h in all_hits])
+        z = np.concatenate([h[1] for h in all_hits])
+        keep = z > depth[pix] + 1e-6 * np.abs(depth[pix])
+        np.minimum.at(behind, pix[keep], z[keep])
+    return behind
 
 
 # ---------------------------------------------------------------- fill shading

@@ -166,6 +166,24 @@ class Viewport:
         slope = abs(p[3, 2] * p[2, 3] - p[2, 2] * p[3, 3]) / (w * w)  # d(NDC) / d(view depth)
         return self.scene_depth < np.where(finite, depth - 0.5 * OVERLAY_DEPTH_BIAS / slope, np.inf)
 
+    def within_bias(self, depth: np.ndarray, behind: np.ndarray) -> np.ndarray:
+        """(H, W) bool: where a surface at view depth ``behind`` lies behind
+        the visible one at ``depth`` by less than twice what the overlay
+        moves its surfaces towards the camera (OVERLAY_DEPTH_BIAS in NDC and
+        view.blender_depth_allowance), so that Blender's depth test cannot
+        tell them apart (image model §5.6): both show, or a hidden layer
+        there does not."""
+        from solidwire_addon.core.view import OVERLAY_DEPTH_BIAS, blender_depth_allowance
+
+        p = np.asarray(self.view.projection, dtype=np.float64)
+        finite = np.isfinite(depth) & np.isfinite(behind)
+        d = np.where(finite, depth, 1.0)
+        w = p[3, 3] - p[3, 2] * d
+        slope = abs(p[3, 2] * p[2, 3] - p[2, 2] * p[3, 3]) / (w * w)  # d(NDC) / d(view depth)
+        a, b, c, e = blender_depth_allowance(self.view)
+        shift = OVERLAY_DEPTH_BIAS / slope + np.minimum(a + b * np.abs(d), c + e * np.abs(d))
+        return finite & (np.where(finite, behind, 0.0) - d < 2.0 * shift)
+
     def _view_depth(self, view) -> np.ndarray:
         """(H, W) float64 view depth of what the depth buffer holds now
         (+inf where it is clear), through the view's projection: window
