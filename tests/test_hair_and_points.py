@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.support import accuracy, scenes, strand_reference, strand_scenes
+from tests.support import accuracy, robustness, scenes, strand_reference, strand_scenes
 
 
 def _hair_and_points(scene, *, ortho=False):
@@ -421,25 +421,10 @@ def test_a_strand_through_the_near_plane_keeps_its_distance(path, output_dir):
     takes the window line and span of the meshes' edges (edge_setup in
     shaders/edge_geometry.glsl), anchored near the screen."""
     scene = scenes.empty_scene(160, 120, thickness=3.0, softness=0.25)
-    corners = [(-27.54, -0.19, 27.06), (1.297, -0.0365, -0.5913), (0.6522, -0.1639, 1.5426)]
-    strand_scenes.hair(scene, "Hair", [corners], [0.0])
-    scenes.add_camera(
-        scene,
-        location=(-0.119, -1.123, 0.960),
-        target=(0.0, 0.0, 0.915),
-        lens=84.5,
-        shift=(-0.09, -0.18),
-        clip=(0.01, 100.0),
-    )
+    strand_scenes.hair(scene, "Hair", [scenes.CORNERS_THROUGH_THE_NEAR_PLANE], [0.0])
+    scenes.add_clipped_corners_camera(scene)
     ref = strand_reference.render_strand_reference(scene)
-    if path == "overlay":
-        from solidwire_addon.blender.gpu_context import ensure_gpu
-        from tests.support import robustness
-
-        ensure_gpu()
-        _stats, alpha = robustness.Viewport(160, 120).draw(scene)
-    else:
-        alpha = scenes.render_to_file(scene, output_dir / "strand_through_the_near_plane.png")[..., 3]
+    alpha = robustness.image_alpha(scene, path, output_dir / "strand_through_the_near_plane.png")
     report = strand_reference.error_report(alpha, ref)
     print(report)
     accuracy.assert_accurate(report)

@@ -21,7 +21,7 @@ from solidwire_addon.blender import views as view_mod
 from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.core.cache import MeshCache
 from solidwire_addon.core.settings import DrawSettings
-from tests.support import accuracy, reference, scenes
+from tests.support import accuracy, reference, robustness, scenes
 
 pytestmark = pytest.mark.stress
 
@@ -184,24 +184,10 @@ def test_a_silhouette_through_the_near_plane_keeps_its_distance(path, output_dir
     scene = scenes.empty_scene(
         160, 120, thickness=3.0, softness=0.25, use_silhouettes=True, use_boundary_edges=True, boundary_thickness=2.0
     )
-    corners = [(-27.54, -0.19, 27.06), (1.297, -0.0365, -0.5913), (0.6522, -0.1639, 1.5426)]
-    scenes.from_pydata(scene, "Behind", corners, [(0, 1, 2)])
-    scenes.add_camera(
-        scene,
-        location=(-0.119, -1.123, 0.960),
-        target=(0.0, 0.0, 0.915),
-        lens=84.5,
-        shift=(-0.09, -0.18),
-        clip=(0.01, 100.0),
-    )
+    scenes.from_pydata(scene, "Behind", scenes.CORNERS_THROUGH_THE_NEAR_PLANE, [(0, 1, 2)])
+    scenes.add_clipped_corners_camera(scene)
     ref = reference.render_reference(scene)
-    if path == "overlay":
-        from tests.support import robustness
-
-        ensure_gpu()
-        _stats, alpha = robustness.Viewport(160, 120).draw(scene)
-    else:
-        alpha = scenes.render_to_file(scene, output_dir / "silhouette_through_the_near_plane.png")[..., 3]
+    alpha = robustness.image_alpha(scene, path, output_dir / "silhouette_through_the_near_plane.png")
     report = reference.error_report(alpha, ref)
     print(report)
     accuracy.assert_accurate(report)

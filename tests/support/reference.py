@@ -1570,9 +1570,7 @@ def _hidden_line_coverage(
 # ---------------------------------------------------------------- entry point
 
 
-def render_reference(
-    scene, depsgraph=None, size=None, rows=None, settings=None, depth_layers=False
-) -> ReferenceResult:
+def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None, depth_layers=False) -> ReferenceResult:
     """Evaluate SPEC section 1 in float64 for ``scene``'s camera.
 
     ``size`` overrides the render size (the camera projection is computed for
@@ -1624,14 +1622,9 @@ def render_reference(
         mode = s.diagonal_mode
         if mode != "HIDDEN":
             diag_ties = {}
+            diagonals = (pix_face, pix_xy, geo, wa, wb, valid, ~geo.edge_real)
             d_diag, along, _index = _min_distance_per_pixel(
-                pix_face,
-                pix_xy,
-                geo,
-                wa,
-                wb,
-                valid,
-                ~geo.edge_real,
+                *diagonals,
                 want_along=(mode in ("DOTTED", "DASHED")),
                 want_index=True,
                 ties=diag_ties,
@@ -1649,17 +1642,7 @@ def render_reference(
                     return profile(d_pair, w, softness) * density(pair_edge)
 
                 far = np.zeros(len(pix_face), bool)
-                diag_value = _max_value_per_pixel(
-                    pix_face,
-                    pix_xy,
-                    geo,
-                    wa,
-                    wb,
-                    valid,
-                    ~geo.edge_real,
-                    faded,
-                    *_dashes(far, float(s.pattern_period), duty),
-                )
+                diag_value = _max_value_per_pixel(*diagonals, faded, *_dashes(far, float(s.pattern_period), duty))
                 on_silhouette[covered[far]] = True
             wins = diag_value > value
             winner_all[covered[wins]] = 0

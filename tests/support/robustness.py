@@ -108,6 +108,18 @@ def is_blender_data(value) -> bool:
     return isinstance(value, bpy.types.bpy_struct)
 
 
+def image_alpha(scene, path: str, png: Path) -> np.ndarray:
+    """The wire's alpha of ``scene`` through ``path``: "overlay" (the
+    viewport overlay's first redraw, Viewport) or "render" (an F12 written
+    to ``png``)."""
+    if path == "overlay":
+        from solidwire_addon.blender.gpu_context import ensure_gpu
+
+        ensure_gpu()
+        return Viewport(scene.render.resolution_x, scene.render.resolution_y).draw(scene)[1]
+    return scenes.render_to_file(scene, png)[..., 3]
+
+
 def cube_beside(scene, bad_location=(2.6, 0.0, 0.0)):
     """A reference object on the left of the view and a camera that also
     sees ``bad_location`` on the right, where the faulty object goes."""

@@ -384,6 +384,24 @@ def near_plane_scene(scene):
     return []
 
 
+# Three corners, the first far behind the camera of add_clipped_corners_camera
+# (near clip 0.01): the edges from it cross the near plane and end some
+# 10^5 px off-screen, where float32 window points round by about 0.01 px.
+CORNERS_THROUGH_THE_NEAR_PLANE = [(-27.54, -0.19, 27.06), (1.297, -0.0365, -0.5913), (0.6522, -0.1639, 1.5426)]
+
+
+def add_clipped_corners_camera(scene):
+    """The camera of CORNERS_THROUGH_THE_NEAR_PLANE (found by the fuzz)."""
+    return add_camera(
+        scene,
+        location=(-0.119, -1.123, 0.960),
+        target=(0.0, 0.0, 0.915),
+        lens=84.5,
+        shift=(-0.09, -0.18),
+        clip=(0.01, 100.0),
+    )
+
+
 def far_scene(offset: float):
     def build(scene):
         monkey(scene, subdivisions=1, location=(offset, offset, 0.0))
