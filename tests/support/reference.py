@@ -75,6 +75,9 @@ class ReferenceResult:
     # sample (another face, or a triangle of its own face folded behind it;
     # +inf: none), with hidden lines on or ``depth_layers`` asked for.
     next_depth: np.ndarray = None
+    # (H, W) how many triangles the sample's ray meets at the visible depth
+    # (within a relative 1e-6: triangles on one another), likewise.
+    level_hits: np.ndarray = None
 
 
 @dataclass
@@ -1701,21 +1704,26 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
         geo.objects,
         geo.offsets,
         hidden_all.reshape(shape),
-        None if all_hits is None else _next_depth(all_hits, depth).reshape(shape),
+        *(() if all_hits is None else (layer.reshape(shape) for layer in _depth_layers(all_hits, depth))),
     )
 
 
-def _next_depth(all_hits, depth) -> np.ndarray:
+def _depth_layers(all_hits, depth) -> tuple:
     """Per sample, the view depth of the nearest hit behind the visible
-    surface (+inf: none): a hit level with it (a face's two triangles on
-    their shared diagonal) is the surface itself."""
+    surface (+inf: none) and how many hits lie level with that surface
+    (within a relative 1e-6; two triangles of a face meet there only on
+    their shared diagonal, which a sample centre hardly ever hits, so more
+    than one is triangles lying on one another)."""
     behind = np.full(len(depth), np.inf)
+    level = np.zeros(len(depth), np.int64)
     if all_hits:
         pix = np.concatenate([h[0] for h in all_hits])
         z = np.concatenate([h[1] for h in all_hits])
-        keep = z > depth[pix] + 1e-6 * np.abs(depth[pix])
+        apart = np.abs(z - depth[pix]) > 1e-6 * np.abs(depth[pix])
+        keep = apart & (z > depth[pix])
         np.minimum.at(behind, pix[keep], z[keep])
-    return behind
+        np.add.at(level, pix[~apart], 1)
+    return behind, level
 
 
 # ---------------------------------------------------------------- fill shading
