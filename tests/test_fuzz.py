@@ -279,9 +279,10 @@ def test_random_meshes_with_every_line_option_in_the_overlay(mesh, camera, line,
     Blender's. Where a surface of ours lies behind the visible one by less
     than the overlay's depth bias (at a near clip of 0.01 about 0.1 % of
     the distance 5 units away), Blender's depth test cannot tell the two
-    apart (§5.6): both show, or a hidden layer there does not; under hidden
-    lines two triangles lying on one another at the surface's depth both
-    blend their wire (§5.6). Outer halves
+    apart (§5.6): both show, or a hidden layer there does not; and two
+    triangles lying on one another at the surface's depth (a quad or an
+    n-gon whose outline crosses itself) both blend their wire where the
+    overlay draws a mesh directly (§5.6). Outer halves
     of silhouettes blend "over" one another in the overlay (§5.5): where
     they reach, the overlay may be darker than the reference, never
     lighter."""
@@ -299,8 +300,7 @@ def test_random_meshes_with_every_line_option_in_the_overlay(mesh, camera, line,
         assert np.isfinite(alpha).all(), "NaN/Inf pixels"
         ref = reference.render_reference(scene, depth_layers=True)
         blender_decides = viewport.hides(ref.depth) | viewport.within_bias(ref.depth, ref.next_depth)
-        if line.get("use_hidden_lines"):
-            blender_decides |= ref.level_hits > 1
+        blender_decides |= ref.level_hits > 1
         outer = np.zeros_like(blender_decides)
         if line.get("use_silhouettes"):
             without = reference.SettingsWith(scene.solidwire, use_silhouettes=False)
@@ -463,8 +463,8 @@ def test_random_modifier_stacks_under_cage_edges_in_the_overlay(stack, line, cam
     surface nearer than the model's (a back face, which Blender's Solid
     shading does not cull when SolidWire's Backface Culling is on) nothing
     of ours can show, nor where a surface of ours lies within the
-    overlay's depth bias behind the visible one or, under hidden lines, on
-    it, as in the overlay test of every line option."""
+    overlay's depth bias behind the visible one or on it, as in the
+    overlay test of every line option."""
     from solidwire_addon.blender.gpu_context import ensure_gpu
 
     log.forget()
@@ -475,6 +475,5 @@ def test_random_modifier_stacks_under_cage_edges_in_the_overlay(stack, line, cam
         _stats, alpha = viewport.draw(scene)
         ref = reference.render_reference(scene, depth_layers=True)
         ref.on_silhouette |= viewport.hides(ref.depth) | viewport.within_bias(ref.depth, ref.next_depth)
-        if line.get("use_hidden_lines"):
-            ref.on_silhouette |= ref.level_hits > 1
+        ref.on_silhouette |= ref.level_hits > 1
         accuracy.assert_accurate(reference.error_report(alpha, ref))
