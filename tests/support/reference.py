@@ -1527,6 +1527,12 @@ def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj, 
     return flagged
 
 
+# How near two triangles of one face lie, relative to their depth, for the
+# engine to count them as one hidden layer (LEVEL_DEPTH in
+# shaders/quad_partner.glsl).
+LEVEL_DEPTH = 1e-5
+
+
 def _hidden_line_coverage(
     s, all_hits, face, depth, rows, width, geo, wa, wb, valid, proj, height, wire_alpha, undecided=None
 ):
@@ -1550,8 +1556,14 @@ def _hidden_line_coverage(
     order = np.lexsort((z, f, pix))
     pix, z, f = pix[order], z[order], f[order]
     first = np.ones(len(pix), bool)
-    same_depth = np.abs(z[1:] - z[:-1]) <= 1e-6 * np.maximum(np.abs(z[1:]), 1e-30)
-    first[1:] = (pix[1:] != pix[:-1]) | (f[1:] != f[:-1]) | ~same_depth
+    gap = np.abs(z[1:] - z[:-1]) / np.maximum(np.abs(z[1:]), 1e-30)
+    same_face = (pix[1:] == pix[:-1]) & (f[1:] == f[:-1])
+    first[1:] = ~same_face | (gap > 1e-6)
+    if undecided is not None:
+        # The engine counts two triangles of a face as one layer within
+        # LEVEL_DEPTH of each other (its float32 depths of them cannot be
+        # ordered more finely): between the two counts, undecided (§7.2).
+        undecided[pix[1:][same_face & (gap > 1e-6) & (gap <= 2.0 * LEVEL_DEPTH)]] = True
     pix, z, f = pix[first], z[first], f[first]
     if len(pix) == 0:
         return coverage
