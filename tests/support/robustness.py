@@ -172,11 +172,16 @@ class Viewport:
         of the overlay's at ``depth`` cannot show there."""
         from solidwire_addon.core.view import OVERLAY_DEPTH_BIAS
 
-        p = np.asarray(self.view.projection, dtype=np.float64)
         finite = np.isfinite(depth)
-        w = np.where(finite, p[3, 3] - p[3, 2] * np.where(finite, depth, 0.0), 1.0)
-        slope = abs(p[3, 2] * p[2, 3] - p[2, 2] * p[3, 3]) / (w * w)  # d(NDC) / d(view depth)
+        slope = self._ndc_per_view_depth(np.where(finite, depth, 1.0))
         return self.scene_depth < np.where(finite, depth - 0.5 * OVERLAY_DEPTH_BIAS / slope, np.inf)
+
+    def _ndc_per_view_depth(self, depth: np.ndarray) -> np.ndarray:
+        """d(NDC z) / d(view depth) of the last draw's projection at finite
+        view depths ``depth``."""
+        p = np.asarray(self.view.projection, dtype=np.float64)
+        w = p[3, 3] - p[3, 2] * depth
+        return abs(p[3, 2] * p[2, 3] - p[2, 2] * p[3, 3]) / (w * w)
 
     def within_bias(self, depth: np.ndarray, behind: np.ndarray) -> np.ndarray:
         """(H, W) bool: where a surface at view depth ``behind`` lies behind
@@ -187,13 +192,10 @@ class Viewport:
         there does not."""
         from solidwire_addon.core.view import OVERLAY_DEPTH_BIAS, blender_depth_allowance
 
-        p = np.asarray(self.view.projection, dtype=np.float64)
         finite = np.isfinite(depth) & np.isfinite(behind)
         d = np.where(finite, depth, 1.0)
-        w = p[3, 3] - p[3, 2] * d
-        slope = abs(p[3, 2] * p[2, 3] - p[2, 2] * p[3, 3]) / (w * w)  # d(NDC) / d(view depth)
         a, b, c, e = blender_depth_allowance(self.view)
-        shift = OVERLAY_DEPTH_BIAS / slope + np.minimum(a + b * np.abs(d), c + e * np.abs(d))
+        shift = OVERLAY_DEPTH_BIAS / self._ndc_per_view_depth(d) + np.minimum(a + b * np.abs(d), c + e * np.abs(d))
         return finite & (np.where(finite, behind, 0.0) - d < 2.0 * shift)
 
     def _view_depth(self, view) -> np.ndarray:
