@@ -78,6 +78,10 @@ class ReferenceResult:
     # (H, W) how many triangles the sample's ray meets at the visible depth
     # (within a relative 1e-6: triangles on one another), likewise.
     level_hits: np.ndarray = None
+    # (H, W) view depth of the nearest point of a silhouette whose outer half
+    # would reach the sample but lies behind the visible surface there
+    # (+inf: none; image model §5.5).
+    hidden_outer_depth: np.ndarray = None
 
 
 @dataclass
@@ -1382,11 +1386,14 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
     and the pixels an undecided edge's outer half could reach (image model
     §7.2: a side sigma that float32 cannot tell from 0, such as a
     triangle's third corner on its edge's line, decides by rounding whether
-    the edge is a silhouette at all)."""
+    the edge is a silhouette at all); and the view depth of the nearest q
+    whose outer half would reach the sample but lies behind the visible
+    surface there (+inf: none), for the overlay's depth bias (§5.6)."""
     out = np.zeros(len(rows) * width)
     unsure = np.zeros(len(rows) * width, bool)
+    hidden_at = np.full(len(rows) * width, np.inf)
     if geo.sil_edges is None or len(geo.sil_edges) == 0:
-        return out, unsure
+        return out, unsure, hidden_at
     eye = _eye(proj)
     a, b = geo.sil_edges[:, 0], geo.sil_edges[:, 1]
     ones = np.ones((len(a), 1))
@@ -1426,7 +1433,7 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
     wa, wb, valid = _clip_edges_to_window(proj, np.stack([a, b], axis=1), width, height)
     a, b, third, wa, wb, undecided = a[valid], b[valid], third[valid], wa[valid], wb[valid], undecided[valid]
     if len(a) == 0:
-        return out, unsure
+        return out, unsure, hidden_at
     # Clipped 3D endpoints (for q's depth) and their clip w.
     xyz, w = _to_clip(proj, np.stack([a, b], axis=1))
     fa, fb = xyz[:, 0, 2] + w[:, 0], xyz[:, 1, 2] + w[:, 1]
@@ -1482,9 +1489,11 @@ def _outer_half(s, geo, proj, width, height, rows, depth):
         zq = -(a3[e, 2] + u * (b3[e, 2] - a3[e, 2]))
         seen = depth[pixel] >= zq
         value = profile(d, _thickness_at(s, zq, proj, height), softness) * _fade(s, zq)
+        hidden = outer & ~seen & (value > 0.0)
+        np.minimum.at(hidden_at, pixel[hidden], zq[hidden])
         value = np.where(outer & seen, value, 0.0)
         np.maximum.at(out, pixel, value)
-    return out, unsure
+    return out, unsure, hidden_at
 
 
 def _fade(s, z):
@@ -1616,6 +1625,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
     on_silhouette = (faces[1:] != face[None, :]).any(axis=0) | centre_hit["undecided"]
 
     intensity = np.zeros(len(face))
+    hidden_outer_depth = np.full(len(face), np.inf)
     winner_all = np.zeros(len(face), np.int64)  # the line style each sample takes (§3.6)
     hidden_all = np.zeros(len(face))
     d_real_all = np.full(len(face), np.inf)
@@ -1691,7 +1701,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
 
     if getattr(s, "use_silhouettes", False):
         wire_alpha = float(s.wire_color[3])
-        a_out, unsure = _outer_half(s, geo, proj, width, height, rows, depth)
+        a_out, unsure, hidden_outer_depth = _outer_half(s, geo, proj, width, height, rows, depth)
         a_out *= wire_alpha
         on_silhouette |= unsure
         a_base = intensity * wire_alpha
@@ -1717,6 +1727,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
         geo.offsets,
         hidden_all.reshape(shape),
         *(() if all_hits is None else (layer.reshape(shape) for layer in _depth_layers(all_hits, depth))),
+        hidden_outer_depth=hidden_outer_depth.reshape(shape),
     )
 
 
