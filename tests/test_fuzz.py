@@ -4,8 +4,8 @@ real engine to a float EXR (the stacks, and the meshes with every line
 option, also through the viewport overlay) and must raise nothing, hold no
 NaN/Inf and agree with the float64 reference on non-silhouette pixels
 (p99.9 <= 2/255, max <= 0.1); drags of the stacks' vertices in the overlay
-must end on what a fresh frame draws. docs/dev/robustness.md (Fuzzing) says what
-each set draws and what its hunts found.
+must end on what a fresh frame draws. docs/dev/robustness.md (Fuzzing)
+says what each set draws and what its hunts found.
 
 Default CI runs a fixed, derandomised set of examples; a long random hunt:
 ``SOLIDWIRE_FUZZ_EXAMPLES=500 pytest tests/test_fuzz.py`` (make fuzz).
@@ -322,12 +322,12 @@ FOLDED_NEARLY_LEVEL = dict(
 )
 
 
-# An overlay hunt's scene (the fold of a bent hexagon 9 units
-# away, near clip 0.01): a silhouette through the near plane whose outer
-# half reaches a sample where its nearest point lies 1e-4 of the distance
-# behind the visible surface. The render hides it there, as the model
-# says; the overlay's depth bias at that near clip cannot (image model
-# §5.6), so the overlay test leaves such samples out.
+# An overlay hunt's scene (the fold of a bent hexagon 9 units away, near
+# clip 0.01): a silhouette through the near plane whose outer half reaches
+# a sample where its nearest point lies 1e-4 of the distance behind the
+# visible surface. The render hides it there, as the model says; the
+# overlay's depth bias at that near clip cannot (image model §5.6), so the
+# overlay test leaves such samples out.
 OUTER_HALF_WITHIN_BIAS = dict(
     mesh=(
         [
@@ -652,11 +652,11 @@ def test_random_drags_in_the_overlay_draw_what_a_fresh_frame_draws(stack, line, 
     move changed; image model §5.6), and its last one draws what a fresh
     frame of the moved mesh draws once kept (a frame drawn directly, as
     under hidden lines, blends its layers into Blender's 8-bit buffer one
-    by one, its kept image once: they differ by a rounding step or
-    two). A fresh extraction centres the mesh anew
-    where an edit keeps its centre (extract.reposition), so float32 may
-    decide coverage differently within 2 pixels of a silhouette; elsewhere
-    no pixel differs by more than 1.5/255."""
+    by one, its kept image once: they differ by a rounding step or two).
+    A fresh extraction centres the mesh anew where an edit keeps its
+    centre (extract.reposition), so float32 may decide coverage
+    differently within 2 pixels of a silhouette; elsewhere no pixel
+    differs by more than 1.5/255."""
     from mathutils import Vector
 
     from solidwire_addon.blender import runtime
@@ -680,21 +680,21 @@ def test_random_drags_in_the_overlay_draw_what_a_fresh_frame_draws(stack, line, 
         def frame():
             return _draw(scene, [obj], size=SIZE)[0]
 
-        frame()
-        frame()  # the image is kept from here on
-        vertices = obj.data.vertices
-        middle = sum((v.co for v in vertices), Vector()) / len(vertices)
-        dragged = sorted({k % len(vertices) for k in drag["vertices"]})
-        for _step in range(drag["steps"]):
-            for k in dragged:
-                v = vertices[k]
-                v.co = middle + (v.co - middle) * (1.0 - drag["pull"]) + Vector((0.0, 0.0, drag["lift"]))
-            obj.data.update()
-            edited = frame()
-        runtime.mesh_cache.clear()
-        frame()
-        fresh = frame()  # kept, as the drag's redraws are
         with recipe_on_failure(f"stack={stack!r}\nsettings={line!r}\ncamera={camera!r}\ndrag={drag!r}"):
+            frame()
+            frame()  # the image is kept from here on
+            vertices = obj.data.vertices
+            middle = sum((v.co for v in vertices), Vector()) / len(vertices)
+            dragged = sorted({k % len(vertices) for k in drag["vertices"]})
+            for _step in range(drag["steps"]):
+                for k in dragged:
+                    v = vertices[k]
+                    v.co = middle + (v.co - middle) * (1.0 - drag["pull"]) + Vector((0.0, 0.0, drag["lift"]))
+                obj.data.update()
+                edited = frame()
+            runtime.mesh_cache.clear()
+            frame()
+            fresh = frame()  # kept, as the drag's redraws are
             ref = reference.render_reference(scene, size=SIZE)
             near_silhouette = silhouette_mask(np.where(np.isfinite(ref.depth), ref.depth, np.inf), radius=2)
             differs = (np.abs(edited - fresh) > 1.5 / 255).any(axis=2) & ~near_silhouette & ~ref.on_silhouette
