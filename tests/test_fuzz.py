@@ -441,8 +441,7 @@ def test_random_meshes_with_every_line_option_in_the_overlay(mesh, camera, line,
         _stats, alpha = viewport.draw(scene)
         assert np.isfinite(alpha).all(), "NaN/Inf pixels"
         ref = reference.render_reference(scene, depth_layers=True)
-        blender_decides = viewport.hides(ref.depth) | viewport.within_bias(ref.depth, ref.next_depth)
-        blender_decides |= viewport.within_bias(ref.depth, ref.hidden_outer_depth) | (ref.level_hits > 1)
+        blender_decides = viewport.blender_decides(ref)
         outer = np.zeros_like(blender_decides)
         if line.get("use_silhouettes"):
             without = reference.SettingsWith(scene.solidwire, use_silhouettes=False)
@@ -616,8 +615,7 @@ def test_random_modifier_stacks_under_cage_edges_in_the_overlay(stack, line, cam
         viewport = robustness.Viewport(*SIZE)
         _stats, alpha = viewport.draw(scene)
         ref = reference.render_reference(scene, depth_layers=True)
-        ref.on_silhouette |= viewport.hides(ref.depth) | viewport.within_bias(ref.depth, ref.next_depth)
-        ref.on_silhouette |= viewport.within_bias(ref.depth, ref.hidden_outer_depth) | (ref.level_hits > 1)
+        ref.on_silhouette |= viewport.blender_decides(ref)
         accuracy.assert_accurate(reference.error_report(alpha, ref))
 
 

@@ -198,6 +198,16 @@ class Viewport:
         shift = OVERLAY_DEPTH_BIAS / self._ndc_per_view_depth(d) + np.minimum(a + b * np.abs(d), c + e * np.abs(d))
         return finite & (np.where(finite, behind, 0.0) - d < 2.0 * shift)
 
+    def blender_decides(self, ref) -> np.ndarray:
+        """(H, W) bool: where Blender's depth, not the model, decides what
+        the overlay shows (image model §5.6), for a reference asked for its
+        depth layers: Blender's surface lies nearer than the model's; a
+        surface of ours, or the nearest point of an outer half the model
+        hides, lies behind the visible one within the overlay's shift; or
+        two of our triangles lie on one another at the visible depth."""
+        decides = self.hides(ref.depth) | self.within_bias(ref.depth, ref.next_depth)
+        return decides | self.within_bias(ref.depth, ref.hidden_outer_depth) | (ref.level_hits > 1)
+
     def _view_depth(self, view) -> np.ndarray:
         """(H, W) float64 view depth of what the depth buffer holds now
         (+inf where it is clear), through the view's projection: window
