@@ -15,8 +15,6 @@
  * seam. Overlay form: premultiplied "over" into the viewport, occluded by
  * the viewport's depth buffer. */
 
-#define PX_PER_UNIT strand_view.x
-
 #ifdef STRAND_POINTS
 /* A point's disc at p: the outline's intensity, with the depth of the
  * sphere's front, whether p is inside the disc and (for the clipping
@@ -41,14 +39,112 @@ float disc_sample(vec2 p, out float depth, out bool inside, out vec4 clip_positi
   return intensity;
 }
 #else
+#  ifdef STRAND_OVERLAY
+/* Intensities, and front depths relative to their size, closer than this
+ * are a tie at a joint: well above float32's rounding, which may differ
+ * between the two segments' evaluations of one sample (a compiler may
+ * contract their arithmetic differently), and far below a visible step. */
+const float JOINT_TIE = 1e-5;
+
+/* The intensity at window point p of a segment measured from one of its
+ * ends, the joint (`window`: the front part's window points, joint end
+ * first; `depth`: their clip w and view depths; `radii`), and the depth of
+ * the tube's front there: the render's measure from plain window points.
+ * Both segments of a joint evaluate both of them this way, from the same
+ * numbers (strand_vert.glsl, neighbour_from_joint, and their own), so
+ * they agree up to JOINT_TIE. */
+vec2 joint_sample(vec2 p, vec4 window, vec4 depth, vec2 radii)
+{
+  vec2 wa = window.xy, ab = window.zw - window.xy;
+  float len2 = dot(ab, ab);
+  float s = (len2 > 0.0) ? clamp(dot(p - wa, ab) / len2, 0.0, 1.0) : 0.0;
+  float d = length(p - wa - s * ab);
+  float u = s * depth.x / (s * depth.x + (1.0 - s) * depth.y);
+  float inv_w = 1.0 / mix(depth.x, depth.y, u);
+  float z = mix(depth.z, depth.w, u);
+  float radius = mix(radii.x, radii.y, u);
+  float intensity = line_profile(d, max(half_thickness_at(z, inv_w), radius * PX_PER_UNIT * inv_w));
+#    ifdef USE_FADE
+  intensity *= depth_fade(z);
+#    endif
+  return vec2(intensity, z - radius);
+}
+
+/* Whether this segment paints p near its joint with the neighbour
+ * segment (`neighbour_*`: joint_sample's numbers, w -1: none), this one's
+ * numbers from the same joint in `own_*`; `normal`: the joint's bisector
+ * (strand_vert.glsl, joint_normal; (0, 0): none), the neighbour's side
+ * where dot(p - joint_window, normal) * side < 0. As the render's winner:
+ * the larger intensity (write_render's key), then the nearer front; where
+ * both tie (JOINT_TIE), the bisector decides, and without one (a segment
+ * of no length, a joint behind the near plane) the lower point number of
+ * the two segments' other ends. (The render picks among the segments the
+ * surface leaves visible; the overlay cannot see the viewport's depth
+ * here, so where the winner is hidden, nothing of the two shows.) */
+bool keeps_joint_pixel(vec2 p,
+                       vec2 normal,
+                       float side,
+                       vec4 own_window,
+                       vec4 own_depth,
+                       vec2 own_radii,
+                       vec4 neighbour_window,
+                       vec4 neighbour_depth,
+                       vec2 neighbour_radii,
+                       float other,
+                       float neighbour)
+{
+  if (neighbour_depth.x < 0.0) {
+    return true; /* (no neighbour, or it draws nothing) */
+  }
+  vec2 theirs = joint_sample(p, neighbour_window, neighbour_depth, neighbour_radii);
+  if (theirs.x <= 0.0) {
+    return true; /* (the neighbour does not reach p) */
+  }
+  vec2 mine = joint_sample(p, own_window, own_depth, own_radii);
+  if (abs(mine.x - theirs.x) > JOINT_TIE) {
+    return mine.x > theirs.x;
+  }
+  if (abs(mine.y - theirs.y) > JOINT_TIE * max(abs(mine.y), abs(theirs.y))) {
+    return mine.y < theirs.y;
+  }
+  if (normal == vec2(0.0)) {
+    return other <= neighbour; /* (both where the strand turns back onto itself) */
+  }
+  return dot(p - own_window.xy, normal) * side >= 0.0;
+}
+#  endif
+
 /* A strand segment at p: the intensity at its nearest point q, with the
  * depth of the tube's front there and q in clip space. */
 float segment_sample(vec2 p, out float depth, out vec4 clip_position)
 {
   vec2 wa = window_point(seg_a), wb = window_point(seg_b);
 #  ifdef STRAND_OVERLAY
-  /* This segment's side of each joint (strand_vert.glsl, joint_normal). */
-  if (dot(p - wa, seg_split.xy) < 0.0 || dot(p - wb, seg_split.zw) > 0.0) {
+  /* The pixels of each joint this segment paints (keeps_joint_pixel). */
+  vec4 own_depth = vec4(seg_a.w, seg_b.w, seg_depth);
+  if (!keeps_joint_pixel(p,
+                         seg_split.xy,
+                         1.0,
+                         vec4(wa, wb),
+                         own_depth,
+                         seg_radius,
+                         neighbour_a_window,
+                         neighbour_a_depth,
+                         neighbour_radii.xy,
+                         seg_points.y,
+                         seg_points.z) ||
+      !keeps_joint_pixel(p,
+                         seg_split.zw,
+                         -1.0,
+                         vec4(wb, wa),
+                         own_depth.yxwz,
+                         seg_radius.yx,
+                         neighbour_b_window,
+                         neighbour_b_depth,
+                         neighbour_radii.zw,
+                         seg_points.x,
+                         seg_points.w))
+  {
     discard;
   }
 #  endif
@@ -126,9 +222,12 @@ vec4 strand_colour(vec2 p, float intensity, bool inside)
 #ifdef STRAND_OVERLAY
 /* Viewport: the window depth of `depth`, moved towards the camera by the
  * overlay's depth bias (as the mesh wire), tested LESS_EQUAL against what
- * Blender drew; blended "over". */
+ * Blender drew; blended "over". A front nearer than the near plane (the
+ * camera inside a wide tube or sphere) is at the near plane: it hides
+ * nothing of ours there, and nothing of Blender's can lie nearer. */
 void write_overlay(vec4 color, float depth)
 {
+  depth = max(depth, near_plane_depth());
   float clip_z = -params.depth_rows.x * depth + params.depth_rows.y;
   float clip_w = -params.depth_rows.z * depth + params.depth_rows.w;
   float shift = window_depth_shift(depth, params.blender_depth_allowance, params.depth_rows);

@@ -10,15 +10,6 @@
 /* Outside the clip volume: the rasteriser drops the triangle. */
 const vec4 COLLAPSED = vec4(2.0, 2.0, 2.0, 1.0);
 
-/* Window pixels per scene unit at clip w = 1, and the object's radius scale. */
-#define PX_PER_UNIT strand_view.x
-#define RADIUS_SCALE strand_view.y
-
-float view_depth_of(vec3 p)
-{
-  return -dot(object_to_view_z, vec4(p, 1.0));
-}
-
 /* The quad corner `corner` (0..3: (a,-), (b,-), (b,+), (a,+))
  * around window points wa -> wb, `reach` px on every side. */
 vec4 quad_corner_position(vec2 wa, vec2 wb, float reach, int corner)
@@ -36,19 +27,27 @@ vec4 quad_corner_position(vec2 wa, vec2 wb, float reach, int corner)
 
 #if defined(STRAND_OVERLAY) && !defined(STRAND_POINTS)
 /* The overlay blends segments "over" each other, so at a joint two
- * segments would both paint the pixels they share. Each segment keeps only
- * its side of the bisector of the joint: the plane through the joint whose
- * normal is the sum of the two unit directions (the pixels nearer its own
- * segment's line). (0, 0): no split (no neighbour, the end is near-clipped,
- * the neighbour is behind the camera, or the strand turns back on itself). */
-vec2 joint_normal(float neighbour, vec2 win_a, vec2 win_b, bool clipped, bool at_a)
+ * segments would both paint the pixels they share: one of them keeps each
+ * such pixel (strand_frag.glsl, keeps_joint_pixel), by the larger
+ * intensity there, and where the two tie, by the side of the bisector of
+ * the joint: the plane through the joint whose normal is the sum of the
+ * two unit directions (the pixels nearer its own segment's line). (0, 0):
+ * no split (no neighbour, the joint is behind the near plane, or the
+ * strand turns back on itself). A neighbour behind the near plane counts
+ * by the part of its segment in front, as that segment draws itself, so
+ * the two segments of a joint always find the same bisector. */
+vec2 joint_normal(float neighbour, vec4 joint, vec2 win_a, vec2 win_b, bool clipped, bool at_a)
 {
   if (neighbour < 0.0 || clipped) {
     return vec2(0.0);
   }
   vec4 n = object_to_clip * vec4(fetch_texel(vertex_positions, int(neighbour)).xyz, 1.0);
-  if (!(n.z + n.w >= 0.0) || !(n.w > 0.0)) {
-    return vec2(0.0);
+  float depth_n = n.z + n.w, depth_joint = joint.z + joint.w;
+  if (!(depth_n >= 0.0)) {
+    if (!(depth_n < 0.0)) {
+      return vec2(0.0); /* (NaN) */
+    }
+    n = near_clipped(n, joint, depth_n, depth_joint);
   }
   vec2 win_n = window_point(n);
   vec2 along = win_b - win_a;
@@ -57,6 +56,35 @@ vec2 joint_normal(float neighbour, vec2 win_a, vec2 win_b, bool clipped, bool at
     return vec2(0.0);
   }
   return normalize(along) + normalize(other);
+}
+
+/* The segment from point `joint` to point `neighbour` (the one the
+ * joint shares with this segment), as the fragment stage's joint_sample
+ * reads it: its front part's window points from the joint's end
+ * (`window`: joint xy, far xy), their clip w and view depths (`depth`:
+ * w joint, w far, depth joint, depth far; w -1: no neighbour, or it lies
+ * wholly behind the near plane) and radii. */
+void neighbour_from_joint(float joint, float neighbour, out vec4 window, out vec4 depth, out vec2 radii)
+{
+  window = vec4(0.0);
+  depth = vec4(-1.0, -1.0, 0.0, 0.0);
+  radii = vec2(0.0);
+  vec4 a, b, a_front, b_front;
+  vec2 cut, depths;
+  if (neighbour < 0.0 || !front_part(fetch_texel(vertex_positions, int(joint)),
+                                     fetch_texel(vertex_positions, int(neighbour)),
+                                     a,
+                                     b,
+                                     a_front,
+                                     b_front,
+                                     cut,
+                                     depths,
+                                     radii))
+  {
+    return;
+  }
+  window = vec4(window_point(a_front), window_point(b_front));
+  depth = vec4(a_front.w, b_front.w, depths);
 }
 #endif
 
@@ -86,28 +114,26 @@ void main()
   gl_Position = quad_corner_position(centre, centre, reach, corner);
 #else
   vec4 ids = fetch_texel(strand_segments, prim);
-  vec4 pa = fetch_texel(vertex_positions, int(ids.x));
-  vec4 pb = fetch_texel(vertex_positions, int(ids.y));
-  vec4 a = object_to_clip * vec4(pa.xyz, 1.0);
-  vec4 b = object_to_clip * vec4(pb.xyz, 1.0);
-  float depth_a = a.z + a.w, depth_b = b.z + b.w;
-  if (!(depth_a >= 0.0 || depth_b >= 0.0)) {
+  vec4 a, b, a_front, b_front;
+  vec2 cut, depths, radii;
+  if (!front_part(fetch_texel(vertex_positions, int(ids.x)),
+                  fetch_texel(vertex_positions, int(ids.y)),
+                  a,
+                  b,
+                  a_front,
+                  b_front,
+                  cut,
+                  depths,
+                  radii))
+  {
     gl_Position = COLLAPSED; /* wholly behind the near plane (or NaN) */
     return;
   }
-  /* The part in front of the near plane (docs/image_model.md §3.2), its
-   * view depths and radii cut at the same parameters. */
-  float ta = (depth_a < 0.0) ? depth_a / (depth_a - depth_b) : 0.0;
-  float tb = (depth_b < 0.0) ? depth_b / (depth_b - depth_a) : 0.0;
-  vec4 a_front = (depth_a < 0.0) ? near_clipped(a, b, depth_a, depth_b) : a;
-  vec4 b_front = (depth_b < 0.0) ? near_clipped(b, a, depth_b, depth_a) : b;
-  float za = view_depth_of(pa.xyz), zb = view_depth_of(pb.xyz);
-  float ra = max(pa.w, 0.0) * RADIUS_SCALE, rb = max(pb.w, 0.0) * RADIUS_SCALE;
   seg_a = a_front;
   seg_b = b_front;
+  seg_depth = depths;
+  seg_radius = radii;
   edge_setup(a, b, seg_line, seg_span);
-  seg_depth = vec2(mix(za, zb, ta), mix(zb, za, tb));
-  seg_radius = vec2(mix(ra, rb, ta), mix(rb, ra, tb));
   /* The widest half-width is at an end: r / w is monotonic along a segment. */
   float wa_inv = 1.0 / max(a_front.w, 1e-6), wb_inv = 1.0 / max(b_front.w, 1e-6);
   float half_a = max(half_thickness_at(seg_depth.x, wa_inv), seg_radius.x * PX_PER_UNIT * wa_inv);
@@ -115,8 +141,13 @@ void main()
   float reach = min(max(half_a, half_b), 16384.0) + 2.0 * params.softness + 1.0;
   vec2 win_a = window_point(a_front), win_b = window_point(b_front);
 #  ifdef STRAND_OVERLAY
-  seg_split = vec4(joint_normal(ids.z, win_a, win_b, ta > 0.0, true),
-                   joint_normal(ids.w, win_a, win_b, tb > 0.0, false));
+  seg_split = vec4(joint_normal(ids.z, a, win_a, win_b, cut.x > 0.0, true),
+                   joint_normal(ids.w, b, win_a, win_b, cut.y > 0.0, false));
+  seg_points = ids;
+  vec2 radii_a, radii_b;
+  neighbour_from_joint(ids.x, ids.z, neighbour_a_window, neighbour_a_depth, radii_a);
+  neighbour_from_joint(ids.y, ids.w, neighbour_b_window, neighbour_b_depth, radii_b);
+  neighbour_radii = vec4(radii_a, radii_b);
 #  endif
   gl_Position = quad_corner_position(win_a, win_b, reach, corner);
 #endif

@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 from mathutils import Matrix
 
 from solidwire_addon.core import log
-from tests.support import accuracy, reference, robustness, scenes
+from tests.support import accuracy, reference, robustness, scenes, strand_reference, strand_scenes
 
 pytestmark = pytest.mark.fuzz
 
@@ -132,7 +132,9 @@ def transforms(draw):
     }
 
 
-def build(mesh, camera, line, transform):
+def empty_fuzz_scene(line, transform):
+    """An empty scene with ``line``'s settings and ``transform``'s pixel
+    aspect."""
     # diagonal_mode's update resets the duty: set the mode first.
     line = dict(line)
     duty = line.pop("pattern_duty", None)
@@ -140,12 +142,23 @@ def build(mesh, camera, line, transform):
     if duty is not None:
         scene.solidwire.pattern_duty = duty
     scene.render.pixel_aspect_x = transform.get("pixel_aspect", 1.0)
+    return scene
+
+
+def add_fuzz_mesh(scene, mesh):
+    """The object "Fuzz" of ``mesh`` (vertices, faces) in ``scene``."""
     verts, faces = mesh
     data = bpy.data.meshes.new("Fuzz")
     data.from_pydata(verts, [], faces)
     data.update()
     obj = bpy.data.objects.new("Fuzz", data)
     scene.collection.objects.link(obj)
+    return obj
+
+
+def build(mesh, camera, line, transform):
+    scene = empty_fuzz_scene(line, transform)
+    obj = add_fuzz_mesh(scene, mesh)
     obj.location, obj.rotation_euler, obj.scale = transform["location"], transform["rotation"], transform["scale"]
     scenes.add_camera(scene, **camera)
     return scene
@@ -697,3 +710,129 @@ def test_random_drags_in_the_overlay_draw_what_a_fresh_frame_draws(stack, line, 
             near_silhouette = silhouette_mask(np.where(np.isfinite(ref.depth), ref.depth, np.inf), radius=2)
             differs = (np.abs(edited - fresh) > 1.5 / 255).any(axis=2) & ~near_silhouette & ~ref.on_silhouette
             assert not differs.any(), f"{int(differs.sum())} pixels differ from a fresh frame"
+
+
+@st.composite
+def strand_curves(draw):
+    """0-4 hair curves (poly, Catmull-Rom or Bezier, some cyclic) of 1-6
+    points, some repeated or nearly so (zero-length segments), with radii
+    from none to wider than the view, and 0-6 points of a point cloud of
+    one radius (0 draws a dot of the line's width)."""
+    curves, radii, types, cyclic, left, right = [], [], [], [], [], []
+    for _ in range(draw(st.integers(0, 4))):
+        kind = draw(st.sampled_from([strand_scenes.POLY, strand_scenes.CATMULL_ROM, strand_scenes.BEZIER]))
+        points = [draw(point)]
+        for _k in range(draw(st.integers(0, 5))):
+            step = draw(st.sampled_from(["new"] * 4 + ["same", "near"]))
+            if step == "same":
+                points.append(points[-1])
+            elif step == "near":
+                points.append(tuple(p + draw(st.floats(-1e-4, 1e-4)) for p in points[-1]))
+            else:
+                points.append(draw(point))
+        curves.append(points)
+        radius = draw(st.sampled_from([0.0, 0.01, 0.05, 0.3, 3.0, draw(st.floats(0.0, 0.2))]))
+        radii.append([radius * draw(st.sampled_from([1.0, 0.0, 0.5, 2.0])) for _p in points])
+        types.append(kind)
+        cyclic.append(draw(st.booleans()) and len(points) > 2)
+        for handles in (left, right):
+            handles.extend(tuple(p + draw(st.floats(-0.5, 0.5)) for p in q) for q in points)
+    return {
+        "curves": curves,
+        "radii": radii,
+        "types": types,
+        "cyclic": cyclic,
+        "handles": (left, right),
+        "resolution": draw(st.sampled_from([1, 2, 5, 12])),
+        "points": draw(st.lists(point, max_size=6)),
+        "point_radius": draw(st.sampled_from([0.0, 0.02, 0.15, 0.5, draw(st.floats(0.0, 0.3))])),
+    }
+
+
+# A hair and point-cloud scene: build_strands' arguments.
+STRAND_SCENES = dict(
+    hair=strand_curves(), mesh=st.none() | polygons(), camera=cameras(), line=line_settings(), transform=transforms()
+)
+
+
+def strand_recipe(hair, mesh, camera, line, transform) -> str:
+    return f"hair={hair!r}\nmesh={mesh!r}\ncamera={camera!r}\nsettings={line!r}\ntransform={transform!r}"
+
+
+def build_strands(hair, mesh, camera, line, transform):
+    """The hair object (under ``transform``) and point cloud of ``hair``,
+    beside the random mesh (or none), seen by ``camera``."""
+    scene = empty_fuzz_scene(line, transform)
+    if hair["curves"]:
+        obj = strand_scenes.hair(
+            scene,
+            "FuzzHair",
+            hair["curves"],
+            hair["radii"],
+            types=hair["types"],
+            resolution=hair["resolution"],
+            handles=tuple(np.asarray(h, dtype=np.float64) for h in hair["handles"]),
+        )
+        obj.data.attributes.new("cyclic", "BOOLEAN", "CURVE").data.foreach_set("value", hair["cyclic"])
+        obj.location, obj.rotation_euler, obj.scale = transform["location"], transform["rotation"], transform["scale"]
+    if hair["points"]:
+        strand_scenes.point_cloud(scene, "FuzzPoints", hair["points"], hair["point_radius"])
+    if mesh is not None:
+        add_fuzz_mesh(scene, mesh)
+    scenes.add_camera(scene, **camera)
+    return scene
+
+
+@FUZZ
+@given(**STRAND_SCENES)
+def test_random_strands_and_points_match_reference(hair, mesh, camera, line, transform, tmp_path_factory):
+    """Random hair curves and point clouds, beside a random mesh that may
+    hide them, in the F12 render: every strand and disc as
+    tests/support/strand_reference.py measures it (hair-and-points.md)."""
+    log.forget()
+    scene = build_strands(hair, mesh, camera, line, transform)
+    with recipe_on_failure(strand_recipe(hair, mesh, camera, line, transform)):
+        image = robustness.render_exr(scene, tmp_path_factory.getbasetemp() / "fuzz_strands.exr")
+        assert np.isfinite(image).all(), "NaN/Inf pixels"
+        ref = strand_reference.render_strand_reference(scene)
+        report = strand_reference.error_report(image[..., 3].astype(np.float64), ref)
+        accuracy.assert_accurate(report)
+
+
+@FUZZ
+@given(**STRAND_SCENES)
+def test_random_strands_and_points_in_the_overlay(hair, mesh, camera, line, transform):
+    """The same scenes in the viewport overlay's first redraw over Blender's
+    Solid shading depth of the mesh. Left out: where two strands, or a
+    strand and a point, or two points, or two segments of a strand that do
+    not meet at a joint (so also any three) reach a sample ("over" and the
+    render's largest weight differ there by design: only the two segments
+    at a joint choose between them, docs/user/hair-and-points.md), and
+    where the segments of a strand that reach it are not all visible (the
+    overlay's choice at a joint cannot see the viewport's depth); and as in
+    the meshes' overlay test, where
+    Blender's depth decides rather than the model (image model §5.6) and
+    where a strand or disc lies within the overlay's depth bias of the
+    visible surface, in front or behind."""
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+
+    log.forget()
+    ensure_gpu()
+    scene = build_strands(hair, mesh, camera, line, transform)
+    with recipe_on_failure(strand_recipe(hair, mesh, camera, line, transform)):
+        viewport = robustness.Viewport(W, H)
+        _stats, alpha = viewport.draw(scene)
+        assert np.isfinite(alpha).all(), "NaN/Inf pixels"
+        mesh_ref = reference.render_reference(scene, depth_layers=True)
+        ref = strand_reference.render_strand_reference(scene, mesh=mesh_ref)
+        tied = viewport.within_bias(mesh_ref.depth, ref.depth) & viewport.within_bias(ref.depth, mesh_ref.depth)
+        partly_hidden = (ref.reached_any > 1) & (ref.reached < ref.reached_any)
+        ref.on_silhouette |= (
+            viewport.blender_decides(mesh_ref)
+            | tied
+            | (ref.groups > 1)
+            | ref.apart
+            | (ref.reached_any > 2)
+            | partly_hidden
+        )
+        accuracy.assert_accurate(strand_reference.error_report(alpha, ref))

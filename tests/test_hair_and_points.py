@@ -430,3 +430,58 @@ def test_a_strand_through_the_near_plane_keeps_its_distance(path, output_dir):
     accuracy.assert_accurate(report)
     assert report["max"] < 0.01
     assert (ref.strand > 0.99).sum() > 150  # the strand really crosses the frame
+
+
+@pytest.mark.parametrize("path", ["render", "overlay"])
+@pytest.mark.parametrize("reach", ["width", "radius"])
+def test_lines_that_reach_into_the_view_from_outside_are_drawn(reach, path, output_dir):
+    """Primitives just outside the frame that reach into it: a point and a
+    strand by their lines' width, or a strand of an object squashed along
+    the view's x by its radius (which is the same in every direction
+    whatever the object's scale). None is left out for lying outside the
+    view: the frustum test widens by that reach."""
+    # 40 px per unit: the frame spans x in [-2, 2], z in [-1.5, 1.5].
+    if reach == "width":
+        scene = scenes.empty_scene(160, 120, thickness=40.0, softness=0.5)
+        strand_scenes.point_cloud(scene, "Points", [(2.3, 0.0, -0.5)], 0.0)
+        strand_scenes.hair(scene, "Hair", [[(-2.3, 0.0, -1.0), (-2.3, 0.0, 0.0)]], [0.0])
+    else:
+        scene = scenes.empty_scene(160, 120, thickness=1.0, softness=0.5)
+        strand_scenes.hair(scene, "Hair", [[(23.0, 0.0, -0.05), (23.0, 0.0, 0.05)]], [0.5], scale=(0.1, 1.0, 10.0))
+    scenes.add_camera(scene, location=(0.0, -10.0, 0.0), target=(0.0, 0.0, 0.0), ortho_scale=4.0)
+    ref = strand_reference.render_strand_reference(scene)
+    alpha = robustness.image_alpha(scene, path, output_dir / f"reach_in_{reach}_{path}.png")
+    report = strand_reference.error_report(alpha, ref)
+    print(report)
+    accuracy.assert_accurate(report)
+    if reach == "width":  # the point's outline on the right, the strand's on the left
+        assert (ref.strand[:, 150:] > 0.99).sum() > 50
+        assert (ref.strand[:, :10] > 0.99).sum() > 50
+    else:  # the tube on the right
+        assert (ref.strand[:, 150:] > 0.99).sum() > 200
+
+
+@pytest.mark.parametrize("case", ["sharp_turn", "through_the_near_plane"])
+def test_overlay_paints_a_joint_once_with_the_render_s_winner(case, output_dir):
+    """Where two segments of a strand meet, the overlay paints each pixel
+    once, with the larger intensity of the two (the nearer front where
+    they tie), as the render's winner does: a strand that turns sharply,
+    wide at its ends and thin at the joint (each segment's wide part
+    reaches across the other's side of the joint's bisector, which alone
+    used to decide), and a strand whose first segment comes from behind
+    the camera (its neighbour used to find no bisector there and paint
+    over it)."""
+    if case == "sharp_turn":
+        scene = scenes.empty_scene(160, 120, thickness=1.0, softness=1.0)
+        strand_scenes.hair(scene, "Hair", [[(-1.5, 0.0, 1.2), (0.0, 0.0, -1.0), (-0.5, 0.0, 1.2)]], [[0.35, 0.0, 0.35]])
+        scenes.add_camera(scene, location=(0.0, -10.0, 0.0), target=(0.0, 0.0, 0.0), ortho_scale=4.0)
+    else:
+        scene = scenes.empty_scene(160, 120, thickness=3.0, softness=1.0)
+        strand_scenes.hair(scene, "Hair", [[(-0.3, -2.5, 1.0), (0.05, 0.0, 0.95), (-0.05, 0.1, 0.87)]], [0.0])
+        scenes.add_clipped_corners_camera(scene)  # (the first point lies behind it)
+    ref = strand_reference.render_strand_reference(scene)
+    alpha = robustness.image_alpha(scene, "overlay", output_dir / f"joint_{case}.png")
+    report = strand_reference.error_report(alpha, ref)
+    print(report)
+    accuracy.assert_accurate(report)
+    assert ((ref.reached_any == 2) & (ref.strand > 0.5)).sum() > 20  # the two segments really meet there

@@ -1095,6 +1095,13 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             iface.flat("VEC2", "seg_radius")
             if overlay_bias:
                 iface.flat("VEC4", "seg_split")  # bisector normals at the two joints (overlay)
+                iface.flat("VEC4", "seg_points")  # its two points and their neighbours (overlay)
+                # The neighbour segments from each joint (strand_vert.glsl, neighbour_from_joint).
+                iface.flat("VEC4", "neighbour_a_window")
+                iface.flat("VEC4", "neighbour_a_depth")
+                iface.flat("VEC4", "neighbour_b_window")
+                iface.flat("VEC4", "neighbour_b_depth")
+                iface.flat("VEC4", "neighbour_radii")
         info = pulling_info()
         # Push constants: 104 of the 128 bytes every backend guarantees with
         # the overlay's display_shaper (draw_range draws exactly the
@@ -1135,7 +1142,12 @@ def get_strand(points: bool, variant: ShaderVariant, overlay_bias: float = 0.0):
             info.uniform_buf(2, "SolidWireClip", "clip_params")
             info.typedef_source(schema.param_block_glsl() + CLIP_BLOCK_GLSL)
             info.define("USE_CLIP_PLANES", "1")
-        common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("line_style.glsl")
+        common = (
+            read_source("common.glsl")
+            + read_source("edge_geometry.glsl")
+            + read_source("line_style.glsl")
+            + read_source("strand_common.glsl")
+        )
         info.vertex_source(common + read_source("strand_vert.glsl"))
         info.fragment_source(common + _display_source(flags) + shading_source + read_source("strand_frag.glsl"))
         shader = _keep(_cache, (_context, "strand", key), gpu.shader.create_from_info(info))

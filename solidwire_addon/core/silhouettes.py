@@ -37,7 +37,7 @@ from . import shaders
 from .cache import table_texture, texture_bytes
 from .draw import DrawTarget, bind_display_transform, indexed_quad_batch, params_block, shader_variant
 from .extract import EDGE0_REAL, EDGE1_REAL, EDGE2_REAL
-from .view import translation
+from .view import line_reach, translation
 
 NO_FACE = -1.0
 # Each triangle corner's next one and the third one.
@@ -47,17 +47,10 @@ _THIRD_CORNER = np.array([2, 0, 1], np.intp)
 
 def outer_reach(settings, view) -> tuple | None:
     """How far past its mesh's own projection an outer half can reach, as
-    view.outside_frustum_many's ``reach`` (pixels, pixels times clip w,
-    window width, height), or None with silhouettes off: the fin's reach of
-    shaders/silhouette_vert.glsl (the widest core, its fall-off and a pixel;
-    in world widths the core's pixels at clip w = 1 over w)."""
-    if not settings.use_silhouettes:
-        return None
-    pixels = 0.5 * max(float(settings.thickness), float(settings.thickness_far)) + 2.0 * float(settings.softness) + 1.0
-    per_w = 0.0
-    if settings.thickness_mode == "WORLD":  # (settings.pack_params' world_half_thickness_px)
-        per_w = 0.5 * max(float(settings.world_thickness), 0.0) * 0.5 * view.height * abs(float(view.projection[1][1]))
-    return (pixels, per_w, view.width, view.height)
+    view.outside_frustum_many's ``reach`` (view.line_reach: the fin's reach
+    of shaders/silhouette_vert.glsl is the line's), or None with
+    silhouettes off."""
+    return line_reach(settings, view) if settings.use_silhouettes else None
 
 
 def candidate_edges(triangles: np.ndarray, edge_flags: np.ndarray) -> np.ndarray:

@@ -42,7 +42,7 @@ from .draw import (
 )
 from .log import one_line, warn_once
 from .targets import read_texture
-from .view import determinant3, outside_frustum_many, translation
+from .view import determinant3, line_reach, outside_frustum_many, translation
 
 CURVES, POINTS = "curves", "points"
 
@@ -57,10 +57,12 @@ class StrandGeometry:
 
     ``points`` (N, 4) float32: position relative to ``centre`` (float64; the
     draw composes the translation in float64 so large coordinates keep their
-    precision) and radius. ``segments`` (S, 4) float32 rows (i0, i1,
-    previous, next) of point indices (curves only): the segment's ends and
-    the points before i0 and after i1 along the strand (-1: none), which
-    the overlay uses to split a joint between its two segments."""
+    precision) and radius; ``bounds_min``/``bounds_max`` the box of those
+    positions, ``radius_max`` the largest radius (object units).
+    ``segments`` (S, 4) float32 rows (i0, i1, previous, next) of point
+    indices (curves only): the segment's ends and the points before i0 and
+    after i1 along the strand (-1: none), which the overlay uses to decide
+    which of the two segments at a joint paints a pixel."""
 
     kind: str
     points: np.ndarray
@@ -68,6 +70,7 @@ class StrandGeometry:
     centre: np.ndarray
     bounds_min: np.ndarray
     bounds_max: np.ndarray
+    radius_max: float
     dropped: int = 0  # points left out for a non-finite position or radius
     _textures: tuple | None = None
 
@@ -154,14 +157,14 @@ def _finish(kind, values: np.ndarray, segments: np.ndarray | None, dropped: int)
         return None
     lo, hi = values[:, :3].min(axis=0), values[:, :3].max(axis=0)
     centre = 0.5 * (lo + hi)
-    reach = float(np.max(values[:, 3], initial=0.0))
     rows = values.copy()
     rows[:, :3] -= centre
     rows = rows.astype(np.float32)
     seg_rows = None
     if segments is not None:
         seg_rows = np.asarray(segments, dtype=np.float32)
-    return StrandGeometry(kind, rows, seg_rows, centre, lo - centre - reach, hi - centre + reach, dropped)
+    radius_max = float(np.max(values[:, 3], initial=0.0))
+    return StrandGeometry(kind, rows, seg_rows, centre, lo - centre, hi - centre, radius_max, dropped)
 
 
 def bezier(points: np.ndarray, left: np.ndarray, right: np.ndarray, resolution: int, cyclic: bool) -> np.ndarray:
@@ -386,7 +389,12 @@ def _draw(items, view, settings, target: DrawTarget, scene_depth=None) -> int:
                 continue
             object_to_view = view.view_matrix @ item.matrix @ translation(geometry.centre)
             object_to_clip = view.projection @ object_to_view
-            if outside_frustum_many(object_to_clip[None], geometry.bounds_min, geometry.bounds_max)[0]:
+            radius_scale = _radius_scale(item.matrix)
+            # A line reaches past its points by its width and, in any
+            # direction whatever the object's scale, by its radius (pixels
+            # at clip w = 1): the vertex stage's quads (strand_vert.glsl).
+            reach = line_reach(styled(settings, item.style), view, geometry.radius_max * radius_scale * px_per_unit)
+            if outside_frustum_many(object_to_clip[None], geometry.bounds_min, geometry.bounds_max, reach)[0]:
                 continue
             if shader is None:
                 shader = shaders.get_strand(kind == POINTS, variant, overlay_bias)
@@ -412,7 +420,7 @@ def _draw(items, view, settings, target: DrawTarget, scene_depth=None) -> int:
             shader.uniform_block("params", block)
             shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
-            shader.uniform_float("strand_view", [px_per_unit, _radius_scale(item.matrix), 0.0, 0.0])
+            shader.uniform_float("strand_view", [px_per_unit, radius_scale, 0.0, 0.0])
             point_table, segment_table = geometry.textures()
             shader.uniform_sampler("vertex_positions", point_table)
             if segment_table is not None:

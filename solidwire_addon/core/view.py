@@ -232,6 +232,18 @@ def outside_frustum_many(object_to_clip: np.ndarray, bounds_min, bounds_max, rea
     return (x > wx).all(1) | (x < -wx).all(1) | (y > wy).all(1) | (y < -wy).all(1) | (z < -w).all(1)
 
 
+def line_reach(settings, view, per_w: float = 0.0) -> tuple:
+    """How far past its geometry's own projection a line drawn with
+    ``settings`` can reach, as outside_frustum_many's ``reach`` (pixels,
+    pixels times clip w, window width, height): the widest half-thickness,
+    two softness widths and a pixel (a world thickness in pixels at clip
+    w = 1, over w), and ``per_w`` more at clip w = 1 (a strand's radius)."""
+    pixels = 0.5 * max(float(settings.thickness), float(settings.thickness_far)) + 2.0 * float(settings.softness) + 1.0
+    if settings.thickness_mode == "WORLD":  # (settings.pack_params' world_half_thickness_px)
+        per_w += 0.5 * max(float(settings.world_thickness), 0.0) * 0.5 * view.height * abs(float(view.projection[1][1]))
+    return (pixels, per_w, view.width, view.height)
+
+
 def wholly_in_front(object_to_clip: np.ndarray, bounds_min, bounds_max) -> bool:
     """Whether every box of (N, 4, 4) ``object_to_clip`` lies in front of the
     near plane (clip z + w > 0 at every corner) with a margin of 1e-4 of the

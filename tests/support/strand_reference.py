@@ -48,6 +48,10 @@ class StrandReference:
     on_silhouette: np.ndarray  # (H, W) mesh silhouettes and undecided occlusion
     depth: np.ndarray  # (H, W) depth of the winner (inf: none)
     mesh: reference.ReferenceResult
+    reached: np.ndarray  # (H, W) how many primitives (strand segments, points) reach the sample unhidden
+    reached_any: np.ndarray  # (H, W) the same, hidden or not
+    groups: np.ndarray  # (H, W) how many strands and points reach it, hidden or not (a strand's segments are one)
+    apart: np.ndarray  # (H, W) two segments of one strand reach it that do not meet, or not only those that do
 
 
 def catmull_rom(points, resolution, cyclic):
@@ -55,8 +59,9 @@ def catmull_rom(points, resolution, cyclic):
     2 p0 - p1), float64."""
     points = np.asarray(points, dtype=np.float64)
     n = len(points)
-    if n < 2 or resolution <= 1:
+    if n < 2:
         return points
+    resolution = max(int(resolution), 1)  # (at 1, a closed curve still has its closing segment)
     ext = (
         np.concatenate([points[-1:], points, points[:2]])
         if cyclic
@@ -110,9 +115,12 @@ def _attribute(data, name, count, width, prop, dtype=np.float64):
 
 
 def primitives(depsgraph, show="show_in_render"):
-    """(segments [(A, B, rA, rB, matrix, name)], points [(p, r, matrix, name)])
-    of every shown Curves / PointCloud instance, object space."""
+    """(segments [(A, B, rA, rB, matrix, name, strand)], points [(p, r,
+    matrix, name)]) of every shown Curves / PointCloud instance, object
+    space; ``strand`` numbers the strands (a strand's segments are
+    consecutive)."""
     segments, points = [], []
+    strand = 0
     for instance in depsgraph.object_instances:
         obj = instance.object
         if obj.type not in ("CURVES", "POINTCLOUD"):
@@ -164,9 +172,12 @@ def primitives(depsgraph, show="show_in_render"):
                 pairs = [(i, i + 1) for i in range(len(ev) - 1)] + (
                     [(len(ev) - 1, 0)] if closed and len(ev) > 2 else []
                 )
+            strand += 1
             for i, j in pairs:
                 if np.isfinite(ev[i]).all() and np.isfinite(ev[j]).all():
-                    segments.append((ev[i, :3], ev[j, :3], max(ev[i, 3], 0.0), max(ev[j, 3], 0.0), matrix, obj.name))
+                    segments.append(
+                        (ev[i, :3], ev[j, :3], max(ev[i, 3], 0.0), max(ev[j, 3], 0.0), matrix, obj.name, strand)
+                    )
     return segments, points
 
 
@@ -189,15 +200,30 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
     best_z = np.full((height, width), np.inf)
     undecided = np.zeros((height, width), bool)
     near = np.zeros((height, width), bool)  # a candidate so far sat on a bucket boundary
+    reached = np.zeros((height, width), np.int32)
+    reached_any = np.zeros((height, width), np.int32)
+    groups = np.zeros((height, width), np.int32)
+    last_group = np.full((height, width), np.iinfo(np.int64).min, np.int64)  # (no group yet)
+    last_order = np.full((height, width), -2, np.int64)
+    apart = np.zeros((height, width), bool)
 
     def window(clip):
         return np.array([(clip[0] / clip[3] + 1) * 0.5 * width, (clip[1] / clip[3] + 1) * 0.5 * height])
 
-    def consider(x0, x1, y0, y1, weight, intensity, depth):
-        """Offer a primitive's values over the pixel box [x0, x1) x [y0, y1)."""
+    def consider(x0, x1, y0, y1, weight, intensity, depth, group, order=-2):
+        """Offer a primitive's values (of strand or point ``group``, the
+        ``order``-th segment of all) over the pixel box [x0, x1) x [y0, y1)."""
         box = (slice(y0, y1), slice(x0, x1))
         lim = limit[box]
         visible = (depth <= lim) & (weight > 0)
+        reached[box] += visible
+        reaches = (weight > 0) & (depth <= far)
+        reached_any[box] += reaches
+        new_group = reaches & (last_group[box] != group)
+        groups[box] += new_group
+        apart[box] |= reaches & ~new_group & (last_order[box] != order - 1)
+        last_group[box] = np.where(new_group, group, last_group[box])
+        last_order[box] = np.where(reaches, order, last_order[box])
         close = np.isfinite(lim) & (np.abs(depth - lim) <= UNDECIDED * np.maximum(np.abs(lim), 1e-9)) & (weight > 0)
         undecided[box] |= close
         bw, bz = best_w[box], best_z[box]
@@ -220,7 +246,7 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
         return x0, x1, y0, y1
 
     segments, points = primitives(depsgraph)
-    for a_obj, b_obj, ra, rb, matrix, _name in segments:
+    for order, (a_obj, b_obj, ra, rb, matrix, _name, strand) in enumerate(segments):
         scale = abs(np.linalg.det(matrix[:3, :3])) ** (1 / 3)
         o2v = view_matrix @ matrix
         va, vb = o2v @ np.append(a_obj, 1.0), o2v @ np.append(b_obj, 1.0)
@@ -257,8 +283,11 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
         value = reference.profile(d, 2.0 * np.maximum(h, r * ppu / w), soft)  # (full width)
         if getattr(s, "use_fade", False):
             value = value * reference._fade(s, z)
-        consider(x0, x1, y0, y1, value, value, z - r)
-    for p_obj, r, matrix, _name in points:
+        consider(x0, x1, y0, y1, value, value, z - r, strand, order)
+        undecided[y0:y1, x0:x1] |= _end_by_rounding(
+            px, py, wa_, wb_, reach, (ka[3], kb[3]), (za, zb), (ra, rb), h, s, ppu
+        )
+    for point_number, (p_obj, r, matrix, _name) in enumerate(points):
         scale = abs(np.linalg.det(matrix[:3, :3])) ** (1 / 3)
         v = view_matrix @ matrix @ np.append(p_obj, 1.0)
         k = proj @ v
@@ -276,13 +305,44 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
         value = reference.profile(np.abs(rim), 2.0 * h, soft)
         if getattr(s, "use_fade", False):
             value = value * reference._fade(s, np.full_like(px, -v[2]))
-        consider(x0, x1, y0, y1, np.where(rim <= 0, 1.0, value), value, np.full_like(px, -v[2] - r))
+        consider(x0, x1, y0, y1, np.where(rim <= 0, 1.0, value), value, np.full_like(px, -v[2] - r), -1 - point_number)
 
     wire_alpha = float(s.wire_color[3])
     a_s = best_i * wire_alpha
     a_m = mesh.intensity * wire_alpha
     total = (a_s + (1 - a_s) * a_m) / max(wire_alpha, 1e-12)
-    return StrandReference(total, best_i, best_w, mesh.on_silhouette | undecided, best_z, mesh)
+    return StrandReference(
+        total, best_i, best_w, mesh.on_silhouette | undecided, best_z, mesh, reached, reached_any, groups, apart
+    )
+
+
+def _end_by_rounding(px, py, wa, wb, reach, w_ends, z_ends, r_ends, h, s, ppu) -> np.ndarray:
+    """Samples (px, py) of a segment whose window direction float32 cannot
+    fix to 0.01 px over its reach (as a silhouette's, image model §7.2:
+    its ends' window coordinates carry about 2^-22 of their size M), where
+    that direction's error, M 2^-22 / |b - a| radians, could move the
+    nearest point q to the other end, and the two ends give different
+    intensities (their radius or depth differ): which end a sample measures
+    is rounding's choice there."""
+    ab = wb - wa
+    length = float(np.hypot(*ab))
+    size = max(np.abs(wa).max(), np.abs(wb).max())
+    slack = size * 2.0**-22
+    if length * reference.SIDE_REACH_PX >= reach * slack:
+        return np.zeros(px.shape, bool)
+    if length > 0:
+        along = ((px - wa[0]) * ab[0] + (py - wa[1]) * ab[1]) / length
+        across = np.abs((px - wa[0]) * ab[1] - (py - wa[1]) * ab[0]) / length
+        band = np.abs(along - 0.5 * length) <= 0.5 * length + across * slack / length + slack
+    else:
+        band = np.ones(px.shape, bool)
+    ends = []
+    for (ex, ey), w, z, r in zip((wa, wb), w_ends, z_ends, r_ends):
+        value = reference.profile(np.hypot(px - ex, py - ey), 2.0 * max(h, r * ppu / w), float(s.softness))
+        if getattr(s, "use_fade", False):
+            value = value * reference._fade(s, np.full_like(px, z))
+        ends.append(value)
+    return band & (np.abs(ends[0] - ends[1]) > 1e-3)
 
 
 def error_report(measured, ref: StrandReference) -> dict:

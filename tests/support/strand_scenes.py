@@ -44,8 +44,8 @@ def hair(
                     data.set_types(type=type_name, indices=indices)
         if handles is not None:
             for attribute, values in zip(("handle_left", "handle_right"), handles):
-                name = _HANDLE[attribute] if by_modifier else attribute
-                data.attributes.new(name, "FLOAT_VECTOR", "POINT").data.foreach_set(
+                stored = _HANDLE[attribute] if by_modifier else attribute
+                data.attributes.new(stored, "FLOAT_VECTOR", "POINT").data.foreach_set(
                     "vector", np.asarray(values, dtype=np.float32).ravel()
                 )
         if resolution is not None:
