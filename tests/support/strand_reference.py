@@ -19,7 +19,8 @@ Per sample c (pixel centre) and primitive:
 A primitive is visible at c when its depth <= the visible mesh surface's
 depth there (and the clip end). Of the visible ones, the largest weight
 wins, weights in the same step floor((1 - weight) * 1023) counting as equal
-and the nearest of those winning; its I gives a = wire alpha * I, composited "over"
+and the nearest of those winning (a depth below 0, a front behind the
+camera, counting as 0: two such in one step are a tie); its I gives a = wire alpha * I, composited "over"
 the mesh image: alpha = a + (1 - a) a_mesh.
 
 Samples where the occlusion test is undecided (primitive depth within a
@@ -228,7 +229,10 @@ def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> 
         undecided[box] |= close
         bw, bz = best_w[box], best_z[box]
         rank, best_rank = np.floor((1.0 - weight) * BUCKETS), np.floor((1.0 - bw) * BUCKETS)
-        better = visible & ((rank < best_rank) | ((rank == best_rank) & (depth < bz)))
+        # (A front behind the camera is at the camera: the render keys depth from 0.)
+        key, best_key = np.maximum(depth, 0.0), np.maximum(bz, 0.0)
+        better = visible & ((rank < best_rank) | ((rank == best_rank) & (key < best_key)))
+        undecided[box] |= visible & (bw > 0) & (rank == best_rank) & (key == 0.0) & (best_key == 0.0)
         # float32 may put a weight on the other side of a bucket boundary
         # (an exact 1 never moves); with a rival there, the winner is a tie.
         x = (1.0 - weight) * BUCKETS
