@@ -94,9 +94,16 @@ void line_through(vec2 window_a, vec2 window_b, out vec3 line, out vec2 span)
   vec2 wb = window_b - centre;
   vec2 ab = wb - wa;
   float len2 = dot(ab, ab);
+  if (len2 == 0.0) {
+    /* A single point (coincident ends, or an edge along a view ray) is a
+     * segment too (image model §3.2): any unit line through it, with an
+     * empty span, measures the distance to it. */
+    line = vec3(1.0, 0.0, -wa.x);
+    span = vec2(wa.y);
+    return;
+  }
   if (!(len2 > 0.0)) {
-    /* Projects to a point (an edge along a view ray): the faces beside it
-     * are edge-on, and its ends belong to other edges. */
+    /* A non-finite end: no projection, no distance. */
     line = vec3(0.0, 0.0, NO_EDGE);
     span = vec2(0.0);
     return;
@@ -153,6 +160,12 @@ void edge_setup(vec4 a, vec4 b, out vec3 line, out vec2 span)
    * there). Only the span uses the clipped end. */
   vec3 l = cross(window_homogeneous(a), window_homogeneous(b));
   float len2 = dot(l.xy, l.xy);
+  if (len2 == 0.0) {
+    /* Along a view ray: the front part projects to its front end's point. */
+    vec2 point = window_point((depth_a >= 0.0) ? a : b);
+    line_through(point, point, line, span);
+    return;
+  }
   if (!(len2 > 0.0)) {
     line = vec3(0.0, 0.0, NO_EDGE);
     span = vec2(0.0);

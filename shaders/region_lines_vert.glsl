@@ -75,7 +75,7 @@ void run_segment(int texel, bool used, float half_width, inout RunBox box, out v
    * lower-id end): the same bits as a block walk would compute. */
   edge_setup(a, b, line, span);
   if (dot(line.xy, line.xy) == 0.0) {
-    return; /* wholly behind the near plane, or a point */
+    return; /* wholly behind the near plane */
   }
   line_out = vec4(line, span.x);
   end_out = span.y;

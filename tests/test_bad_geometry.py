@@ -271,6 +271,40 @@ def test_an_edge_beside_a_dropped_face_stays_drawn_under_the_edge_angle(bad, out
     assert x_right > W // 2, "the quad's right edge, shared with the dropped face, is drawn"
 
 
+@pytest.mark.parametrize("edge_angle", [0.0, 0.5], ids=["own-faces", "one-region"])
+def test_an_edge_whose_ends_coincide_draws_the_point_it_shrinks_to(edge_angle, output_dir):
+    """An edge whose two vertices lie at one position (an unmerged seam, a
+    NURBS sphere's pole) is a point, drawn as the disc a very short edge
+    draws there (image model §3.2), whether the resolve or the region-lines
+    pass draws it. Here it is marked sharp (a class 6 px wide beside the
+    1 px wire), so the disc shows. Before, a point drew nothing while an
+    edge 1e-5 long drew the disc, so a render and the float64 reference
+    disagreed wherever float32 rounded such an edge to a point and float64
+    did not (a random text, curve and surface test: a pole's disc missing,
+    0.12 at its edge)."""
+    images = {}
+    for name, gap, sharp in (("point", 0.0, True), ("short", 1e-5, True), ("unmarked", 0.0, False)):
+        scene = scenes.empty_scene(
+            W, H, edge_angle=edge_angle, thickness=1.0, use_sharp_edges=True, sharp_thickness=6.0
+        )
+        # A 2 x 2 grid whose middle vertex is two: P (0) and P' (1), both
+        # corners of the lower right and upper left faces, whose shared
+        # edge P P' has no length.
+        verts = [(0.0, 0.0, 0.0), (gap, 0.0, 0.0)]
+        verts += [(x, 0.0, z) for z, x in ((-0.8, -0.9), (-0.8, 0.0), (-0.8, 0.9), (0.0, 0.9))]  # 2-5
+        verts += [(x, 0.0, z) for z, x in ((0.8, 0.9), (0.8, 0.0), (0.8, -0.9), (0.0, -0.9))]  # 6-9
+        faces = [(2, 3, 0, 9), (3, 4, 5, 1, 0), (1, 5, 6, 7), (9, 0, 1, 7, 8)]
+        obj = _mesh_object(scene, "Seam", verts, [], faces, (0.0, 0.0, 0.0))
+        next(e for e in obj.data.edges if set(e.vertices) == {0, 1}).use_edge_sharp = sharp
+        scenes.add_camera(scene, location=(0.2, -4.0, 0.3), target=(0.0, 0.0, 0.0))
+        report = accuracy.measure(scene, f"coincident_ends_{name}_{edge_angle}", output_dir)
+        accuracy.assert_accurate(report)
+        images[name] = scenes.load_png(output_dir / f"coincident_ends_{name}_{edge_angle}.png")[..., 3]
+    assert np.abs(images["point"] - images["short"]).max() <= 2.0 / 255.0
+    # Not vacuous: the class's disc adds to what the wire draws there.
+    assert (images["point"] - images["unmarked"]).sum() > 5.0
+
+
 def test_degenerate_triangles_are_counted():
     arrays = extract.build_arrays(
         positions=np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0)], np.float32),

@@ -1,10 +1,10 @@
-"""Property-based tests: random small meshes, cameras and settings, and
-random modifier stacks under cage edges. Every example renders through the
-real engine to a float EXR (the stacks, and the meshes with every line
-option, also through the viewport overlay) and must raise nothing, hold no
-NaN/Inf and agree with the float64 reference on non-silhouette pixels
-(p99.9 <= 2/255, max <= 0.1); drags of the stacks' vertices in the overlay
-must end on what a fresh frame draws. docs/dev/robustness.md (Fuzzing)
+"""Property-based tests: random small meshes, cameras and settings, random
+modifier stacks under cage edges, hair and point clouds, and text, curves,
+surfaces and metaballs. Every example renders through the real engine to a
+float EXR (most also through the viewport overlay) and must raise nothing,
+hold no NaN/Inf and agree with the float64 reference on non-silhouette
+pixels (p99.9 <= 2/255, max <= 0.1); drags of the stacks' vertices in the
+overlay must end on what a fresh frame draws. docs/dev/robustness.md (Fuzzing)
 says what each set draws and what its hunts found.
 
 Default CI runs a fixed, derandomised set of examples; a long random hunt:
@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, Phase, example, given, settings
 from hypothesis import strategies as st
-from mathutils import Matrix
+from mathutils import Matrix, Vector
 
 from solidwire_addon.core import log
 from tests.support import accuracy, reference, robustness, scenes, strand_reference, strand_scenes
@@ -49,15 +49,16 @@ point = st.tuples(coord, coord, coord)
 
 @st.composite
 def polygons(draw):
-    """A few triangles, quads and n-gons; some share vertices, some are far,
-    nearly degenerate or (rarely) hold a NaN/Inf corner."""
+    """A few triangles, quads and n-gons; some share vertices, some have
+    vertices at others' positions, some are far, nearly degenerate or
+    (rarely) hold a NaN/Inf corner."""
     verts: list[tuple] = []
     faces: list[tuple] = []
     for _ in range(draw(st.integers(1, 4))):
         size = draw(st.sampled_from([3, 3, 4, 4, 4, 5, 6]))
         face = []
         for _corner in range(size):
-            kind = draw(st.sampled_from(["new"] * 6 + ["shared", "near", "far", "bad"]))
+            kind = draw(st.sampled_from(["new"] * 6 + ["shared", "copy", "near", "far", "bad"]))
             if kind == "shared" and verts:
                 index = draw(st.integers(0, len(verts) - 1))
                 if index in face:
@@ -65,7 +66,11 @@ def polygons(draw):
                 else:
                     face.append(index)
                     continue
-            if kind == "near" and face:
+            if kind == "copy" and verts:
+                # A vertex of its own at another's exact position (an
+                # unmerged seam, a pole): edges of length 0 (§3.2).
+                verts.append(verts[draw(st.integers(0, len(verts) - 1))])
+            elif kind == "near" and face:
                 base = verts[face[-1]]
                 offset = draw(st.tuples(*[st.floats(-1e-3, 1e-3)] * 3))
                 verts.append(tuple(b + o for b, o in zip(base, offset)))
@@ -450,19 +455,26 @@ def test_random_meshes_with_every_line_option_in_the_overlay(mesh, camera, line,
     scene = build(mesh, camera, line, transform)
     mark_edges(scene.objects["Fuzz"].data, marked)
     with recipe_on_failure(repro(mesh, camera, line, transform) + f"\nmarked={marked!r}"):
-        viewport = robustness.Viewport(W, H)
-        _stats, alpha = viewport.draw(scene)
-        assert np.isfinite(alpha).all(), "NaN/Inf pixels"
-        ref = reference.render_reference(scene, depth_layers=True)
-        blender_decides = viewport.blender_decides(ref)
-        outer = np.zeros_like(blender_decides)
-        if line.get("use_silhouettes"):
-            without = reference.SettingsWith(scene.solidwire, use_silhouettes=False)
-            outer = ref.intensity != reference.render_reference(scene, settings=without).intensity
-            lighter = (alpha < ref.intensity - 0.1) & outer & ~blender_decides & ~ref.on_silhouette
-            assert not lighter.any(), f"{int(lighter.sum())} pixels lack outer halves"
-        ref.on_silhouette = ref.on_silhouette | blender_decides | outer
-        accuracy.assert_accurate(reference.error_report(alpha, ref))
+        check_overlay(scene)
+
+
+def check_overlay(scene, size=(W, H)):
+    """The overlay's first redraw of ``scene`` at ``size`` over Blender's
+    Solid shading depth against the reference, as
+    test_random_meshes_with_every_line_option_in_the_overlay says."""
+    viewport = robustness.Viewport(*size)
+    _stats, alpha = viewport.draw(scene)
+    assert np.isfinite(alpha).all(), "NaN/Inf pixels"
+    ref = reference.render_reference(scene, depth_layers=True)
+    blender_decides = viewport.blender_decides(ref)
+    outer = np.zeros_like(blender_decides)
+    if scene.solidwire.use_silhouettes:
+        without = reference.SettingsWith(scene.solidwire, use_silhouettes=False)
+        outer = ref.intensity != reference.render_reference(scene, settings=without).intensity
+        lighter = (alpha < ref.intensity - 0.1) & outer & ~blender_decides & ~ref.on_silhouette
+        assert not lighter.any(), f"{int(lighter.sum())} pixels lack outer halves"
+    ref.on_silhouette = ref.on_silhouette | blender_decides | outer
+    accuracy.assert_accurate(reference.error_report(alpha, ref))
 
 
 # Modifier stacks under cage edges (image model §3.5): a primitive, what
@@ -625,11 +637,7 @@ def test_random_modifier_stacks_under_cage_edges_in_the_overlay(stack, line, cam
     ensure_gpu()
     scene = build_stack(stack, line, camera)
     with recipe_on_failure(f"stack={stack!r}\nsettings={line!r}\ncamera={camera!r}"):
-        viewport = robustness.Viewport(*SIZE)
-        _stats, alpha = viewport.draw(scene)
-        ref = reference.render_reference(scene, depth_layers=True)
-        ref.on_silhouette |= viewport.blender_decides(ref)
-        accuracy.assert_accurate(reference.error_report(alpha, ref))
+        check_overlay(scene, SIZE)
 
 
 @st.composite
@@ -668,7 +676,6 @@ def test_random_drags_in_the_overlay_draw_what_a_fresh_frame_draws(stack, line, 
     centre (extract.reposition), so float32 may decide coverage
     differently within 2 pixels of a silhouette; elsewhere no pixel
     differs by more than 1.5/255."""
-    from mathutils import Vector
 
     from solidwire_addon.blender import runtime
     from solidwire_addon.blender.gpu_context import ensure_gpu
@@ -836,3 +843,149 @@ def test_random_strands_and_points_in_the_overlay(hair, mesh, camera, line, tran
             | partly_hidden
         )
         accuracy.assert_accurate(strand_reference.error_report(alpha, ref))
+
+
+# Tessellated sources (image model §3.9): text, curves with a fill, an
+# extrusion or a bevel, NURBS surfaces and metaballs, drawn as their
+# outlines and profiles (or, with Tessellation, every edge).
+@st.composite
+def tessellated_sources(draw):
+    """A text, curve, metaball or NURBS surface primitive, as
+    add_tessellated_source builds it."""
+    kind = draw(st.sampled_from(["FONT", "CURVE", "META", "SURFACE"]))
+    source = {
+        "kind": kind,
+        "resolution": draw(st.sampled_from([1, 2, 4, 12])),
+        "extrude": draw(st.sampled_from([0.0, 0.0, 0.05, 0.3, draw(st.floats(0.0, 0.5))])),
+        "bevel_depth": draw(st.sampled_from([0.0, 0.0, 0.02, 0.1, draw(st.floats(0.0, 0.2))])),
+        "bevel_resolution": draw(st.integers(0, 4)),
+        "show_tessellation": draw(st.booleans()),
+    }
+    if kind == "FONT":
+        # Letters with holes, dots, sharp and round corners; line breaks.
+        source["body"] = draw(st.text(alphabet="AaBbOo08@#!.,:;ilWMg&%$ \n", min_size=1, max_size=5))
+        source["size"] = draw(st.floats(0.3, 3.0))
+        source["shear"] = draw(st.sampled_from([0.0, 0.0, 0.3, -0.5]))
+        source["offset"] = draw(st.sampled_from([0.0, 0.0, 0.02, -0.02]))
+    elif kind == "CURVE":
+        source["points"] = [draw(point) for _ in range(draw(st.integers(2, 6)))]
+        source["flat"] = draw(st.booleans())
+        source["cyclic"] = draw(st.booleans())
+        source["spline"] = draw(st.sampled_from(["BEZIER", "POLY", "NURBS"]))
+        # The first of the list valid for the dimensions if this one is not.
+        source["fill_mode"] = draw(st.sampled_from(["FULL", "BACK", "FRONT", "HALF", "BOTH", "NONE"]))
+        source["handles"] = draw(st.sampled_from(["AUTO", "VECTOR", "ALIGNED"]))
+    elif kind == "META":
+        element = st.tuples(
+            point, st.floats(0.2, 1.5), st.sampled_from(["BALL", "CAPSULE", "PLANE", "ELLIPSOID", "CUBE"])
+        )
+        source["elements"] = draw(st.lists(element, min_size=1, max_size=3))
+        source["meta_resolution"] = draw(st.sampled_from([0.1, 0.2, 0.4]))
+    else:
+        source["surface"] = draw(st.sampled_from(["torus", "sphere", "cylinder", "surface", "curve", "circle"]))
+    return source
+
+
+def add_tessellated_source(scene, source):
+    """The object "FuzzSource" of ``source`` (tessellated_sources) in ``scene``."""
+    kind = source["kind"]
+    if kind == "SURFACE":
+        before = set(bpy.data.objects)
+        getattr(bpy.ops.surface, f"primitive_nurbs_surface_{source['surface']}_add")()
+        obj = next(o for o in bpy.data.objects if o not in before)
+        for collection in list(obj.users_collection):
+            collection.objects.unlink(obj)
+        scene.collection.objects.link(obj)
+        obj.name = "FuzzSource"
+        obj.data.resolution_u = obj.data.resolution_v = source["resolution"]
+        return obj
+    if kind == "META":
+        data = bpy.data.metaballs.new("FuzzSource")
+        data.resolution = data.render_resolution = source["meta_resolution"]
+        for co, radius, element_type in source["elements"]:
+            element = data.elements.new(type=element_type)
+            element.co, element.radius = co, radius
+    else:
+        data = bpy.data.curves.new("FuzzSource", kind)
+        data.resolution_u, data.render_resolution_u = source["resolution"], 0
+        data.extrude, data.bevel_depth = source["extrude"], source["bevel_depth"]
+        data.bevel_resolution = source["bevel_resolution"]
+        if kind == "FONT":
+            data.body, data.size = source["body"], source["size"]
+            data.shear, data.offset = source["shear"], source["offset"]
+        else:
+            _add_spline(data, source)
+    obj = bpy.data.objects.new("FuzzSource", data)
+    scene.collection.objects.link(obj)
+    return obj
+
+
+def _add_spline(curve, source):
+    curve.dimensions = "2D" if source["flat"] else "3D"
+    modes = ("NONE", "BACK", "FRONT", "BOTH") if source["flat"] else ("FULL", "BACK", "FRONT", "HALF")
+    curve.fill_mode = source["fill_mode"] if source["fill_mode"] in modes else modes[0]
+    points = [(x, y, 0.0) if source["flat"] else (x, y, z) for x, y, z in source["points"]]
+    spline = curve.splines.new(source["spline"])
+    if source["spline"] == "BEZIER":
+        spline.bezier_points.add(len(points) - 1)
+        for bezier_point, co in zip(spline.bezier_points, points):
+            bezier_point.co = co
+            bezier_point.handle_left_type = bezier_point.handle_right_type = source["handles"]
+    else:
+        spline.points.add(len(points) - 1)
+        for spline_point, co in zip(spline.points, points):
+            spline_point.co = (*co, 1.0)
+    spline.use_cyclic_u = source["cyclic"]
+
+
+def build_tessellated(source, camera, line, transform):
+    """``source`` under ``transform``, seen by ``camera`` moved by the centre
+    of the object's bounds (text runs along +x from its origin, surfaces and
+    metaballs are of any size: aimed at the origin, most would miss)."""
+    scene = empty_fuzz_scene(line, transform)
+    scene.solidwire.show_tessellation = source["show_tessellation"]
+    obj = add_tessellated_source(scene, source)
+    obj.location, obj.rotation_euler, obj.scale = transform["location"], transform["rotation"], transform["scale"]
+    bpy.context.view_layer.update()
+    centre = sum((obj.matrix_world @ Vector(corner) for corner in obj.bound_box), Vector()) / 8.0
+    moved = {key: tuple(a + b for a, b in zip(camera[key], centre)) for key in ("location", "target")}
+    scenes.add_camera(scene, **{**camera, **moved})
+    return scene
+
+
+# A tessellated source's scene: build_tessellated's arguments, with the
+# line options of the meshes' richest set (their edge marks apart: these
+# objects have no mesh of their own to mark).
+TESSELLATED_SCENES = dict(source=tessellated_sources(), camera=cameras(), line=rich_settings(), transform=transforms())
+
+
+def tessellated_recipe(source, camera, line, transform) -> str:
+    return f"source={source!r}\ncamera={camera!r}\nsettings={line!r}\ntransform={transform!r}"
+
+
+@FUZZ
+@given(**TESSELLATED_SCENES)
+def test_random_tessellated_sources_match_reference(source, camera, line, transform, tmp_path_factory):
+    """Random text, curves, metaballs and NURBS surfaces in the F12 render,
+    against the reference of their evaluated meshes under §3.9."""
+    line = {key: value for key, value in line.items() if key != "marked"}
+    log.forget()
+    scene = build_tessellated(source, camera, line, transform)
+    with recipe_on_failure(tessellated_recipe(source, camera, line, transform)):
+        check(scene, tmp_path_factory.getbasetemp() / "fuzz_tessellated.exr")
+
+
+@FUZZ
+@given(**TESSELLATED_SCENES)
+def test_random_tessellated_sources_in_the_overlay(source, camera, line, transform):
+    """The same scenes in the overlay's first redraw, over Blender's Solid
+    shading depth of the objects' tessellation, as the meshes' overlay test
+    compares them."""
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+
+    line = {key: value for key, value in line.items() if key != "marked"}
+    log.forget()
+    ensure_gpu()
+    scene = build_tessellated(source, camera, line, transform)
+    with recipe_on_failure(tessellated_recipe(source, camera, line, transform)):
+        check_overlay(scene)

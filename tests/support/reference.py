@@ -1634,8 +1634,6 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
         pix_xy = np.stack([covered % width + 0.5, rows[covered // width] + 0.5], axis=1).astype(np.float64)
         pix_face = face[covered]
         wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
-        # An edge that projects to a single point draws no line (§3.1).
-        valid &= (wa != wb).any(axis=1)
         softness = float(s.softness)
         thickness = _thickness_at(s, depth[covered], proj, height, geo.face_thickness[pix_face])
         value, d_real, winner, density, tied = _line_intensity(

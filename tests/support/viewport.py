@@ -22,12 +22,15 @@ from solidwire_addon.blender.gpu_context import ensure_gpu
 from solidwire_addon.blender.views import camera_view
 from solidwire_addon.core.view import View
 
+# The object types whose surfaces Solid shading draws into the depth.
+SURFACE_TYPES = ("MESH", "CURVE", "FONT", "SURFACE", "META")
+
 
 def draw_scene_depth(framebuffer, size, depsgraph, view: View, objects) -> None:
     """Into ``framebuffer``, the depth Blender's Solid shading leaves for
-    ``objects`` (evaluated meshes; others, and meshes without triangles, are
-    skipped): object-space float32 positions through a float32
-    model-view-projection, no re-centring, no float64. The overlay plans
+    ``objects`` (the evaluated meshes of SURFACE_TYPES; others, and meshes
+    without triangles, are skipped): object-space float32 positions
+    through a float32 model-view-projection, no re-centring, no float64. The overlay plans
     Solid shading with Blender's depth holding every surface it draws, so a
     test of that mode draws this first."""
     from gpu_extras.batch import batch_for_shader
@@ -44,16 +47,21 @@ def draw_scene_depth(framebuffer, size, depsgraph, view: View, objects) -> None:
             gpu.matrix.load_projection_matrix(projection)
             for obj in objects:
                 obj_eval = obj.evaluated_get(depsgraph)
-                if obj_eval.type != "MESH":
+                if obj_eval.type not in SURFACE_TYPES:
                     continue
-                mesh = obj_eval.data
-                mesh.calc_loop_triangles()
-                if not len(mesh.loop_triangles):
+                # Text, curves, surfaces and metaballs: their tessellation,
+                # which Solid shading draws as it draws a mesh.
+                mesh = obj_eval.to_mesh()
+                try:
+                    mesh.calc_loop_triangles()
+                    coords = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+                    mesh.vertices.foreach_get("co", coords)
+                    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+                    mesh.loop_triangles.foreach_get("vertices", tris)
+                finally:
+                    obj_eval.to_mesh_clear()
+                if not len(tris):
                     continue
-                coords = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-                mesh.vertices.foreach_get("co", coords)
-                tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
-                mesh.loop_triangles.foreach_get("vertices", tris)
                 batch = batch_for_shader(shader, "TRIS", {"pos": coords.reshape(-1, 3)}, indices=tris.reshape(-1, 3))
                 gpu.matrix.load_matrix(view_matrix @ obj_eval.matrix_world)
                 shader.bind()
