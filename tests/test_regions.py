@@ -898,6 +898,33 @@ def test_peeled_hidden_layers_beside_faces_of_their_own(classed, output_dir):
     assert solidwire_addon.stats().get("hidden_region_layers", 0) >= 2
 
 
+def test_a_region_with_no_lines_beside_one_with_them_under_hidden_lines(output_dir):
+    """A closed part whose edges the edge angle all hides is a region that
+    owns no line (a separate eyeball beside an open body), numbered after
+    the open part's region, whose boundary lines it owns. Under hidden
+    lines the render sizes the regions' walks (cache.GPUMesh.region_sizes)
+    and took the line-less region's count from past the end of its table:
+    the whole F12 failed (a random metaball test: "index 54 is out of
+    bounds")."""
+    scene = scenes.empty_scene(120, 90, use_cage_edges=False, edge_angle=3.0, use_hidden_lines=True)
+    verts = [
+        (-2.0, 0.0, -0.5),
+        (-1.0, 0.0, -0.5),
+        (0.0, 0.0, -0.5),
+        (-2.0, 0.0, 0.5),
+        (-1.0, 0.0, 0.5),
+        (0.0, 0.0, 0.5),
+    ]
+    faces = [(0, 1, 4, 3), (1, 2, 5, 4)]  # an open strip: its outline is drawn
+    verts += [(1.0, -0.5, -0.5), (2.0, -0.5, -0.5), (1.5, 0.5, -0.5), (1.5, 0.0, 0.5)]
+    faces += [(6, 8, 7), (6, 7, 9), (7, 8, 9), (8, 6, 9)]  # a tetrahedron: every edge hidden
+    scenes.from_pydata(scene, "OpenAndClosed", verts, faces)
+    scenes.add_camera(scene, location=(0.5, -5.0, 2.0), target=(0.0, 0.0, 0.0))
+    report = accuracy.measure(scene, "regions_one_without_lines", output_dir)
+    accuracy.assert_accurate(report)
+    _assert_region_lines_drawn()
+
+
 def test_the_edge_flags_are_made_only_for_a_pass_that_reads_them(output_dir):
     """A cage look's resolve takes every line from the region-lines image
     and reads no triangle's edge flags, with the Edge Distance pass too (d

@@ -328,9 +328,12 @@ class GPUMesh:
             sizes = (0, 0.0, self.triangle_count)
         else:
             owners = np.concatenate([lines[0::2, 3], lines[1::2, 2]]).astype(np.int64)
-            counts = np.bincount(owners[owners >= 0])
             in_regions = regions >= 0
             of_triangle = regions[in_regions].astype(np.int64)
+            # (A region may own no line at all: a closed surface whose
+            # edges the edge angle hides, with no class. It counts 0.)
+            most_region = int(of_triangle.max()) + 1 if len(of_triangle) else 0
+            counts = np.bincount(owners[owners >= 0], minlength=most_region)
             mean = float(counts[of_triangle].mean()) if len(of_triangle) else 0.0
             outside = self.triangle_count - len(of_triangle)
             sizes = (int(counts.max()) if len(counts) else 0, mean, outside)
