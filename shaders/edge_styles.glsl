@@ -6,9 +6,10 @@
  * file. */
 
 /* A class's half width where the wire's is `wire_half_thickness`: its own
- * width scaled as the wire's is scaled from the Thickness in the parameter
- * block (the thickness mode's factor; an object's override is already in
- * both, draw.styled); unscaled where that Thickness is 0. */
+ * width scaled as the wire's is scaled from the scene's Thickness (image
+ * model §3.6: the thickness mode's factor, and an object's own Thickness,
+ * which is in the wire's width but not in class_width_scale); unscaled
+ * where the scene's Thickness is 0. */
 float style_half_thickness(int style, float wire_half_thickness)
 {
 #if STYLE_COUNT > 1
@@ -16,11 +17,9 @@ float style_half_thickness(int style, float wire_half_thickness)
     return wire_half_thickness;
   }
   float own = style_own_half_thickness(style);
-#  if THICKNESS_MODE != 0
   if (params.class_width_scale > 0.0) {
     own *= wire_half_thickness * params.class_width_scale;
   }
-#  endif
   return own;
 #else
   return wire_half_thickness;

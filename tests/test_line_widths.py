@@ -46,6 +46,44 @@ def test_class_widths_follow_the_wire(mode, override, output_dir):
     accuracy.assert_accurate(report)
 
 
+@pytest.mark.parametrize("mode", ["PIXELS", "DEPTH", "WORLD"])
+@pytest.mark.parametrize("scene_thickness, own_thickness", [(0.0, 3.0), (1.5, 0.0)], ids=["scene-0", "own-0"])
+def test_class_widths_where_one_thickness_is_0(mode, scene_thickness, own_thickness, output_dir):
+    """The ratio is to the scene's Thickness, never to an object's: at a
+    scene Thickness of 0 an object's classes keep their own widths whatever
+    its Thickness, and an object whose own Thickness is 0 keeps its classes
+    where its wire still has a width (World mode's comes from World
+    Thickness, Depth Cue's far end from Thickness Far). Before, the engine
+    divided by the object's Thickness: classes at a scene Thickness of 0
+    vanished in World widths (a random test of objects with their own
+    settings: 18 pixels up to 1.0), and an object's Thickness of 0 took
+    its classes' width away in every mode."""
+    scene = scenes.empty_scene(
+        200,
+        150,
+        thickness=scene_thickness,
+        use_sharp_edges=True,
+        sharp_thickness=4.0,
+        thickness_mode=mode,
+        thickness_far=2.0,
+        thickness_depth_start=4.0,
+        thickness_depth_end=9.0,
+        world_thickness=0.03,
+    )
+    cube = _classed_cube(scene)
+    cube.solidwire.use_override = True
+    cube.solidwire.thickness = own_thickness
+    scenes.add_camera(scene, location=(3.5, -5.0, 2.8), target=(0, 0.6, 0))
+    name = f"class_width_{mode.lower()}_scene_{scene_thickness}_own_{own_thickness}"
+    report = accuracy.measure(scene, name, output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    scene.solidwire.use_sharp_edges = False
+    without = reference.render_reference(scene)
+    if scene_thickness == 0.0 or mode != "PIXELS":
+        assert (ref.intensity - without.intensity).sum() > 50.0  # the classes show
+
+
 @pytest.mark.parametrize("thickness", [1e-30, 1.1754943508222875e-38])
 def test_a_class_beside_a_vanishing_thickness(thickness, output_dir):
     """In World widths a class is T_k / T times the wire's width: beside a

@@ -368,11 +368,10 @@ def styled(settings, style, show_wire: bool = True):
     pass whatever the override's colour (the fill-only surface pass under
     hidden lines)."""
     if style is not None:
-        # Class widths keep their ratio to the wire's (image model §3.6).
-        scale = style.thickness / settings.thickness if settings.thickness > 0.0 else 1.0
-        classes = {f"{name}_thickness": getattr(settings, f"{name}_thickness") * scale for name in EDGE_CLASSES}
+        # (Class widths follow the wire's through the parameter block's
+        # class_width_scale, which keeps the scene's Thickness: params_block.)
         settings = replace(
-            settings, wire_color=style.wire_color, thickness=style.thickness, fill_color=style.fill_color, **classes
+            settings, wire_color=style.wire_color, thickness=style.thickness, fill_color=style.fill_color
         )
     if not show_wire and settings.wire_color[3] != 0.0:
         settings = replace(settings, wire_color=(*settings.wire_color[:3], 0.0))
@@ -535,7 +534,7 @@ def draw(
         block = blocks.get(style)
         if block is None:
             block = blocks[style] = gpu.types.GPUUniformBuf(
-                params_block(styled(settings, style, show_wire), view, target)
+                params_block(styled(settings, style, show_wire), view, target, class_reference=settings.thickness)
             )
         return block
 
@@ -786,13 +785,14 @@ def _bind_extras(shader, variant, extras) -> None:
         shader.uniform_sampler("peel_depth", extras["peel_depth"])
 
 
-def params_block(settings, view: View, target: DrawTarget) -> bytes:
+def params_block(settings, view: View, target: DrawTarget, class_reference: float | None = None) -> bytes:
     """The parameter block of a draw of ``target`` in ``view``
-    (settings.pack_params): a viewport overlay's (``target.depth_bias``)
-    moves its surfaces towards the camera by Blender's depth allowance
-    (view.blender_depth_allowance)."""
+    (settings.pack_params; ``class_reference``: the scene's Thickness where
+    ``settings`` are an object's, styled): a viewport overlay's
+    (``target.depth_bias``) moves its surfaces towards the camera by
+    Blender's depth allowance (view.blender_depth_allowance)."""
     allowance = blender_depth_allowance(view) if target.depth_bias else NO_DEPTH_ALLOWANCE
-    return pack_params(settings, view.viewport, view.projection, allowance)
+    return pack_params(settings, view.viewport, view.projection, allowance, class_reference)
 
 
 def bind_display_transform(shader, display) -> None:

@@ -1323,10 +1323,9 @@ def _param_slots(names) -> list:
     return [slots[name] for name in names]
 
 
-_HALF_WIDTH_SLOTS = _param_slots(
-    ["half_thickness", "half_thickness_far"] + [f"{name}_half_thickness" for name in draw_mod.EDGE_CLASSES]
-)
-(_SOFTNESS_SLOT,) = _param_slots(["softness"])
+_WIRE_HALF_SLOTS = _param_slots(["half_thickness", "half_thickness_far"])
+_CLASS_HALF_SLOTS = _param_slots([f"{name}_half_thickness" for name in draw_mod.EDGE_CLASSES])
+(_SOFTNESS_SLOT, _CLASS_SCALE_SLOT) = _param_slots(["softness", "class_width_scale"])
 
 
 def _line_reach_px(settings, items) -> float | None:
@@ -1338,8 +1337,14 @@ def _line_reach_px(settings, items) -> float | None:
         return None
     reach = 0.0
     for style in {item.style for item in items} | {None}:
-        values = np.frombuffer(pack_params(draw_mod.styled(settings, style), (0.0, 0.0, 1.0, 1.0)), np.float32)
-        reach = max(reach, float(values[_HALF_WIDTH_SLOTS].max() + 2.0 * values[_SOFTNESS_SLOT]))
+        styled = draw_mod.styled(settings, style)
+        block = pack_params(styled, (0.0, 0.0, 1.0, 1.0), class_reference=settings.thickness)
+        values = np.frombuffer(block, np.float32)
+        wire = float(values[_WIRE_HALF_SLOTS].max())
+        # A class's half width as shaders/edge_styles.glsl scales it.
+        scale = float(values[_CLASS_SCALE_SLOT])
+        classes = float(values[_CLASS_HALF_SLOTS].max()) * (wire * scale if scale > 0.0 else 1.0)
+        reach = max(reach, max(wire, classes) + 2.0 * float(values[_SOFTNESS_SLOT]))
     return reach + 2.0
 
 

@@ -938,10 +938,11 @@ CLI_RANGES = (
 VIEW_PARAMS = (
     ("viewport", "vec4"),  # x0, y0, width, height of the target, px
     ("world_half_thickness_px", "float"),  # world_thickness / 2 in px at clip w = 1
-    # 2 / thickness (0 where it is 0, float32's largest where it overflows):
-    # what an edge class's width is multiplied by per unit of the wire's in
-    # the World and Depth Cue modes (image model §3.6). Divided in float64:
-    # a Thickness below float32's normal range would be 0 to a GPU.
+    # 2 / the scene's Thickness (0 where it is 0, float32's largest where
+    # it overflows): what an edge class's width is multiplied by per unit of
+    # the wire's, whose width carries the thickness mode and an object's own
+    # Thickness (image model §3.6). Divided in float64: a Thickness below
+    # float32's normal range would be 0 to a GPU.
     ("class_width_scale", "float"),
     ("inv_clip_end", "float"),  # 1 / the view's clip end (linear depth of the render)
     ("depth_rows", "vec4"),  # the projection's P22, P23, P32, P33 (view depth <-> window depth)

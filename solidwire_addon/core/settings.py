@@ -85,19 +85,25 @@ def _class_width_scale(thickness: float) -> float:
     return min(2.0 / thickness, float(np.finfo(np.float32).max))
 
 
-def pack_params(settings, viewport, projection=None, blender_depth_allowance=(0.0,) * 4) -> bytes:
+def pack_params(
+    settings, viewport, projection=None, blender_depth_allowance=(0.0,) * 4, class_reference: float | None = None
+) -> bytes:
     """The std140 parameter block (layout: schema.PARAM_BLOCK).
 
     ``projection`` (the view's) is needed for world-space thickness: window
     pixels per scene unit across the view at clip w = 1 are
     0.5 * height * projection[1][1]; the shader divides by the fragment's w.
     ``blender_depth_allowance``: the viewport overlay's
-    view.blender_depth_allowance, none elsewhere."""
+    view.blender_depth_allowance, none elsewhere. ``class_reference``: the
+    Thickness class widths keep their ratio to (image model §3.6), the
+    scene's; None: ``settings.thickness`` (they are the scene's)."""
+    if class_reference is None:
+        class_reference = settings.thickness
     px_per_unit = 0.0 if projection is None else 0.5 * float(viewport[3]) * abs(float(projection[1][1]))
     view_values = {
         "viewport": tuple(float(v) for v in viewport),
         "world_half_thickness_px": 0.5 * max(float(settings.world_thickness), 0.0) * px_per_unit,
-        "class_width_scale": _class_width_scale(float(settings.thickness)),
+        "class_width_scale": _class_width_scale(float(class_reference)),
         "inv_clip_end": 0.0 if projection is None else 1.0 / clip_end_of(projection),
         "depth_rows": (0.0,) * 4 if projection is None else depth_rows(projection),
         "blender_depth_allowance": tuple(float(v) for v in blender_depth_allowance),
