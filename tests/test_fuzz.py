@@ -479,12 +479,14 @@ def check_overlay(scene, size=(W, H)):
 
 # Several objects, each with its own settings (SPEC 3.3, image model §5.9):
 # an override's Thickness (0 included), which its classes' widths follow
-# under every thickness mode (§3.6), or an object left out of the render.
+# under every thickness mode (§3.6), or an object left out of the render;
+# some instanced (an instance takes the settings of the object it
+# instances).
 @st.composite
 def styled_objects(draw):
-    """1-3 random meshes, each with its edge marks, an offset, and None
-    (the scene's settings), a Thickness override or "hidden" (Show in
-    Render off)."""
+    """1-3 random meshes, each with its edge marks, an offset, None (the
+    scene's settings), a Thickness override or "hidden" (Show in Render
+    off), and 0-2 collection instances of it."""
     objects = []
     for _ in range(draw(st.integers(1, 3))):
         objects.append(
@@ -493,9 +495,23 @@ def styled_objects(draw):
                 "marked": draw(st.integers(0, 2**16 - 1)),
                 "offset": draw(st.tuples(*[st.floats(-1.0, 1.0)] * 3)),
                 "style": draw(st.sampled_from([None, None, "hidden", 0.0, 0.5, 6.0, draw(st.floats(0.0, 10.0))])),
+                # Collection instances of it (offset, rotation, scale, some
+                # mirrored), the object itself drawn too or not.
+                "instances": draw(st.lists(instance_transforms(), max_size=2)),
+                "keep_original": draw(st.booleans()),
             }
         )
     return objects
+
+
+@st.composite
+def instance_transforms(draw):
+    sign = draw(st.sampled_from([(1, 1, 1), (1, 1, 1), (-1, 1, 1), (1, -1, -1)]))
+    return (
+        draw(st.tuples(*[st.floats(-1.5, 1.5)] * 3)),
+        draw(st.tuples(*[st.floats(-math.pi, math.pi)] * 3)),
+        tuple(k * draw(st.floats(0.5, 1.5)) for k in sign),
+    )
 
 
 def build_styled(objects, camera, line, transform):
@@ -515,8 +531,25 @@ def build_styled(objects, camera, line, transform):
             # Colours apart: the alpha compared is the wire's intensity.
             obj.solidwire.use_override = True
             obj.solidwire.thickness = item["style"]
+        _instance(scene, obj, item["instances"], item["keep_original"])
     scenes.add_camera(scene, **camera)
     return scene
+
+
+def _instance(scene, obj, transforms, keep_original: bool) -> None:
+    """Collection instances of ``obj`` under ``transforms`` (none: nothing
+    changes); ``obj`` itself leaves the scene unless ``keep_original``."""
+    if not transforms:
+        return
+    collection = bpy.data.collections.new(f"{obj.name}Set")
+    collection.objects.link(obj)
+    if not keep_original:
+        scene.collection.objects.unlink(obj)
+    for k, (location, rotation, scale) in enumerate(transforms):
+        empty = bpy.data.objects.new(f"{obj.name}Copy{k}", None)
+        empty.instance_type, empty.instance_collection = "COLLECTION", collection
+        empty.location, empty.rotation_euler, empty.scale = location, rotation, scale
+        scene.collection.objects.link(empty)
 
 
 STYLED_SCENES = dict(objects=styled_objects(), camera=cameras(), line=rich_settings(), transform=transforms())
@@ -549,6 +582,84 @@ def test_random_objects_with_their_own_settings_in_the_overlay(objects, camera, 
     scene = build_styled(objects, camera, line, transform)
     with recipe_on_failure(f"objects={objects!r}\ncamera={camera!r}\nsettings={line!r}\ntransform={transform!r}"):
         check_overlay(scene)
+
+
+# Fill and wire colours (image model §5.1, §5.2, §5.8): every colour
+# source over random meshes with materials, object colours and colour
+# attributes of both domains and types, flat, Studio-lit or matcap-lit.
+channel = st.floats(0.0, 1.0)
+colour = st.tuples(channel, channel, channel)
+
+
+@st.composite
+def colour_looks(draw):
+    """line_settings with the fill on and every colour source and shading."""
+    values = draw(line_settings())
+    values.update(
+        use_fill=True,
+        fill_shading=draw(st.sampled_from(["FLAT", "STUDIO", "MATCAP"])),
+        matcap=draw(st.sampled_from(["clay_studio", "metal_carpaint", "toon_light"])),
+        fill_color_source=draw(st.sampled_from(["SINGLE", "OBJECT", "MATERIAL", "RANDOM", "ATTRIBUTE"])),
+        wire_color_source=draw(st.sampled_from(["SINGLE", "OBJECT", "RANDOM"])),
+        fill_color=draw(colour),
+        wire_color=(*draw(colour), draw(st.sampled_from([1.0, 1.0, 0.5, 0.0, draw(channel)]))),
+    )
+    return values
+
+
+@st.composite
+def paints(draw):
+    """What colours a mesh: its object colour, 0-2 materials (an empty slot
+    among them) over its faces, and a colour attribute (or none)."""
+    return {
+        "object_color": draw(colour),
+        "materials": draw(st.lists(st.none() | colour, max_size=2)),
+        "material_of_face": draw(st.lists(st.integers(0, 3), min_size=6, max_size=6)),
+        "attribute": draw(
+            st.none() | st.tuples(st.sampled_from(["POINT", "CORNER"]), st.sampled_from(["BYTE_COLOR", "FLOAT_COLOR"]))
+        ),
+        "attribute_seed": draw(st.integers(0, 2**16)),
+        "smooth": draw(st.booleans()),
+    }
+
+
+def paint(obj, paint_recipe):
+    """Colour ``obj`` as ``paint_recipe`` (paints) says."""
+    mesh = obj.data
+    obj.color = (*paint_recipe["object_color"], 1.0)
+    for k, rgb in enumerate(paint_recipe["materials"]):
+        material = None
+        if rgb is not None:
+            material = bpy.data.materials.new(f"Paint{k}")
+            material.diffuse_color = (*rgb, 1.0)
+        mesh.materials.append(material)
+    for poly in mesh.polygons:
+        poly.material_index = paint_recipe["material_of_face"][poly.index % 6]
+        poly.use_smooth = paint_recipe["smooth"]
+    if paint_recipe["attribute"] is not None:
+        domain, data_type = paint_recipe["attribute"]
+        attribute = mesh.color_attributes.new("Paint", data_type, domain)
+        rng = np.random.default_rng(paint_recipe["attribute_seed"])
+        values = rng.uniform(0.0, 1.0, (len(attribute.data), 4)).astype(np.float32)
+        values[:, 3] = 1.0
+        attribute.data.foreach_set("color", values.ravel())
+        mesh.color_attributes.active_color = attribute
+
+
+@FUZZ
+@given(mesh=polygons(), paint_recipe=paints(), camera=cameras(), line=colour_looks(), transform=transforms())
+def test_random_colours_match_reference(mesh, paint_recipe, camera, line, transform, tmp_path_factory):
+    """Random meshes under every fill and wire colour source and fill
+    shading: the file's colours against the reference's (A c_w + (1 - A)
+    times the shaded fill), as tests/test_fill_shading.py measures them."""
+    log.forget()
+    scene = build(mesh, camera, line, transform)
+    paint(scene.objects["Fuzz"], paint_recipe)
+    with recipe_on_failure(repro(mesh, camera, line, transform) + f"\npaint={paint_recipe!r}"):
+        rgba = scenes.render_to_file(scene, tmp_path_factory.getbasetemp() / "fuzz_colours.png")
+        ref = reference.render_reference(scene)
+        expected = reference.expected_fill_rgb(ref, float(scene.solidwire.wire_color[3]))
+        accuracy.assert_accurate(reference.color_error_report(rgba, expected, ref))
 
 
 # Modifier stacks under cage edges (image model §3.5): a primitive, what

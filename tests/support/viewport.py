@@ -28,9 +28,9 @@ SURFACE_TYPES = ("MESH", "CURVE", "FONT", "SURFACE", "META")
 
 def draw_scene_depth(framebuffer, size, depsgraph, view: View, objects) -> None:
     """Into ``framebuffer``, the depth Blender's Solid shading leaves for
-    ``objects`` (the evaluated meshes of SURFACE_TYPES; others, and meshes
-    without triangles, are skipped): object-space float32 positions
-    through a float32 model-view-projection, no re-centring, no float64. The overlay plans
+    ``objects`` and their instances (_surfaces; others, and meshes without
+    triangles, are skipped): object-space float32 positions through a
+    float32 model-view-projection, no re-centring, no float64. The overlay plans
     Solid shading with Blender's depth holding every surface it draws, so a
     test of that mode draws this first."""
     from gpu_extras.batch import batch_for_shader
@@ -45,31 +45,45 @@ def draw_scene_depth(framebuffer, size, depsgraph, view: View, objects) -> None:
         gpu.state.color_mask_set(False, False, False, False)
         with gpu.matrix.push_pop(), gpu.matrix.push_pop_projection():
             gpu.matrix.load_projection_matrix(projection)
-            for obj in objects:
-                obj_eval = obj.evaluated_get(depsgraph)
-                if obj_eval.type not in SURFACE_TYPES:
-                    continue
-                # Text, curves, surfaces and metaballs: their tessellation,
-                # which Solid shading draws as it draws a mesh.
-                mesh = obj_eval.to_mesh()
-                try:
-                    mesh.calc_loop_triangles()
-                    coords = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
-                    mesh.vertices.foreach_get("co", coords)
-                    tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
-                    mesh.loop_triangles.foreach_get("vertices", tris)
-                finally:
-                    obj_eval.to_mesh_clear()
-                if not len(tris):
-                    continue
+            for coords, tris, matrix in _surfaces(depsgraph, objects):
                 batch = batch_for_shader(shader, "TRIS", {"pos": coords.reshape(-1, 3)}, indices=tris.reshape(-1, 3))
-                gpu.matrix.load_matrix(view_matrix @ obj_eval.matrix_world)
+                gpu.matrix.load_matrix(view_matrix @ matrix)
                 shader.bind()
                 shader.uniform_float("color", (0.5, 0.5, 0.5, 1.0))
                 batch.draw(shader)
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.depth_test_set("NONE")
         gpu.state.depth_mask_set(False)
+
+
+def _surfaces(depsgraph, objects) -> list:
+    """(float32 positions, triangle corners, object -> world) of every
+    surface Solid shading draws for ``objects``: their own evaluated
+    geometry and the instances they make (a collection instance, geometry
+    nodes). Text, curves, surfaces and metaballs give their tessellation,
+    which Solid shading draws as it draws a mesh."""
+    names = {obj.name for obj in objects}
+    surfaces = []
+    for instance in depsgraph.object_instances:
+        owner = instance.parent if instance.is_instance and instance.parent is not None else instance.object
+        if owner.original.name not in names or not (instance.is_instance or instance.show_self):
+            continue
+        obj_eval = instance.object
+        if obj_eval.type not in SURFACE_TYPES:
+            continue
+        matrix = Matrix(instance.matrix_world)  # (a copy: the instance is gone after this step)
+        mesh = obj_eval.to_mesh()
+        try:
+            mesh.calc_loop_triangles()
+            coords = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+            mesh.vertices.foreach_get("co", coords)
+            tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+            mesh.loop_triangles.foreach_get("vertices", tris)
+        finally:
+            obj_eval.to_mesh_clear()
+        if len(tris):
+            surfaces.append((coords, tris, matrix))
+    return surfaces
 
 
 class ViewportUnavailable(RuntimeError):
