@@ -21,21 +21,27 @@ def _classed_cube(scene, name="Cube", **kwargs):
     return cube
 
 
-@pytest.mark.parametrize("mode", ["PIXELS", "DEPTH", "WORLD"])
-@pytest.mark.parametrize("override", [False, True])
-def test_class_widths_follow_the_wire(mode, override, output_dir):
-    scene = scenes.empty_scene(
+def _classes_scene(mode, thickness, thickness_far):
+    """A 200 x 150 scene with the sharp class 4 px wide under ``mode``
+    (Depth Cue from 4 to 9 units, World widths of 0.03)."""
+    return scenes.empty_scene(
         200,
         150,
-        thickness=1.5,
+        thickness=thickness,
         use_sharp_edges=True,
         sharp_thickness=4.0,
         thickness_mode=mode,
-        thickness_far=0.75,
+        thickness_far=thickness_far,
         thickness_depth_start=4.0,
         thickness_depth_end=9.0,
         world_thickness=0.03,
     )
+
+
+@pytest.mark.parametrize("mode", ["PIXELS", "DEPTH", "WORLD"])
+@pytest.mark.parametrize("override", [False, True])
+def test_class_widths_follow_the_wire(mode, override, output_dir):
+    scene = _classes_scene(mode, thickness=1.5, thickness_far=0.75)
     cube = _classed_cube(scene)
     scenes.cube(scene, "Other", size=1.0, location=(0.0, 2.5, -0.5))  # the scene's own widths
     if override:
@@ -58,18 +64,7 @@ def test_class_widths_where_one_thickness_is_0(mode, scene_thickness, own_thickn
     vanished in World widths (a random test of objects with their own
     settings: 18 pixels up to 1.0), and an object's Thickness of 0 took
     its classes' width away in every mode."""
-    scene = scenes.empty_scene(
-        200,
-        150,
-        thickness=scene_thickness,
-        use_sharp_edges=True,
-        sharp_thickness=4.0,
-        thickness_mode=mode,
-        thickness_far=2.0,
-        thickness_depth_start=4.0,
-        thickness_depth_end=9.0,
-        world_thickness=0.03,
-    )
+    scene = _classes_scene(mode, thickness=scene_thickness, thickness_far=2.0)
     cube = _classed_cube(scene)
     cube.solidwire.use_override = True
     cube.solidwire.thickness = own_thickness
