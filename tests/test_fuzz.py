@@ -598,7 +598,8 @@ def colour_looks(draw):
     values.update(
         use_fill=True,
         fill_shading=draw(st.sampled_from(["FLAT", "STUDIO", "MATCAP"])),
-        matcap=draw(st.sampled_from(["clay_studio", "metal_carpaint", "toon_light"])),
+        # (Bundled with every Blender from 4.2 on; 5.0 renamed others.)
+        matcap=draw(st.sampled_from(["clay_studio", "metal_carpaint", "check_rim_dark"])),
         fill_color_source=draw(st.sampled_from(["SINGLE", "OBJECT", "MATERIAL", "RANDOM", "ATTRIBUTE"])),
         wire_color_source=draw(st.sampled_from(["SINGLE", "OBJECT", "RANDOM"])),
         fill_color=draw(colour),
