@@ -1115,7 +1115,9 @@ def test_the_overlay_keeps_its_peeled_hidden_layers_between_redraws(output_dir):
     each redraw equals the passes drawn directly afresh, also when only
     Blender's depth changed (an object SolidWire does not draw now hides
     part of the near cube, whose own lines then show as hidden lines
-    there); a moved vertex or another setting draws directly again."""
+    there); another setting draws directly again, and a moved vertex
+    after that redraw draws the kept images whole (the next move of a drag
+    then redraws only what it changes)."""
     from solidwire_addon.core import targets
 
     width, height = 200, 150
@@ -1152,8 +1154,8 @@ def test_the_overlay_keeps_its_peeled_hidden_layers_between_redraws(output_dir):
     cube.data.vertices[0].co.z += 0.3
     cube.data.update()
     moved, stats = redraw(cubes)
-    assert not stats.get("frame_reused") and not np.array_equal(brighter, moved)
-    assert np.array_equal(moved, fresh(cubes)[0])
+    assert stats.get("frame_edited") == 1 and not np.array_equal(brighter, moved)
+    _assert_kept_redraw(moved, fresh(cubes)[0])
     redraw(cubes)
     assert "frame, occluded" in targets.overlay_targets_for(width, height).kept
     scene.solidwire.use_hidden_lines = False
@@ -1261,6 +1263,50 @@ def test_an_edit_redraws_the_kept_frame_where_it_changed(case, monkeypatch, outp
         _assert_kept_redraw(partial, direct)
         redraw()  # (kept whole again: the next move starts from a kept frame)
         redraw()
+
+
+def test_a_drag_whose_first_step_extracts_again_goes_on_redrawing_what_it_changes():
+    """A drag whose first step splits a quad the other way extracts the mesh
+    again, so that redraw draws directly; the next step is still an edit of
+    what was drawn, kept whole, and the steps after it redraw only the
+    rectangle they change, as a drag that extracts nothing does."""
+    from solidwire_addon.core import targets
+
+    width, height = 160, 120
+    scene = scenes.empty_scene(width, height, use_cage_edges=True, use_fill=True, thickness=1.5, use_hidden_lines=True)
+    obj = scenes.monkey(scene, subdivisions=0, rotation=(0.3, 0.1, 0.6))
+    scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
+    mesh = obj.data
+
+    def redraw():
+        return _overlay_redraw(scene, (width, height), [obj])
+
+    quad = next(p for p in mesh.polygons if p.loop_total == 4)
+    _first, second, _third, fourth = quad.vertices
+    untouched = next(v for v in range(len(mesh.vertices)) if v not in quad.vertices)
+    redraw()
+    redraw()
+
+    def move():
+        mesh.vertices[untouched].co *= 0.98  # (towards the origin: the bounds stay)
+        mesh.update()
+        return redraw()
+
+    # Corner 1 past the diagonal 0-2, on the side of corner 3: Blender
+    # splits the quad over the diagonal 1-3 instead (extract.quad_flip).
+    corner = mesh.vertices[second]
+    corner.co = corner.co + (mesh.vertices[fourth].co - corner.co) * 0.75
+    mesh.update()
+    _image, stats = redraw()
+    assert stats["meshes_extracted"] == 1, stats
+    _image, stats = move()
+    assert stats.get("frame_edited") == 1 and not stats.get("frame_partial"), stats
+    for step in range(2):
+        partial, stats = move()
+        assert stats.get("frame_partial") == 1, (step, stats)
+    targets.release()
+    redraw()
+    assert np.array_equal(partial, redraw()[0])
 
 
 def test_the_overlay_inside_a_clipping_region_keeps_whole_regions():

@@ -371,14 +371,23 @@ def _kept_frame_rect(targets, key, frame: Frame, settings, hidden: bool):
     some vertices (an edit, a drag: _moved_items), and then the window
     rectangle the moves changed (_redraw_rect; () where they changed
     nothing; None where that is not known), all of the kept images that
-    needs drawing again."""
+    needs drawing again.
+
+    An edit of what the last redraw drew directly (a drag whose first step
+    extracted the mesh again, a quad now split the other way; an edit
+    right after an orbit) is an edit too, with the whole of the kept
+    images to draw: the next step of the drag then redraws only what it
+    changes, where drawing this one directly would leave every later step
+    to draw directly too."""
     visible = targets.kept.get("frame")
-    if visible is None or visible.key is None or (hidden and "frame, occluded" not in targets.kept):
-        return False, None
-    moved = _moved_items(visible.key, key, frame.items)
-    if moved is None:
-        return False, None
-    return True, _redraw_rect(moved, frame.view, settings, frame.items)
+    if visible is not None and visible.key is not None and not (hidden and "frame, occluded" not in targets.kept):
+        moved = _moved_items(visible.key, key, frame.items)
+        if moved is not None:
+            return True, _redraw_rect(moved, frame.view, settings, frame.items)
+    drawn = targets.drawn_keys.get("frame")
+    if drawn != key and _moved_items(drawn, key, frame.items) is not None:
+        return True, None
+    return False, None
 
 
 def _composite_shader():
