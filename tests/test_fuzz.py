@@ -207,6 +207,19 @@ def recipe_on_failure(recipe: str):
         raise
 
 
+def scene_recipe(camera, line, transform, **content) -> str:
+    """The recipe of a scene of ``content`` (its objects, its source) seen
+    by ``camera`` with the settings ``line`` under ``transform``."""
+    parts = [f"{name}={value!r}" for name, value in content.items()]
+    return "\n".join([*parts, f"camera={camera!r}", f"settings={line!r}", f"transform={transform!r}"])
+
+
+def without_marks(line: dict) -> dict:
+    """The settings of a rich_settings() draw, less which edges it marks
+    (the scenes that take it mark their own)."""
+    return {key: value for key, value in line.items() if key != "marked"}
+
+
 @st.composite
 def edge_settings(draw):
     """Line settings plus the edge selection (image model §3.4-§3.7): edge
@@ -560,10 +573,10 @@ STYLED_SCENES = dict(objects=styled_objects(), camera=cameras(), line=rich_setti
 def test_random_objects_with_their_own_settings_match_reference(objects, camera, line, transform, tmp_path_factory):
     """Up to three random meshes with every line option, each drawn with the
     scene's settings, its own Thickness or not at all."""
-    line = {key: value for key, value in line.items() if key != "marked"}
+    line = without_marks(line)
     log.forget()
     scene = build_styled(objects, camera, line, transform)
-    with recipe_on_failure(f"objects={objects!r}\ncamera={camera!r}\nsettings={line!r}\ntransform={transform!r}"):
+    with recipe_on_failure(scene_recipe(camera, line, transform, objects=objects)):
         check(scene, tmp_path_factory.getbasetemp() / "fuzz_styled.exr")
 
 
@@ -576,11 +589,11 @@ def test_random_objects_with_their_own_settings_in_the_overlay(objects, camera, 
     Blender's depth decides, and those pixels are left out."""
     from solidwire_addon.blender.gpu_context import ensure_gpu
 
-    line = {key: value for key, value in line.items() if key != "marked"}
+    line = without_marks(line)
     log.forget()
     ensure_gpu()
     scene = build_styled(objects, camera, line, transform)
-    with recipe_on_failure(f"objects={objects!r}\ncamera={camera!r}\nsettings={line!r}\ntransform={transform!r}"):
+    with recipe_on_failure(scene_recipe(camera, line, transform, objects=objects)):
         check_overlay(scene)
 
 
@@ -1153,19 +1166,15 @@ def build_tessellated(source, camera, line, transform):
 TESSELLATED_SCENES = dict(source=tessellated_sources(), camera=cameras(), line=rich_settings(), transform=transforms())
 
 
-def tessellated_recipe(source, camera, line, transform) -> str:
-    return f"source={source!r}\ncamera={camera!r}\nsettings={line!r}\ntransform={transform!r}"
-
-
 @FUZZ
 @given(**TESSELLATED_SCENES)
 def test_random_tessellated_sources_match_reference(source, camera, line, transform, tmp_path_factory):
     """Random text, curves, metaballs and NURBS surfaces in the F12 render,
     against the reference of their evaluated meshes under §3.9."""
-    line = {key: value for key, value in line.items() if key != "marked"}
+    line = without_marks(line)
     log.forget()
     scene = build_tessellated(source, camera, line, transform)
-    with recipe_on_failure(tessellated_recipe(source, camera, line, transform)):
+    with recipe_on_failure(scene_recipe(camera, line, transform, source=source)):
         check(scene, tmp_path_factory.getbasetemp() / "fuzz_tessellated.exr")
 
 
@@ -1177,9 +1186,9 @@ def test_random_tessellated_sources_in_the_overlay(source, camera, line, transfo
     compares them."""
     from solidwire_addon.blender.gpu_context import ensure_gpu
 
-    line = {key: value for key, value in line.items() if key != "marked"}
+    line = without_marks(line)
     log.forget()
     ensure_gpu()
     scene = build_tessellated(source, camera, line, transform)
-    with recipe_on_failure(tessellated_recipe(source, camera, line, transform)):
+    with recipe_on_failure(scene_recipe(camera, line, transform, source=source)):
         check_overlay(scene)

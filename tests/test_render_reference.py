@@ -458,6 +458,53 @@ def test_faces_lying_on_one_another_are_undecided(output_dir):
     assert (covered & ~ref.on_silhouette).sum() > 0.4 * covered.sum()
 
 
+def test_a_hidden_triangle_through_the_near_plane_is_undecided_along_its_sides(output_dir):
+    """Under hidden lines, a triangle behind a wall that reaches behind the
+    camera: the side of its front part that projects onto the middle
+    column's sample centres lies within 0.01 px of them, so whether those
+    samples see it as a hidden layer is the rasteriser's rounding (image
+    model §7.2), as along the sides of a triangle wholly in front."""
+    width, height = 41, 31
+    scene = scenes.empty_scene(width, height, thickness=1.0, softness=3.0, use_hidden_lines=True, hidden_alpha=1.0)
+    scenes.from_pydata(scene, "Wall", [(-4, -3, -4), (4, -3, -4), (4, -3, 4), (-4, -3, 4)], [(0, 1, 2, 3)])
+    # Its side from behind the camera to the far corner lies in the plane
+    # x = 0: in the window, on x = 20.5, the middle column's sample centres.
+    scenes.from_pydata(scene, "Through", [(0.0, -5.5, 0.3), (0.0, 5.0, -0.5), (3.0, 5.0, 0.0)], [(0, 1, 2)])
+    scenes.add_camera(scene, location=(0.0, -5.0, 0.0), target=(0.0, 0.0, 0.0))
+    ref = reference.render_reference(scene)
+    middle = width // 2
+    behind_the_wall = (ref.face >= 0) & np.isfinite(ref.next_depth)
+    assert behind_the_wall[:, middle].sum() >= 3, "the triangle lies behind the wall along the middle column"
+    assert ref.on_silhouette[behind_the_wall[:, middle], middle].all()
+    assert not ref.on_silhouette[behind_the_wall[:, middle], middle + 3].any()
+    accuracy.assert_accurate(accuracy.measure(scene, "hidden_through_near_plane", output_dir))
+
+
+def test_a_sliver_behind_the_surface_is_undecided_under_hidden_lines(output_dir):
+    """Under hidden lines, a triangle behind a wall whose plane nearly holds
+    the eye (5e-4 px across, 5e-3 px to the right of the middle column's
+    sample centres: ten of its widths away, no near miss of its own):
+    rays a hundredth of a pixel apart step over it, so whether those
+    samples see it as a hidden layer is the rasteriser's rounding (image
+    model §7.2)."""
+    width, height = 41, 31
+    scene = scenes.empty_scene(width, height, thickness=1.0, softness=3.0, use_hidden_lines=True, hidden_alpha=1.0)
+    scenes.from_pydata(scene, "Wall", [(-4, -3, -4), (4, -3, -4), (4, -3, 4), (-4, -3, 4)], [(0, 1, 2, 3)])
+    # 50 mm over a 36 mm sensor 41 px wide: 56.94 px per unit at depth 1;
+    # the side at depth 7 lies 0.005 px right of x = 20.5, the far corner at
+    # depth 9 another 0.0005 px right.
+    pixels_per_unit = 50.0 / 36.0 * width
+    near_x, far_x = 0.005 * 7.0 / pixels_per_unit, 0.0055 * 9.0 / pixels_per_unit
+    scenes.from_pydata(scene, "Sliver", [(near_x, 2.0, -1.0), (near_x, 2.0, 1.0), (far_x, 4.0, 0.0)], [(0, 1, 2)])
+    scenes.add_camera(scene, location=(0.0, -5.0, 0.0), target=(0.0, 0.0, 0.0))
+    ref = reference.render_reference(scene)
+    middle = width // 2
+    rows = np.flatnonzero(np.abs(np.arange(height) + 0.5 - height / 2) < 3.0)  # (the sliver spans more)
+    assert ref.on_silhouette[rows, middle].all()
+    assert not ref.on_silhouette[rows, middle + 3].any()
+    accuracy.assert_accurate(accuracy.measure(scene, "sliver_behind_the_surface", output_dir))
+
+
 def test_an_edge_that_projects_to_a_point_draws_no_line(output_dir):
     """A pentagon two of whose corners coincide: the edge between them is a
     single point on screen and draws nothing (image model §3.2), also under

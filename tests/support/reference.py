@@ -1541,10 +1541,16 @@ def _fade(s, z):
 
 def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj, near_misses=()) -> np.ndarray:
     """Samples within 0.01 px of an edge of a triangle behind the visible
-    surface, hit or just missed (§7: whether the rasteriser covers them is
-    undecided — at a fold seen edge-on, two triangles meet within 1e-4 px of
-    the sample, on either side of it)."""
+    surface, hit or just missed, or of a sliver there (§7: whether the
+    rasteriser covers them is undecided — at a fold seen edge-on, two
+    triangles meet within 1e-4 px of the sample, on either side of it)."""
     flagged = np.zeros(len(face), bool)
+    # A sliver behind the visible surface: rays 0.01 px apart step over it,
+    # and one whose plane nearly holds the ray has no near miss to measure.
+    row_of = np.full(height, -1, np.int64)
+    row_of[rows] = np.arange(len(rows))
+    for pix, _depth in _sliver_samples(geo, proj, width, height, rows, row_of):
+        flagged[pix[face[pix] >= 0]] = True
     found = list(all_hits or ()) + list(near_misses or ())
     if not found:
         return flagged
@@ -1567,6 +1573,21 @@ def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj, 
         d, _ = _segment_distance(xy, win[:, k], win[:, (k + 1) % 3])
         near |= d <= 0.01
     flagged[pix[near & front]] = True
+    # A triangle across the near plane: the sides of its part in front,
+    # the cut along the near plane among them, as the rasteriser clips it.
+    for triangle in np.unique(tri[~front]):
+        at = np.flatnonzero((tri == triangle) & ~front)
+        clipped = _near_clipped_polygon(geo.tri_view[triangle], h[at[0]], width, height)
+        if clipped is None:
+            continue
+        points = clipped[0]
+        for k in range(len(points)):
+            ends = (
+                np.broadcast_to(points[k], (len(at), 2)),
+                np.broadcast_to(points[(k + 1) % len(points)], (len(at), 2)),
+            )
+            d, _ = _segment_distance(xy[at], *ends)
+            flagged[pix[at[d <= 0.01]]] = True
     return flagged
 
 
