@@ -14,8 +14,10 @@ A failure prints the scene recipe (``repro``) to rebuild it by hand.
 
 from __future__ import annotations
 
+import importlib
 import math
 import os
+import pkgutil
 from contextlib import contextmanager
 
 import bpy
@@ -29,6 +31,27 @@ from solidwire_addon.core import log
 from tests.support import accuracy, reference, robustness, scenes, strand_reference, strand_scenes
 
 pytestmark = pytest.mark.fuzz
+
+
+def _load_every_project_module() -> None:
+    """Import every module of the project. Hypothesis mixes the literal
+    constants of the local modules loaded so far into what it draws, so a
+    derandomised example depends on which modules the tests that ran
+    before happened to import (the order is random): with all of them
+    loaded first, every run and every machine draws the same examples, and
+    a CI failure replays here."""
+    for package in ("solidwire_addon", "scripts", "tests", "tests.pure"):
+        for module in pkgutil.iter_modules(importlib.import_module(package).__path__, f"{package}."):
+            if not module.name.endswith("conftest"):
+                importlib.import_module(module.name)
+                if module.ispkg:
+                    for inner in pkgutil.walk_packages(
+                        importlib.import_module(module.name).__path__, f"{module.name}."
+                    ):
+                        importlib.import_module(inner.name)
+
+
+_load_every_project_module()
 
 W, H = 48, 36
 LONG_RUN = int(os.environ.get("SOLIDWIRE_FUZZ_EXAMPLES", "0") or 0)
