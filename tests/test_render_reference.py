@@ -505,6 +505,36 @@ def test_a_sliver_behind_the_surface_is_undecided_under_hidden_lines(output_dir)
     accuracy.assert_accurate(accuracy.measure(scene, "sliver_behind_the_surface", output_dir))
 
 
+def test_two_lines_of_equal_strength_leave_the_colour_undecided():
+    """Two squares side by side, their outline sharp and the edge between
+    them a seam, both classes 4 px wide: where the seam meets the outline
+    both lines reach full strength, so which class's colour a sample takes
+    is float32's choice (image model §7.3a); along the lines away from
+    there it is decided."""
+    scene = scenes.empty_scene(
+        120,
+        90,
+        thickness=1.0,
+        use_sharp_edges=True,
+        sharp_thickness=4.0,
+        sharp_pattern="SOLID",
+        use_seam_edges=True,
+        seam_thickness=4.0,
+        seam_pattern="SOLID",
+    )
+    plane = scenes.grid(scene, "Plane", x_segments=2, y_segments=1, size=1.0)
+    vertices = plane.data.vertices
+    for edge in plane.data.edges:
+        edge.use_seam = all(abs(vertices[v].co.x) < 1e-6 for v in edge.vertices)
+        edge.use_edge_sharp = not edge.use_seam
+    scenes.add_camera(scene, location=(0.2, -0.3, 4.0), target=(0.0, 0.0, 0.0))
+    ref = reference.render_reference(scene)
+    full = ref.intensity > 0.999
+    assert (ref.style_undecided & full).sum() >= 8
+    assert (~ref.style_undecided & full).sum() > 20 * (ref.style_undecided & full).sum()
+    assert not (ref.style_undecided & (ref.intensity == 0.0)).any()
+
+
 def test_an_edge_that_projects_to_a_point_draws_no_line(output_dir):
     """A pentagon two of whose corners coincide: the edge between them is a
     single point on screen and draws nothing (image model §3.2), also under

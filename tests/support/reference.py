@@ -90,6 +90,11 @@ class ReferenceResult:
     # triangle or lit by the seen side's normal is undecided (§7.2); None
     # where the fill is neither.
     shading_undecided: np.ndarray = None
+    # (H, W) bool: the two strongest lines of different colours lie within
+    # STYLE_TIE of each other, so which style's colour the sample takes
+    # (§3.6) is float32's choice (two wide lines both at full strength,
+    # one of them only just); its intensity is decided.
+    style_undecided: np.ndarray = None
 
 
 @dataclass
@@ -1313,9 +1318,10 @@ def _dashes(far_phase, period, duty):
 
 
 def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height, thickness, softness):
-    """(I, d_real, winning style, density(entry index)) per covered sample:
-    the nearest line of each style in the sample's block, each style's
-    P(d) times its pattern and density fade, the largest taken (§3.6-§3.7)."""
+    """(I, d_real, winning style, density(entry index), tied, runner-up)
+    per covered sample: the nearest line of each style in the sample's
+    block, each style's P(d) times its pattern and density fade, the
+    largest taken (§3.6-§3.7); ``runner-up`` the largest of another style."""
     keys = geo.face_key[pix_face]
     chain_a, chain_b, chain_ok = _clip_edges_to_window(proj, geo.chain_view, width, height)
     chain_length = np.where(chain_ok, np.linalg.norm(np.nan_to_num(chain_b - chain_a), axis=1), np.inf)
@@ -1332,6 +1338,7 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
     d_real = np.full(len(pix_face), np.inf)
     winner = np.zeros(len(pix_face), np.int64)
     tied = np.zeros(len(pix_face), bool)  # a patterned line's phase is undecided
+    runner_up = np.zeros(len(pix_face))
     for style in range(len(EDGE_CLASSES) + 1):
         select = geo.edge_real & (geo.edge_style == style)
         if not select.any():
@@ -1358,10 +1365,11 @@ def _line_intensity(s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height
             )
         else:
             v = profile(d, width_px, softness)
+        runner_up = np.maximum(runner_up, np.minimum(value, v))
         wins = v > value
         winner[wins] = style
         value = np.maximum(value, v)
-    return value, d_real, winner, density, tied
+    return value, d_real, winner, density, tied, runner_up
 
 
 def _class_width(s, name, wire_width):
@@ -1591,6 +1599,11 @@ def _hidden_edge_samples(all_hits, face, depth, rows, width, height, geo, proj, 
     return flagged
 
 
+# How near the two strongest lines of different styles may lie in intensity
+# for float32 to pick either one's colour (§3.6): the profile is flat where
+# a line reaches full strength, so two wide lines there differ by far less.
+STYLE_TIE = 1e-4
+
 # How near two triangles of one face lie, relative to their depth, for the
 # engine to count them as one hidden layer (LEVEL_DEPTH in
 # shaders/quad_partner.glsl).
@@ -1682,6 +1695,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
     intensity = np.zeros(len(face))
     hidden_outer_depth = np.full(len(face), np.inf)
     winner_all = np.zeros(len(face), np.int64)  # the line style each sample takes (§3.6)
+    style_undecided = np.zeros(len(face), bool)
     hidden_all = np.zeros(len(face))
     d_real_all = np.full(len(face), np.inf)
     covered = np.nonzero(face >= 0)[0]
@@ -1691,7 +1705,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
         wa, wb, valid = _clip_edges_to_window(proj, geo.edges_view, width, height)
         softness = float(s.softness)
         thickness = _thickness_at(s, depth[covered], proj, height, geo.face_thickness[pix_face])
-        value, d_real, winner, density, tied = _line_intensity(
+        value, d_real, winner, density, tied, runner_up = _line_intensity(
             s, geo, pix_face, pix_xy, wa, wb, valid, proj, width, height, thickness, softness
         )
         on_silhouette[covered[tied]] = True
@@ -1722,9 +1736,13 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
                 far = np.zeros(len(pix_face), bool)
                 diag_value = _max_value_per_pixel(*diagonals, faded, *_dashes(far, float(s.pattern_period), duty))
                 on_silhouette[covered[far]] = True
+            runner_up = np.where(
+                winner_all[covered] > 0, np.maximum(runner_up, np.minimum(value, diag_value)), runner_up
+            )
             wins = diag_value > value
             winner_all[covered[wins]] = 0
             value = np.maximum(value, diag_value)
+        style_undecided[covered] = (runner_up > 0.0) & (value - runner_up <= STYLE_TIE)
         value *= _fade(s, depth[covered])
         if hidden_lines:
             wire_alpha = float(s.wire_color[3])
@@ -1785,6 +1803,7 @@ def render_reference(scene, depsgraph=None, size=None, rows=None, settings=None,
         *(() if all_hits is None else (layer.reshape(shape) for layer in _depth_layers(all_hits, depth))),
         hidden_outer_depth=hidden_outer_depth.reshape(shape),
         shading_undecided=centre_hit["shading_undecided"].reshape(shape) if per_triangle_colour else None,
+        style_undecided=style_undecided.reshape(shape),
     )
 
 
@@ -1949,6 +1968,7 @@ def color_error_report(measured_srgb: np.ndarray, expected_linear: np.ndarray, r
     off = ~ref.on_silhouette & covered
     if ref.shading_undecided is not None:
         off &= ~ref.shading_undecided
+    off &= ~ref.style_undecided
     d = np.nan_to_num(diff[off], nan=1.0)
     return {
         **_statistics(d),
