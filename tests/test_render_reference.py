@@ -505,6 +505,27 @@ def test_a_sliver_behind_the_surface_is_undecided_under_hidden_lines(output_dir)
     accuracy.assert_accurate(accuracy.measure(scene, "sliver_behind_the_surface", output_dir))
 
 
+def test_two_faces_on_one_another_behind_the_surface_are_undecided_under_hidden_lines(output_dir):
+    """Under hidden lines, two quads lying on one another behind a wall (the
+    same corners, two faces): float32 depths cannot order them, so whether
+    a sample behind both meets one hidden layer or two is rounding's choice
+    (image model §7.2); behind a quad of its own it is decided."""
+    width, height = 48, 32
+    scene = scenes.empty_scene(width, height, thickness=1.0, use_hidden_lines=True)
+    scenes.from_pydata(scene, "Wall", [(-6, -3, -4), (6, -3, -4), (6, -3, 4), (-6, -3, 4)], [(0, 1, 2, 3)])
+    square = [(-2.5, 2, -1), (-0.5, 2, -1), (-0.5, 2, 1), (-2.5, 2, 1)]
+    scenes.from_pydata(scene, "Twins", square + square, [(0, 1, 2, 3), (4, 5, 6, 7)])
+    scenes.from_pydata(scene, "Single", [(x + 3.0, y, z) for x, y, z in square], [(0, 1, 2, 3)])
+    scenes.add_camera(scene, location=(0.0, -5.0, 0.0), target=(0.0, 0.0, 0.0))
+    ref = reference.render_reference(scene)
+    behind = ref.hidden > 0.0
+    left = np.arange(width)[None, :] < width // 2
+    assert (behind & left).sum() > 20 and (behind & ~left).sum() > 20
+    assert ref.on_silhouette[behind & left].all()
+    assert not ref.on_silhouette[behind & ~left].any()
+    accuracy.assert_accurate(accuracy.measure(scene, "faces_on_one_another_behind", output_dir))
+
+
 def test_two_lines_of_equal_strength_leave_the_colour_undecided():
     """Two squares side by side, their outline sharp and the edge between
     them a seam, both classes 4 px wide: where the seam meets the outline

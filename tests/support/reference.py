@@ -1644,6 +1644,16 @@ def _hidden_line_coverage(
     pix, z, f = pix[first], z[first], f[first]
     if len(pix) == 0:
         return coverage
+    if undecided is not None:
+        # Two faces behind the sample at one depth (within a relative 1e-6:
+        # faces on one another, or crossing there): float32 depths cannot
+        # order them, and whether the engine finds one layer or two is
+        # rounding's choice (§7.2).
+        by_depth = np.lexsort((z, pix))
+        p, zz, ff = pix[by_depth], z[by_depth], f[by_depth]
+        level = (p[1:] == p[:-1]) & (ff[1:] != ff[:-1])
+        level &= np.abs(zz[1:] - zz[:-1]) <= 1e-6 * np.maximum(np.abs(zz[1:]), 1e-30)
+        undecided[p[1:][level]] = True
     xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
     hidden_ties = {}
     d, along = _min_distance_per_pixel(
