@@ -150,6 +150,44 @@ bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out f
   return depth >= near; /* (a part the near plane clips is no surface) */
 }
 
+/* How far float32 may move the weights quad_partner_covers found for p
+ * (corners a, b, c as there), as a bound on each weight. The rasteriser
+ * interpolates the surface's own depth with errors of the same size, and
+ * both grow where the weights cancel: a long thin triangle, or one corner
+ * far off screen, gives window products of hundreds of pixels squared for
+ * an area of a few. A partner's depth taken a hair nearer (PARTNER_DEPTH_HAIR)
+ * must also be taken this much nearer (times its corners' depth span), or
+ * the surface's own triangle behind the hair shows as a layer behind
+ * itself. Four float32 steps per product: one for the partner's products,
+ * one for the rasteriser's, and room for the corners' own rounding. */
+float partner_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
+{
+  const float STEPS = 4.0 * 1.1920929e-7;
+  vec3 w = vec3(a.z, b.z, c.z);
+  if (min(min(a.w, b.w), c.w) >= near_plane_depth() && min(min(w.x, w.y), w.z) > 0.0) {
+    vec2 pa = a.xy / w.x, pb = b.xy / w.y, pc = c.xy / w.z;
+    vec2 ab = pb - pa, ac = pc - pa, ap = p - pa;
+    float area = abs(ab.x * ac.y - ab.y * ac.x);
+    float spread = abs(ab.x * ac.y) + abs(ab.y * ac.x);
+    float products = abs(ap.x * ac.y) + abs(ap.y * ac.x) + abs(ab.x * ap.y) + abs(ab.y * ap.x);
+    return area > 0.0 ? STEPS * (products + 2.0 * spread) / area : 1.0;
+  }
+  /* Through the near plane: the edge functions of quad_partner_covers. */
+  vec3 q = vec3(p, 1.0);
+  float sum = abs(dot(cross(b.xyz, c.xyz) + cross(c.xyz, a.xyz) + cross(a.xyz, b.xyz), q));
+  float products = (length(b.xyz) * length(c.xyz) + length(c.xyz) * length(a.xyz) + length(a.xyz) * length(b.xyz)) *
+                   length(q);
+  return sum > 0.0 ? STEPS * 2.0 * products / sum : 1.0;
+}
+
+/* How far float32 may move the depth `values` (one per corner) that weights
+ * of partner_weight_error interpolate. */
+float partner_depth_error(vec2 p, vec4 a, vec4 b, vec4 c, vec3 values)
+{
+  float span = max(max(values.x, values.y), values.z) - min(min(values.x, values.y), values.z);
+  return partner_weight_error(p, a, b, c) * span;
+}
+
 /* The corners (quad_partner_corner) of the other triangle of `triangle`
  * (corner ids `ids`, edge flags `flags`) and their clip positions, where it
  * has one; else false, with every corner zero. */

@@ -834,6 +834,59 @@ def test_a_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir, monkeypa
 
 
 @pytest.mark.parametrize("layers", ["walked", "peeled"])
+def test_a_long_thin_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir, monkeypatch):
+    """A folded hexagon with one corner 50 units off under an orthographic
+    camera (found by the fuzz): its triangles are hundreds of pixels long
+    and a few wide, so float32 moves the depth of the nearer one, where the
+    farther one finds it covering a pixel, by several times the hair by
+    which that depth is taken nearer. The farther triangle must still see
+    the surface as its own face and draw no layer (image model §5.4;
+    quad_partner.glsl, partner_weight_error): 3 pixels of the hexagon's
+    outline showed through itself, up to 0.1."""
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+    from solidwire_addon.core import passes
+
+    if layers == "peeled":
+        monkeypatch.setattr(passes, "PEEL_MIN_REGION_LINES", 0.0)
+    scene = scenes.empty_scene(
+        48,
+        36,
+        thickness=0.5,
+        softness=2.5,
+        use_hidden_lines=True,
+        hidden_alpha=1.0,
+        hidden_duty=1.0,
+        use_density_fade=True,
+        density_fade_length=14.6,
+    )
+    corners = [
+        (-0.0767, -0.3477, 0.377),
+        (-33.8376, -3.3439, -33.4603),
+        (0.7186, 0.4365, 0.3909),
+        (-1.0431, 0.1355, -0.347),
+        (1.7353, -0.3006, 0.2448),
+        (-0.6925, -0.4302, -1.906),
+    ]
+    scenes.from_pydata(scene, "Folded", corners, [(0, 1, 2, 3, 4, 5)])
+    scenes.add_camera(
+        scene,
+        location=(1.3123, 1.2767, -1.3907),
+        target=(0.09, 0.0, -0.831),
+        ortho_scale=8.548,
+        shift=(-0.0655, -0.1016),
+        clip=(0.5, 20.0),
+        sensor_fit="VERTICAL",
+    )
+    accuracy.assert_accurate(accuracy.measure(scene, f"long_thin_folded_ngon_{layers}", output_dir))
+    ref = reference.render_reference(scene)
+    assert (ref.face >= 0).sum() > 150 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
+    ensure_gpu()
+    stats, alpha = robustness.Viewport(48, 36).draw(scene)
+    assert stats.get("hidden_region_layers", 0) == (2 if layers == "peeled" else 0)
+    accuracy.assert_accurate(reference.error_report(alpha, ref))
+
+
+@pytest.mark.parametrize("layers", ["walked", "peeled"])
 def test_a_culled_triangle_of_a_folded_quad_hides_nothing(layers, output_dir, monkeypatch):
     """Two quads of a mirrored object under hidden lines with back faces
     culled (found by the fuzz): one folds so far that its second triangle
