@@ -180,10 +180,16 @@ float partner_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
   return sum > 0.0 ? STEPS * 2.0 * products / sum : 1.0;
 }
 
-/* How far float32 may move the depth `values` (one per corner) that weights
- * of partner_weight_error interpolate. */
-float partner_depth_error(vec2 p, vec4 a, vec4 b, vec4 c, vec3 values)
+/* How far float32 may move the depth `values` (one per corner: view
+ * depths, or window depths where `window` is set) that weights of
+ * partner_weight_error interpolate. Only the part in front of the near
+ * plane is drawn, so a corner behind it counts as the near plane's depth
+ * (a corner behind the eye has no window depth of its own). */
+float partner_depth_error(vec2 p, vec4 a, vec4 b, vec4 c, vec3 values, bool window)
 {
+  bvec3 in_front = greaterThanEqual(vec3(a.w, b.w, c.w), vec3(near_plane_depth()));
+  vec3 nearest = vec3(window ? 0.0 : near_plane_depth());
+  values = mix(nearest, values, in_front);
   float span = max(max(values.x, values.y), values.z) - min(min(values.x, values.y), values.z);
   return partner_weight_error(p, a, b, c) * span;
 }

@@ -195,14 +195,11 @@ void leave_out_the_visible_face()
     return;
   }
 #  ifdef LINEAR_DEPTH
-  float rounding = partner_depth_error(gl_FragCoord.xy, a, b, c, vec3(a.w, b.w, c.w));
+  float rounding = partner_depth_error(gl_FragCoord.xy, a, b, c, vec3(a.w, b.w, c.w), false);
   gl_FragDepth = (depth * (1.0 - PARTNER_DEPTH_HAIR) - rounding) * params.inv_clip_end;
 #  else
   vec3 partner_w = vec3(a.z, b.z, c.z);
-  /* (A corner behind the eye has no window depth: the whole range then.) */
-  vec3 corner_depths = min(min(partner_w.x, partner_w.y), partner_w.z) > 0.0 ? window_depth_w / partner_w :
-                                                                              vec3(0.0, 1.0, 0.0);
-  float rounding = partner_depth_error(gl_FragCoord.xy, a, b, c, corner_depths);
+  float rounding = partner_depth_error(gl_FragCoord.xy, a, b, c, window_depth_w / partner_w, true);
   gl_FragDepth = min(dot(weights, window_depth_w) / dot(weights, partner_w) - PARTNER_DEPTH_HAIR - rounding,
                      gl_FragCoord.z);
 #  endif

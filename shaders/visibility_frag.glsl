@@ -49,7 +49,7 @@ float nearer_than_the_other_triangle(int triangle, float depth)
     return depth;
   }
   /* (The layers are recorded in linear depth: shaders.py.) */
-  float rounding = partner_depth_error(gl_FragCoord.xy, a, b, c, vec3(a.w, b.w, c.w));
+  float rounding = partner_depth_error(gl_FragCoord.xy, a, b, c, vec3(a.w, b.w, c.w), false);
   return min((partner_view_depth * (1.0 - PARTNER_DEPTH_HAIR) - rounding) * params.inv_clip_end, depth);
 }
 #endif
