@@ -776,6 +776,22 @@ def test_a_folded_quad_through_the_near_plane_is_no_hidden_layer_of_itself(outpu
     assert (ref.face >= 0).sum() > 200 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
 
 
+def _assert_one_face_without_layers(scene, name, layers, least_pixels, output_dir):
+    """``scene``, one folded face under hidden lines, drawn as the reference
+    draws it (at least ``least_pixels`` covered, no hidden layer anywhere)
+    by the render and by the overlay, whose hidden layers are ``layers``
+    ("walked" or "peeled": two peeled layers, the surface's and the next)."""
+    from solidwire_addon.blender.gpu_context import ensure_gpu
+
+    accuracy.assert_accurate(accuracy.measure(scene, name, output_dir))
+    ref = reference.render_reference(scene)
+    assert (ref.face >= 0).sum() > least_pixels and (ref.hidden > 0).sum() == 0
+    ensure_gpu()
+    stats, alpha = robustness.Viewport(*ref.face.shape[::-1]).draw(scene)
+    assert stats.get("hidden_region_layers", 0) == (2 if layers == "peeled" else 0)
+    accuracy.assert_accurate(reference.error_report(alpha, ref))
+
+
 @pytest.mark.parametrize("layers", ["walked", "peeled"])
 def test_a_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir, monkeypatch):
     """A hexagon that is not flat, whose triangles overlap on screen, two of
@@ -786,7 +802,6 @@ def test_a_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir, monkeypa
     triangles (quad_partner.glsl, NGON_SIBLINGS) in the direct hidden-line
     pass and in the peeled layers' record; the render and the overlay, where
     14 pixels showed the hexagon's outline through itself."""
-    from solidwire_addon.blender.gpu_context import ensure_gpu
     from solidwire_addon.core import passes
 
     if layers == "peeled":
@@ -823,14 +838,7 @@ def test_a_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir, monkeypa
         clip=(0.5, 20.0),
         sensor_fit="HORIZONTAL",
     )
-    report = accuracy.measure(scene, f"folded_ngon_{layers}", output_dir)
-    accuracy.assert_accurate(report)
-    ref = reference.render_reference(scene)
-    assert (ref.face >= 0).sum() > 80 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
-    ensure_gpu()
-    stats, alpha = robustness.Viewport(48, 36).draw(scene)
-    assert stats.get("hidden_region_layers", 0) == (2 if layers == "peeled" else 0)
-    accuracy.assert_accurate(reference.error_report(alpha, ref))
+    _assert_one_face_without_layers(scene, f"folded_ngon_{layers}", layers, 80, output_dir)
 
 
 @pytest.mark.parametrize("layers", ["walked", "peeled"])
@@ -843,7 +851,6 @@ def test_a_long_thin_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir
     the surface as its own face and draw no layer (image model §5.4;
     quad_partner.glsl, partner_weight_error): 3 pixels of the hexagon's
     outline showed through itself, up to 0.1."""
-    from solidwire_addon.blender.gpu_context import ensure_gpu
     from solidwire_addon.core import passes
 
     if layers == "peeled":
@@ -877,13 +884,7 @@ def test_a_long_thin_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir
         clip=(0.5, 20.0),
         sensor_fit="VERTICAL",
     )
-    accuracy.assert_accurate(accuracy.measure(scene, f"long_thin_folded_ngon_{layers}", output_dir))
-    ref = reference.render_reference(scene)
-    assert (ref.face >= 0).sum() > 150 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
-    ensure_gpu()
-    stats, alpha = robustness.Viewport(48, 36).draw(scene)
-    assert stats.get("hidden_region_layers", 0) == (2 if layers == "peeled" else 0)
-    accuracy.assert_accurate(reference.error_report(alpha, ref))
+    _assert_one_face_without_layers(scene, f"long_thin_folded_ngon_{layers}", layers, 150, output_dir)
 
 
 @pytest.mark.parametrize("layers", ["walked", "peeled"])
