@@ -776,12 +776,17 @@ def test_a_folded_quad_through_the_near_plane_is_no_hidden_layer_of_itself(outpu
     assert (ref.face >= 0).sum() > 200 and (ref.hidden > 0).sum() == 0  # one face: no hidden layer anywhere
 
 
-def _assert_one_face_without_layers(scene, name, layers, least_pixels, output_dir):
+def _assert_one_face_without_layers(scene, name, layers, least_pixels, output_dir, monkeypatch):
     """``scene``, one folded face under hidden lines, drawn as the reference
     draws it (at least ``least_pixels`` covered, no hidden layer anywhere)
     by the render and by the overlay, whose hidden layers are ``layers``
-    ("walked" or "peeled": two peeled layers, the surface's and the next)."""
+    ("walked", or "peeled" whatever the regions' size: two peeled layers,
+    the surface's and the next)."""
     from solidwire_addon.blender.gpu_context import ensure_gpu
+    from solidwire_addon.core import passes
+
+    if layers == "peeled":
+        monkeypatch.setattr(passes, "PEEL_MIN_REGION_LINES", 0.0)
 
     accuracy.assert_accurate(accuracy.measure(scene, name, output_dir))
     ref = reference.render_reference(scene)
@@ -802,10 +807,6 @@ def test_a_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir, monkeypa
     triangles (quad_partner.glsl, NGON_SIBLINGS) in the direct hidden-line
     pass and in the peeled layers' record; the render and the overlay, where
     14 pixels showed the hexagon's outline through itself."""
-    from solidwire_addon.core import passes
-
-    if layers == "peeled":
-        monkeypatch.setattr(passes, "PEEL_MIN_REGION_LINES", 0.0)
     scene = scenes.empty_scene(
         48,
         36,
@@ -838,7 +839,7 @@ def test_a_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir, monkeypa
         clip=(0.5, 20.0),
         sensor_fit="HORIZONTAL",
     )
-    _assert_one_face_without_layers(scene, f"folded_ngon_{layers}", layers, 80, output_dir)
+    _assert_one_face_without_layers(scene, f"folded_ngon_{layers}", layers, 80, output_dir, monkeypatch)
 
 
 @pytest.mark.parametrize("layers", ["walked", "peeled"])
@@ -851,10 +852,6 @@ def test_a_long_thin_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir
     the surface as its own face and draw no layer (image model §5.4;
     quad_partner.glsl, partner_weight_error): 3 pixels of the hexagon's
     outline showed through itself, up to 0.1."""
-    from solidwire_addon.core import passes
-
-    if layers == "peeled":
-        monkeypatch.setattr(passes, "PEEL_MIN_REGION_LINES", 0.0)
     scene = scenes.empty_scene(
         48,
         36,
@@ -884,7 +881,7 @@ def test_a_long_thin_folded_ngon_is_no_hidden_layer_of_itself(layers, output_dir
         clip=(0.5, 20.0),
         sensor_fit="VERTICAL",
     )
-    _assert_one_face_without_layers(scene, f"long_thin_folded_ngon_{layers}", layers, 150, output_dir)
+    _assert_one_face_without_layers(scene, f"long_thin_folded_ngon_{layers}", layers, 150, output_dir, monkeypatch)
 
 
 @pytest.mark.parametrize("layers", ["walked", "peeled"])
