@@ -526,6 +526,40 @@ def test_two_faces_on_one_another_behind_the_surface_are_undecided_under_hidden_
     accuracy.assert_accurate(accuracy.measure(scene, "faces_on_one_another_behind", output_dir))
 
 
+def test_a_sample_just_outside_a_sliver_whose_plane_passes_in_front_is_undecided(output_dir):
+    """A sliver (a triangle 1e-4 px thin on screen) hidden behind a wall,
+    its plane running nearly along the rays: a row of pixel centres lies
+    0.003 px beside its thin side. A rasteriser that covers them (a
+    snapping step) gives them the sliver's plane depth there, about 4,
+    far in front of the wall at 7 and of every corner of the sliver
+    (7.2-7.4), so which face they show is rounding's choice (image model
+    §7.2); a pixel farther from the sliver is decided."""
+    width, height = 48, 32
+    scene = scenes.empty_scene(width, height, thickness=1.0)
+    camera = scenes.add_camera(scene, location=(0.0, -5.0, 0.0), target=(0.0, 0.0, 0.0))
+    scenes.from_pydata(scene, "Wall", [(-6, 2, -4), (6, 2, -4), (6, 2, 4), (-6, 2, 4)], [(0, 1, 2, 3)])
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    proj = np.array(camera.calc_matrix_camera(depsgraph, x=width, y=height), dtype=np.float64)
+
+    def world_point(window_x, window_y, depth):
+        # View point at `depth` on the ray through the window point; this
+        # camera's view axes are world x, z and -y, its eye at y = -5.
+        u = (2.0 * window_x / width - 1.0) / proj[0, 0]
+        v = (2.0 * window_y / height - 1.0) / proj[1, 1]
+        return (depth * u, depth - 5.0, depth * v)
+
+    row = 16.5 + 0.003  # the sliver's thin side, 0.003 px above the pixel centres of row 16
+    corners = [world_point(4.5, row, 7.2), world_point(44.5, row, 7.2), world_point(24.5, row + 1e-4, 7.4)]
+    scenes.from_pydata(scene, "Sliver", corners, [(0, 1, 2)])
+    ref = reference.render_reference(scene)
+    assert np.isfinite(ref.depth).all() and ref.depth.max() < 7.2  # the wall hides every corner
+    beside = np.zeros((height, width), bool)
+    beside[16, 4:45] = True  # (the sliver runs from pixel centre 4.5 to 44.5)
+    assert ref.on_silhouette[beside].all()
+    assert not ref.on_silhouette[~beside].any()
+    accuracy.assert_accurate(accuracy.measure(scene, "beside_a_sliver", output_dir))
+
+
 def test_two_lines_of_equal_strength_leave_the_colour_undecided():
     """Two squares side by side, their outline sharp and the edge between
     them a seam, both classes 4 px wide: where the seam meets the outline

@@ -1071,7 +1071,7 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
         )
         altitude = np.where(longest > 0, area2 / np.maximum(longest, 1e-300), 0.0)
     thin = np.flatnonzero(front & np.isfinite(win).all(axis=(1, 2)) & (altitude < SLIVER_PX) & (longest > 0))
-    polygons = [(win[k], -tri[k, :, 2].max()) for k in thin]
+    polygons = [(win[k], -tri[k, :, 2].max(), (win[k], h[k, :, 3], -tri[k, :, 2])) for k in thin]
     crossing = np.flatnonzero(ahead.any(axis=1) & ~ahead.all(axis=1) & np.isfinite(h).all(axis=(1, 2)))
     for k in crossing:  # few
         clipped = _near_clipped_polygon(tri[k], h[k], width, height)
@@ -1079,11 +1079,11 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
             continue
         points, depth = clipped
         if 0.0 < _polygon_width(points) < SLIVER_PX:
-            polygons.append((points, depth))
+            polygons.append((points, depth, None))
     out = []
     evaluated = np.zeros(height, bool)
     evaluated[rows] = True
-    for points, depth in polygons:  # few, and each covers few pixels
+    for points, depth, plane in polygons:  # few, and each covers few pixels
         lo = np.floor(points.min(axis=0) - 1.0).astype(int)
         hi = np.ceil(points.max(axis=0) + 1.0).astype(int)
         xs = np.arange(max(lo[0], 0), min(hi[0], width))
@@ -1108,8 +1108,35 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
         near = dist <= SLIVER_REACH_PX
         if near.any():
             pix = row_of[gy.ravel()[near].astype(int)] * width + gx.ravel()[near].astype(int)
-            out.append((pix, np.full(len(pix), depth)))
+            sample_depth = np.full(len(pix), depth)
+            if plane is not None:
+                sample_depth = np.minimum(sample_depth, _plane_depth_at(*plane, pts[near]))
+            out.append((pix, sample_depth))
     return out
+
+
+def _plane_depth_at(corners, clip_w, depths, points) -> np.ndarray:
+    """The view depth a rasteriser gives window ``points`` (N, 2) when it
+    covers them with the triangle of window ``corners`` (3, 2), clip w
+    ``clip_w`` and view depths ``depths``: its plane's, perspective-correct
+    (depth / w and 1 / w are affine on screen), also at a point just
+    outside it. Across a sliver's thin side that plane runs nearly along
+    the rays, so a sample a snapping step outside it can take a depth far
+    nearer than any of its corners (§7.2). -inf where the plane lies
+    behind the eye along the sample's ray (nothing bounds the depth then)
+    and the nearest corner's depth where the triangle has no window area."""
+    a, b, c = corners
+    area2 = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    if area2 == 0.0:
+        return np.full(len(points), depths.min())
+    # Window barycentrics, extrapolated outside the triangle.
+    wb = ((c[0] - b[0]) * (points[:, 1] - b[1]) - (c[1] - b[1]) * (points[:, 0] - b[0])) / area2
+    wc = ((a[0] - c[0]) * (points[:, 1] - c[1]) - (a[1] - c[1]) * (points[:, 0] - c[0])) / area2
+    weights = np.stack([wb, wc, 1.0 - wb - wc], axis=1)  # of corners a, b, c
+    inverse_w = weights @ (1.0 / clip_w)
+    depth_over_w = weights @ (depths / clip_w)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(inverse_w > 0.0, depth_over_w / inverse_w, -np.inf)
 
 
 def _near_clipped_polygon(view, clip, width, height):
