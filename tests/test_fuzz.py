@@ -259,7 +259,67 @@ def edge_settings(draw):
     return values
 
 
+# Found by a hunt on bpy 5.3.0: a folded hexagon under an orthographic
+# camera and the depth fade; a pixel centre 6.4e-4 px inside the triangle
+# in front, whose neighbour of the same face lies behind it there (depth
+# 1.22 against 2.34). The rasteriser showed the one behind, and the fade
+# read its depth (image model §7.2: a folded face's contour is undecided).
+FOLD_CONTOUR = dict(
+    mesh=(
+        [
+            (1.52681368680942e-54, 1.7734495525463378, 0.010972640954281854),
+            (-1.4012984627980034e-45, 1.7734495525463378, 0.010972640954281854),
+            (1.118540077522332, 1.1, 0.2),
+            (-0.03638775534670957, 0.7963503272893173, 0.33737717331158334),
+            (19.210129946140945, -10.159397681167729, 2.5999457509724736e-161),
+            (-2.9354778513772675e-230, -1.5330173947233714, 1.5735905126137348),
+            (-1.192092896e-07, 2.0, 5.798281345325984e-254),
+            (-1.4772421521139483e-42, 0.016820675837817323, -1.0532015464771476e-271),
+            (-0.05303335954771482, 2.6344668533821883e-170, 0.20665918479568246),
+            (28.707942827049337, -1.598570942160201e-05, -16.298339892153596),
+            (-0.07758687294281286, 1.1, 1e-06),
+            (1.6339493580423676, 0.0, 1.5965364917565372),
+            (1.0573721699423926, -0.24617822644396314, 1.6213769750610542e-286),
+            (2.225073858507e-311, 1.3065280682694125, -2.255770810493117e-266),
+            (1.8363943712544408, -4.3964552380936566e-172, -1.6504258554554907),
+        ],
+        [(0, 1, 2, 3, 4), (5, 6, 7, 8, 9, 10), (11, 12, 13, 14)],
+    ),
+    camera={
+        "location": (0.8765036950419971, -0.9818322099389332, 0.33737717331158334),
+        "target": (-0.03638775534670957, 0.7963503272893173, 0.33737717331158334),
+        "lens": 61.402075529585204,
+        "ortho_scale": 5.434367389734665,
+        "shift": (-8.590151161070602e-243, -0.2647341940052961),
+        "clip": (0.1, 20.0),
+        "sensor_fit": "HORIZONTAL",
+    },
+    line={
+        "thickness": 3.0,
+        "softness": 100.0,
+        "diagonal_mode": "SOLID",
+        "use_backface_culling": False,
+        "use_fade": True,
+        "fade_start": 0.23653788687198146,
+        "fade_end": 9.707093852047185,
+        "edge_angle": 1.0,
+        "use_boundary_edges": True,
+        "boundary_thickness": 3.9314063383492153,
+        "boundary_pattern": "SOLID",
+        "use_density_fade": True,
+        "density_fade_length": 4.0,
+    },
+    transform={
+        "rotation": (-3.18778952377472e-222, 2.9858437246395573, -2.4438812189233317),
+        "scale": (0.763904116754128, -1.7265540859485773, -1.9127558804062568),
+        "location": (-0.2218211363157478, -0.2, 0.033729368163820106),
+        "pixel_aspect": 1.0,
+    },
+)
+
+
 @FUZZ
+@example(**FOLD_CONTOUR)
 @given(mesh=polygons(), camera=cameras(), line=edge_settings(), transform=transforms())
 def test_random_edge_selections_match_reference(mesh, camera, line, transform, tmp_path_factory):
     check_example(mesh, camera, line, transform, tmp_path_factory.getbasetemp() / "fuzz_edges.exr")

@@ -974,14 +974,67 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
         for pix, depth in undecided_hits + _sliver_samples(geo, proj, width, height, rows, row_of):
             near = depth <= best_depth[0, pix] * (1.0 + UNDECIDED_DEPTH)
             flagged[pix[near]] = True
-        centre_hit["undecided"] = flagged
         # Which triangle of the visible face the sample shows is rounding's
         # choice where a sample 0.01 px off shows another (a fold's edge).
         other_triangle = ((best_tri[1:] != best_tri[0]) & (best_face[1:] == best_face[0])).any(axis=0)
+        flagged |= _fold_contour(geo, inv_proj, proj, width, height, rows, best_tri, best_depth)
+        centre_hit["undecided"] = flagged
         centre_hit["shading_undecided"] = other_triangle | _side_undecided(
             side_hits, best_depth[0], centre_hit["front"]
         )
     return best_face, best_depth
+
+
+def _fold_contour(geo, inv_proj, proj, width, height, rows, best_tri, best_depth) -> np.ndarray:
+    """Samples on the contour of a folded face (§7.2): a probe 0.01 px off
+    shows another triangle of the visible face, and one of the two
+    triangles covers the other's sample too, at another depth. There the
+    visible depth jumps within the face (the triangles lie on one another),
+    so whether the rasteriser covers the sample with the near one or shows
+    the far one is its rounding's choice, and with it every term that reads
+    the visible depth. Triangles that only meet along an edge (a flat
+    n-gon's, a bent quad's) cover no sample of one another and keep the
+    depth continuous."""
+    flagged = np.zeros(best_tri.shape[1], bool)
+    centre_tri, centre_depth = best_tri[0], best_depth[0]
+    for s in range(1, len(OFFSETS)):
+        other = np.flatnonzero((best_tri[s] >= 0) & (centre_tri >= 0) & (best_tri[s] != centre_tri))
+        other = other[geo.tri_face[best_tri[s, other]] == geo.tri_face[centre_tri[other]]]
+        if not len(other):
+            continue
+        px = other % width + 0.5
+        py = rows[other // width] + 0.5
+        ox, oy = OFFSETS[s]
+        # The probe's triangle at the centre, and the centre's at the probe.
+        for tri, x, y, seen_depth in (
+            (best_tri[s, other], px, py, centre_depth[other]),
+            (centre_tri[other], px + ox, py + oy, best_depth[s, other]),
+        ):
+            depth = _triangle_depth_on_ray(geo.tri_view[tri], inv_proj, proj, x, y, width, height)
+            jump = np.abs(depth - seen_depth) > UNDECIDED_DEPTH * np.abs(seen_depth)
+            flagged[other[np.isfinite(depth) & jump]] = True
+    return flagged
+
+
+def _triangle_depth_on_ray(corners, inv_proj, proj, x, y, width, height) -> np.ndarray:
+    """View depth where the ray through window point (x, y) meets each of
+    the triangles ``corners`` (N, 3, 3) within the clip range, NaN where it
+    misses."""
+    origin, direction, t_near, t_far = _rays(inv_proj, proj, x, y, width, height)
+    v0 = corners[:, 0]
+    e1 = corners[:, 1] - v0
+    e2 = corners[:, 2] - v0
+    pvec = np.cross(direction, e2)
+    det = np.einsum("ij,ij->i", e1, pvec)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv_det = 1.0 / det
+        tvec = origin - v0
+        u = np.einsum("ij,ij->i", tvec, pvec) * inv_det
+        qvec = np.cross(tvec, e1)
+        v = np.einsum("ij,ij->i", direction, qvec) * inv_det
+        t = np.einsum("ij,ij->i", e2, qvec) * inv_det
+        hit = (det != 0.0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= t_near) & (t <= t_far)
+        return np.where(hit, -(origin[:, 2] + t * direction[:, 2]), np.nan)
 
 
 def _side_undecided(side_hits, visible_depth, visible_front) -> np.ndarray:
