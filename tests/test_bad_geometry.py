@@ -271,6 +271,35 @@ def test_an_edge_beside_a_dropped_face_stays_drawn_under_the_edge_angle(bad, out
     assert x_right > W // 2, "the quad's right edge, shared with the dropped face, is drawn"
 
 
+def test_a_curve_edge_beside_a_dropped_face_stays_its_outline(output_dir):
+    """A curve's tessellation hides the edges between its coplanar faces
+    (image model §3.9), and that rule compares face normals too: a face
+    dropped for a non-finite corner has none (§3.4). Here a ribbon lies flat
+    under +Z, and its last point is NaN, so its second segment's face is
+    dropped (Blender gives it the normal +Z as well). The edge the two
+    segments share is the drawn face's outline. Before, the outline mask
+    read Blender's normals and hid it (a random test of tessellated sources:
+    a silhouette missing beside a bevel's dropped ring; 100 pixels up to 1.0
+    here)."""
+    scene = scenes.empty_scene(64, 48, thickness=1.5)
+    curve = bpy.data.curves.new("Ribbon", "CURVE")
+    curve.dimensions = "3D"
+    curve.extrude = 0.3
+    spline = curve.splines.new("POLY")
+    spline.points.add(2)
+    for point, x in zip(spline.points, (-1.0, 0.4, float("nan"))):
+        point.co = (x, 0.0, 0.0, 1.0)
+        point.tilt = math.pi / 2  # the ribbon lies in the XY plane
+    ribbon = bpy.data.objects.new("Ribbon", curve)
+    scene.collection.objects.link(ribbon)
+    scenes.add_camera(scene, location=(0.0, -0.3, 4.0), target=(0, 0, 0))
+    report = accuracy.measure(scene, "curve_edge_beside_dropped_face", output_dir)
+    accuracy.assert_accurate(report)
+    ref = reference.render_reference(scene)
+    lit_columns = np.flatnonzero((ref.intensity > 0.9).sum(axis=0) > 10)
+    assert len(lit_columns) == 2, "the ribbon's two ends are drawn across it"
+
+
 @pytest.mark.parametrize("edge_angle", [0.0, 0.5], ids=["own-faces", "one-region"])
 def test_an_edge_whose_ends_coincide_draws_the_point_it_shrinks_to(edge_angle, output_dir):
     """An edge whose two vertices lie at one position (an unmerged seam, a

@@ -612,9 +612,12 @@ def _mesh_for(
             # Every look selects edges on a mesh with n-gons: each n-gon's
             # outline is drawn by the region-lines pass (edge_select.select_edges).
             if edges.active or arrays.has_ngons:
+                if corner_vert is None and arrays.dropped_triangles:
+                    corner_vert = mesh_reading.read_corner_verts(source_mesh)  # read once for both below
                 cage_edges = None
                 if outline:
-                    cage_edges = outlines.outline_mask(source_mesh, face_offsets)
+                    normals = mesh_reading.drawn_face_normals(source_mesh, arrays, corner_vert, face_offsets)
+                    cage_edges = outlines.outline_mask(source_mesh, normals, face_offsets)
                 elif edges.use_cage:
                     # The cage's regions (joined across what the angle hides); select_edges
                     # takes them only where the enabled classes style drawn edges alone.

@@ -122,6 +122,21 @@ def read_face_normals(mesh) -> np.ndarray:
     return _read(mesh.polygon_normals, "vector", len(mesh.polygons), np.float32, 3)
 
 
+def drawn_face_normals(mesh, arrays: MeshArrays, corner_vert, face_offsets: np.ndarray) -> np.ndarray:
+    """(P, 3) float32: Blender's face normals, NaN for a face dropped for a
+    non-finite corner (``arrays``: the mesh's extraction, which knows
+    whether it dropped any): such a face is not drawn and has no normal,
+    whatever Blender reports for it, so no rule that compares normals (the
+    edge angle, a tessellation's coplanar faces) hides an edge beside it
+    (image model §3.4). ``corner_vert``: read here where None and needed."""
+    normals = read_face_normals(mesh)
+    if arrays.dropped_triangles:
+        positions = arrays.source_positions if arrays.source_positions is not None else read_positions(mesh)
+        corners = corner_vert if corner_vert is not None else read_corner_verts(mesh)
+        normals = extract.without_dropped_faces(normals, positions, corners, face_offsets[:-1])
+    return normals
+
+
 def read_mesh(mesh) -> dict[str, np.ndarray]:
     """Bulk-read a Blender mesh with Blender's triangles (``loop_triangles``):
     the input of core.extract.build_arrays (the reference path)."""
@@ -384,10 +399,7 @@ def apply_edge_selection(
     joined = None
     if selection.edge_angle > 0.0:
         # Beside a mask only its edges can be hidden by the angle: only they are tested.
-        normals = read_face_normals(mesh)
-        if arrays.dropped_triangles:
-            positions = arrays.source_positions if arrays.source_positions is not None else read_positions(mesh)
-            normals = extract.without_dropped_faces(normals, positions, corner_vert, face_offsets[:-1])
+        normals = drawn_face_normals(mesh, arrays, corner_vert, face_offsets)
         state = edge_select.EdgeAngleState(
             corner_edge, face_offsets, normals, len(verts), selection.edge_angle, candidates=drawn
         )

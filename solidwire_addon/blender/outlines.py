@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..core import edge_select
-from .mesh_reading import read_edge_topology, read_face_normals, read_face_offsets
+from .mesh_reading import read_edge_topology, read_face_offsets
 
 # Object types whose evaluated mesh is a tessellation Blender made.
 TESSELLATED_TYPES = frozenset({"FONT", "CURVE", "SURFACE", "META"})
@@ -50,12 +50,14 @@ def is_curve_outline(obj) -> bool:
     return _source_type(obj) in ("FONT", "CURVE")
 
 
-def outline_mask(mesh, face_offsets: np.ndarray | None = None) -> tuple[np.ndarray, None]:
+def outline_mask(mesh, face_normals: np.ndarray, face_offsets: np.ndarray | None = None) -> tuple[np.ndarray, None]:
     """(drawn mask, chain ids = None) of ``mesh``'s edges in the form
     mesh_reading.apply_edge_selection takes for its cage input: False for an edge
-    of exactly two faces in one plane."""
+    of exactly two faces in one plane. ``face_normals``: the drawn faces'
+    normals (mesh_reading.drawn_face_normals: a dropped face has none, so
+    the edge it shares with a drawn face is that face's outline)."""
     if face_offsets is None:
         face_offsets = read_face_offsets(mesh)
     verts, corner_edge = read_edge_topology(mesh)
-    flat = edge_select.flat_edges(corner_edge, face_offsets, read_face_normals(mesh), len(verts), COPLANAR_ANGLE)
+    flat = edge_select.flat_edges(corner_edge, face_offsets, face_normals, len(verts), COPLANAR_ANGLE)
     return ~flat, None
