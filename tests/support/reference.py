@@ -905,8 +905,7 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
         scale = np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
         for s, (ox, oy) in enumerate(OFFSETS):
             origin, direction, t_near, t_far = _rays(inv_proj, proj, px + 0.5 + ox, py + 0.5 + oy, width, height)
-            pvec = np.cross(direction, e2)
-            det = np.einsum("ij,ij->i", e1, pvec)
+            det, u_det, v_det, t_det = _ray_triangle_terms(origin, direction, v0, e1, e2)
             ok = np.abs(det) > 1e-13 * scale * np.linalg.norm(direction, axis=1)
             if backface_culling:
                 # Which side faces the ray is undecided for a triangle seen
@@ -918,20 +917,14 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
                 undecided = np.zeros(len(det), bool)
             with np.errstate(divide="ignore", invalid="ignore"):
                 inv_det = np.where(ok, 1.0 / det, 0.0)
-                tvec = origin - v0
-                u = np.einsum("ij,ij->i", tvec, pvec) * inv_det
-                qvec = np.cross(tvec, e1)
-                v = np.einsum("ij,ij->i", direction, qvec) * inv_det
-                t = np.einsum("ij,ij->i", e2, qvec) * inv_det
+                u, v, t = u_det * inv_det, v_det * inv_det, t_det * inv_det
             inside = (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= t_near) & (t <= t_far)
             hit = ok & inside
             depth = -(origin[:, 2] + t * direction[:, 2])
             if s == 0 and centre_hit is not None and undecided.any():
                 with np.errstate(divide="ignore", invalid="ignore"):
                     inv_u = np.where(undecided, 1.0 / det, 0.0)
-                    uu = np.einsum("ij,ij->i", tvec, pvec) * inv_u
-                    vv = np.einsum("ij,ij->i", direction, qvec) * inv_u
-                    tt = np.einsum("ij,ij->i", e2, qvec) * inv_u
+                    uu, vv, tt = u_det * inv_u, v_det * inv_u, t_det * inv_u
                 near_hit = undecided & (uu >= 0) & (vv >= 0) & (uu + vv <= 1) & (tt >= t_near) & (tt <= t_far)
                 undecided_hits.append((pixel[near_hit], -(origin[near_hit, 2] + tt[near_hit] * direction[near_hit, 2])))
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
@@ -1016,23 +1009,31 @@ def _fold_contour(geo, inv_proj, proj, width, height, rows, best_tri, best_depth
     return flagged
 
 
+def _ray_triangle_terms(origin, direction, v0, e1, e2):
+    """Möller-Trumbore for rays (origin, direction) against triangles with
+    corner v0 and sides e1, e2, row by row: (det, u det, v det, t det), so
+    that the barycentrics u, v and the ray parameter t are the last three
+    over det (each caller divides where its det is usable)."""
+    pvec = np.cross(direction, e2)
+    tvec = origin - v0
+    qvec = np.cross(tvec, e1)
+    return (
+        np.einsum("ij,ij->i", e1, pvec),
+        np.einsum("ij,ij->i", tvec, pvec),
+        np.einsum("ij,ij->i", direction, qvec),
+        np.einsum("ij,ij->i", e2, qvec),
+    )
+
+
 def _triangle_depth_on_ray(corners, inv_proj, proj, x, y, width, height) -> np.ndarray:
     """View depth where the ray through window point (x, y) meets each of
     the triangles ``corners`` (N, 3, 3) within the clip range, NaN where it
     misses."""
     origin, direction, t_near, t_far = _rays(inv_proj, proj, x, y, width, height)
     v0 = corners[:, 0]
-    e1 = corners[:, 1] - v0
-    e2 = corners[:, 2] - v0
-    pvec = np.cross(direction, e2)
-    det = np.einsum("ij,ij->i", e1, pvec)
+    det, u_det, v_det, t_det = _ray_triangle_terms(origin, direction, v0, corners[:, 1] - v0, corners[:, 2] - v0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        inv_det = 1.0 / det
-        tvec = origin - v0
-        u = np.einsum("ij,ij->i", tvec, pvec) * inv_det
-        qvec = np.cross(tvec, e1)
-        v = np.einsum("ij,ij->i", direction, qvec) * inv_det
-        t = np.einsum("ij,ij->i", e2, qvec) * inv_det
+        u, v, t = u_det / det, v_det / det, t_det / det
         hit = (det != 0.0) & (u >= 0) & (v >= 0) & (u + v <= 1) & (t >= t_near) & (t <= t_far)
         return np.where(hit, -(origin[:, 2] + t * direction[:, 2]), np.nan)
 
