@@ -1125,7 +1125,7 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
         )
         altitude = np.where(longest > 0, area2 / np.maximum(longest, 1e-300), 0.0)
     thin = np.flatnonzero(front & np.isfinite(win).all(axis=(1, 2)) & (altitude < SLIVER_PX) & (longest > 0))
-    polygons = [(win[k], -tri[k, :, 2].max(), (win[k], h[k, :, 3], -tri[k, :, 2])) for k in thin]
+    polygons = [(win[k], -tri[k, :, 2].max(), (h[k, :, 3], -tri[k, :, 2])) for k in thin]
     crossing = np.flatnonzero(ahead.any(axis=1) & ~ahead.all(axis=1) & np.isfinite(h).all(axis=(1, 2)))
     for k in crossing:  # few
         clipped = _near_clipped_polygon(tri[k], h[k], width, height)
@@ -1164,7 +1164,7 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
             pix = row_of[gy.ravel()[near].astype(int)] * width + gx.ravel()[near].astype(int)
             sample_depth = np.full(len(pix), depth)
             if plane is not None:
-                sample_depth = np.minimum(sample_depth, _plane_depth_at(*plane, pts[near]))
+                sample_depth = np.minimum(sample_depth, _plane_depth_at(points, *plane, pts[near]))
             out.append((pix, sample_depth))
     return out
 
