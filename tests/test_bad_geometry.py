@@ -105,6 +105,19 @@ def _huge_far_away(scene, name, loc):
     return _mesh_object(scene, name, verts, [], [(0, 1, 2), (3, 4, 5)], loc)
 
 
+def _huge_coordinates(scene, name, loc):
+    # Finite, but past what float32 can square: 3e38 is what Blender stores
+    # for a curve point set to inf; 2e19 squared overflows float32. Their
+    # faces are dropped as a NaN vertex's are (image model §2.1); 1e19, just
+    # under the limit, is kept (that face runs out of the picture).
+    verts, faces = _strip(3)
+    verts[2] = (3.0e38, 0.0, -0.8)  # quads 0 and 1
+    verts[7] = (1.5, -2.0e19, 0.8)  # quad 2
+    verts += [(-1.4, 0.0, 1.0), (-0.6, 0.0, 1.0), (-1.0, 0.0, 1.6), (-1.0, 1.0e19, 1.6)]
+    faces += [(8, 9, 10), (8, 10, 11)]
+    return _mesh_object(scene, name, verts, [], faces, loc)
+
+
 # case -> (builder, text the one message must contain or None, draws anything)
 CASES = {
     "nan_and_inf_vertices": (_nonfinite, "non-finite", True),
@@ -116,6 +129,7 @@ CASES = {
     # An empty mesh is also what a pure instancer evaluates to: no message.
     "empty_mesh": (_empty, None, False),
     "coordinates_1e8": (_huge_far_away, None, False),
+    "huge_coordinates": (_huge_coordinates, "huge (1.8e19 or more)", True),
 }
 
 

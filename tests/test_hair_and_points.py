@@ -185,6 +185,29 @@ def test_empty_and_broken_data_are_skipped_with_one_line(output_dir, capfd):
     assert np.isfinite(rgba).all()
 
 
+def test_huge_coordinates_are_left_out_as_nan_is(output_dir, capfd):
+    """A coordinate or radius of 1.8e19 or more (float32 overflows when it
+    squares one; 3e38 is what Blender stores for inf) leaves its point out,
+    with the segments that touch it, as NaN does (image model §2.1): the
+    render matches the reference, which does the same, and says so once."""
+    scene = scenes.empty_scene(120, 90, thickness=1.5)
+    strand_scenes.point_cloud(scene, "HugePoints", [(3.0e38, 0.0, 0.0), (0.0, 0.0, 0.5), (-1.0, 0.0, -0.5)], 0.2)
+    strand_scenes.hair(
+        scene,
+        "HugeHair",
+        [[(-2.0, 0.0, -1.0), (-1.0, 0.0, 1.0), (0.0, -2.0e19, 1.0), (1.0, 0.0, 1.2), (2.0, 0.0, -1.0)]],
+        [0.02],
+    )
+    scenes.add_camera(scene, location=(0.0, -6.0, 0.0), target=(0.0, 0.0, 0.0))
+    capfd.readouterr()
+    _rgba, ref, report = _measure(scene, "hair_points_huge", output_dir)
+    err = capfd.readouterr().err
+    assert err.count("'HugePoints'") == 1 and err.count("'HugeHair'") == 1, err
+    assert "huge (1.8e19 or more)" in err
+    accuracy.assert_accurate(report)
+    assert (ref.weight >= 0.5).sum() > 50  # the two good points and the two good segments
+
+
 def test_catmull_rom_as_blender_evaluates_it():
     """The strands follow the evaluated curve: every control point on it,
     (n - 1) * resolution + 1 points, the reference's evaluation exactly."""

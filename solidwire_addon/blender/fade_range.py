@@ -29,7 +29,7 @@ def visible_depth_extent(depsgraph, view_matrix, object_filter=None):
         pointer = obj.data.as_pointer()
         if pointer not in boxes:  # (read once per mesh, however many instances draw it)
             box = np.array(obj.bound_box, dtype=np.float64)
-            boxes[pointer] = mesh_reading.finite_vertex_box(obj, (box.min(axis=0), box.max(axis=0)))
+            boxes[pointer] = mesh_reading.drawn_vertex_box(obj, (box.min(axis=0), box.max(axis=0)))
         box = boxes[pointer]
         if box is None:
             continue

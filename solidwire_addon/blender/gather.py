@@ -388,7 +388,7 @@ class _FrameGather:
                         if box is not None and _outside(self.view_projection, instance, box, self.view_reach):
                             # Only an off-screen object pays for the check: a
                             # small part of what extracting it would cost.
-                            box = mesh_reading.finite_vertex_box(obj, box)
+                            box = mesh_reading.drawn_vertex_box(obj, box)
                         if box is not None and _outside(self.view_projection, instance, box, self.view_reach):
                             self.deferred[pointer] = (key, uids, box, 1)
                             return None
@@ -646,7 +646,7 @@ def _mesh_for(
             warn_once(
                 ("nonfinite", obj.name),
                 f"SolidWire: object '{obj.name}' has {arrays.dropped_triangles} triangles in faces with "
-                "non-finite (NaN/Inf) vertex coordinates; those faces are not drawn",
+                "non-finite (NaN/Inf) or huge (1.8e19 or more) vertex coordinates; those faces are not drawn",
             )
         if arrays.degenerate_triangles:
             warn_once(

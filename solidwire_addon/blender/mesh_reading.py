@@ -64,22 +64,24 @@ def read_positions(mesh) -> np.ndarray:
     return out if out is not None else _read(mesh.vertices, "co", count, np.float32, 3)
 
 
-def finite_vertex_box(obj, box):
+def drawn_vertex_box(obj, box):
     """``box`` ((lo, hi), the evaluated object's bound box as Blender
-    reports it) checked against the vertices: with a non-finite vertex
-    Blender's box can be finite and still miss finite ones, which are drawn.
-    Then the box of the finite vertices; None where there are none, or the
-    positions cannot be read. One read of the positions (about 2 ms per
-    million vertices on the 2-core VM)."""
+    reports it) checked against the vertices: with a vertex that is not
+    drawn (NaN, Inf or past extract.COORDINATE_LIMIT) Blender's box can miss
+    the drawn ones, or span nothing but that vertex. Then the box of the
+    drawable vertices; None where there are none, or the positions cannot be
+    read. One read of the positions (about 2 ms per million vertices on the
+    2-core VM)."""
     if obj.original.mode == "EDIT":
         return box  # the evaluated mesh can be an empty wrapper (blender/gather.py)
     try:
         positions = read_positions(obj.data)
     except (AttributeError, RuntimeError, ValueError):
         return None
-    if np.isfinite(positions).all():
+    drawable = extract.drawable_vertices(positions)
+    if drawable is None:
         return box
-    drawn = positions[np.isfinite(positions).all(axis=1)].astype(np.float64)
+    drawn = positions[drawable].astype(np.float64)
     return (drawn.min(axis=0), drawn.max(axis=0)) if len(drawn) else None
 
 
@@ -124,7 +126,7 @@ def read_face_normals(mesh) -> np.ndarray:
 
 def drawn_face_normals(mesh, arrays: MeshArrays, corner_vert, face_offsets: np.ndarray) -> np.ndarray:
     """(P, 3) float32: Blender's face normals, NaN for a face dropped for a
-    non-finite corner (``arrays``: the mesh's extraction, which knows
+    corner that is not drawable (``arrays``: the mesh's extraction, which knows
     whether it dropped any): such a face is not drawn and has no normal,
     whatever Blender reports for it, so no rule that compares normals (the
     edge angle, a tessellation's coplanar faces) hides an edge beside it

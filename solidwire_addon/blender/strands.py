@@ -104,8 +104,9 @@ def gather_strands(depsgraph, *, object_filter=None, object_settings=None, color
                     count = geometry.dropped
                     warn_once(
                         ("strands nonfinite", obj.name),
-                        f"SolidWire: '{obj.name}' has {count} point{'s' if count != 1 else ''} with non-finite "
-                        "coordinates or radius, left out (with the strand segments that touch them)",
+                        f"SolidWire: '{obj.name}' has {count} point{'s' if count != 1 else ''} with a non-finite "
+                        "(NaN/Inf) or huge (1.8e19 or more) coordinate or radius, left out (with the strand "
+                        "segments that touch them)",
                     )
             geometry = by_data[pointer]
             if geometry is None:

@@ -63,7 +63,7 @@ class MeshArrays:
     triangle_polygons: np.ndarray  # (T,) int32 polygon index of each triangle
     bounds_min: np.ndarray  # (3,) float64, mesh space (not re-centred)
     bounds_max: np.ndarray  # (3,) float64
-    dropped_triangles: int = 0  # triangles skipped for non-finite vertices
+    dropped_triangles: int = 0  # triangles skipped for vertices that are not drawable (drawable_vertices)
     # Vertex ids of every n-gon's outline in loop order, one polygon after
     # another; an n-gon triangle's column 3 says where its polygon starts.
     ngon_corners: np.ndarray = None
@@ -272,17 +272,17 @@ def _face_vertices(vertex_count: int, corners: np.ndarray) -> np.ndarray | None:
 
 def _recentre(
     positions: np.ndarray,
-    finite_vertex: np.ndarray | None,
+    drawable_vertex: np.ndarray | None,
     columns: np.ndarray | None = None,
     face_vertex: np.ndarray | None = None,
 ):
     """(local float32, centre, bounds_min, bounds_max).
 
-    Bounds and centre cover the finite vertices that drawn faces use
-    (``finite_vertex`` / ``face_vertex`` None: all of them): a loose vertex
+    Bounds and centre cover the drawable vertices that drawn faces use
+    (``drawable_vertex`` / ``face_vertex`` None: all of them): a loose vertex
     far away must neither move the centre (the faces would lose float32
     precision) nor widen the bounds used for culling (see _centre_of)."""
-    if finite_vertex is None and face_vertex is None:
+    if drawable_vertex is None and face_vertex is None:
         if len(positions):
             # Reductions over an (N, 3) array's short axis are slow in numpy:
             # reduce each contiguous column of the transposed copy instead.
@@ -295,9 +295,9 @@ def _recentre(
         local = np.subtract(positions, centre.astype(np.float32))
         return local, centre, bounds_min, bounds_max
     counted = (
-        finite_vertex
+        drawable_vertex
         if face_vertex is None
-        else (face_vertex if finite_vertex is None else finite_vertex & face_vertex)
+        else (face_vertex if drawable_vertex is None else drawable_vertex & face_vertex)
     )
     if not counted.any():
         zero = np.zeros(3)
@@ -306,8 +306,8 @@ def _recentre(
     bounds_max = positions[counted].max(axis=0).astype(np.float64)
     centre = _centre_of(bounds_min, bounds_max)
     local = np.subtract(positions, centre.astype(np.float32))
-    if finite_vertex is not None:
-        local[~finite_vertex] = 0.0
+    if drawable_vertex is not None:
+        local[~drawable_vertex] = 0.0
     return local, centre, bounds_min, bounds_max
 
 
@@ -342,24 +342,34 @@ def _centre_of(bounds_min: np.ndarray, bounds_max: np.ndarray) -> np.ndarray:
     return np.where(exact, middle, 0.0)
 
 
-def _finite_vertices(positions: np.ndarray) -> np.ndarray | None:
-    """None when every vertex is finite, else the per-vertex mask. One
-    contiguous sum answers the common case (NaN/Inf propagate; a sum that
-    overflows only sends us to the exact check). Inf + -Inf in that sum is
-    expected here, not a fault: numpy's warning about it is silenced, as
-    it would otherwise reach Blender's console for every such mesh."""
-    with np.errstate(invalid="ignore", over="ignore"):
-        total = positions.sum(dtype=np.float64)
-    if np.isfinite(total):
-        return None
-    finite = np.isfinite(positions).all(axis=1)
-    return None if finite.all() else finite
+# A vertex with a coordinate of magnitude 2**64 (about 1.8e19) or more is
+# not drawn, as if it were NaN (image model §2.1): float32, in which Blender
+# and the GPU compute, overflows when it squares such a coordinate (a
+# length, a normal), and near 3.4e38 its projection overflows where the
+# float64 reference's would not. No real scene comes near it; a curve point
+# set to inf does (Blender stores it as 3.4e38).
+COORDINATE_LIMIT = 2.0**64
 
 
-def _finite_faces(finite_vertex: np.ndarray, corner_vert: np.ndarray, loop_start: np.ndarray) -> np.ndarray:
-    """Per face: True when every corner's vertex is finite."""
+def drawable_vertices(positions: np.ndarray) -> np.ndarray | None:
+    """None when every vertex is drawable (finite, every coordinate below
+    COORDINATE_LIMIT in magnitude), else the per-vertex mask. One float32
+    dot product of the coordinates with themselves answers the common case:
+    when it is finite no square overflowed, so every coordinate is below
+    the limit (NaN and Inf propagate; a sum that overflows only sends us
+    to the exact check). It is about 9x cheaper than a float64 sum."""
+    flat = np.ascontiguousarray(positions, dtype=np.float32).reshape(-1)
+    with np.errstate(invalid="ignore", over="ignore"):  # Inf * 0 and overflow are expected here
+        if np.isfinite(np.dot(flat, flat)):
+            return None
+        drawable = (np.abs(positions) < COORDINATE_LIMIT).all(axis=1)  # NaN compares False
+    return None if drawable.all() else drawable
+
+
+def _drawable_faces(drawable_vertex: np.ndarray, corner_vert: np.ndarray, loop_start: np.ndarray) -> np.ndarray:
+    """Per face: True when every corner's vertex is drawable (drawable_vertices)."""
     ok = np.ones(len(loop_start), dtype=bool)
-    bad_corners = np.flatnonzero(~finite_vertex[corner_vert])
+    bad_corners = np.flatnonzero(~drawable_vertex[corner_vert])
     if len(bad_corners):
         order = np.argsort(loop_start, kind="stable")
         # The face of a corner: the last face starting at or before it.
@@ -369,14 +379,15 @@ def _finite_faces(finite_vertex: np.ndarray, corner_vert: np.ndarray, loop_start
 
 def without_dropped_faces(face_normals: np.ndarray, positions: np.ndarray, corner_vert, face_starts) -> np.ndarray:
     """``face_normals`` (F, 3) with NaN rows for the faces with a
-    non-finite corner: such a face is not drawn (image model §2.1), so it
-    has no normal, and the edge angle hides no edge beside it (§3.4).
-    ``face_normals`` itself where every vertex is finite."""
-    finite_vertex = _finite_vertices(positions)
-    if finite_vertex is None:
+    corner that is not drawable (drawable_vertices): such a face is not
+    drawn (image model §2.1), so it has no normal, and the edge angle hides
+    no edge beside it (§3.4). ``face_normals`` itself where every vertex is
+    drawable."""
+    drawable_vertex = drawable_vertices(positions)
+    if drawable_vertex is None:
         return face_normals
     normals = np.array(face_normals, np.float32)
-    normals[~_finite_faces(finite_vertex, np.asarray(corner_vert), np.asarray(face_starts))] = np.nan
+    normals[~_drawable_faces(drawable_vertex, np.asarray(corner_vert), np.asarray(face_starts))] = np.nan
     return normals
 
 
@@ -404,14 +415,14 @@ def build_arrays(
     tri_loops = np.asarray(tri_loops, dtype=np.int32).reshape(-1, 3)
     tri_polygons = np.asarray(tri_polygons, dtype=np.int32)
 
-    # A vertex at NaN/Inf cannot be projected: drop every triangle of each
-    # face that uses it (the whole face: a kept triangle of it would draw
-    # edges to a corner that has no position) and keep its bounds out of the
-    # centre, rather than poison the image.
-    finite_vertex = _finite_vertices(positions)
+    # A vertex at NaN/Inf (or past COORDINATE_LIMIT) cannot be projected:
+    # drop every triangle of each face that uses it (the whole face: a kept
+    # triangle of it would draw edges to a corner that has no position) and
+    # keep its bounds out of the centre, rather than poison the image.
+    drawable_vertex = drawable_vertices(positions)
     dropped = 0
-    if finite_vertex is not None:
-        keep = _finite_faces(finite_vertex, corner_vert, loop_start)[tri_polygons]
+    if drawable_vertex is not None:
+        keep = _drawable_faces(drawable_vertex, corner_vert, loop_start)[tri_polygons]
         dropped = int((~keep).sum())
         tri_loops, tri_polygons = tri_loops[keep], tri_polygons[keep]
 
@@ -433,7 +444,7 @@ def build_arrays(
         flags[is_ngon_tri] |= IS_NGON | (loop_total[tri_polygons[is_ngon_tri]] << NGON_SHIFT)
 
     face_vertex = _face_vertices(len(positions), triangles[:, :3].ravel())
-    local, centre, bounds_min, bounds_max = _recentre(positions, finite_vertex, face_vertex=face_vertex)
+    local, centre, bounds_min, bounds_max = _recentre(positions, drawable_vertex, face_vertex=face_vertex)
     return MeshArrays(
         local,
         centre,
@@ -602,7 +613,7 @@ def build_arrays_fast(
             raise ValueError("this mesh needs Blender's triangulation (n-gons or undecided quads)")
         return np.asarray(blender_tris(tri_indices), dtype=np.int32).reshape(-1, 3)
 
-    finite_vertex = _finite_vertices(positions)
+    drawable_vertex = drawable_vertices(positions)
     all_quads = face_count > 0 and tri_count == 2 * face_count and int(sizes.min()) == 4
     if all_quads:
         quad_faces = None
@@ -624,9 +635,9 @@ def build_arrays_fast(
         first = ask_blender(quad_tri_start[undecided])
         flip[undecided] = first[:, 2] == quad_loop_start[undecided] + 3
 
-    if finite_vertex is not None:
+    if drawable_vertex is not None:
         # Rare: hand the full triangle list to the reference path, which
-        # drops triangles with non-finite corners and repacks n-gons.
+        # drops triangles with corners that are not drawable and repacks n-gons.
         tri_loops = np.empty((tri_count, 3), dtype=np.int32)
         ql = quad_loop_start[:, None] + np.where(flip[:, None], [[0, 1, 3]], [[0, 1, 2]]).astype(np.int32)
         tri_loops[quad_tri_start] = ql
@@ -739,7 +750,7 @@ def reposition(
     if quads is None or flip is None or previous.face_offsets_crc is None:
         return None
     positions = np.asarray(positions, dtype=np.float32).reshape(-1, 3)
-    if len(positions) != previous.vertex_count or _finite_vertices(positions) is not None:
+    if len(positions) != previous.vertex_count or drawable_vertices(positions) is not None:
         return None
     offsets = np.ascontiguousarray(face_offsets, dtype=np.int32)
     if zlib.crc32(memoryview(offsets).cast("B")) != previous.face_offsets_crc:

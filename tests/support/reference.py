@@ -53,6 +53,15 @@ OFFSETS = np.array(
     ]
 )
 PAIR_CHUNK = 400_000
+# §2.1: a coordinate of this magnitude or more is dropped as NaN is.
+COORDINATE_LIMIT = 2.0**64
+
+
+def drawable(values, axis=-1) -> np.ndarray:
+    """Where every value along ``axis`` is finite and below
+    COORDINATE_LIMIT in magnitude (§2.1)."""
+    with np.errstate(invalid="ignore"):
+        return (np.abs(np.asarray(values, np.float64)) < COORDINATE_LIMIT).all(axis=axis)
 
 
 @dataclass
@@ -194,7 +203,7 @@ def _corner_colors(mesh, tri_loops, tri_vertices) -> np.ndarray:
 
 def _flat_edges(mesh, loop_poly, real_a, real_b, angle, poly_ok) -> set:
     """{(lo, hi)} vertex pairs of the edges that the edge angle hides. A
-    dropped face (``poly_ok`` False: a non-finite corner, §2.1) has no
+    dropped face (``poly_ok`` False: a corner that is not drawable, §2.1) has no
     normal: no edge beside it is hidden by the angle."""
     if not angle > 0.0:
         return set()
@@ -628,11 +637,12 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             zip(loop_poly.tolist(), np.minimum(real_a, real_b).tolist(), np.maximum(real_a, real_b).tolist())
         )
         diag = set()
-        # A face with a non-finite (NaN/Inf) corner is not drawn at all
-        # (§2.1): it has no edges either, so it makes no silhouette
-        # candidate and leaves its neighbours' shared edges boundaries.
-        finite = np.isfinite(vco).all(axis=1)
-        poly_ok = np.bincount(loop_poly, weights=~finite[loop_vert], minlength=npoly) == 0
+        # A face with a corner that is not drawable (NaN, Inf or past
+        # COORDINATE_LIMIT) is not drawn at all (§2.1): it has no edges
+        # either, so it makes no silhouette candidate and leaves its
+        # neighbours' shared edges boundaries.
+        drawn_vertex = drawable(vco, axis=1)
+        poly_ok = np.bincount(loop_poly, weights=~drawn_vertex[loop_vert], minlength=npoly) == 0
         half_edges: dict = {}  # real edge -> third vertices of its drawn triangles
         for t in range(ntri):  # small meshes only (reference)
             p = int(tri_p[t])
@@ -666,7 +676,7 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
             sb = np.array([e[1] for e in sil])
             of = np.array([e[2][0] for e in sil])
             og = np.array([e[2][1] if len(e[2]) == 2 else -1 for e in sil])
-            ok_s = finite[sa] & finite[sb] & finite[of] & ((og < 0) | finite[np.maximum(og, 0)])
+            ok_s = drawn_vertex[sa] & drawn_vertex[sb] & drawn_vertex[of] & ((og < 0) | drawn_vertex[np.maximum(og, 0)])
             sa, sb, of, og = sa[ok_s], sb[ok_s], of[ok_s], og[ok_s]
             sil_edges.append(np.stack([vco[sa], vco[sb]], axis=1))
             third_g = np.where((og >= 0)[:, None], vco[np.maximum(og, 0)], np.nan)
@@ -701,7 +711,7 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         tri_faces.append(face_offset + tri_p[tri_ok])
         face_key.append(face_offset + sel["key"])
         ea, eb = sel["a"], sel["b"]
-        ok = finite[ea] & finite[eb]
+        ok = drawn_vertex[ea] & drawn_vertex[eb]
         edges.append(np.stack([vco[ea[ok]], vco[eb[ok]]], axis=1))
         edge_faces.append(face_offset + sel["owner"][ok])
         edge_real.append(np.ones(ok.sum(), bool))

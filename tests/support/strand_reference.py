@@ -141,7 +141,7 @@ def primitives(depsgraph, show="show_in_render"):
         rad = np.zeros(count) if rad is None else rad
         if obj.type == "POINTCLOUD":
             for p, r in zip(pos, rad):
-                if np.isfinite(p).all() and np.isfinite(r):
+                if reference.drawable(p) and reference.drawable([r]):
                     points.append((p, max(r, 0.0), matrix, obj.name))
             continue
         ncurves = len(data.curves)
@@ -175,7 +175,7 @@ def primitives(depsgraph, show="show_in_render"):
                 )
             strand += 1
             for i, j in pairs:
-                if np.isfinite(ev[i]).all() and np.isfinite(ev[j]).all():
+                if reference.drawable(ev[i]) and reference.drawable(ev[j]):
                     segments.append(
                         (ev[i, :3], ev[j, :3], max(ev[i, 3], 0.0), max(ev[j, 3], 0.0), matrix, obj.name, strand)
                     )
