@@ -419,6 +419,29 @@ def test_stray_far_vertex_does_not_spoil_the_faces(output_dir):
     accuracy.assert_accurate(report)
 
 
+def test_the_coordinate_limit_holds_in_the_mesh_s_own_space(output_dir, capfd):
+    """The limit of 1.8e19 is on the mesh's own coordinates, as Blender
+    stores them (image model §2.1), whatever the object's scale: a face
+    with a corner at 2e19 in an object scaled by 0.25 is dropped, one with
+    a corner at 1e19 in an object scaled by 4 is drawn (it runs away from
+    the camera, past the far clip: see image model §2.1 on float32's range
+    across the view)."""
+    scene = scenes.empty_scene(64, 48)
+    for name, far_corner, scale, x in (
+        ("Shrunk", (-2.0e19, 0.0, 1.0), 0.25, -1.2),  # 5e18 in the world
+        ("Grown", (0.0, 1.0e19, 1.0), 4.0, 1.2),  # 4e19 in the world
+    ):
+        near_corners = [(-1.0 / scale, 0.0, -1.0 / scale), (1.0 / scale, 0.0, -1.0 / scale), (0.0, 0.0, 1.0 / scale)]
+        obj = _mesh_object(scene, name, [*near_corners, far_corner], [], [(0, 1, 2), (0, 2, 3)], (x, 0.0, 0.0))
+        obj.scale = (scale, scale, scale)
+    scenes.add_camera(scene, location=(0.0, -6.0, 0.5), target=(0.0, 0.0, 0.0))
+    capfd.readouterr()
+    report = accuracy.measure(scene, "coordinate_limit_in_mesh_space", output_dir)
+    said = capfd.readouterr()
+    accuracy.assert_accurate(report)
+    assert "'Shrunk'" in said.out + said.err and "'Grown'" not in said.out + said.err
+
+
 def test_messages_are_capped(capfd):
     """Thousands of broken objects (or an error text that changes every
     redraw) print at most MAX_MESSAGES lines and one line saying so."""

@@ -638,10 +638,10 @@ def _gather_geometry(depsgraph, view_matrix, s=None) -> _Geometry:
         )
         diag = set()
         # A face with a corner that is not drawable (NaN, Inf or past
-        # COORDINATE_LIMIT) is not drawn at all (§2.1): it has no edges
-        # either, so it makes no silhouette candidate and leaves its
-        # neighbours' shared edges boundaries.
-        drawn_vertex = drawable(vco, axis=1)
+        # COORDINATE_LIMIT in the mesh's own space) is not drawn at all
+        # (§2.1): it has no edges either, so it makes no silhouette
+        # candidate and leaves its neighbours' shared edges boundaries.
+        drawn_vertex = drawable(co, axis=1) & np.isfinite(vco).all(axis=1)
         poly_ok = np.bincount(loop_poly, weights=~drawn_vertex[loop_vert], minlength=npoly) == 0
         half_edges: dict = {}  # real edge -> third vertices of its drawn triangles
         for t in range(ntri):  # small meshes only (reference)
