@@ -1099,7 +1099,8 @@ def test_random_drags_in_the_overlay_draw_what_a_fresh_frame_draws(stack, line, 
 @st.composite
 def strand_curves(draw):
     """0-4 hair curves (poly, Catmull-Rom or Bezier, some cyclic) of 1-6
-    points, some repeated or nearly so (zero-length segments), with radii
+    points, some repeated or nearly so (zero-length segments), a few not
+    drawable (NaN, Inf, 3e38), with radii
     from none to wider than the view, and 0-6 points of a point cloud of
     one radius (0 draws a dot of the line's width)."""
     curves, radii, types, cyclic, left, right = [], [], [], [], [], []
@@ -1107,9 +1108,18 @@ def strand_curves(draw):
         kind = draw(st.sampled_from([strand_scenes.POLY, strand_scenes.CATMULL_ROM, strand_scenes.BEZIER]))
         points = [draw(point)]
         for _k in range(draw(st.integers(0, 5))):
-            step = draw(st.sampled_from(["new"] * 4 + ["same", "near"]))
+            step = draw(st.sampled_from(["new"] * 8 + ["same", "same", "near", "near", "bad"]))
             if step == "same":
                 points.append(points[-1])
+            elif step == "bad":
+                # Non-finite or past the coordinate limit (3e38: what
+                # Blender stores for inf): the point is left out with the
+                # segments that touch it, image model §2.1. (Not -2e19:
+                # a curve through it passes points under the limit but
+                # far past what float32 draws to a pixel, §2.1.)
+                bad = list(draw(point))
+                bad[draw(st.integers(0, 2))] = draw(st.sampled_from([math.nan, math.inf, -math.inf, 3.0e38]))
+                points.append(tuple(bad))
             elif step == "near":
                 points.append(tuple(p + draw(st.floats(-1e-4, 1e-4)) for p in points[-1]))
             else:

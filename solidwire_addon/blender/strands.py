@@ -98,7 +98,9 @@ def gather_strands(depsgraph, *, object_filter=None, object_settings=None, color
                 geometry = geometry_of(obj)
                 by_data[pointer] = geometry
                 if geometry is None:
-                    what = "no points" if len(obj.data.points) == 0 else "no points with finite coordinates"
+                    what = (
+                        "no points" if len(obj.data.points) == 0 else "no points with finite coordinates under 1.8e19"
+                    )
                     warn_once(("strands empty", obj.name), f"SolidWire skips '{obj.name}': it has {what}")
                 elif geometry.dropped:
                     count = geometry.dropped

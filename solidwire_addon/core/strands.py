@@ -206,8 +206,8 @@ def curves_geometry(
     Blender's defaults, Catmull-Rom at 12), ``handles`` (left, right) (P, 3)
     each, or None. Catmull-Rom curves and Bezier curves with handles are
     evaluated (positions and radius alike); other types draw their control
-    polygon. A segment with a non-finite end is left out. None when nothing
-    is left."""
+    polygon. A segment with an end that is not drawable (_drawable) is left
+    out. None when nothing is left."""
     positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     count = len(positions)
     radius = np.zeros(count) if radius is None else np.asarray(radius, dtype=np.float64).reshape(-1)
@@ -238,11 +238,16 @@ def curves_geometry(
         rows = offsets[members][:, None] + np.arange(n)[None, :]
         control = values[rows]  # (m, n, 4)
         if how:
-            if how == 1:
-                evaluated = catmull_rom(control, int(resolution), bool(is_closed))
-            else:
-                left, right = (np.asarray(h, dtype=np.float64).reshape(-1, 3)[rows] for h in handles)
-                evaluated = bezier(control, left, right, int(resolution), bool(is_closed))
+            # A point that is not drawable spreads NaN and Inf to the
+            # evaluated points near it (Inf * 0): expected, and those are
+            # left out below, so numpy's warning would only reach Blender's
+            # console.
+            with np.errstate(invalid="ignore", over="ignore"):
+                if how == 1:
+                    evaluated = catmull_rom(control, int(resolution), bool(is_closed))
+                else:
+                    left, right = (np.asarray(h, dtype=np.float64).reshape(-1, 3)[rows] for h in handles)
+                    evaluated = bezier(control, left, right, int(resolution), bool(is_closed))
             chain = _chain(evaluated.shape[1], False, bool(is_closed)) if evaluated.shape[1] >= 2 else None
         else:
             evaluated = control
