@@ -506,9 +506,55 @@ OUTER_HALF_WITHIN_BIAS = dict(
 )
 
 
+# A hunt's scene (every line option, the render): a triangle seen nearly
+# edge-on, its sharp tip 0.0012 px beside two pixel centres, where it is
+# 0.002 px wide; the rasteriser covered them, every probe 0.01 px off
+# passed beside it (image model §7.2: a snapping step).
+SHARP_TIP = dict(
+    mesh=(
+        [
+            (1.672954935330857, -2.1901812721062697e-171, 0.055),
+            (0.0, 0.0, 0.21687179616334928),
+            (-5.449154054348433e-31, 0.0, 0.0),
+            (-1.965918879784856, 0.0, 0.0),
+            (-18.17828205329796, -29.903481982522173, 3.6275171636453115e-111),
+            (-0.8967787028625487, 0.2110849978372955, -math.inf),
+        ],
+        [(0, 1, 2), (3, 4, 5)],
+    ),
+    camera={
+        "location": (0.7478810141301162, -0.21151952065267526, -0.4725130359273385),
+        "target": (1.8926943201609813e-290, -0.15518135682291478, -0.4725130359273385),
+        "lens": 16.0,
+        "ortho_scale": None,
+        "shift": (0.288187946048638, -0.06791480285832915),
+        "clip": (0.01, 100.0),
+        "sensor_fit": "HORIZONTAL",
+    },
+    line={
+        "thickness": 40.0,
+        "softness": 100.0,
+        "diagonal_mode": "HIDDEN",
+        "use_backface_culling": False,
+        "use_fade": True,
+        "fade_start": 0.5880388208629085,
+        "fade_end": 12.640707203117724,
+        "edge_angle": 3.0,
+        "thickness_mode": "DEPTH",
+        "thickness_far": 0.0,
+        "thickness_depth_start": 3.7931361538598916,
+        "thickness_depth_end": 11.078239915960406,
+        "use_silhouettes": False,
+        "marked": 2,
+    },
+    transform={"rotation": (0.0, 0.0, 0.0), "scale": (0.3, 0.3, 0.3), "location": (0.0, 0.0, 0.0), "pixel_aspect": 1.0},
+)
+
+
 @FUZZ
 @given(mesh=polygons(), camera=cameras(), line=rich_settings(), transform=transforms())
 @example(**FOLDED_NEARLY_LEVEL)
+@example(**SHARP_TIP)
 def test_random_meshes_with_every_line_option_match_reference(mesh, camera, line, transform, tmp_path_factory):
     """Random meshes under every line option at once. A long hunt also
     reports the difference image model §5.4 (an n-gon folded three deep)

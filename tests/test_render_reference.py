@@ -560,6 +560,38 @@ def test_a_sample_just_outside_a_sliver_whose_plane_passes_in_front_is_undecided
     accuracy.assert_accurate(accuracy.measure(scene, "beside_a_sliver", output_dir))
 
 
+def test_a_sample_a_snapping_step_beside_a_sharp_tip_is_undecided(output_dir):
+    """Two triangles with a sharp tip (22 degrees) over the background. A
+    pixel centre lies 0.0012 px outside the first one's edge just above its
+    tip, where the triangle is 0.002 px wide: all four probes 0.01 px off
+    pass beside it, yet a rasteriser that snaps corners to 1/256 px may
+    cover the sample (image model §7.2), so it is undecided. Beside the
+    second one the pixel centre lies 0.006 px outside, farther than a
+    snapping step: decided, background."""
+    width, height = 48, 32
+    scene = scenes.empty_scene(width, height, thickness=1.0)
+    camera = scenes.add_camera(scene, location=(0.0, -5.0, 0.0), target=(0.0, 0.0, 0.0))
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    proj = np.array(camera.calc_matrix_camera(depsgraph, x=width, y=height), dtype=np.float64)
+
+    def world_point(window_x, window_y, depth=7.0):
+        # View point at `depth` on the ray through the window point; this
+        # camera's view axes are world x, z and -y, its eye at y = -5.
+        u = (2.0 * window_x / width - 1.0) / proj[0, 0]
+        v = (2.0 * window_y / height - 1.0) / proj[1, 1]
+        return (depth * u, depth - 5.0, depth * v)
+
+    for name, x in (("Near", 14.5 + 0.0012), ("Far", 34.5 + 0.006)):
+        tip = (x, 16.4946)  # 0.0054 px below the pixel centres of row 16
+        corners = [world_point(*tip), world_point(x + 4.0, tip[1] + 10.0), world_point(x, tip[1] + 10.0)]
+        scenes.from_pydata(scene, name, corners, [(0, 1, 2)])
+    ref = reference.render_reference(scene)
+    assert ref.face[16, 14] == -1 and ref.face[16, 34] == -1  # the centres lie outside both
+    assert ref.on_silhouette[16, 14]
+    assert not ref.on_silhouette[16, 34]
+    accuracy.assert_accurate(accuracy.measure(scene, "beside_a_sharp_tip", output_dir))
+
+
 def test_two_lines_of_equal_strength_leave_the_colour_undecided():
     """Two squares side by side, their outline sharp and the edge between
     them a seam, both classes 4 px wide: where the seam meets the outline

@@ -885,6 +885,8 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
     tri_ids = np.nonzero(x1 >= x0)[0]
     if len(tri_ids) == 0:
         return best_face, best_depth
+    tip_slack = _tip_slack(geo.tri_view, proj, width, height) if centre_hit is not None else None
+    tip_misses: list = []  # (pixel, depth, face, triangle) of centre rays just outside a triangle
     # Only rows we evaluate: count per triangle the rows of its bbox in `rows`.
     row_mask = np.zeros(height + 1, np.int64)
     row_mask[rows] = 1
@@ -940,6 +942,11 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
             h_pix, h_depth, h_face = pixel[hit], depth[hit], geo.tri_face[pair_tri[hit]]
             if s == 0 and all_hits is not None:
                 all_hits.append((h_pix, h_depth, h_face, pair_tri[hit]))
+            if s == 0 and tip_slack is not None:
+                slack = tip_slack[pair_tri]
+                miss = ok & ~inside & (u >= -slack) & (v >= -slack) & (u + v <= 1 + slack)
+                miss &= (t >= t_near) & (t <= t_far)
+                tip_misses.append((pixel[miss], depth[miss], geo.tri_face[pair_tri[miss]], pair_tri[miss]))
             if s == 0 and near_misses is not None:
                 slack = NEAR_MISS_BARYCENTRIC
                 miss = ok & ~inside & (u >= -slack) & (v >= -slack) & (u + v <= 1 + slack)
@@ -977,6 +984,7 @@ def _visibility(geo, proj, width, height, rows, backface_culling, all_hits=None,
         for pix, depth in undecided_hits + _sliver_samples(geo, proj, width, height, rows, row_of):
             near = depth <= best_depth[0, pix] * (1.0 + UNDECIDED_DEPTH)
             flagged[pix[near]] = True
+        flagged |= _tip_samples(tip_misses, best_face[0], best_depth[0], geo, proj, width, height, rows)
         # Which triangle of the visible face the sample shows is rounding's
         # choice where a sample 0.01 px off shows another (a fold's edge).
         other_triangle = ((best_tri[1:] != best_tri[0]) & (best_face[1:] == best_face[0])).any(axis=0)
@@ -1111,6 +1119,11 @@ class _RunnerUp:
 # rasteriser's sub-pixel snapping, and probes 0.01 px apart can miss it.
 SLIVER_PX = 0.05
 SLIVER_REACH_PX = 0.01
+# How far outside a triangle a rasteriser may still cover a sample: it
+# snaps the window corners to a grid of 1/256 px (8 sub-pixel bits, as
+# llvmpipe and Direct3D-class GPUs do), which moves an edge by up to
+# about 0.003 px.
+SNAP_REACH_PX = 2.0**-8
 
 
 def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
@@ -1177,6 +1190,55 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
                 sample_depth = np.minimum(sample_depth, _plane_depth_at(points, *plane, pts[near]))
             out.append((pix, sample_depth))
     return out
+
+
+def _tip_slack(tri_view, proj, width, height) -> np.ndarray:
+    """Per triangle, the barycentric slack that holds every centre ray
+    passing within SNAP_REACH_PX (window) outside it: a sample at window
+    distance d outside edge k lies d / altitude_k outside in window
+    barycentrics, and the ray's barycentrics (on the triangle's plane,
+    perspective-correct) differ from those by at most the ratio of its
+    corners' clip w. 0 for a triangle not wholly in front of the near
+    plane (_sliver_samples takes those)."""
+    h = np.concatenate([tri_view, np.ones(tri_view.shape[:2] + (1,))], axis=2) @ proj.T
+    slack = np.zeros(len(tri_view))
+    with np.errstate(all="ignore"):
+        front = ((h[..., 2] + h[..., 3]) >= 0).all(axis=1) & (h[..., 3] > 0).all(axis=1)
+        win = (h[..., :2] / h[..., 3:4] + 1.0) * 0.5 * np.array([width, height])
+        a, b, c = win[:, 0], win[:, 1], win[:, 2]
+        area2 = np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
+        longest = np.max(
+            np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1), np.linalg.norm(a - c, axis=1)]),
+            axis=0,
+        )
+        altitude = area2 / longest
+        spread = h[..., 3].max(axis=1) / h[..., 3].min(axis=1)
+        wanted = 1.25 * SNAP_REACH_PX * spread / altitude
+    use = front & np.isfinite(wanted)
+    slack[use] = np.minimum(wanted[use], NEAR_MISS_BARYCENTRIC)
+    return slack
+
+
+def _tip_samples(tip_misses, face, depth, geo, proj, width, height, rows) -> np.ndarray:
+    """Samples within SNAP_REACH_PX outside a triangle of another face
+    than the visible one, whose plane there lies in front of the visible
+    face or level with it (§7.2): the rasteriser's snapping may cover them
+    with that triangle. The four probes 0.01 px off find such samples
+    beside an edge; not beside a sharp tip, which can pass between them (a
+    tip 0.004 px wide there, 0.0012 px from the sample, the first found)."""
+    flagged = np.zeros(len(face), bool)
+    if not tip_misses:
+        return flagged
+    pix, z, f, tri = (np.concatenate([m[k] for m in tip_misses]) for k in range(4))
+    keep = (f != face[pix]) & (z <= depth[pix] * (1.0 + UNDECIDED_DEPTH))
+    pix, tri = pix[keep], tri[keep]
+    if len(pix) == 0:
+        return flagged
+    win = _window(proj, geo.tri_view[tri], width, height)  # (N, 3, 2)
+    xy = np.stack([pix % width + 0.5, rows[pix // width] + 0.5], axis=1).astype(np.float64)
+    distance = np.min([_segment_distance(xy, win[:, k], win[:, (k + 1) % 3])[0] for k in range(3)], axis=0)
+    flagged[pix[distance <= SNAP_REACH_PX]] = True
+    return flagged
 
 
 def _plane_depth_at(corners, clip_w, depths, points) -> np.ndarray:
