@@ -1126,16 +1126,13 @@ SLIVER_REACH_PX = 0.01
 SNAP_REACH_PX = 2.0**-8
 
 
-def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
-    """[(pixels, depth)]: samples within SLIVER_REACH_PX of a sliver triangle
-    (§7: their visible face is undecided), with the sliver's nearest depth.
-    A triangle through the near plane is a sliver where its front part is
-    (a triangle whose plane nearly holds the eye): the polygon clipped to
-    the near plane, as thin across as SLIVER_PX."""
-    tri = geo.tri_view
-    if len(tri) == 0:
-        return []
-    h = np.concatenate([tri, np.ones(tri.shape[:2] + (1,))], axis=2) @ proj.T  # (T, 3, 4)
+def _window_triangles(tri_view, proj, width, height):
+    """Per triangle (view-space corners ``tri_view``, (T, 3, 3)): clip
+    corners (T, 3, 4), which corners lie ahead of the near plane, whether
+    the whole triangle does (and in front of the eye), window corners
+    (T, 3, 2), its longest window side and smallest window altitude (0
+    where it has no length)."""
+    h = np.concatenate([tri_view, np.ones(tri_view.shape[:2] + (1,))], axis=2) @ proj.T
     with np.errstate(all="ignore"):
         ahead = h[..., 2] + h[..., 3] >= 0
         front = ahead.all(axis=1) & (h[..., 3] > 0).all(axis=1)
@@ -1147,6 +1144,19 @@ def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
             axis=0,
         )
         altitude = np.where(longest > 0, area2 / np.maximum(longest, 1e-300), 0.0)
+    return h, ahead, front, win, longest, altitude
+
+
+def _sliver_samples(geo, proj, width, height, rows, row_of) -> list:
+    """[(pixels, depth)]: samples within SLIVER_REACH_PX of a sliver triangle
+    (§7: their visible face is undecided), with the sliver's nearest depth.
+    A triangle through the near plane is a sliver where its front part is
+    (a triangle whose plane nearly holds the eye): the polygon clipped to
+    the near plane, as thin across as SLIVER_PX."""
+    tri = geo.tri_view
+    if len(tri) == 0:
+        return []
+    h, ahead, front, win, longest, altitude = _window_triangles(tri, proj, width, height)
     thin = np.flatnonzero(front & np.isfinite(win).all(axis=(1, 2)) & (altitude < SLIVER_PX) & (longest > 0))
     polygons = [(win[k], -tri[k, :, 2].max(), (h[k, :, 3], -tri[k, :, 2])) for k in thin]
     crossing = np.flatnonzero(ahead.any(axis=1) & ~ahead.all(axis=1) & np.isfinite(h).all(axis=(1, 2)))
@@ -1200,18 +1210,9 @@ def _tip_slack(tri_view, proj, width, height) -> np.ndarray:
     perspective-correct) differ from those by at most the ratio of its
     corners' clip w. 0 for a triangle not wholly in front of the near
     plane (_sliver_samples takes those)."""
-    h = np.concatenate([tri_view, np.ones(tri_view.shape[:2] + (1,))], axis=2) @ proj.T
+    h, _ahead, front, _win, _longest, altitude = _window_triangles(tri_view, proj, width, height)
     slack = np.zeros(len(tri_view))
     with np.errstate(all="ignore"):
-        front = ((h[..., 2] + h[..., 3]) >= 0).all(axis=1) & (h[..., 3] > 0).all(axis=1)
-        win = (h[..., :2] / h[..., 3:4] + 1.0) * 0.5 * np.array([width, height])
-        a, b, c = win[:, 0], win[:, 1], win[:, 2]
-        area2 = np.abs((b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]))
-        longest = np.max(
-            np.stack([np.linalg.norm(b - a, axis=1), np.linalg.norm(c - b, axis=1), np.linalg.norm(a - c, axis=1)]),
-            axis=0,
-        )
-        altitude = area2 / longest
         spread = h[..., 3].max(axis=1) / h[..., 3].min(axis=1)
         wanted = 1.25 * SNAP_REACH_PX * spread / altitude
     use = front & np.isfinite(wanted)
