@@ -551,10 +551,83 @@ SHARP_TIP = dict(
 )
 
 
+# An overlay hunt's scene, in the render too (open, docs/dev/robustness.md:
+# "a folded n-gon's hidden layer within the error bound of the surface"):
+# the far one of a folded pentagon's two triangles behind a sample takes
+# its sibling's depth less that depth's float32 error bound, which through
+# the near plane came to 1e-3 of the depth, more than the sibling's gap to
+# the surface, so one hidden layer of two is dropped (1 pixel, 0.19). A
+# strict expected failure: it passes, and so fails, once that is fixed.
+HIDDEN_LAYER_WITHIN_BOUND = dict(
+    mesh=(
+        [
+            (-3.323503866642227e-12, -1.829236749135232, -1.1570067258617411),
+            (-3.323503866642227e-12, -1.8292714868147226, -1.157006785466386),
+            (0.2, 0.76, -0.17953109668607103),
+            (1.4128950016444229e-155, 4.52394709911983e-123, 0.349),
+            (0.0, -1.9623640642063345, -1.6355172190291603),
+            (-0.0007652639007150323, 0.0009747487472645676, 0.0006718358183818607),
+            (-3.323503866642227e-12, -1.829236749135232, -1.1570067258617411),
+            (1.4128950016444229e-155, 4.52394709911983e-123, 0.349),
+            (0.0, 0.0, 0.0),
+            (9.84256083726575e-25, 1.446826723677094, 0.0),
+            (1.7187673523392424e-135, 0.0, 0.0006718358183818607),
+            (0.0, 0.0, 5.942163630774628e-280),
+            (0.0007654405855413988, 0.0, 0.0),
+        ],
+        [(0, 1, 2, 3, 4), (5, 6, 7, 8, 9), (10, 11, 12)],
+    ),
+    camera={
+        "location": (0.6712467790792587, 0.0052254478102189035, 0.0012042739495391154),
+        "target": (0.3712947088756391, 0.0, 0.0),
+        "lens": 12.0,
+        "ortho_scale": None,
+        "shift": (0.0, 0.0),
+        "clip": (0.01, 20.0),
+        "sensor_fit": "AUTO",
+    },
+    line={
+        "thickness": 3.0,
+        "softness": 0.01,
+        "diagonal_mode": "HIDDEN",
+        "use_backface_culling": False,
+        "use_fade": False,
+        "fade_start": 0.0,
+        "fade_end": 8.555903384780046e-192,
+        "edge_angle": 0.0,
+        "use_density_fade": True,
+        "density_fade_length": 1.141220452248736,
+        "thickness_mode": "DEPTH",
+        "thickness_far": 0.5,
+        "thickness_depth_start": 0.1260668107174633,
+        "thickness_depth_end": 0.0,
+        "use_hidden_lines": True,
+        "hidden_alpha": 0.2528155584776231,
+        "hidden_period": 16.864863413642546,
+        "hidden_duty": 0.5,
+        "use_silhouettes": False,
+        "use_sharp_edges": True,
+        "sharp_thickness": 3.1920260833660254,
+        "sharp_pattern": "SOLID",
+        "use_seam_edges": True,
+        "seam_thickness": 0.0,
+        "seam_pattern": "SOLID",
+        "marked": 642,
+    },
+    transform={
+        "rotation": (0.6722175998559012, 2.0299840055874787, 1.1767688827265112e-18),
+        "scale": (0.9150259212827181, -1.3214562013386955, -1.9862480243996279),
+        "location": (-0.3027913269815276, 0.47016454292020976, 0.39695089966996555),
+        "pixel_aspect": 1.0,
+    },
+)
+
+
 @FUZZ
 @given(mesh=polygons(), camera=cameras(), line=rich_settings(), transform=transforms())
 @example(**FOLDED_NEARLY_LEVEL)
 @example(**SHARP_TIP)
+@example(**HIDDEN_LAYER_WITHIN_BOUND).xfail(raises=AssertionError, reason="open: a hidden layer within the error bound")
 def test_random_meshes_with_every_line_option_match_reference(mesh, camera, line, transform, tmp_path_factory):
     """Random meshes under every line option at once. A long hunt also
     reports the difference image model §5.4 (an n-gon folded three deep)
