@@ -351,6 +351,13 @@ def _centre_of(bounds_min: np.ndarray, bounds_max: np.ndarray) -> np.ndarray:
 COORDINATE_LIMIT = 2.0**64
 
 
+def drawable(values: np.ndarray, axis: int) -> np.ndarray:
+    """Where every value along ``axis`` is finite and below
+    COORDINATE_LIMIT in magnitude (NaN compares False)."""
+    with np.errstate(invalid="ignore"):
+        return (np.abs(values) < COORDINATE_LIMIT).all(axis=axis)
+
+
 def drawable_vertices(positions: np.ndarray) -> np.ndarray | None:
     """None when every vertex is drawable (finite, every coordinate below
     COORDINATE_LIMIT in magnitude), else the per-vertex mask. One float32
@@ -362,8 +369,8 @@ def drawable_vertices(positions: np.ndarray) -> np.ndarray | None:
     with np.errstate(invalid="ignore", over="ignore"):  # Inf * 0 and overflow are expected here
         if np.isfinite(np.dot(flat, flat)):
             return None
-        drawable = (np.abs(positions) < COORDINATE_LIMIT).all(axis=1)  # NaN compares False
-    return None if drawable.all() else drawable
+    mask = drawable(positions, axis=1)
+    return None if mask.all() else mask
 
 
 def _drawable_faces(drawable_vertex: np.ndarray, corner_vert: np.ndarray, loop_start: np.ndarray) -> np.ndarray:

@@ -40,7 +40,7 @@ from .draw import (
     shader_variant,
     styled,
 )
-from .extract import COORDINATE_LIMIT
+from .extract import drawable
 from .log import one_line, warn_once
 from .targets import read_texture
 from .view import determinant3, line_reach, outside_frustum_many, translation
@@ -189,14 +189,6 @@ def bezier(points: np.ndarray, left: np.ndarray, right: np.ndarray, resolution: 
     return np.concatenate([out, points[..., :1, :] if cyclic else points[..., -1:, :]], axis=-2)
 
 
-def _drawable(values: np.ndarray, axis: int) -> np.ndarray:
-    """Where every position coordinate and radius along ``axis`` is
-    finite and below extract.COORDINATE_LIMIT in magnitude, as a mesh's
-    vertices must be to be drawn (image model §2.1). NaN compares False."""
-    with np.errstate(invalid="ignore"):
-        return (np.abs(values) < COORDINATE_LIMIT).all(axis=axis)
-
-
 def curves_geometry(
     positions, radius=None, offsets=None, curve_types=None, resolutions=None, cyclic=None, handles=None
 ) -> StrandGeometry | None:
@@ -206,8 +198,8 @@ def curves_geometry(
     Blender's defaults, Catmull-Rom at 12), ``handles`` (left, right) (P, 3)
     each, or None. Catmull-Rom curves and Bezier curves with handles are
     evaluated (positions and radius alike); other types draw their control
-    polygon. A segment with an end that is not drawable (_drawable) is left
-    out. None when nothing is left."""
+    polygon. A segment with an end that is not drawable (extract.drawable)
+    is left out. None when nothing is left."""
     positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     count = len(positions)
     radius = np.zeros(count) if radius is None else np.asarray(radius, dtype=np.float64).reshape(-1)
@@ -255,7 +247,7 @@ def curves_geometry(
         m, e = evaluated.shape[:2]
         parts.append(evaluated.reshape(-1, 4))
         if chain is not None:
-            good = _drawable(evaluated, axis=2)  # (m, e)
+            good = drawable(evaluated, axis=2)  # (m, e): positions and radius, as a mesh's vertices (§2.1)
             dropped += int((~good).sum())
             base = total + e * np.arange(m)[:, None, None]
             seg = np.where(chain[None] >= 0, chain[None] + base, -1)  # (m, S, 4)
@@ -285,12 +277,12 @@ def curves_geometry(
 
 def points_geometry(positions, radius=None) -> StrandGeometry | None:
     """Discs of a PointCloud: ``positions`` (P, 3), ``radius`` (P,) (None:
-    0). A point whose position or radius is not drawable (_drawable) is
+    0). A point whose position or radius is not drawable (extract.drawable) is
     left out."""
     positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     radius = np.zeros(len(positions)) if radius is None else np.asarray(radius, dtype=np.float64).reshape(-1)
     values = np.concatenate([positions, radius[:, None]], axis=1)
-    good = _drawable(values, axis=1)
+    good = drawable(values, axis=1)
     return _finish(POINTS, values[good], None, int((~good).sum()))
 
 
