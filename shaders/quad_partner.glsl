@@ -102,6 +102,19 @@ vec4 quad_partner_corner(vec4 clip, float view_depth_of_corner)
   return vec4(window_homogeneous(clip), view_depth_of_corner);
 }
 
+/* Corner h (a homogeneous window point, x_win w, y_win w, w) with window
+ * point p as the origin: (h.xy - p h.z, h.z). Its edge functions then need
+ * no p: (h_j x h_k) . (p, 1) is perp_dot of the two moved corners. */
+vec3 around(vec3 h, vec2 p)
+{
+  return vec3(h.xy - p * h.z, h.z);
+}
+
+float perp_dot(vec3 u, vec3 v)
+{
+  return u.x * v.y - u.y * v.x;
+}
+
 /* Whether the part of the other triangle (corners a, b, c of
  * quad_partner_corner; all zero for none) in front of the near plane
  * covers window point p, and there the weights of its corners in the
@@ -110,7 +123,11 @@ vec4 quad_partner_corner(vec4 clip, float view_depth_of_corner)
  * one through it (a corner behind the camera, as a quad that crosses the
  * near plane has) by its edge functions in homogeneous window space,
  * (h_j x h_k) . (p, 1), which share det[h_a; h_b; h_c]'s sign exactly
- * where a point of the triangle in front of the eye projects to p. */
+ * where a point of the triangle in front of the eye projects to p. They are
+ * taken with p as the origin (around): the same values (the shift has
+ * determinant 1), from products of the corners' offsets from p, which
+ * float32 keeps far better than those of the corners' own coordinates,
+ * hundreds of pixels for a corner behind the eye. */
 bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out float depth)
 {
   weights = vec3(0.0);
@@ -133,13 +150,12 @@ bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out f
     weights = window_weights / (window_weights.x + window_weights.y + window_weights.z);
   }
   else {
-    vec3 q = vec3(p, 1.0);
-    vec3 bc = cross(b.xyz, c.xyz), ca = cross(c.xyz, a.xyz), ab = cross(a.xyz, b.xyz);
-    float det = dot(a.xyz, bc);
+    vec3 ta = around(a.xyz, p), tb = around(b.xyz, p), tc = around(c.xyz, p);
+    float det = dot(ta, cross(tb, tc));
     if (det == 0.0) {
       return false; /* none, or a triangle seen edge-on */
     }
-    vec3 e = vec3(dot(bc, q), dot(ca, q), dot(ab, q)) * sign(det);
+    vec3 e = vec3(perp_dot(tb, tc), perp_dot(tc, ta), perp_dot(ta, tb)) * sign(det);
     float sum = e.x + e.y + e.z;
     if (min(min(e.x, e.y), e.z) < 0.0 || !(sum > 0.0)) {
       return false;
@@ -148,6 +164,21 @@ bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out f
   }
   depth = dot(weights, vec3(a.w, b.w, c.w));
   return depth >= near; /* (a part the near plane clips is no surface) */
+}
+
+const float FLOAT_STEP = 1.1920929e-7;
+
+/* The magnitudes of perp_dot(u, v)'s two products. */
+float perp_dot_magnitude(vec3 u, vec3 v)
+{
+  return abs(u.x * v.y) + abs(u.y * v.x);
+}
+
+/* How far perp_dot(u, v) may move when its moved corners u and v are each
+ * off by their rounding ru and rv (in float32 steps) per coordinate. */
+float moved_rounding(vec3 u, vec2 ru, vec3 v, vec2 rv)
+{
+  return dot(ru, abs(v.yx)) + dot(abs(u.xy), rv.yx);
 }
 
 /* How far float32 may move the weights quad_partner_covers found for p
@@ -162,7 +193,7 @@ bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out f
  * one for the rasteriser's, and room for the corners' own rounding. */
 float partner_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
 {
-  const float STEPS = 4.0 * 1.1920929e-7;
+  const float STEPS = 4.0 * FLOAT_STEP;
   vec3 w = vec3(a.z, b.z, c.z);
   if (min(min(a.w, b.w), c.w) >= near_plane_depth() && min(min(w.x, w.y), w.z) > 0.0) {
     vec2 pa = a.xy / w.x, pb = b.xy / w.y, pc = c.xy / w.z;
@@ -172,12 +203,16 @@ float partner_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
     float products = abs(ap.x * ac.y) + abs(ap.y * ac.x) + abs(ab.x * ap.y) + abs(ab.y * ap.x);
     return area > 0.0 ? STEPS * (products + 2.0 * spread) / area : 1.0;
   }
-  /* Through the near plane: the edge functions of quad_partner_covers. */
-  vec3 q = vec3(p, 1.0);
-  float sum = abs(dot(cross(b.xyz, c.xyz) + cross(c.xyz, a.xyz) + cross(a.xyz, b.xyz), q));
-  float products = (length(b.xyz) * length(c.xyz) + length(c.xyz) * length(a.xyz) + length(a.xyz) * length(b.xyz)) *
-                   length(q);
-  return sum > 0.0 ? STEPS * 2.0 * products / sum : 1.0;
+  /* Through the near plane: the edge functions of quad_partner_covers, as
+   * products of the corners moved to p as the origin, and the rounding of
+   * that move (one step of each corner's coordinate and of p times its w,
+   * twice) carried through the products. */
+  vec3 ta = around(a.xyz, p), tb = around(b.xyz, p), tc = around(c.xyz, p);
+  vec2 ra = abs(a.xy) + 2.0 * abs(p * a.z), rb = abs(b.xy) + 2.0 * abs(p * b.z), rc = abs(c.xy) + 2.0 * abs(p * c.z);
+  float sum = abs(perp_dot(tb, tc) + perp_dot(tc, ta) + perp_dot(ta, tb));
+  float products = perp_dot_magnitude(tb, tc) + perp_dot_magnitude(tc, ta) + perp_dot_magnitude(ta, tb);
+  float moved = moved_rounding(tb, rb, tc, rc) + moved_rounding(tc, rc, ta, ra) + moved_rounding(ta, ra, tb, rb);
+  return sum > 0.0 ? 2.0 * (STEPS * products + FLOAT_STEP * moved) / sum : 1.0;
 }
 
 /* How far float32 may move the depth `values` (one per corner: view
