@@ -126,8 +126,8 @@ float perp_dot(vec3 u, vec3 v)
  * where a point of the triangle in front of the eye projects to p. They are
  * taken with p as the origin (around): the same values (the shift has
  * determinant 1), from products of the corners' offsets from p, which
- * float32 keeps far better than those of the corners' own coordinates,
- * hundreds of pixels for a corner behind the eye. */
+ * float32 keeps far better than those of the corners' own coordinates
+ * (large beside their differences where a corner is behind the eye). */
 bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out float depth)
 {
   weights = vec3(0.0);
