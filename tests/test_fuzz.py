@@ -670,15 +670,19 @@ def folded_face_scene(corners, hidden: bool):
 )
 def test_a_random_folded_face_is_no_hidden_layer_of_itself(corners, tmp_path_factory):
     """A face is never a hidden layer of itself (image model §5.4): one face
-    alone, however folded, draws the same with hidden lines as without. Its
-    triangles behind its own surface take their nearer sibling's depth less
-    float32's error bound of it (shaders/quad_partner.glsl); a bound too
-    small shows them, one too large drops a layer behind another face
-    (HIDDEN_LAYER_WITHIN_BOUND)."""
+    alone, however folded, draws the same with hidden lines as without,
+    away from its silhouettes. Its triangles behind its own surface take
+    their nearer sibling's depth less float32's error bound of it
+    (shaders/quad_partner.glsl); a bound too small shows them, one too
+    large drops a layer behind another face (HIDDEN_LAYER_WITHIN_BOUND)."""
     path = tmp_path_factory.getbasetemp() / "fuzz_folded.exr"
     plain, hidden = (robustness.render_exr(folded_face_scene(corners, h), path)[..., 3] for h in (False, True))
     assert np.isfinite(hidden).all(), "NaN/Inf pixels"
-    assert np.abs(hidden - plain).max() <= 2 / 255, f"a layer of the face itself: corners={corners!r}"
+    # Beside a silhouette (a fold's own edge included) the rasteriser's
+    # snapping decides which triangles cover a pixel (image model §7.2).
+    decided = ~reference.render_reference(folded_face_scene(corners, True)).on_silhouette
+    difference = np.abs(hidden - plain)[decided]
+    assert difference.max(initial=0.0) <= 2 / 255, f"a layer of the face itself: corners={corners!r}"
 
 
 @FUZZ
@@ -742,15 +746,19 @@ def folded_face_scene(corners, hidden: bool):
 )
 def test_a_random_folded_face_is_no_hidden_layer_of_itself(corners, tmp_path_factory):
     """A face is never a hidden layer of itself (image model §5.4): one face
-    alone, however folded, draws the same with hidden lines as without. Its
-    triangles behind its own surface take their nearer sibling's depth less
-    float32's error bound of it (shaders/quad_partner.glsl); a bound too
-    small shows them, one too large drops a layer behind another face
-    (HIDDEN_LAYER_WITHIN_BOUND)."""
+    alone, however folded, draws the same with hidden lines as without,
+    away from its silhouettes. Its triangles behind its own surface take
+    their nearer sibling's depth less float32's error bound of it
+    (shaders/quad_partner.glsl); a bound too small shows them, one too
+    large drops a layer behind another face (HIDDEN_LAYER_WITHIN_BOUND)."""
     path = tmp_path_factory.getbasetemp() / "fuzz_folded.exr"
     plain, hidden = (robustness.render_exr(folded_face_scene(corners, h), path)[..., 3] for h in (False, True))
     assert np.isfinite(hidden).all(), "NaN/Inf pixels"
-    assert np.abs(hidden - plain).max() <= 2 / 255, f"a layer of the face itself: corners={corners!r}"
+    # Beside a silhouette (a fold's own edge included) the rasteriser's
+    # snapping decides which triangles cover a pixel (image model §7.2).
+    decided = ~reference.render_reference(folded_face_scene(corners, True)).on_silhouette
+    difference = np.abs(hidden - plain)[decided]
+    assert difference.max(initial=0.0) <= 2 / 255, f"a layer of the face itself: corners={corners!r}"
 
 
 @FUZZ
