@@ -215,18 +215,38 @@ float partner_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
   return sum > 0.0 ? 2.0 * (STEPS * products + FLOAT_STEP * moved) / sum : 1.0;
 }
 
+/* partner_weight_error where the layer is tested against a depth that
+ * another renderer drew (Blender's Solid shading depth under the overlay):
+ * that one rounds the corners' own window coordinates, not their offsets
+ * from p, so through the near plane the bound keeps the products of those
+ * coordinates, (h_j x h_k) . (p, 1) taken as it stands. */
+float foreign_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
+{
+  bool in_front = min(min(a.w, b.w), c.w) >= near_plane_depth() && min(min(a.z, b.z), c.z) > 0.0;
+  if (in_front) {
+    return partner_weight_error(p, a, b, c);
+  }
+  vec3 q = vec3(p, 1.0);
+  float sum = abs(dot(cross(b.xyz, c.xyz) + cross(c.xyz, a.xyz) + cross(a.xyz, b.xyz), q));
+  float products = (length(b.xyz) * length(c.xyz) + length(c.xyz) * length(a.xyz) + length(a.xyz) * length(b.xyz)) *
+                   length(q);
+  return sum > 0.0 ? 4.0 * FLOAT_STEP * 2.0 * products / sum : 1.0;
+}
+
 /* How far float32 may move the depth `values` (one per corner: view
  * depths, or window depths where `window` is set) that weights of
  * partner_weight_error interpolate. Only the part in front of the near
  * plane is drawn, so a corner behind it counts as the near plane's depth
- * (a corner behind the eye has no window depth of its own). */
+ * (a corner behind the eye has no window depth of its own). Window depths
+ * are those of the overlay, tested against Blender's depth
+ * (foreign_weight_error). */
 float partner_depth_error(vec2 p, vec4 a, vec4 b, vec4 c, vec3 values, bool window)
 {
   bvec3 in_front = greaterThanEqual(vec3(a.w, b.w, c.w), vec3(near_plane_depth()));
   vec3 nearest = vec3(window ? 0.0 : near_plane_depth());
   values = mix(nearest, values, in_front);
   float span = max(max(values.x, values.y), values.z) - min(min(values.x, values.y), values.z);
-  return partner_weight_error(p, a, b, c) * span;
+  return (window ? foreign_weight_error(p, a, b, c) : partner_weight_error(p, a, b, c)) * span;
 }
 
 /* The corners (quad_partner_corner) of the other triangle of `triangle`

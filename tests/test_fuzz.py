@@ -627,64 +627,6 @@ HIDDEN_LAYER_WITHIN_BOUND = dict(
 )
 
 
-@st.composite
-def folded_faces(draw):
-    """The corners of one face of 4 to 6 corners around the view of a
-    camera at the origin looking along +Y (folded_face_scene): folded, so
-    that its triangles overlap on screen, and often through the near plane
-    (0.01), with corners behind the camera."""
-    size = draw(st.integers(4, 6))
-    return [(draw(st.floats(-1.0, 1.0)), draw(st.floats(-0.6, 2.0)), draw(st.floats(-1.0, 1.0))) for _ in range(size)]
-
-
-def folded_face_scene(corners, hidden: bool):
-    scene = scenes.empty_scene(W, H, thickness=3.0, use_hidden_lines=hidden, hidden_alpha=1.0, hidden_duty=1.0)
-    scenes.from_pydata(scene, "Folded", corners, [tuple(range(len(corners)))])
-    scenes.add_camera(scene, location=(0.0, 0.0, 0.0), target=(0.0, 1.0, 0.0), lens=12.0, clip=(0.01, 100.0))
-    return scene
-
-
-@FUZZ
-@given(corners=folded_faces())
-# Two faces whose triangles behind the surface showed as layers of their own
-# with partner_depth_error at 0 (4 of 400 random faces did): one through
-# the near plane, one in front of it.
-@example(
-    corners=[
-        (-0.806, -0.0678, 0.503),
-        (0.4263, 1.8159, 0.7276),
-        (-0.0621, 1.1233, -0.7796),
-        (0.4007, 1.372, -0.5772),
-        (-0.7773, 0.1335, 0.783),
-        (-0.7802, 1.4171, -0.6384),
-    ]
-)
-@example(
-    corners=[
-        (0.7722, 1.4549, -0.4323),
-        (-0.1269, 0.9862, -0.9776),
-        (0.0615, 0.7687, 0.2734),
-        (-0.7803, 0.6001, 0.3203),
-        (-0.8156, 0.0204, 0.6205),
-    ]
-)
-def test_a_random_folded_face_is_no_hidden_layer_of_itself(corners, tmp_path_factory):
-    """A face is never a hidden layer of itself (image model §5.4): one face
-    alone, however folded, draws the same with hidden lines as without,
-    away from its silhouettes. Its triangles behind its own surface take
-    their nearer sibling's depth less float32's error bound of it
-    (shaders/quad_partner.glsl); a bound too small shows them, one too
-    large drops a layer behind another face (HIDDEN_LAYER_WITHIN_BOUND)."""
-    path = tmp_path_factory.getbasetemp() / "fuzz_folded.exr"
-    plain, hidden = (robustness.render_exr(folded_face_scene(corners, h), path)[..., 3] for h in (False, True))
-    assert np.isfinite(hidden).all(), "NaN/Inf pixels"
-    # Beside a silhouette (a fold's own edge included) the rasteriser's
-    # snapping decides which triangles cover a pixel (image model §7.2).
-    decided = ~reference.render_reference(folded_face_scene(corners, True)).on_silhouette
-    difference = np.abs(hidden - plain)[decided]
-    assert difference.max(initial=0.0) <= 2 / 255, f"a layer of the face itself: corners={corners!r}"
-
-
 @FUZZ
 @given(mesh=polygons(), camera=cameras(), line=rich_settings(), transform=transforms())
 @example(**FOLDED_NEARLY_LEVEL)
@@ -720,6 +662,19 @@ def folded_face_scene(corners, hidden: bool):
     return scene
 
 
+def assert_no_layer_of_itself(corners, draw, decided=lambda ref: ~ref.on_silhouette):
+    """One folded face (folded_face_scene) drawn by ``draw`` (scene -> alpha)
+    with hidden lines and without must agree where ``decided`` (of the
+    reference with its depth layers) holds: beside a silhouette (a fold's
+    own edge included) the rasteriser's snapping decides which triangles
+    cover a pixel (image model §7.2)."""
+    plain, hidden = (draw(folded_face_scene(corners, with_hidden)) for with_hidden in (False, True))
+    assert np.isfinite(hidden).all(), "NaN/Inf pixels"
+    mask = decided(reference.render_reference(folded_face_scene(corners, True), depth_layers=True))
+    difference = np.abs(hidden - plain)[mask]
+    assert difference.max(initial=0.0) <= 2 / 255, f"a layer of the face itself: corners={corners!r}"
+
+
 @FUZZ
 @given(corners=folded_faces())
 # Two faces whose triangles behind the surface showed as layers of their own
@@ -752,13 +707,44 @@ def test_a_random_folded_face_is_no_hidden_layer_of_itself(corners, tmp_path_fac
     (shaders/quad_partner.glsl); a bound too small shows them, one too
     large drops a layer behind another face (HIDDEN_LAYER_WITHIN_BOUND)."""
     path = tmp_path_factory.getbasetemp() / "fuzz_folded.exr"
-    plain, hidden = (robustness.render_exr(folded_face_scene(corners, h), path)[..., 3] for h in (False, True))
-    assert np.isfinite(hidden).all(), "NaN/Inf pixels"
-    # Beside a silhouette (a fold's own edge included) the rasteriser's
-    # snapping decides which triangles cover a pixel (image model §7.2).
-    decided = ~reference.render_reference(folded_face_scene(corners, True)).on_silhouette
-    difference = np.abs(hidden - plain)[decided]
-    assert difference.max(initial=0.0) <= 2 / 255, f"a layer of the face itself: corners={corners!r}"
+    assert_no_layer_of_itself(corners, lambda scene: robustness.render_exr(scene, path)[..., 3])
+
+
+@FUZZ
+@given(corners=folded_faces())
+# Faces whose triangles behind the surface showed as layers of their own in
+# the overlay with partner_depth_error at 0 (2 of 300 random faces did),
+# both through the near plane.
+@example(
+    corners=[
+        (-0.4245, 1.7607, -0.1459),
+        (0.7005, 1.889, 0.3637),
+        (0.2629, -0.5283, -0.2569),
+        (-0.7433, 1.3538, 0.6956),
+        (0.8001, 0.6228, -0.0764),
+        (0.1474, -0.3324, 0.1116),
+    ]
+)
+@example(
+    corners=[
+        (-0.0947, -0.4004, -0.8733),
+        (0.4566, -0.4233, 0.2166),
+        (0.9254, -0.3527, -0.2709),
+        (0.0123, 1.1078, 0.186),
+        (0.0152, 1.363, -0.5683),
+        (-0.7716, -0.2564, -0.538),
+    ]
+)
+def test_a_random_folded_face_is_no_hidden_layer_of_itself_in_the_overlay(corners):
+    """The same in the viewport overlay's first redraw, whose layers are
+    tested in window depth against Blender's Solid shading depth of the
+    face, away from where that depth decides (as check_overlay)."""
+    viewport = robustness.Viewport(W, H)
+    assert_no_layer_of_itself(
+        corners,
+        lambda scene: viewport.draw(scene)[1].copy(),
+        lambda ref: ~ref.on_silhouette & ~viewport.blender_decides(ref),
+    )
 
 
 @FUZZ
