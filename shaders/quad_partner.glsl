@@ -115,6 +115,13 @@ float perp_dot(vec3 u, vec3 v)
   return u.x * v.y - u.y * v.x;
 }
 
+/* Whether a triangle (corners a, b, c of quad_partner_corner) lies wholly
+ * in front of the near plane, where its window points exist. */
+bool wholly_in_front(vec4 a, vec4 b, vec4 c)
+{
+  return min(min(a.w, b.w), c.w) >= near_plane_depth() && min(min(a.z, b.z), c.z) > 0.0;
+}
+
 /* Whether the part of the other triangle (corners a, b, c of
  * quad_partner_corner; all zero for none) in front of the near plane
  * covers window point p, and there the weights of its corners in the
@@ -134,7 +141,7 @@ bool quad_partner_covers(vec2 p, vec4 a, vec4 b, vec4 c, out vec3 weights, out f
   depth = 0.0;
   vec3 w = vec3(a.z, b.z, c.z);
   float near = near_plane_depth();
-  if (min(min(a.w, b.w), c.w) >= near && min(min(w.x, w.y), w.z) > 0.0) {
+  if (wholly_in_front(a, b, c)) {
     vec2 pa = a.xy / w.x, pb = b.xy / w.y, pc = c.xy / w.z;
     vec2 ab = pb - pa, ac = pc - pa;
     float area = ab.x * ac.y - ab.y * ac.x;
@@ -195,7 +202,7 @@ float partner_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
 {
   const float STEPS = 4.0 * FLOAT_STEP;
   vec3 w = vec3(a.z, b.z, c.z);
-  if (min(min(a.w, b.w), c.w) >= near_plane_depth() && min(min(w.x, w.y), w.z) > 0.0) {
+  if (wholly_in_front(a, b, c)) {
     vec2 pa = a.xy / w.x, pb = b.xy / w.y, pc = c.xy / w.z;
     vec2 ab = pb - pa, ac = pc - pa, ap = p - pa;
     float area = abs(ab.x * ac.y - ab.y * ac.x);
@@ -222,8 +229,7 @@ float partner_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
  * coordinates, (h_j x h_k) . (p, 1) taken as it stands. */
 float foreign_weight_error(vec2 p, vec4 a, vec4 b, vec4 c)
 {
-  bool in_front = min(min(a.w, b.w), c.w) >= near_plane_depth() && min(min(a.z, b.z), c.z) > 0.0;
-  if (in_front) {
+  if (wholly_in_front(a, b, c)) {
     return partner_weight_error(p, a, b, c);
   }
   vec3 q = vec3(p, 1.0);
