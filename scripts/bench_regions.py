@@ -20,17 +20,27 @@ the overlay's redraws in X-ray or Wireframe shading (X-ray alpha 0.5).
     .venv/bin/python -m scripts.bench_regions --walks [--levels 2 3 4]
     .venv/bin/python -m scripts.bench_regions --hidden-lines [--levels 2 3 4 5]
     .venv/bin/python -m scripts.bench_regions --shading xray|wireframe [--levels 2 3 4 5]
+    .venv/bin/python -m scripts.bench_regions --runs 16 [--levels 2 3 4 5] [--json FILE]
 
 Every ratio is taken within one process, rounds alternating between the two
 looks so that a change in machine load hits both alike; the table gives the
-best of the rounds (Markdown, for the README).
+best of the rounds (Markdown, for the README). ``--runs N`` repeats the main
+tables in N fresh processes, one after another, and gives each ratio's
+median and range over them: the README's tables, which one process alone
+cannot give on a noisy machine. ``--json FILE`` also writes the milliseconds
+(with ``--runs``, a list of every run's).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
+import os
+import statistics
+import subprocess
 import sys
+import tempfile
 import time
 
 import bpy
@@ -303,7 +313,177 @@ def walk_table(size, levels, repeats: int) -> None:
             print(f"| {name} | {level} | {a:.0f} | {c:.0f} | {c / a:.2f}x |", flush=True)
 
 
+# The main table's measures (compare's keys) and the looks of the second
+# table against the plain frame, in the order the tables print them.
+MEASURES = (
+    ("f12", "F12"),
+    ("redraw", "overlay redraw"),
+    ("edit", "redraw after an edit"),
+    ("extract", "first extraction"),
+)
+ANGLE_LOOKS = {
+    "plain": {},
+    "angle": dict(edge_angle=math.radians(20.0)),
+    "classes": dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True),
+    "angle + classes": dict(edge_angle=math.radians(20.0), use_sharp_edges=True, use_seam_edges=True),
+}
+
+
+def measure_tables(size, levels, repeats: int, shading: str, hidden_lines: bool) -> dict:
+    """The main table's measures (best ms of each look, per level) and,
+    in Solid shading without hidden lines, the second table's (per look):
+    {"levels": {level: {"triangles": n, "all": {...}, "cage": {...}}},
+    "looks": {name: {"f12": ms, "redraw": ms}}}."""
+    viewport = Viewport(size, shading)
+    base = dict(use_hidden_lines=True) if hidden_lines else {}
+    results: dict = {"levels": {}, "looks": {}}
+    for level in levels:
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        solidwire_addon.register()
+        scene, monkey = build_scene(size, level)
+        triangles = len(monkey.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
+        looks = {"all": base, "cage": dict(base, use_cage_edges=True)}
+        results["levels"][str(level)] = dict(
+            triangles=triangles, **compare(scene, monkey, size, looks, repeats, viewport)
+        )
+    if hidden_lines or shading != "solid":
+        return results
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    solidwire_addon.register()
+    scene, monkey = build_scene(size, 2)
+    modifier = monkey.modifiers[0]
+    modifier.show_viewport = modifier.show_render = False
+    bpy.ops.object.select_all(action="DESELECT")
+    apply_subdivision(monkey, 3)
+    results["looks_triangles"] = len(monkey.data.loop_triangles)
+    results["looks"] = compare(scene, monkey, size, ANGLE_LOOKS, repeats, viewport)
+    return results
+
+
+def print_tables(results: dict) -> None:
+    """One run's tables (best of its rounds, Markdown)."""
+    print(
+        "| level | triangles | F12 every edge (ms) | F12 cage | ratio | overlay redraw every edge | cage | ratio |"
+        " edit redraw every edge | cage | ratio | first extraction every edge | cage | ratio |"
+    )
+    print("|---:|---:|" + "---:|" * 12)
+    for level, row in results["levels"].items():
+        cells = []
+        for key, _title in MEASURES:
+            a, c = row["all"][key], row["cage"][key]
+            cells += [f"{a:.0f}", f"{c:.0f}", f"{c / a:.2f}x"]
+        print(f"| {level} | {row['triangles']:,} | " + " | ".join(cells) + " |", flush=True)
+    looks = results["looks"]
+    if not looks:
+        return
+    print(
+        f"\nSuzanne subdivided 3 times and applied ({results['looks_triangles']:,} triangles); "
+        "ratio against the plain frame\n"
+    )
+    print("| look | F12 (ms) | ratio | overlay redraw (ms) | ratio |")
+    print("|---|---:|---:|---:|---:|")
+    for name, best in looks.items():
+        f, r = best["f12"], best["redraw"]
+        print(
+            f"| {name} | {f:.0f} | {f / looks['plain']['f12']:.2f}x | {r:.0f} | {r / looks['plain']['redraw']:.2f}x |"
+        )
+
+
+def _median_and_range(values) -> str:
+    """'1.03× (0.87–1.20)': the median of ``values`` and their range."""
+    return f"{statistics.median(values):.2f}× ({min(values):.2f}–{max(values):.2f})"
+
+
+def summary_tables(runs: list) -> str:
+    """The README's tables from several runs' results (measure_tables):
+    each ratio the median of the runs' ratios, with their range, and the
+    median milliseconds of each look beside it."""
+    lines = [
+        f"medians (ranges) of {len(runs)} runs; ratio = cage / every edge",
+        "",
+        "| Subdivision level | " + " | ".join(title for _key, title in MEASURES) + " |",
+        "|---|" + "---:|" * len(MEASURES),
+    ]
+    milliseconds = []
+    for level, row in runs[0]["levels"].items():
+        cells, ms = [], []
+        for key, _title in MEASURES:
+            every = [run["levels"][level]["all"][key] for run in runs]
+            cage = [run["levels"][level]["cage"][key] for run in runs]
+            cells.append(_median_and_range([c / a for a, c in zip(every, cage)]))
+            ms.append(f"{statistics.median(every):.1f} / {statistics.median(cage):.1f}")
+        triangles = row["triangles"]
+        lines.append(f"| {level} ({round(triangles / 1000):,}k triangles) | " + " | ".join(cells) + " |")
+        milliseconds.append(f"| {level} | " + " | ".join(ms) + " |")
+    lines += [
+        "",
+        "median ms, every edge / cage:",
+        "",
+        "| level | " + " | ".join(title for _key, title in MEASURES) + " |",
+        "|---:|" + "---:|" * len(MEASURES),
+        *milliseconds,
+    ]
+    if runs[0]["looks"]:
+        lines += [
+            "",
+            f"Suzanne subdivided 3 times and applied ({runs[0]['looks_triangles']:,} triangles), against the plain frame:",
+            "",
+            "| look | F12 | overlay redraw |",
+            "|---|---:|---:|",
+        ]
+        for name in runs[0]["looks"]:
+            if name == "plain":
+                continue
+            cells = [
+                _median_and_range([run["looks"][name][key] / run["looks"]["plain"][key] for run in runs])
+                for key in ("f12", "redraw")
+            ]
+            lines.append(f"| {name} | " + " | ".join(cells) + " |")
+        plain = statistics.median(run["looks"]["plain"]["f12"] for run in runs)
+        lines.append(f"\n(the plain frame's F12: median {plain:.1f} ms)")
+    return "\n".join(lines)
+
+
+def run_many(argv: list, runs: int, json_path: str | None = None) -> int:
+    """The main tables from ``runs`` fresh processes of this benchmark
+    (``argv`` as _child_argv leaves it), one after another: medians and
+    ranges, as the README gives them; ``json_path``: every run's results,
+    a list, written there too. A fresh process a run, as a user's session
+    would be: what one process compiles or caches does not carry over."""
+    results = []
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "run.json")
+        for index in range(runs):
+            print(f"run {index + 1} of {runs}", file=sys.stderr, flush=True)
+            done = subprocess.run([sys.executable, "-m", "scripts.bench_regions", *argv, "--json", path], check=False)
+            if done.returncode != 0:
+                print(f"error: run {index + 1} failed (exit status {done.returncode})", file=sys.stderr)
+                return 1
+            with open(path, encoding="utf-8") as file:
+                results.append(json.load(file))
+    if json_path:
+        with open(json_path, "w", encoding="utf-8") as file:
+            json.dump(results, file)
+    print(summary_tables(results))
+    return 0
+
+
+def _child_argv(argv: list) -> list:
+    """``argv`` less its --runs and --json options (``--runs N`` or
+    ``--runs=N``): what each of run_many's processes is given."""
+    kept, skip = [], False
+    for arg in argv:
+        if skip:
+            skip = False
+        elif arg in ("--runs", "--json"):
+            skip = True
+        elif not arg.startswith(("--runs=", "--json=")):
+            kept.append(arg)
+    return kept
+
+
 def main(argv=None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="1280x720")
     parser.add_argument("--repeats", type=int, default=3)
@@ -316,8 +496,18 @@ def main(argv=None) -> int:
     parser.add_argument(
         "--shading", choices=tuple(SHADINGS), default="solid", help="the viewport state of the overlay's redraws"
     )
+    parser.add_argument(
+        "--runs", type=int, default=1, help="the main tables from this many fresh processes: medians and ranges"
+    )
+    parser.add_argument(
+        "--json", help="also write the main tables' results (milliseconds; with --runs, a list of every run's) here"
+    )
     args = parser.parse_args(argv)
     size = tuple(int(v) for v in args.size.split("x"))
+    if args.runs > 1:
+        if args.walks or args.ngon_diagonals or args.stacks:
+            parser.error("--runs gives the main tables only")
+        return run_many(_child_argv(argv), args.runs, args.json)
     solidwire_addon.register()
     try:
         ensure_gpu()
@@ -333,57 +523,15 @@ def main(argv=None) -> int:
             print(f"{size[0]}x{size[1]}, first extraction, best of {args.repeats} alternating rounds\n")
             stack_table(size, args.levels, args.repeats, args.stack)
             return 0
-        viewport = Viewport(size, args.shading)
-        base = dict(use_hidden_lines=True) if args.hidden_lines else {}
         print(f"{size[0]}x{size[1]}, best of {args.repeats} alternating rounds; ratio = cage / every edge")
         if args.shading != "solid":
             print(f"overlay redraws in {args.shading} shading (X-ray, alpha 0.5)")
         print("hidden lines on in both looks\n" if args.hidden_lines else "")
-        print(
-            "| level | triangles | F12 every edge (ms) | F12 cage | ratio | overlay redraw every edge | cage | ratio |"
-            " edit redraw every edge | cage | ratio | first extraction every edge | cage | ratio |"
-        )
-        print("|---:|---:|" + "---:|" * 12)
-        for level in args.levels:
-            bpy.ops.wm.read_factory_settings(use_empty=True)
-            solidwire_addon.register()
-            scene, monkey = build_scene(size, level)
-            triangles = len(monkey.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
-            looks = {"all": base, "cage": dict(base, use_cage_edges=True)}
-            best = compare(scene, monkey, size, looks, args.repeats, viewport)
-            cells = []
-            for key in ("f12", "redraw", "edit", "extract"):
-                a, c = best["all"][key], best["cage"][key]
-                cells += [f"{a:.0f}", f"{c:.0f}", f"{c / a:.2f}x"]
-            print(f"| {level} | {triangles:,} | " + " | ".join(cells) + " |", flush=True)
-        if args.hidden_lines or args.shading != "solid":
-            return 0
-
-        bpy.ops.wm.read_factory_settings(use_empty=True)
-        solidwire_addon.register()
-        scene, monkey = build_scene(size, 2)
-        looks = {
-            "plain": {},
-            "angle": dict(edge_angle=math.radians(20.0)),
-            "classes": dict(use_boundary_edges=True, use_sharp_edges=True, use_seam_edges=True),
-            "angle + classes": dict(edge_angle=math.radians(20.0), use_sharp_edges=True, use_seam_edges=True),
-        }
-        modifier = monkey.modifiers[0]
-        modifier.show_viewport = modifier.show_render = False
-        bpy.ops.object.select_all(action="DESELECT")
-        apply_subdivision(monkey, 3)
-        best = compare(scene, monkey, size, looks, args.repeats, viewport)
-        print(
-            "\nSuzanne subdivided 3 times and applied "
-            f"({len(monkey.data.loop_triangles):,} triangles); ratio against the plain frame\n"
-        )
-        print("| look | F12 (ms) | ratio | overlay redraw (ms) | ratio |")
-        print("|---|---:|---:|---:|---:|")
-        for name in looks:
-            f, r = best[name]["f12"], best[name]["redraw"]
-            print(
-                f"| {name} | {f:.0f} | {f / best['plain']['f12']:.2f}x | {r:.0f} | {r / best['plain']['redraw']:.2f}x |"
-            )
+        results = measure_tables(size, args.levels, args.repeats, args.shading, args.hidden_lines)
+        print_tables(results)
+        if args.json:
+            with open(args.json, "w", encoding="utf-8") as file:
+                json.dump(results, file)
     finally:
         solidwire_addon.unregister()
     return 0
