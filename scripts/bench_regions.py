@@ -329,6 +329,14 @@ ANGLE_LOOKS = {
 }
 
 
+def machine(size) -> str:
+    """What drew the numbers (times are only comparable on one machine):
+    the GPU driver's renderer, Blender's version, the CPU count, the size."""
+    return (
+        f"{gpu.platform.renderer_get()}, Blender {bpy.app.version_string}, {os.cpu_count()} CPUs, {size[0]} x {size[1]}"
+    )
+
+
 def measure_tables(size, levels, repeats: int, shading: str, hidden_lines: bool) -> dict:
     """The main table's measures (best ms of each look, per level) and,
     in Solid shading without hidden lines, the second table's (per look):
@@ -336,7 +344,7 @@ def measure_tables(size, levels, repeats: int, shading: str, hidden_lines: bool)
     "looks": {name: {"f12": ms, "redraw": ms}}}."""
     viewport = Viewport(size, shading)
     base = dict(use_hidden_lines=True) if hidden_lines else {}
-    results: dict = {"levels": {}, "looks": {}}
+    results: dict = {"machine": machine(size), "levels": {}, "looks": {}}
     for level in levels:
         bpy.ops.wm.read_factory_settings(use_empty=True)
         solidwire_addon.register()
@@ -399,7 +407,7 @@ def summary_tables(runs: list) -> str:
     each ratio the median of the runs' ratios, with their range, and the
     median milliseconds of each look beside it."""
     lines = [
-        f"medians (ranges) of {len(runs)} runs; ratio = cage / every edge",
+        f"{runs[0]['machine']}: medians (ranges) of {len(runs)} runs; ratio = cage / every edge",
         "",
         "| Subdivision level | " + " | ".join(title for _key, title in MEASURES) + " |",
         "|---|" + "---:|" * len(MEASURES),

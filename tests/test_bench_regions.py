@@ -11,6 +11,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import bpy
+
 from scripts import bench_regions
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,7 +35,8 @@ def test_runs_give_each_ratio_s_median_and_range_over_fresh_processes(tmp_path):
     runs = json.loads(path.read_text())
     assert len(runs) == 2
     assert runs[0]["levels"]["2"]["triangles"] == runs[1]["levels"]["2"]["triangles"] > 0
-    summary = done.stdout[done.stdout.index("medians (ranges) of 2 runs") :].rstrip("\n")
+    assert "96 x 54" in runs[0]["machine"] and bpy.app.version_string in runs[0]["machine"]
+    summary = done.stdout[done.stdout.index(runs[0]["machine"]) :].rstrip("\n")
     assert summary == bench_regions.summary_tables(runs)
     # The level's row: each measure the median of the two runs' ratios, with their range.
     row = next(line for line in summary.splitlines() if line.startswith("| 2 ("))
