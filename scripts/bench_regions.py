@@ -344,7 +344,8 @@ def measure_tables(size, levels, repeats: int, shading: str, hidden_lines: bool)
     "looks": {name: {"f12": ms, "redraw": ms}}}."""
     viewport = Viewport(size, shading)
     base = dict(use_hidden_lines=True) if hidden_lines else {}
-    results: dict = {"machine": machine(size), "levels": {}, "looks": {}}
+    conditions = f"overlay in {shading} shading" + (", hidden lines on in both looks" if hidden_lines else "")
+    results: dict = {"machine": machine(size), "conditions": conditions, "levels": {}, "looks": {}}
     for level in levels:
         bpy.ops.wm.read_factory_settings(use_empty=True)
         solidwire_addon.register()
@@ -407,7 +408,7 @@ def summary_tables(runs: list) -> str:
     each ratio the median of the runs' ratios, with their range, and the
     median milliseconds of each look beside it."""
     lines = [
-        f"{runs[0]['machine']}: medians (ranges) of {len(runs)} runs; ratio = cage / every edge",
+        f"{runs[0]['machine']}, {runs[0]['conditions']}: medians (ranges) of {len(runs)} runs; ratio = cage / every edge",
         "",
         "| Subdivision level | " + " | ".join(title for _key, title in MEASURES) + " |",
         "|---|" + "---:|" * len(MEASURES),

@@ -36,6 +36,7 @@ def test_runs_give_each_ratio_s_median_and_range_over_fresh_processes(tmp_path):
     assert len(runs) == 2
     assert runs[0]["levels"]["2"]["triangles"] == runs[1]["levels"]["2"]["triangles"] > 0
     assert "96 x 54" in runs[0]["machine"] and bpy.app.version_string in runs[0]["machine"]
+    assert runs[0]["conditions"] == "overlay in solid shading"
     summary = done.stdout[done.stdout.index(runs[0]["machine"]) :].rstrip("\n")
     assert summary == bench_regions.summary_tables(runs)
     # The level's row: each measure the median of the two runs' ratios, with their range.
