@@ -98,15 +98,48 @@ int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
     if (kept == SEGMENT_SLOTS) {
       return -1;
     }
+#  ifdef WALK_TABLE_PASS
+    walk_picks[kept] = k; /* the pre-pass keeps which (walk_table_vert.glsl) */
+#  else
     float chain = span.y - span.x;
-#  ifdef USE_DENSITY_FADE
+#    ifdef USE_DENSITY_FADE
     chain = chain_length(texel + 1, span);
-#  endif
+#    endif
     store_segment(kept, line, span, segment.z, chain);
+#  endif
     kept++;
   }
   return kept;
 }
+
+#  ifdef WALK_TABLE
+/* The segments the walk-table pre-pass picked for this triangle
+ * (walk_table_vert.glsl: its count, then two block indices a channel),
+ * set up as select_segments() would have: the same segments, the same
+ * code, at one corner per triangle instead of three SIMD lanes. */
+int read_walk_table(int triangle)
+{
+  int row = triangle >> WALK_TABLE_SHIFT;
+  vec4 picks = texelFetch(walk_table, ivec2(triangle - (row << WALK_TABLE_SHIFT), row), 0);
+  int kept = int(picks.x);
+  for (int slot = 0; slot < kept; slot++) {
+    float pair = (slot < 2) ? picks.y : ((slot < 4) ? picks.z : picks.w);
+    float high = floor(pair / float(WALK_PICK_BASE));
+    int k = int(((slot & 1) == 0) ? pair - high * float(WALK_PICK_BASE) : high);
+    int texel = ngon_corner_start + SEGMENT_TEXELS * k;
+    vec4 segment = fetch_texel(ngon_corners, texel);
+    vec3 line;
+    vec2 span;
+    edge_setup(vertex_clip(segment.x), vertex_clip(segment.y), line, span);
+    float chain = span.y - span.x;
+#    ifdef USE_DENSITY_FADE
+    chain = chain_length(texel + 1, span);
+#    endif
+    store_segment(slot, line, span, segment.z, chain);
+  }
+  return kept;
+}
+#  endif
 
 /* The widest reach of any line at this triangle: the largest half width of
  * the wire and of every style at its corners, plus the 2s falloff and a
@@ -278,7 +311,11 @@ void select_block_segments(int corner, bool in_front, vec2 t0, vec2 t1, vec2 t2,
   }
   else if ((edge_flags & IN_REGION) != 0 && provoking) {
     /* Behind the near plane a corner has no window position: walk. */
+#  ifdef WALK_TABLE
+    segment_count = in_front ? read_walk_table(SW_VERTEX_ID / 3) : -1;
+#  else
     segment_count = in_front ? select_segments(t0, t1, t2, line_reach(clip_w.x, clip_w.y, clip_w.z)) : -1;
+#  endif
   }
 }
 #endif
@@ -349,7 +386,7 @@ void partner_outputs(int triangle, vec4 ids)
 /* The per-corner work. The resolve pass (resolve_frag.glsl) runs it too,
  * for the provoking corner of the triangle a pixel shows, with
  * SW_VERTEX_ID standing for gl_VertexID and every output a plain global. */
-#ifdef RESOLVE_PASS
+#if defined(RESOLVE_PASS) || defined(WALK_TABLE_PASS)
 void solidwire_corner()
 #else
 void main()

@@ -28,6 +28,7 @@ from .extract import (
     ngon_triangles_overlap,
     ngons_flat,
 )
+from .shaders import WALK_TABLE_SHIFT
 
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
@@ -225,6 +226,7 @@ class GPUMesh:
         self.mesh_bounds = (arrays.bounds_min, arrays.bounds_max)  # mesh space
 
         self._batch = None  # batch, made on first use
+        self._walk_table = None  # (points batch, table texture): walk_table(), made on first use
         self.gpu_bytes = sum(
             texture_bytes(table)
             for table in (self.positions, self.triangles, self.ngon_corners, self.corners, self.attribute_colors)
@@ -244,6 +246,26 @@ class GPUMesh:
             self._batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
             self.gpu_bytes += 3 * self.triangle_count * 4
         return self._batch
+
+    def walk_table(self):
+        """(points batch, RGBA32F table) of the walk-table pre-pass
+        (core/draw.py _run_walk_table, shaders/walk_table_vert.glsl): one
+        point per triangle with its edge-flag word, and a texel per
+        triangle, 2^WALK_TABLE_SHIFT a row. Made on first use: only meshes
+        whose regions are walked in a direct draw need it. (No framebuffer
+        is kept: one belongs to the GL context that made it, and a mesh is
+        drawn by the viewport's and the render engine's.)"""
+        if self._walk_table is None:
+            fmt = gpu.types.GPUVertFormat()
+            fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
+            vbo = gpu.types.GPUVertBuf(fmt, self.triangle_count)
+            vbo.attr_fill("edge_flags", np.asarray(self.edge_flags_cpu, dtype=np.int32))
+            width = 1 << WALK_TABLE_SHIFT
+            size = (width, max(1, -(-self.triangle_count // width)))
+            table = gpu.types.GPUTexture(size, format="RGBA32F")
+            self._walk_table = (gpu.types.GPUBatch(type="POINTS", buf=vbo), table)
+            self.gpu_bytes += 4 * self.triangle_count + texture_bytes(table)
+        return self._walk_table
 
     def flag_table(self):
         """The edge-flag word of every triangle, as an RG32F texture

@@ -96,7 +96,10 @@ class DrawTarget:
     by vertex only: gl_PrimitiveID would start again at each range).
     ``line_runs`` (LINES): which runs of each mesh's region-lines table it
     draws (ALL_RUNS, WIRE_RUNS: then without the edge classes' code,
-    CLASS_RUNS).
+    CLASS_RUNS). ``depth_only``: the caller masks the colour (a depth
+    pre-pass drawn with the surface's own program, so that the depths
+    agree): nothing but the depth matters, and the walk-table pre-pass
+    (_run_walk_table), whose picks only colour reads, is left out.
 
     The hidden layers of multi-face regions (passes._peel_hidden_regions):
     ``region_layers`` (VISIBILITY) records only the triangles whose lines
@@ -130,6 +133,7 @@ class DrawTarget:
     behind_tiles: object = None
     region_layers_peeled: bool = False
     line_runs: str = ALL_RUNS
+    depth_only: bool = False
 
     def hidden(self, region_layers_peeled: bool = False) -> DrawTarget:
         """The hidden-line layer over this target (image model §5.4): every
@@ -273,6 +277,7 @@ class ExactProgram:
     supports_ngons = True
     supports_instancing = True
     supports_setup_table = True
+    supports_walk_table = True
 
     def shader(self, variant):
         return shaders.get(variant)
@@ -294,6 +299,19 @@ INSTANCING_MIN = 16
 # invocation per triangle, shaders/setup_comp.glsl) instead of from every
 # corner of the vertex stage; below it the dispatch costs more than it saves.
 SETUP_TABLE_MIN = 50_000
+
+# A mesh whose triangles' regions hold at least this many lines on average
+# (cache.GPUMesh.region_sizes), drawn object by object in a direct draw that
+# walks them (under hidden lines, passes.PEEL_MIN_REGION_LINES below), picks
+# each triangle's segments in the walk-table pre-pass (_run_walk_table)
+# instead of at its provoking corner. On a CPU rasteriser a corner's loop
+# over the block holds up the other corners shaded beside it, so choosing
+# at one corner of three costs as much as choosing at all three (measured:
+# Suzanne with cage edges at level 3 under hidden lines, F12 1280 x 720 on
+# llvmpipe, the hidden-line pass 247 ms choosing at one corner, 245 at all
+# three, 197 with the pre-pass; docs/dev/benchmarks.md). Below eight lines
+# a block is too short for the pre-pass's draw to pay.
+WALK_TABLE_MIN_LINES = 8
 
 # Triangle numbers, instances and draw numbers travel as float32 whole
 # numbers in the visibility record: exact below 2^24.
@@ -565,6 +583,7 @@ def draw(
             # Both deferred stages must split and number the draws alike:
             # instancing does not depend on the stage's variant.
             instancing=program.supports_instancing and not target.aovs,
+            depth_only=target.depth_only,
             numbering=_DrawNumbers(
                 stage,
                 extras,
@@ -626,6 +645,7 @@ class _Part:
     flat_ngons_alone: bool = False  # every n-gon is a region of its own and flat (asked where diagonals show)
     ngons_may_fold: bool = False  # an n-gon may not be flat: its triangles can overlap on screen
     own_edges: bool = False  # some listed faces measure their own edges (edge_select.OWN_EDGES_MEASURED)
+    walk_table: bool = False  # a direct draw's walk picks its segments in the walk-table pre-pass
 
     def variant(self, variant):
         """``variant`` for this part. The visibility and region-lines passes
@@ -680,6 +700,18 @@ class _Part:
             part_variant = replace(part_variant, edge_classes=False, style_colors=True)
         if variant.no_lines:
             part_variant = replace(part_variant, ngons=False, setup_table=False, no_edge_setup=True, own_edges=False)
+        if (
+            self.walk_table
+            and part_variant.ngons
+            # (A peeled mesh's region triangles are dropped before any walk.)
+            and not (
+                part_variant.resolve
+                or part_variant.region_lines
+                or part_variant.instanced
+                or part_variant.region_layers_peeled
+            )
+        ):
+            part_variant = replace(part_variant, walk_table=True)
         return part_variant
 
 
@@ -702,11 +734,20 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False, hi
         mesh = g.mesh
         ngons = program.supports_ngons and mesh.has_ngons
         table = setup_ok and not ngons and draws_of[id(mesh)] == 1 and _setup_size(mesh, stage, g.object_to_clip, view)
+        walk_table = (
+            ngons
+            and stage is None
+            and draws_of[id(mesh)] == 1
+            and getattr(program, "supports_walk_table", False)
+            and mesh.region_line_count > 0
+            and mesh.region_sizes()[1] >= WALK_TABLE_MIN_LINES
+        )
         part = _Part(
             ngons=ngons,
             lines_only=ngons and getattr(mesh, "blocks_only_for_region_lines", False),
             colored=getattr(mesh, "attribute_colors", None) is not None,
             setup_table=table,
+            walk_table=bool(walk_table),
             in_front=wholly_in_front(g.object_to_clip, mesh.bounds_min, mesh.bounds_max),
             run_segments=getattr(mesh, "region_run_segments", 1),
             lines_from_image_only=getattr(mesh, "lines_only_from_region_pass", False),
@@ -741,6 +782,7 @@ class _DrawCall:
     bases: np.ndarray
     instancing: bool
     numbering: _DrawNumbers
+    depth_only: bool = False
 
 
 def clip_space_planes(planes, view: View) -> list:
@@ -917,6 +959,13 @@ class _DrawNumbers:
         else:
             picked_quad_batch(picked, count).draw(shader)
 
+    def direct_ranges(self, mesh, object_to_clip):
+        """The triangle ranges (triangle_ranges_reaching) a direct,
+        non-instanced draw of ``mesh`` draws, or None for all of them."""
+        if self.window is None:
+            return None
+        return triangle_ranges_reaching(mesh, object_to_clip, self.view.viewport, self.window)
+
     def draw(self, shader, mesh, batch_of, object_to_clip, instance_count: int = 0, object_to_view_z=None) -> None:
         """One draw call of ``mesh``; ``batch_of()`` gives the direct draw's
         batch (asked for only when drawing directly). ``object_to_view_z``:
@@ -924,10 +973,8 @@ class _DrawNumbers:
         ``behind``)."""
         if self.stage is None:
             batch = batch_of()
-            ranges = None
-            if self.window is not None and not instance_count:
-                # (A triangle list in table order: triangle t is corners 3t..3t+2.)
-                ranges = triangle_ranges_reaching(mesh, object_to_clip, self.view.viewport, self.window)
+            # (A triangle list in table order: triangle t is corners 3t..3t+2.)
+            ranges = None if instance_count else self.direct_ranges(mesh, object_to_clip)
             if instance_count:
                 batch.draw_instanced(shader, instance_start=0, instance_count=instance_count)
             elif ranges is None:
@@ -1265,6 +1312,26 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
                 shader.bind()
                 bound = _UNBOUND  # the pre-pass bound its own block
                 shader.uniform_sampler("setup_table", mesh.setup_table)
+            if variant.walk_table and call.depth_only:
+                # (The same program, for the same depths; its picks are
+                # never read. Bound all the same: the program samples it.)
+                shader.uniform_sampler("walk_table", mesh.walk_table()[1])
+            elif variant.walk_table:
+                # (Before each draw, as the set-up pre-pass: the picks are
+                # for this object's matrix.)
+                walk_table = _run_walk_table(
+                    mesh,
+                    variant,
+                    object_to_clip,
+                    one.object_to_view,
+                    ubo(style),
+                    numbering.direct_ranges(mesh, object_to_clip),
+                )
+                shader.bind()
+                bound = _UNBOUND  # the pre-pass bound its own block
+                _bind_extras(shader, variant, extras)
+                numbering.bind(shader)
+                shader.uniform_sampler("walk_table", walk_table)
             if style is not bound:
                 bound = style
                 shader.uniform_block("params", ubo(style))
@@ -1376,6 +1443,55 @@ def _run_setup(mesh, object_to_clip, block, in_front: bool = False, viewport=Non
     mesh.setup_key = key
 
 
+def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges=None):
+    """The walk-table pre-pass of one draw (shaders/walk_table_vert.glsl):
+    one point per triangle of ``mesh`` writes which segments of its block
+    lie within reach of it, into the mesh's table (cache.GPUMesh.walk_table),
+    which it returns for the draw to read; ``ranges``: only the triangle
+    ranges the draw draws (_DrawNumbers.direct_ranges: an edit's partial
+    redraw), None for all. Draws into the table's own framebuffer and puts
+    back the bound one, its viewport and the blend and depth state."""
+    batch, table = mesh.walk_table()
+    # (Made for each run, as the pass targets' are: a framebuffer belongs to
+    # the GL context that made it, and a mesh is drawn in two.)
+    framebuffer = gpu.types.GPUFrameBuffer(color_slots=(table,))
+    pass_variant = replace(variant, walk_table=False, walk_table_pass=True, clip_planes=False)
+    shader = shaders.get(pass_variant)
+    saved_viewport = gpu.state.viewport_get()
+    saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
+    try:
+        with framebuffer.bind():
+            gpu.state.viewport_set(0, 0, table.width, table.height)
+            gpu.state.blend_set("NONE")
+            gpu.state.depth_test_set("NONE")
+            gpu.state.depth_mask_set(False)
+            # One texel a point: Blender's viewport leaves a point size of
+            # its own (programmable or fixed) behind, which widened the
+            # points over their neighbours' texels after a viewport draw.
+            # (Its draws set their own again: nothing to put back.)
+            gpu.state.program_point_size_set(False)
+            gpu.state.point_size_set(1.0)
+            shader.bind()
+            shader.uniform_block("params", block)
+            if shaders.uses_uniform(shader, "object_to_clip"):
+                shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
+            if shaders.uses_uniform(shader, "object_to_view_z"):
+                shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
+            shader.uniform_int("walk_table_size", (table.width, table.height))
+            _bind_mesh(shader, pass_variant, mesh)
+            if ranges is None:
+                batch.draw(shader)
+            else:  # (one point a triangle, in table order)
+                for start, count in zip(ranges[0].tolist(), ranges[1].tolist()):
+                    batch.draw_range(shader, elem_start=start, elem_count=count)
+    finally:
+        gpu.state.viewport_set(*saved_viewport)
+        gpu.state.blend_set(saved[0])
+        gpu.state.depth_test_set(saved[1])
+        gpu.state.depth_mask_set(saved[2])
+    return table
+
+
 def _material_table(mesh, materials, tables: dict):
     """Texture of the IndexMA value of each triangle of ``mesh`` for one
     object's materials (face material index -> slot -> the material's
@@ -1422,7 +1538,7 @@ def _draw_instanced(groups: list[InstancedDraw], variant, call: _DrawCall) -> No
     """One draw_instanced call per (mesh, style, facing) group; every
     instance's matrices in one float texture for the whole frame."""
     ubo, settings, stats, extras, numbering = call.ubo, call.settings, call.stats, call.extras, call.numbering
-    shader = shaders.get(replace(variant, instanced=True, setup_table=False))
+    shader = shaders.get(replace(variant, instanced=True, setup_table=False, walk_table=False))
     table = table_texture(np.concatenate([_instance_rows(g.object_to_view, g.object_to_clip, g.info) for g in groups]))
     shader.bind()
     bound = None

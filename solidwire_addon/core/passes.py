@@ -215,7 +215,7 @@ class SurfacePass(RenderPass):
         ):
             gpu.state.blend_set("NONE")
             gpu.state.color_mask_set(False, False, False, False)
-            draw_mod.draw(items, view, settings, target=base)
+            draw_mod.draw(items, view, settings, target=replace(base, depth_only=True))
             gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set("ALPHA_PREMULT")
         # Without the wire and the fill the pass would draw nothing the
@@ -419,7 +419,7 @@ def _draw_kept_frame(frame: Frame, settings, targets, visible, occluded, rect=No
     with front.bind(), _scissored(rect):
         _clear(front, width, height)
         gpu.state.color_mask_set(False, False, False, False)
-        draw_mod.draw(items, view, settings, target=lines_base, cull=cull)
+        draw_mod.draw(items, view, settings, target=replace(lines_base, depth_only=True), cull=cull)
         gpu.state.color_mask_set(True, True, True, True)
         gpu.state.blend_set("ALPHA_PREMULT")
         if occluded is None:

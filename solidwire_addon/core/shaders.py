@@ -42,6 +42,11 @@ SETUP_TEXELS = 7
 # (4095 texels wide, under the 16384 limit for 9.5M triangles).
 SETUP_ROW_TRIANGLES = 585
 SETUP_MAX_TRIANGLES = SETUP_ROW_TRIANGLES * 16384
+# The walk-table pre-pass's table (shaders/walk_table_vert.glsl): 2^SHIFT
+# triangles a row; two picks a channel, below WALK_PICK_BASE each (a block
+# longer than that is walked whole).
+WALK_TABLE_SHIFT = 12
+WALK_PICK_BASE = 4096
 SETUP_GROUP_SIZE = 64  # compute invocations per work group, one per triangle
 
 CLIP_PLANES = 6  # as many as Blender's clipping region (RegionView3D.clip_planes)
@@ -175,6 +180,14 @@ class ShaderVariant:
     # The ATTRIBUTE fill source for a mesh that has a colour attribute: the
     # fill is its colours, interpolated over each triangle (ATTRIBUTE_COLORS).
     attribute_colors: bool = False
+    # Walked regions in a direct draw (a mesh of large regions that is not
+    # peeled, docs/dev/how-it-works.md "Walked regions"): ``walk_table_pass``
+    # is the pre-pass that picks, once per triangle, the segments of its
+    # block within reach (shaders/walk_table_vert.glsl); a draw with
+    # ``walk_table`` reads those picks (WALK_TABLE) instead of choosing them
+    # at its provoking corner.
+    walk_table: bool = False
+    walk_table_pass: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -286,6 +299,7 @@ SAMPLERS = {
     "triangle_material": (7, "FLOAT_2D"),
     "display_lut": (8, "FLOAT_3D"),
     "setup_table": (9, "FLOAT_2D"),
+    "walk_table": (9, "FLOAT_2D"),  # (never beside the set-up table: a walked mesh has blocks)
     "visibility": (10, "FLOAT_2D"),
     "triangle_flag_table": (11, "FLOAT_2D"),
     "region_line_image": (12, "DEPTH_2D"),
@@ -462,6 +476,14 @@ def _create_info(variant: ShaderVariant):
             raise ValueError("the resolve pass writes no depth (the visibility pass did)")
         info.define("LINEAR_DEPTH", "1")
         compat.depth_write(info, "ANY")
+    if variant.walk_table or variant.walk_table_pass:
+        if not variant.ngons or variant.instanced or variant.resolve or variant.setup_table:
+            raise ValueError("only a direct, non-instanced draw that walks blocks has a walk table")
+        info.define("WALK_TABLE_SHIFT", str(WALK_TABLE_SHIFT))
+        info.define("WALK_PICK_BASE", str(WALK_PICK_BASE))
+    if variant.walk_table:
+        add_sampler(info, "walk_table")
+        info.define("WALK_TABLE", "1")
     if variant.ngons:
         info.define("USE_NGONS", "1")
         info.define("SEGMENT_SLOTS", str(SEGMENT_SLOTS))
@@ -489,10 +511,39 @@ def _create_info(variant: ShaderVariant):
             + (OBJECT_BLOCK_GLSL if variant.write_aovs else "")
             + (CLIP_BLOCK_GLSL if variant.clip_planes else "")
         )
+    if variant.walk_table_pass:
+        _add_walk_table_sources(info, variant, iface)
+        return info
     if not variant.resolve:
         info.vertex_out(iface.stage_interface())  # last: the steps above add varyings
     _add_sources(info, variant, iface)
     return info
+
+
+def _add_walk_table_sources(info, variant: ShaderVariant, iface: _Interface) -> None:
+    """The walk-table pre-pass (shaders/walk_table_vert.glsl): the draw's
+    own corner code with every varying a plain global, run once per
+    triangle as its provoking corner, handing on one texel of picks."""
+    if variant.clip_planes:
+        raise ValueError("the walk-table pre-pass is not clipped (its points are table texels)")
+    walk = gpu.types.GPUStageInterfaceInfo("solidwire_walk_iface")
+    walk.flat("VEC4", "walk_pick")
+    info.vertex_out(walk)
+    info.push_constant("IVEC2", "walk_table_size")
+    common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("quad_partner.glsl")
+    styles = read_source("line_style.glsl") + edge_styles_source()
+    head = read_source("item_table.glsl") if variant.per_item else ""
+    info.vertex_source(
+        "#define SW_VERTEX_ID (3 * gl_VertexID + 2)\n#define WALK_TABLE_PASS 1\nint walk_picks[SEGMENT_SLOTS];\n"
+        + iface.globals_glsl()
+        + head
+        + common
+        + styles
+        + read_source("clip_region.glsl")
+        + read_source("solidwire_vert.glsl")
+        + read_source("walk_table_vert.glsl")
+    )
+    info.fragment_source(read_source("walk_table_frag.glsl"))
 
 
 def _define_partner_depth_hair(info, linear_depth: bool) -> None:

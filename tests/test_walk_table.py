@@ -1,0 +1,131 @@
+"""The walk-table pre-pass (shaders/walk_table_vert.glsl): where a direct
+draw walks its regions' lines (under hidden lines, meshes whose regions are
+not peeled), one point per triangle picks the segments of its block within
+reach, and the draw reads those picks instead of choosing them at its
+provoking corner. Same selection code, so the image is the same to the
+bit, in a render (every pass) and in the viewport overlay; the accuracy of
+the walked hidden lines against the float64 reference is
+tests/test_regions.py's."""
+
+from __future__ import annotations
+
+import math
+
+import bpy
+import gpu
+import numpy as np
+import pytest
+
+from solidwire_addon.blender.views import camera_view
+from solidwire_addon.core import draw, targets
+from tests.support import scenes
+from tests.test_overlay import FakeViewport
+
+
+def _walked_scene(width: int, height: int, **look):
+    """A second Suzanne under a level-2 Subdivision Surface, with cage edges
+    and hidden lines (regions of 16 lines on average: walked, not peeled),
+    and a sheet under a level-3 one (32), beside a floor that crosses the
+    near plane."""
+    scene = scenes.empty_scene(width, height, use_cage_edges=True, use_hidden_lines=True, **look)
+    scenes.near_plane_scene(scene)
+    monkey = scenes.monkey(scene, "Walked", location=(-0.2, 1.6, 0.6), rotation=(0.2, 0.0, 0.6))
+    monkey.modifiers.new("Subdivision", "SUBSURF").levels = 2
+    for edge in monkey.data.edges[:60]:
+        edge.use_seam = edge.index % 2 == 0
+        edge.use_edge_sharp = edge.index % 2 == 1
+    # A wavy sheet behind the other Suzanne: its faces numbered row by row,
+    # so a move of one corner reaches few of its blocks of triangles (an
+    # edit's partial redraw).
+    sheet = scenes.grid(scene, "Sheet", x_segments=12, y_segments=12, size=2.5)
+    sheet.location, sheet.rotation_euler = (0.6, 7.5, 1.2), (1.45, 0.0, 0.1)
+    for vertex in sheet.data.vertices:
+        vertex.co.z += 0.15 * math.sin(3.0 * vertex.co.x)
+    sheet.modifiers.new("Subdivision", "SUBSURF").levels = 3
+    return scene
+
+
+_SHIPPED_MIN_LINES = draw.WALK_TABLE_MIN_LINES
+
+
+def _counting(monkeypatch, table_on: bool) -> list:
+    """Turn the pre-pass on (or off) and count its runs."""
+    runs = []
+    real = draw._run_walk_table
+    monkeypatch.setattr(draw, "WALK_TABLE_MIN_LINES", _SHIPPED_MIN_LINES if table_on else 10**9)
+    # Each run's mesh and triangle ranges (None: every triangle).
+    monkeypatch.setattr(
+        draw,
+        "_run_walk_table",
+        lambda *args: (runs.append((args[0], args[5] if len(args) > 5 else None)), real(*args))[1],
+    )
+    return runs
+
+
+LOOKS = {
+    "plain": {},
+    # Every style's reach, the density fade's chain lengths, the angle's regions.
+    "classes, fade, angle": dict(
+        use_seam_edges=True, use_sharp_edges=True, use_density_fade=True, edge_angle=0.35, hidden_period=6.0
+    ),
+}
+
+
+@pytest.mark.parametrize("look", LOOKS)
+def test_walk_table_gives_the_same_render(look, output_dir, monkeypatch):
+    scene = _walked_scene(240, 180, **LOOKS[look])
+    runs = _counting(monkeypatch, table_on=False)
+    at_corners = scenes.render_multilayer_exr(scene, output_dir / f"walk_off_{look}.exr")
+    assert runs == []
+    runs = _counting(monkeypatch, table_on=True)
+    from_table = scenes.render_multilayer_exr(scene, output_dir / f"walk_on_{look}.exr")
+    assert runs, "the pre-pass never ran: the walked mesh is not walked here any more"
+    assert at_corners.keys() == from_table.keys()
+    for name, values in at_corners.items():
+        np.testing.assert_array_equal(from_table[name], values, err_msg=name)
+    # Lines show at all (the comparison is not of two empty images).
+    assert (from_table["ViewLayer.Combined.A"] > 0).mean() > 0.02
+
+
+def test_walk_table_gives_the_same_overlay(monkeypatch):
+    """The first redraw draws directly, the second (the same key) into the
+    images the overlay keeps (passes._overlay_kept_frame), the third after
+    a vertex moved all of them again, the fourth (the drag's next step)
+    only the triangles that reach what it changed, the pre-pass too: each
+    the same either way."""
+    scene = _walked_scene(200, 150)
+    walked = scene.objects["Sheet"]
+    vertex = walked.data.vertices[0]
+    start = tuple(vertex.co)
+
+    def overlay_images(table_on: bool):
+        runs = _counting(monkeypatch, table_on)
+        monkeypatch.setattr(targets, "_overlay_targets", {})  # no image kept from before
+        vertex.co = start
+        walked.data.update()
+        images = []
+        for redraw in range(4):
+            if redraw >= 2:  # an edit, then its next step: the vertex moves
+                vertex.co.z += 0.02
+                walked.data.update()
+            depsgraph = bpy.context.evaluated_depsgraph_get()
+            # What Blender's own viewport leaves behind (its vertices' point
+            # size): the pre-pass's points must still be one texel each.
+            gpu.state.program_point_size_set(False)
+            gpu.state.point_size_set(4.0)
+            viewport = FakeViewport(200, 150)
+            viewport.draw_overlay(depsgraph, camera_view(scene, depsgraph, (200, 150)), scene.solidwire.snapshot())
+            images.append(viewport.rgba())
+        return runs, images
+
+    runs, at_corners = overlay_images(False)
+    assert runs == []
+    runs, from_table = overlay_images(True)
+    assert len(runs) >= 4
+    # The edit's pre-pass drew the triangles the edit's draw drew alone.
+    mesh, edit_ranges = runs[-1]
+    assert edit_ranges is not None and 0 < edit_ranges[1].sum() < mesh.triangle_count
+    for table_image, corner_image in zip(from_table, at_corners):
+        np.testing.assert_array_equal(table_image, corner_image)
+        assert (table_image[..., 3] > 0).mean() > 0.05
+    assert not np.array_equal(from_table[3], from_table[1])  # the edit shows
