@@ -302,7 +302,7 @@ SETUP_TABLE_MIN = 50_000
 
 # A mesh whose triangles' regions hold at least this many lines on average
 # (cache.GPUMesh.region_sizes), drawn object by object in a direct draw that
-# walks them (under hidden lines, passes.PEEL_MIN_REGION_LINES below), picks
+# walks them (under hidden lines: the meshes below passes.PEEL_MIN_REGION_LINES), picks
 # each triangle's segments in the walk-table pre-pass (_run_walk_table)
 # instead of at its provoking corner. On a CPU rasteriser a corner's loop
 # over the block holds up the other corners shaded beside it, so choosing
