@@ -513,6 +513,13 @@ vec4 fragment_colour(float intensity, int winner)
     wire_weight = intensity * class_color.a;
   }
 #endif
+#ifdef WIRE_LAYER
+  /* The render under hidden lines: the wire in a layer of its own,
+   * premultiplied (ShaderVariant.wire_layer); the colour is the fill
+   * alone, and the hidden lines go between the two. */
+  frag_wire = vec4(wire_rgb * wire_weight, wire_weight);
+  wire_weight = 0.0;
+#endif
 #if defined(USE_FILL) && !defined(HIDDEN_PASS)
 #  ifdef ITEM_COLORS
   vec3 fill_rgb = item_fill;

@@ -622,6 +622,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "view_depth": (True, lambda v: v.write_view_depth),
         "aovs": (True, lambda v: v.write_aovs),
         "lines": (draw.HIDDEN_LINES, lambda v: v.hidden_pass),
+        "wire_layer": (True, lambda v: v.wire_layer),
     }
     state_or_input = {
         "depth_test",

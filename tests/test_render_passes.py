@@ -168,3 +168,44 @@ def test_mirrored_object_normals_face_the_camera():
     ref = reference.render_reference(scene, size=(48, 36))
     off = ~ref.on_silhouette
     assert np.abs(normal - _expected_normals(scene, ref))[off].max() <= 1e-4
+
+
+def test_render_passes_leave_the_image_alone_under_hidden_lines(tmp_path):
+    """Asking for every render pass changes no pixel of the Combined image,
+    also under hidden lines, where the surface pass puts the visible wire in
+    a layer of its own for the hidden lines to go between it and the fill:
+    a cage look with edge classes in their own colours, dotted diagonals and
+    a shaded fill (it once drew the class lines in the wire's colour when
+    the passes were on)."""
+    scene = scenes.empty_scene(
+        160,
+        120,
+        use_fill=True,
+        fill_shading="STUDIO",
+        use_hidden_lines=True,
+        hidden_alpha=0.6,
+        use_cage_edges=True,
+        use_seam_edges=True,
+        use_sharp_edges=True,
+        diagonal_mode="DOTTED",
+    )
+    scenes.add_camera(scene, location=(1.2, -3.4, 1.0), target=(0.0, 0.0, 0.0), lens=45.0)
+    monkey = scenes.monkey(scene, rotation=(0.0, 0.0, 0.5))
+    monkey.modifiers.new("Subdivision", "SUBSURF").levels = 1
+    for edge in monkey.data.edges[:80]:
+        edge.use_seam = edge.index % 2 == 0
+        edge.use_edge_sharp = edge.index % 2 == 1
+    plain = _multilayer_render(scene, tmp_path / "plain.exr")
+    _enable_all(scene.view_layers[0])
+    with_passes = _multilayer_render(scene, tmp_path / "passes.exr")
+    layer = scene.view_layers[0].name
+    combined = [
+        np.stack([channels[f"{layer}.Combined.{c}"] for c in "RGBA"], axis=-1) for channels in (plain, with_passes)
+    ]
+    assert np.abs(combined[1] - combined[0]).max() <= 1e-6
+    # The image shows the class colours, the wire's and the hidden lines.
+    wire = exr.exr_pass(with_passes, layer, "Wire", "X")[..., 0]
+    hidden = exr.exr_pass(with_passes, layer, "Hidden Wire", "X")[..., 0]
+    assert (wire > 0.9).sum() > 200 and (hidden > 0.5).sum() > 50
+    lines = combined[0][wire > 0.9][:, :3]
+    assert len(np.unique(np.round(lines, 2), axis=0)) >= 3

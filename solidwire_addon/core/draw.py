@@ -85,7 +85,11 @@ class DrawTarget:
     straight into Blender's buffer. Outputs: the view
     depth in a second colour target, the render passes' targets (``aovs``),
     and which ``lines`` the colour shows (WIRE_LINES, NO_LINES,
-    HIDDEN_LINES). ``triangle_ids_by_vertex``: how the VISIBILITY stage
+    HIDDEN_LINES); ``wire_layer`` (WIRE_LINES, the render under hidden
+    lines): the colour shows the fill alone and the visible wire goes,
+    premultiplied and unblended, into a colour target of its own (after
+    the render passes' two), so that the hidden lines can go between the
+    two (passes.WirePass). ``triangle_ids_by_vertex``: how the VISIBILITY stage
     numbers triangles (options.DrawOptions). ``scissor_window`` (x, y,
     width, height, reach; LINES and VISIBILITY): the caller draws inside
     that window rectangle alone (a scissor) and nothing drawn reaches
@@ -134,6 +138,7 @@ class DrawTarget:
     region_layers_peeled: bool = False
     line_runs: str = ALL_RUNS
     depth_only: bool = False
+    wire_layer: bool = False
 
     def hidden(self, region_layers_peeled: bool = False) -> DrawTarget:
         """The hidden-line layer over this target (image model §5.4): every
@@ -152,6 +157,7 @@ class DrawTarget:
             lines=HIDDEN_LINES,
             region_lines=None,
             view_depth=False,
+            wire_layer=False,
             region_layers_peeled=region_layers_peeled,
         )
 
@@ -190,6 +196,11 @@ def shader_variant(settings, target: DrawTarget | None = None) -> shaders.Shader
             material_colors=False,
             attribute_colors=False,
         )
+    if target.wire_layer and target.stage in (None, RESOLVE):
+        # (The record and lines stages of such a surface write no colour.)
+        if target.lines != WIRE_LINES:
+            raise ValueError("only a surface draw of the visible wire puts that wire in a layer of its own")
+        variant = replace(variant, wire_layer=True)
     if target.aovs:
         variant = replace(variant, write_aovs=True)
     elif target.lines == NO_LINES and target.stage in (None, RESOLVE):

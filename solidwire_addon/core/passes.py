@@ -6,11 +6,13 @@ sync and draw steps:
 
     RegionLinesPass   the lines of multi-face regions as an image the surface
                       and wire passes read (docs/image_model.md §2.6)
-    SurfacePass       every drawn face: depth, the fill colour and (unless
-                      hidden lines are on) the visible wire, in one pass
+    SurfacePass       every drawn face: depth, the fill colour and the
+                      visible wire, in one pass (with hidden lines offscreen
+                      the wire into a layer of its own)
     HiddenLinesPass   hidden lines, behind the surface depth, blended "over"
     WirePass          the visible wire over the hidden lines (only with
-                      hidden lines)
+                      hidden lines: that layer, or over the viewport the
+                      wire drawn again)
     OutputsPass       the read-back image and the render passes (offscreen)
     SilhouettePass    the outer half of silhouette edges (image model §5.5)
     StrandsPass       hair and point clouds (core/strands.py)
@@ -167,8 +169,10 @@ class RegionLinesPass(RenderPass):
 
 class SurfacePass(RenderPass):
     """Every drawn face: depth, the fill and, with ``wire``, the visible
-    wire. ``wire`` False (under hidden lines) draws no wire whatever an
-    object's override says."""
+    wire. ``wire`` False (under hidden lines) shows no wire whatever an
+    object's override says: offscreen the pass draws the wire into a layer
+    of its own instead (targets.wire_layer), which WirePass blends over the
+    hidden lines; over the viewport WirePass draws it again."""
 
     def __init__(self, settings, *, wire: bool = True):
         super().__init__(settings)
@@ -180,7 +184,8 @@ class SurfacePass(RenderPass):
             frame.items,
             frame.view,
             self.settings,
-            wire=self.wire,
+            wire=True,
+            wire_layer=not self.wire,
             aovs=frame.aovs,
             cull=frame.cull,
             options=frame.options,
@@ -241,7 +246,7 @@ class HiddenLinesPass(RenderPass):
             # into its target and blended over the image from there ("over"
             # is associative), not drawn twice.
             frame.extra[HIDDEN_WIRE_PASS] = _hidden_wire(frame, self.settings)
-            _blended(frame, lambda: _blend_own_layer(targets))
+            _blended(frame, lambda: _blend_layer(targets, targets.own_layer))
             return
         peeled = _peel_hidden_regions(
             frame,
@@ -494,48 +499,19 @@ class WirePass(RenderPass):
     surface's depth and view depth alone."""
 
     def render(self, frame: Frame) -> None:
-        lines = _wire_region_lines(frame, self.settings)
-        # Into a layer of its own, unblended, then "over" the image: where
-        # two triangles lie at the surface's very depth (a flat n-gon whose
-        # outline crosses itself has triangles on one another) both pass
-        # the depth test, and blended straight over the hidden lines the
-        # line would count twice (1 - (1 - I)^2); here the last one stays,
-        # as in the surface pass without hidden lines.
-        targets, view = frame.targets, frame.view
-        framebuffer = targets.own_layer_framebuffer()
-        with framebuffer.bind():
-            _clear(framebuffer, view.width, view.height, depth=False)
-            try:
-                _draw(frame, self.settings, replace(frame.base, depth_write=False, region_lines=lines))
-            finally:
-                gpu.state.depth_test_set("NONE")
-        _blended(frame, lambda: _blend_own_layer(targets))
+        # The surface pass drew the wire into a layer of its own, unblended
+        # (SurfacePass): where two triangles lie at the surface's very depth
+        # (a flat n-gon whose outline crosses itself has triangles on one
+        # another) the last one stays, as in the surface pass without hidden
+        # lines, where blended straight over the hidden lines the line would
+        # count twice (1 - (1 - I)^2). That layer goes "over" the image now.
+        targets = frame.targets
+        if targets.wire_layer is not None:
+            _blended(frame, lambda: _blend_layer(targets, targets.wire_layer))
 
     def over_viewport(self, frame: Frame) -> None:
         if not frame.frame_kept:
             frame.stats = _draw(frame, self.settings, replace(frame.base, region_lines=frame.region_lines))
-
-
-def _wire_region_lines(frame: Frame, settings):
-    """The region-lines image for the offscreen wire drawn on its own (under
-    hidden lines), or None where no mesh has multi-face regions: a
-    visibility record of those meshes over the surface depth already drawn
-    (only the nearest surface passes it), then the region-lines pass over
-    it, so that the wire's pixels read their lines instead of walking their
-    regions (docs/image_model.md §2.6). Where the record's stages do not
-    compile here the wire walks."""
-    items = _line_image_readers(frame.items)
-    if not _has_region_lines(items) or not shaders.deferred_available():
-        return None
-    stats = frame.stats if frame.stats is not None else DrawStats()
-    try:
-        _record_visibility(
-            frame.targets, items, frame.view, settings, frame.base, frame.options, cull=frame.cull, keep_depth=True
-        )
-        return _draw_region_lines(frame.targets, items, frame.view, settings, frame.base, frame.cull, stats)
-    except shaders.DeferredUnavailable as exc:
-        _refused(exc)
-        return None
 
 
 class OutputsPass(RenderPass):
@@ -590,8 +566,8 @@ def plan(settings, *, strands: bool = False) -> tuple[RenderPass, ...]:
     passes: list[RenderPass] = [RegionLinesPass(settings)]
     if settings.use_hidden_lines:
         # Hidden lines sit under the visible wire and over the fill: the
-        # surface pass draws the fill (no wire), then hidden lines, then the
-        # wire on its own.
+        # surface pass shows the fill alone (offscreen its wire goes into a
+        # layer of its own), then hidden lines, then the wire.
         wire_only = replace(settings, use_fill=False)
         passes += [SurfacePass(settings, wire=False), HiddenLinesPass(wire_only), WirePass(wire_only)]
     else:
@@ -707,18 +683,25 @@ def draw_surface(
     settings,
     *,
     wire: bool = True,
+    wire_layer: bool = False,
     aovs: bool = False,
     cull: bool = True,
     options: DrawOptions = DEFAULT_OPTIONS,
 ):
     """The surface pass into ``targets`` (cleared first): depth, the fill
-    and the visible wire (none with ``wire`` False), and the render passes'
-    outputs with ``aovs``. Meshes dense on screen are drawn deferred
+    and the visible wire (none with ``wire`` False; into
+    ``targets.wire_layer`` instead of the colour with ``wire_layer``), and
+    the render passes' outputs with ``aovs``. Meshes dense on screen are drawn deferred
     (docs/image_model.md §2.5, draw.split_deferred) unless ``options`` say
     otherwise, the rest directly, into the same depth buffer; the same image
     either way. Returns the DrawStats."""
     width, height = view.width, view.height
-    target = DrawTarget(linear_depth=True, aovs=aovs, lines=draw_mod.WIRE_LINES if wire else draw_mod.NO_LINES)
+    target = DrawTarget(
+        linear_depth=True,
+        aovs=aovs,
+        lines=draw_mod.WIRE_LINES if wire else draw_mod.NO_LINES,
+        wire_layer=wire and wire_layer,
+    )
     deferred, direct = ([], list(items))
     if options.deferred_surface and shaders.deferred_available():
         no_lines = None if wire else draw_mod.DEFERRED_MIN_DENSITY_NO_LINES
@@ -728,7 +711,7 @@ def draw_surface(
     # viewport overlay's direct meshes do: no pixel walks a region's edges.
     line_stats = DrawStats()
     direct_lines = _direct_region_lines(targets, direct, view, settings, target, cull, options, line_stats)
-    framebuffer = targets.framebuffer(aovs=aovs)
+    framebuffer = targets.framebuffer(aovs=aovs, wire_layer=target.wire_layer)
     with framebuffer.bind():
         _clear(framebuffer, width, height)
         targets.clear_view_depth()
@@ -745,7 +728,9 @@ def draw_surface(
             )
         except shaders.DeferredUnavailable as exc:
             _refused(exc)
-            return draw_surface(targets, items, view, settings, wire=wire, aovs=aovs, cull=cull, options=options)
+            return draw_surface(
+                targets, items, view, settings, wire=wire, wire_layer=wire_layer, aovs=aovs, cull=cull, options=options
+            )
     return stats
 
 
@@ -780,7 +765,7 @@ def _deferred_surface(
     # The lines of multi-face regions as quads over the record, so that no
     # pixel walks a region's edges (docs/image_model.md §2.6).
     images = _region_line_images(targets, items, view, settings, target, cull, stats)
-    with targets.resolve_framebuffer(aovs=target.aovs).bind():
+    with targets.resolve_framebuffer(aovs=target.aovs, wire_layer=target.wire_layer).bind():
         gpu.state.viewport_set(0, 0, width, height)
         resolve = replace(target, stage=draw_mod.RESOLVE, visibility=targets.visible, view_depth=True, **images)
         draw_mod.draw(items, view, settings, target=resolve, cull=cull)
@@ -1660,16 +1645,16 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
     return read_texture(targets.own_layer, 4)[..., 3:4]
 
 
-def _blend_own_layer(targets) -> None:
-    """``targets.own_layer`` (premultiplied colour on nothing) blended as
-    the caller set over the bound colour target, where a surface is (no
-    line lies over the background)."""
+def _blend_layer(targets, layer) -> None:
+    """``layer`` (premultiplied colour on nothing: targets.own_layer or
+    targets.wire_layer) blended as the caller set over the bound colour
+    target, where a surface is (no line lies over the background)."""
     shader = shaders.get_overlay_composite(0.0)
     shader.bind()
     shader.uniform_float("depth_rows", (0.0,) * 4)  # (no allowance: its depth is never written)
     shader.uniform_float("blender_depth_allowance", NO_DEPTH_ALLOWANCE)
     shader.uniform_sampler("record_depth", targets.depth)
-    shader.uniform_sampler("surface_image", targets.own_layer)
+    shader.uniform_sampler("surface_image", layer)
     gpu.state.depth_test_set("NONE")
     gpu.state.depth_mask_set(False)
     draw_mod.draw_rectangle(shader, (-1.0, -1.0, 1.0, 1.0))

@@ -188,6 +188,11 @@ class ShaderVariant:
     # at its provoking corner.
     walk_table: bool = False
     walk_table_pass: bool = False
+    # The surface pass of the render under hidden lines: the colour is the
+    # fill alone and the visible wire goes to an output of its own
+    # (WIRE_LAYER, frag_wire), drawn unblended like the colour, so that the
+    # hidden lines can be blended between the two (passes.WirePass).
+    wire_layer: bool = False
 
     @property
     def uses_corners(self) -> bool:
@@ -341,6 +346,13 @@ def output_and_feature_defines(info, variant: ShaderVariant) -> None:
     if variant.write_view_depth:
         info.fragment_out(1, "FLOAT", "frag_view_depth")
         info.define("WRITE_VIEW_DEPTH", "1")
+    if variant.wire_layer:
+        if not variant.write_view_depth or variant.hidden_pass or variant.display_transform:
+            raise ValueError("only the render's surface pass puts its wire in a layer of its own")
+        # The colour target after the view depth's and the render passes'
+        # (targets.Targets._color_slots).
+        info.fragment_out(4 if variant.write_aovs else 2, "VEC4", "frag_wire")
+        info.define("WIRE_LAYER", "1")
     info.define("DIAGONALS", str(variant.diagonals))
     if variant.use_fill:
         info.define("USE_FILL", "1")

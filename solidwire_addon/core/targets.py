@@ -48,6 +48,7 @@ class Targets:
         self.lines_key = None  # what the overlay's lines were drawn for (passes._overlay_lines_key)
         self.aov = self.normal = None  # render-pass targets, made on first use
         self.own_layer = None  # a colour layer drawn apart (own_layer_framebuffer), made on first use
+        self.wire_layer = None  # the render's visible wire under hidden lines (DrawTarget.wire_layer), likewise
         self.visible = None  # the deferred surface's visibility record, made on first use
         # The hidden layers of multi-face regions (passes._peel_hidden_regions),
         # made on first use: two depth images the layers alternate between,
@@ -88,34 +89,42 @@ class Targets:
             self.surface = gpu.types.GPUTexture(self.size, format="RGBA32F")
         return gpu.types.GPUFrameBuffer(color_slots=(self.surface,))
 
-    def resolve_framebuffer(self, aovs: bool = False):
+    def resolve_framebuffer(self, aovs: bool = False, wire_layer: bool = False):
         """The deferred surface's second stage: the colour targets of
         :meth:`framebuffer` over the depth the first stage wrote, which the
         resolve only tests (its rectangle passes where a surface was
         recorded, shaders/resolve_vert.glsl)."""
-        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self._color_slots(aovs))
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self._color_slots(aovs, wire_layer))
 
-    def framebuffer(self, aovs: bool = False):
+    def framebuffer(self, aovs: bool = False, wire_layer: bool = False):
         """A framebuffer over the textures. Made per use: textures are shared
         between GL contexts but framebuffer objects are not, and the render
         engine's context differs from the one scripts draw in. With ``aovs``
         the render passes' two targets too (RGBA32F: d_real, I_vis, object
-        index; world normal), created on first use."""
-        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self._color_slots(aovs))
+        index; world normal), with ``wire_layer`` the visible wire's own
+        layer after them (draw.DrawTarget.wire_layer), each created on first
+        use."""
+        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self._color_slots(aovs, wire_layer))
 
-    def _color_slots(self, aovs: bool) -> tuple:
+    def _color_slots(self, aovs: bool, wire_layer: bool = False) -> tuple:
+        # (The shaders' output locations follow this order:
+        # shaders.output_and_feature_defines.)
         slots = (self.color, self.view_depth)
         if aovs:
             if self.aov is None:
                 self.aov = gpu.types.GPUTexture(self.size, format="RGBA32F")
                 self.normal = gpu.types.GPUTexture(self.size, format="RGBA32F")
             slots += (self.aov, self.normal)
+        if wire_layer:
+            if self.wire_layer is None:
+                self.wire_layer = gpu.types.GPUTexture(self.size, format="RGBA32F")
+            slots += (self.wire_layer,)
         return slots
 
     def own_layer_framebuffer(self):
         """A colour layer of its own over the surface depth, blended over the
-        image afterwards (passes._blend_own_layer): the Hidden Wire pass's
-        layers, or the visible wire under hidden lines."""
+        image afterwards (passes._blend_layer): the Hidden Wire pass's
+        layers."""
         if self.own_layer is None:
             self.own_layer = gpu.types.GPUTexture(self.size, format="RGBA32F")
         return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=(self.own_layer,))
