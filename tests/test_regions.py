@@ -1164,7 +1164,7 @@ def test_the_overlay_keeps_its_peeled_hidden_layers_between_redraws(output_dir):
     assert "frame, occluded" not in targets.overlay_targets_for(width, height).kept
 
 
-@pytest.mark.parametrize("cage, fill", [(False, False), (True, False), (False, True)])
+@pytest.mark.parametrize("cage, fill", [(False, False), (True, False), (False, True), (True, True)])
 def test_the_overlay_keeps_its_direct_hidden_lines_between_redraws(cage, fill, output_dir):
     """As the peeled layers above, the walked hidden lines (every edge, or
     a cage whose regions are walked), with or without the fill: every
@@ -1205,7 +1205,9 @@ def test_the_overlay_keeps_its_direct_hidden_lines_between_redraws(cage, fill, o
         assert ((alpha > 0.9) & (alpha_occluded > 0.2) & (alpha_occluded < 0.45)).sum() > 30
 
 
-@pytest.mark.parametrize("case", ["peeled cage", "walked cage", "every edge, fill", "no hidden lines, sparse"])
+@pytest.mark.parametrize(
+    "case", ["peeled cage", "walked cage", "walked cage, fill", "every edge, fill", "no hidden lines, sparse"]
+)
 def test_an_edit_redraws_the_kept_frame_where_it_changed(case, monkeypatch, output_dir):
     """An edit that only moves vertices (a drag) redraws the overlay's kept
     images (_overlay_kept_frame) inside the window rectangle the move

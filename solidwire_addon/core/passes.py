@@ -246,7 +246,7 @@ class HiddenLinesPass(RenderPass):
             # into its target and blended over the image from there ("over"
             # is associative), not drawn twice.
             frame.extra[HIDDEN_WIRE_PASS] = _hidden_wire(frame, self.settings)
-            _blended(frame, lambda: _blend_layer(targets, targets.own_layer))
+            _blend_layer(targets.color, targets.depth, targets.own_layer, frame.view)
             return
         peeled = _peel_hidden_regions(
             frame,
@@ -507,7 +507,7 @@ class WirePass(RenderPass):
         # count twice (1 - (1 - I)^2). That layer goes "over" the image now.
         targets = frame.targets
         if targets.wire_layer is not None:
-            _blended(frame, lambda: _blend_layer(targets, targets.wire_layer))
+            _blend_layer(targets.color, targets.depth, targets.wire_layer, frame.view)
 
     def over_viewport(self, frame: Frame) -> None:
         if not frame.frame_kept:
@@ -1645,19 +1645,28 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
     return read_texture(targets.own_layer, 4)[..., 3:4]
 
 
-def _blend_layer(targets, layer) -> None:
+def _blend_layer(colour, depth, layer, view: View) -> None:
     """``layer`` (premultiplied colour on nothing: targets.own_layer or
-    targets.wire_layer) blended as the caller set over the bound colour
-    target, where a surface is (no line lies over the background)."""
+    targets.wire_layer) blended "over" the colour texture ``colour`` where
+    the depth image ``depth`` holds a surface (no line lies over the
+    background). Drawn into the colour alone: the depth is read, not
+    attached, so no texture is read and attached at once."""
     shader = shaders.get_overlay_composite(0.0)
-    shader.bind()
-    shader.uniform_float("depth_rows", (0.0,) * 4)  # (no allowance: its depth is never written)
-    shader.uniform_float("blender_depth_allowance", NO_DEPTH_ALLOWANCE)
-    shader.uniform_sampler("record_depth", targets.depth)
-    shader.uniform_sampler("surface_image", layer)
-    gpu.state.depth_test_set("NONE")
-    gpu.state.depth_mask_set(False)
-    draw_mod.draw_rectangle(shader, (-1.0, -1.0, 1.0, 1.0))
+    framebuffer = gpu.types.GPUFrameBuffer(color_slots=(colour,))
+    with framebuffer.bind():
+        gpu.state.viewport_set(0, 0, view.width, view.height)
+        gpu.state.blend_set("ALPHA_PREMULT")
+        gpu.state.depth_test_set("NONE")
+        gpu.state.depth_mask_set(False)
+        shader.bind()
+        shader.uniform_float("depth_rows", (0.0,) * 4)  # (no allowance: its depth is never written)
+        shader.uniform_float("blender_depth_allowance", NO_DEPTH_ALLOWANCE)
+        shader.uniform_sampler("record_depth", depth)
+        shader.uniform_sampler("surface_image", layer)
+        try:
+            draw_mod.draw_rectangle(shader, (-1.0, -1.0, 1.0, 1.0))
+        finally:
+            gpu.state.blend_set("NONE")
 
 
 def _composite_silhouettes(rgba, targets, items, view, settings):
