@@ -506,8 +506,7 @@ class WirePass(RenderPass):
         # lines, where blended straight over the hidden lines the line would
         # count twice (1 - (1 - I)^2). That layer goes "over" the image now.
         targets = frame.targets
-        if targets.wire_layer is not None:
-            _blend_layer(targets.color, targets.depth, targets.wire_layer, frame.view)
+        _blend_layer(targets.color, targets.depth, targets.wire_layer, frame.view)
 
     def over_viewport(self, frame: Frame) -> None:
         if not frame.frame_kept:

@@ -94,7 +94,7 @@ class Targets:
         :meth:`framebuffer` over the depth the first stage wrote, which the
         resolve only tests (its rectangle passes where a surface was
         recorded, shaders/resolve_vert.glsl)."""
-        return gpu.types.GPUFrameBuffer(depth_slot=self.depth, color_slots=self._color_slots(aovs, wire_layer))
+        return self.framebuffer(aovs, wire_layer)
 
     def framebuffer(self, aovs: bool = False, wire_layer: bool = False):
         """A framebuffer over the textures. Made per use: textures are shared
