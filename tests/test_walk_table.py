@@ -3,8 +3,10 @@ draw walks its regions' lines (under hidden lines, meshes whose regions are
 not peeled), one point per triangle picks the segments of its block within
 reach, and the draw reads those picks instead of choosing them at its
 provoking corner. Same selection code, so the image is the same to the
-bit, in a render (every pass) and in the viewport overlay; the accuracy of
-the walked hidden lines against the float64 reference is
+bit, in a render (every pass) and in the viewport overlay. The hidden-line
+draw then leaves out the region triangles it picked nothing for
+(options.DrawOptions.drop_lineless_triangles), again the same image. The
+accuracy of the walked hidden lines against the float64 reference is
 tests/test_regions.py's."""
 
 from __future__ import annotations
@@ -16,8 +18,10 @@ import gpu
 import numpy as np
 import pytest
 
+from solidwire_addon.blender import runtime
 from solidwire_addon.blender.views import camera_view
 from solidwire_addon.core import draw, targets
+from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 from tests.test_overlay import FakeViewport
 
@@ -48,11 +52,14 @@ def _walked_scene(width: int, height: int, **look):
 _SHIPPED_MIN_LINES = draw.WALK_TABLE_MIN_LINES
 
 
-def _counting(monkeypatch, table_on: bool) -> list:
-    """Turn the pre-pass on (or off) and count its runs."""
+def _counting(monkeypatch, table_on: bool, drop_lineless: bool = False) -> list:
+    """Turn the pre-pass on (or off), and with it the hidden-line draw's
+    leaving out of the triangles it picked nothing for, and count its
+    runs."""
     runs = []
     real = draw._run_walk_table
     monkeypatch.setattr(draw, "WALK_TABLE_MIN_LINES", _SHIPPED_MIN_LINES if table_on else 10**9)
+    monkeypatch.setattr(runtime, "options", DrawOptions(drop_lineless_triangles=drop_lineless))
     # Each run's mesh and triangle ranges (None: every triangle).
     monkeypatch.setattr(
         draw,
@@ -77,12 +84,19 @@ def test_walk_table_gives_the_same_render(look, output_dir, monkeypatch):
     runs = _counting(monkeypatch, table_on=False)
     at_corners = scenes.render_multilayer_exr(scene, output_dir / f"walk_off_{look}.exr")
     assert runs == []
-    runs = _counting(monkeypatch, table_on=True)
-    from_table = scenes.render_multilayer_exr(scene, output_dir / f"walk_on_{look}.exr")
-    assert runs, "the pre-pass never ran: the walked mesh is not walked here any more"
-    assert at_corners.keys() == from_table.keys()
-    for name, values in at_corners.items():
-        np.testing.assert_array_equal(from_table[name], values, err_msg=name)
+    assert "lineless_triangles_left_out" not in runtime.stats()
+    for drop_lineless in (False, True):
+        runs = _counting(monkeypatch, table_on=True, drop_lineless=drop_lineless)
+        from_table = scenes.render_multilayer_exr(scene, output_dir / f"walk_on_{look}_{drop_lineless}.exr")
+        assert runs, "the pre-pass never ran: the walked mesh is not walked here any more"
+        stats = runtime.stats()
+        assert ("lineless_triangles_left_out" in stats) == drop_lineless
+        left_out = stats.get("lineless_triangles_left_out", 0)
+        if look == "plain":  # (under the denser lines of the other look every triangle has one near)
+            assert (left_out > 0) == drop_lineless
+        assert at_corners.keys() == from_table.keys()
+        for name, values in at_corners.items():
+            np.testing.assert_array_equal(from_table[name], values, err_msg=f"{name}, dropped {left_out}")
     # Lines show at all (the comparison is not of two empty images).
     assert (from_table["ViewLayer.Combined.A"] > 0).mean() > 0.02
 
@@ -98,8 +112,8 @@ def test_walk_table_gives_the_same_overlay(monkeypatch):
     vertex = walked.data.vertices[0]
     start = tuple(vertex.co)
 
-    def overlay_images(table_on: bool):
-        runs = _counting(monkeypatch, table_on)
+    def overlay_images(table_on: bool, drop_lineless: bool = False):
+        runs = _counting(monkeypatch, table_on, drop_lineless)
         monkeypatch.setattr(targets, "_overlay_targets", {})  # no image kept from before
         vertex.co = start
         walked.data.update()
@@ -116,16 +130,23 @@ def test_walk_table_gives_the_same_overlay(monkeypatch):
             viewport = FakeViewport(200, 150)
             viewport.draw_overlay(depsgraph, camera_view(scene, depsgraph, (200, 150)), scene.solidwire.snapshot())
             images.append(viewport.rgba())
+            left_out.append(runtime.stats().get("lineless_triangles_left_out", 0))
         return runs, images
 
+    left_out = []
     runs, at_corners = overlay_images(False)
-    assert runs == []
-    runs, from_table = overlay_images(True)
-    assert len(runs) >= 4
-    # The edit's pre-pass drew the triangles the edit's draw drew alone.
-    mesh, edit_ranges = runs[-1]
-    assert edit_ranges is not None and 0 < edit_ranges[1].sum() < mesh.triangle_count
-    for table_image, corner_image in zip(from_table, at_corners):
-        np.testing.assert_array_equal(table_image, corner_image)
-        assert (table_image[..., 3] > 0).mean() > 0.05
-    assert not np.array_equal(from_table[3], from_table[1])  # the edit shows
+    assert runs == [] and not any(left_out)
+    for drop_lineless in (False, True):
+        left_out = []
+        runs, from_table = overlay_images(True, drop_lineless)
+        assert len(runs) >= 4
+        # The edit's pre-pass drew the triangles the edit's draw drew alone.
+        mesh, edit_ranges = runs[-1]
+        assert edit_ranges is not None and 0 < edit_ranges[1].sum() < mesh.triangle_count
+        # Every redraw that draws (not the one that composites what the
+        # first kept) left triangles out, the edit's inside its ranges too.
+        assert all(left_out[k] > 0 for k in (0, 2, 3)) if drop_lineless else not any(left_out)
+        for table_image, corner_image in zip(from_table, at_corners):
+            np.testing.assert_array_equal(table_image, corner_image)
+            assert (table_image[..., 3] > 0).mean() > 0.05
+        assert not np.array_equal(from_table[3], from_table[1])  # the edit shows

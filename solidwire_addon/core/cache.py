@@ -76,6 +76,17 @@ def _table(rows: np.ndarray, channels: int, texture_format: str):
     return gpu.types.GPUTexture((width, height), format=texture_format, data=buf)
 
 
+def table_channel(texture):
+    """The first channel of every texel of a float ``texture`` (rows from
+    the first), as a flat FLOAT ``gpu.types.Buffer``: a quarter of what
+    reading an RGBA texture whole moves."""
+    buf = gpu.types.Buffer("FLOAT", texture.width * texture.height)
+    framebuffer = gpu.types.GPUFrameBuffer(color_slots=(texture,))
+    with framebuffer.bind():
+        framebuffer.read_color(0, 0, texture.width, texture.height, 1, 0, "FLOAT", data=buf)
+    return buf
+
+
 def texture_bytes(texture) -> int:
     """The GPU memory of a table made here (float32 channels)."""
     channels = {"RGBA32F": 4, "RG32F": 2, "R32F": 1}[texture.format]
@@ -226,6 +237,7 @@ class GPUMesh:
         self.mesh_bounds = (arrays.bounds_min, arrays.bounds_max)  # mesh space
 
         self._batch = None  # batch, made on first use
+        self._corner_buffer = None  # its vertex buffer, shared with batch_of_triangles()
         self._walk_table = None  # (points batch, table texture): walk_table(), made on first use
         self.gpu_bytes = sum(
             texture_bytes(table)
@@ -239,13 +251,30 @@ class GPUMesh:
         is the per-corner edge-flag word (the vertex stage pulls the rest).
         Made on first use: a mesh only ever drawn deferred never needs it."""
         if self._batch is None:
+            self._batch = gpu.types.GPUBatch(type="TRIS", buf=self._corners())
+        return self._batch
+
+    def batch_of_triangles(self, triangles: np.ndarray):
+        """:attr:`batch` for the triangles ``triangles`` (ascending numbers)
+        alone: an index buffer over the same corners, so gl_VertexID is
+        still 3 t + corner and the vertex stage pulls what it always does.
+        Made per draw (its index buffer is as long as the pick)."""
+        corners = 3 * triangles.astype(np.int32)[:, None] + np.arange(3, dtype=np.int32)
+        return gpu.types.GPUBatch(
+            type="TRIS", buf=self._corners(), elem=gpu.types.GPUIndexBuf(type="TRIS", seq=corners)
+        )
+
+    def _corners(self):
+        """The direct draw's vertex buffer: three corners a triangle, in
+        table order, each with its triangle's edge-flag word."""
+        if self._corner_buffer is None:
             fmt = gpu.types.GPUVertFormat()
             fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
             vbo = gpu.types.GPUVertBuf(fmt, 3 * self.triangle_count)
             vbo.attr_fill("edge_flags", np.repeat(self.edge_flags_cpu, 3))
-            self._batch = gpu.types.GPUBatch(type="TRIS", buf=vbo)
+            self._corner_buffer = vbo
             self.gpu_bytes += 3 * self.triangle_count * 4
-        return self._batch
+        return self._corner_buffer
 
     def walk_table(self):
         """(points batch, RGBA32F table) of the walk-table pre-pass
@@ -266,6 +295,27 @@ class GPUMesh:
             self._walk_table = (gpu.types.GPUBatch(type="POINTS", buf=vbo), table)
             self.gpu_bytes += 4 * self.triangle_count + texture_bytes(table)
         return self._walk_table
+
+    def triangles_with_lines(self, ranges=None) -> np.ndarray:
+        """After the walk-table pre-pass: the triangles (ascending) that
+        can show a line in a hidden-line draw, every one outside a
+        multi-face region and those inside one for which the pre-pass kept
+        a segment or left the whole block to walk (a count other than 0);
+        ``ranges`` (first triangle, count): only inside those, the only
+        texels the pre-pass wrote. A region's triangle with none shows
+        nothing there: its own drawn edges are in its region's block, at
+        distance 0, so they would have been kept. Reads the counts back
+        (one float a triangle)."""
+        _batch, table = self.walk_table()
+        counts = np.asarray(table_channel(table), dtype=np.float32)[: self.triangle_count]
+        keep = (counts != 0.0) | ((self.edge_flags_cpu & IN_REGION) == 0)
+        if ranges is not None:
+            first, count = ranges
+            starts = np.zeros(self.triangle_count + 1, dtype=np.int32)
+            np.add.at(starts, first, 1)
+            np.add.at(starts, first + count, -1)
+            keep &= np.cumsum(starts[:-1]) > 0
+        return np.flatnonzero(keep)
 
     def flag_table(self):
         """The edge-flag word of every triangle, as an RG32F texture

@@ -113,7 +113,10 @@ class DrawTarget:
     HIDDEN_LINES draw with ``region_layers_peeled`` leaves those triangles
     out. ``behind_tiles`` (VISIBILITY with ``peel_depth``, numbered by
     vertex): that depth image by tiles (DepthTiles), so that the blocks of
-    triangles that lie wholly in front of it are left out of the draw."""
+    triangles that lie wholly in front of it are left out of the draw.
+    ``drop_lineless`` (a direct HIDDEN_LINES draw, options.DrawOptions):
+    the region triangles that the walk-table pre-pass found no line near
+    are left out (they would draw nothing)."""
 
     depth_test: str = "LESS_EQUAL"
     depth_write: bool = True
@@ -138,6 +141,7 @@ class DrawTarget:
     region_layers_peeled: bool = False
     line_runs: str = ALL_RUNS
     depth_only: bool = False
+    drop_lineless: bool = False
     wire_layer: bool = False
 
     def hidden(self, region_layers_peeled: bool = False) -> DrawTarget:
@@ -299,6 +303,10 @@ class ExactProgram:
 
 EXACT = ExactProgram()
 
+
+# The DrawStats count of the triangles a hidden-line draw left out for
+# showing no line there (DrawTarget.drop_lineless).
+LINELESS_LEFT_OUT = "lineless_triangles_left_out"
 
 # A mesh drawn by at least this many visible instances is drawn with one
 # draw_instanced call (matrices from a float texture) instead of one draw per
@@ -595,6 +603,12 @@ def draw(
             # instancing does not depend on the stage's variant.
             instancing=program.supports_instancing and not target.aovs,
             depth_only=target.depth_only,
+            # (Only a draw of lines alone: no fill, no depth, so a triangle
+            # that shows no line changes nothing.)
+            drop_lineless=target.drop_lineless
+            and target.lines == HIDDEN_LINES
+            and stage is None
+            and not target.depth_write,
             numbering=_DrawNumbers(
                 stage,
                 extras,
@@ -794,6 +808,7 @@ class _DrawCall:
     instancing: bool
     numbering: _DrawNumbers
     depth_only: bool = False
+    drop_lineless: bool = False  # DrawTarget.drop_lineless, where the draw shows lines alone
 
 
 def clip_space_planes(planes, view: View) -> list:
@@ -1323,6 +1338,7 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
                 shader.bind()
                 bound = _UNBOUND  # the pre-pass bound its own block
                 shader.uniform_sampler("setup_table", mesh.setup_table)
+            triangles = None  # every triangle (of the ranges the draw reaches)
             if variant.walk_table and call.depth_only:
                 # (The same program, for the same depths; its picks are
                 # never read. Bound all the same: the program samples it.)
@@ -1330,19 +1346,15 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
             elif variant.walk_table:
                 # (Before each draw, as the set-up pre-pass: the picks are
                 # for this object's matrix.)
-                walk_table = _run_walk_table(
-                    mesh,
-                    variant,
-                    object_to_clip,
-                    one.object_to_view,
-                    ubo(style),
-                    numbering.direct_ranges(mesh, object_to_clip),
-                )
+                ranges = numbering.direct_ranges(mesh, object_to_clip)
+                walk_table = _run_walk_table(mesh, variant, object_to_clip, one.object_to_view, ubo(style), ranges)
                 shader.bind()
                 bound = _UNBOUND  # the pre-pass bound its own block
                 _bind_extras(shader, variant, extras)
                 numbering.bind(shader)
                 shader.uniform_sampler("walk_table", walk_table)
+                if call.drop_lineless:
+                    triangles = mesh.triangles_with_lines(ranges)
             if style is not bound:
                 bound = style
                 shader.uniform_block("params", ubo(style))
@@ -1358,15 +1370,20 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
             if variant.per_item:
                 shader.uniform_int("item_slot", slot)
             _bind_mesh(shader, variant, mesh)
-            numbering.draw(
-                shader,
-                mesh,
-                lambda mesh=mesh: program.batch(mesh),
-                object_to_clip,
-                object_to_view_z=one.object_to_view[2],
-            )
+            if triangles is None:
+                numbering.draw(
+                    shader,
+                    mesh,
+                    lambda mesh=mesh: program.batch(mesh),
+                    object_to_clip,
+                    object_to_view_z=one.object_to_view[2],
+                )
+            elif len(triangles):
+                mesh.batch_of_triangles(triangles).draw(shader)
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
+            if triangles is not None:
+                stats.add(DrawStats(extra={LINELESS_LEFT_OUT: mesh.triangle_count - len(triangles)}))
     if instanced:
         _draw_instanced(instanced, variant, call)
 

@@ -25,6 +25,14 @@ class DrawOptions:
     # shaders.triangle_ids_by_vertex decide for this GPU. The same frame
     # either way.
     triangle_ids_by_vertex: bool | None = None
+    # A hidden-line draw whose triangles walk their regions (the walk-table
+    # pre-pass picked each one's lines) leaves out the region triangles
+    # that no drawn edge comes within reach of: they show nothing there,
+    # and a software rasteriser otherwise runs the vertex stage for them in
+    # the same SIMD batches as the rest. It reads the table back, which
+    # costs a GPU a round trip for little gain. None lets the backend
+    # decide (shaders.software_rasteriser); the same frame either way.
+    drop_lineless_triangles: bool | None = None
     # A frame starts from the GPU meshes of the last one, re-extracting only
     # what changed (blender/runtime.py); False starts every frame from an
     # empty cache.

@@ -256,7 +256,10 @@ class HiddenLinesPass(RenderPass):
             behind=targets.depth,
             stats=frame.stats,
         )
-        _blended(frame, lambda: _draw_hidden(frame.items, peeled, frame.view, self.settings, frame.base, frame.cull))
+        _blended(
+            frame,
+            lambda: _draw_hidden(frame.items, peeled, frame.view, self.settings, frame.base, frame.cull, frame.stats),
+        )
 
     def over_viewport(self, frame: Frame) -> None:
         if frame.frame_kept:
@@ -280,21 +283,29 @@ class HiddenLinesPass(RenderPass):
             gpu.state.viewport_set(*saved_viewport)
         if peeled:
             targets.surface_key = None  # its record was drawn over: the next redraw records it whole
-        _draw_hidden(frame.items, peeled, view, self.settings, frame.base, frame.cull)
+        _draw_hidden(frame.items, peeled, view, self.settings, frame.base, frame.cull, frame.line_stats)
 
 
-def _draw_hidden(items, peeled, view: View, settings, base: DrawTarget, cull: bool, test: str = "GREATER") -> None:
+def _draw_hidden(
+    items, peeled, view: View, settings, base: DrawTarget, cull: bool, stats: DrawStats | None, test: str = "GREATER"
+) -> None:
     """The direct hidden-line pass into the bound framebuffer: every
     triangle of ``items`` walks its region, except those whose layers
     _peel_hidden_regions drew (the region triangles of ``peeled``; a peeled
     mesh with no other triangle is not drawn at all); ``test``: its depth
-    test (ALWAYS: every fragment, whatever lies in front)."""
+    test (ALWAYS: every fragment, whatever lies in front). The triangles
+    it left out for showing no line (DrawTarget.drop_lineless) go into
+    ``stats``'s extra counts; what it drew is the surface pass's to count."""
     peeled_ids = {id(item) for item in peeled}
     walked = [item for item in items if id(item) not in peeled_ids]
     rest = [item for item in peeled if item.mesh.region_sizes()[2]]
-    draw_mod.draw(walked, view, settings, target=replace(base.hidden(), depth_test=test), cull=cull)
+    drawn = [draw_mod.draw(walked, view, settings, target=replace(base.hidden(), depth_test=test), cull=cull)]
     peeled_target = replace(base.hidden(region_layers_peeled=True), depth_test=test)
-    draw_mod.draw(rest, view, settings, target=peeled_target, cull=cull)
+    drawn.append(draw_mod.draw(rest, view, settings, target=peeled_target, cull=cull))
+    if stats is not None:
+        for counts in drawn:
+            left_out = {key: counts.extra[key] for key in (draw_mod.LINELESS_LEFT_OUT,) if key in counts.extra}
+            stats.add(DrawStats(extra=left_out))
 
 
 def _overlay_kept_frame(frame: Frame, settings, hidden: bool) -> bool:
@@ -445,7 +456,7 @@ def _draw_kept_frame(frame: Frame, settings, targets, visible, occluded, rect=No
         with framebuffer.bind(), _scissored(rect):
             _no_clear(width, height)
             gpu.state.blend_set("ALPHA_PREMULT")
-            _draw_hidden(items, peeled, view, wire_only, base, cull, test=test)
+            _draw_hidden(items, peeled, view, wire_only, base, cull, frame.line_stats, test=test)
     with front.bind(), _scissored(rect):
         _no_clear(width, height)
         gpu.state.blend_set("ALPHA_PREMULT")
@@ -635,7 +646,7 @@ def render_passes(
         items,
         view,
         settings,
-        DrawTarget(linear_depth=True),
+        DrawTarget(linear_depth=True, drop_lineless=_drop_lineless(options)),
         options=options,
         cull=cull,
         strands=tuple(strands),
@@ -902,6 +913,12 @@ def _triangle_ids_by_vertex(options: DrawOptions) -> bool:
     if options.triangle_ids_by_vertex is not None:
         return options.triangle_ids_by_vertex
     return shaders.triangle_ids_by_vertex()
+
+
+def _drop_lineless(options: DrawOptions) -> bool:
+    if options.drop_lineless_triangles is not None:
+        return options.drop_lineless_triangles
+    return shaders.software_rasteriser()
 
 
 def _has_region_lines(items) -> bool:
@@ -1637,7 +1654,7 @@ def _hidden_wire(frame: Frame, settings) -> np.ndarray:
         gpu.state.viewport_set(0, 0, view.width, view.height)
         gpu.state.blend_set("ALPHA_PREMULT")
         try:
-            _draw_hidden(frame.items, peeled, view, settings, frame.base, frame.cull)
+            _draw_hidden(frame.items, peeled, view, settings, frame.base, frame.cull, frame.stats)
         finally:
             gpu.state.blend_set("NONE")
             gpu.state.depth_test_set("NONE")
@@ -1725,7 +1742,9 @@ def draw_over_viewport(
         items,
         view,
         settings,
-        DrawTarget(depth_bias=depth_bias, clip_planes=clip_planes, display=display),
+        DrawTarget(
+            depth_bias=depth_bias, clip_planes=clip_planes, display=display, drop_lineless=_drop_lineless(options)
+        ),
         options=options,
         strands=tuple(strands),
         scene_depth=scene_depth,
