@@ -81,7 +81,24 @@ int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
 {
   int block = edge_flags >> NGON_SHIFT;
   int kept = 0;
-  for (int k = 0; k < block; k++) {
+#  ifdef WALK_TABLE_PASS
+  /* The pre-pass first tests each group of the block by its window box
+   * (walk_groups_vert.glsl): a group whose box lies beyond reach of the
+   * triangle's box holds no segment within reach, and its segments are not
+   * set up. The same segments are kept, in the same order. */
+  vec2 near_low = min(min(t0, t1), t2) - reach, near_high = max(max(t0, t1), t2) + reach;
+  for (int group = 0; group < block; group += WALK_GROUP) {
+    vec4 box = fetch_texel(walk_group_boxes, ngon_corner_start + SEGMENT_TEXELS * group);
+    if (box.x > near_high.x || box.y > near_high.y || box.z < near_low.x || box.w < near_low.y) {
+      continue;
+    }
+    int group_end = min(group + WALK_GROUP, block);
+#  else
+  {
+    const int group = 0;
+    int group_end = block;
+#  endif
+  for (int k = group; k < group_end; k++) {
     int texel = ngon_corner_start + SEGMENT_TEXELS * k;
     vec4 segment = fetch_texel(ngon_corners, texel);
     vec3 line;
@@ -108,6 +125,7 @@ int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
     store_segment(kept, line, span, segment.z, chain);
 #  endif
     kept++;
+  }
   }
   return kept;
 }

@@ -676,6 +676,14 @@ def test_the_wire_over_hidden_lines_past_the_walk_limit(output_dir):
     _assert_region_lines_drawn()
 
 
+@pytest.fixture
+def peel_level_4(monkeypatch):
+    """Peel regions of 64 lines (a cage face at level 4), which the walk
+    takes by default (passes.PEEL_MIN_REGION_LINES): the peeled layers'
+    tests keep their small scenes."""
+    monkeypatch.setattr(passes, "PEEL_MIN_REGION_LINES", 48)
+
+
 def _cubes_one_behind_another(scene, level: int):
     """A subdivided cube and a second one behind it, half hidden by it: up
     to three layers behind the surface (the near cube's far side, the far
@@ -687,12 +695,13 @@ def _cubes_one_behind_another(scene, level: int):
     scenes.add_camera(scene, location=(3.2, -4.5, 2.4), target=(0, 0, 0))
 
 
-@pytest.mark.parametrize("level", [3, 4, 6])
+@pytest.mark.parametrize("level", [3, 4, 5, 6])
 def test_hidden_layers_of_regions_at_every_size(level, output_dir):
     """Under hidden lines the layers behind the surface of a mesh with large
     regions take their lines from the region-lines pass too, one peeled
-    layer at a time (level 4: 64 lines a region, level 6: 256, past the
-    walk's limit); smaller regions are walked. Either way a cage face keeps
+    layer at a time (level 5: 128 lines a region, level 6: 256, past the
+    walk's limit); smaller regions are walked (levels 3 and 4, whose walk
+    tests its groups of segments by their window boxes first). Either way a cage face keeps
     its whole outline behind the surface, dashed and dimmed, and the
     Hidden Wire pass says the same."""
     scene = scenes.empty_scene(
@@ -726,7 +735,7 @@ PEELED_LOOKS = {
 
 
 @pytest.mark.parametrize("name", sorted(PEELED_LOOKS))
-def test_peeled_hidden_layers_in_every_look(name, output_dir):
+def test_peeled_hidden_layers_in_every_look(name, output_dir, peel_level_4):
     """The peeled layers follow the look as the walked ones do: widths in
     scene units at each layer's depth, the depth fade, back faces culled (no
     layer), each object's own wire colour."""
@@ -780,7 +789,7 @@ def test_depth_tiles_keep_every_block_that_may_lie_behind():
     assert not in_front[0] and not over_nothing[0]
 
 
-def test_peeling_stops_at_its_guard(output_dir, monkeypatch, capsys):
+def test_peeling_stops_at_its_guard(output_dir, monkeypatch, capsys, peel_level_4):
     """The peeling ends at the first empty layer; its guard against a
     driver that never empties one stops it with a one-line warning and
     keeps the layers drawn so far."""
@@ -793,7 +802,7 @@ def test_peeling_stops_at_its_guard(output_dir, monkeypatch, capsys):
     assert "hidden lines stop after 2 layers" in capsys.readouterr().out
 
 
-def test_peeled_hidden_layers_of_instances(output_dir):
+def test_peeled_hidden_layers_of_instances(output_dir, peel_level_4):
     """Sixteen copies of one flat grid, drawn instanced, one behind another:
     under the edge angle each grid is one region of 80 lines (its outline),
     peeled through every copy."""
@@ -997,7 +1006,7 @@ def test_the_overlay_draws_region_lines_as_the_render_does(look, output_dir):
     assert diff[off].max() <= 0.1
 
 
-def test_the_overlay_peels_hidden_region_layers_as_the_render_does(output_dir):
+def test_the_overlay_peels_hidden_region_layers_as_the_render_does(output_dir, peel_level_4):
     """Under hidden lines the viewport overlay peels the layers of large
     regions in its own targets, from the front (Blender's depth cannot be
     read), and Blender's depth test keeps those behind the surface: the
@@ -1108,7 +1117,7 @@ def _assert_kept_redraw(image, expected):
     assert (diff > 1.5 / 255.0).mean() < 1e-3 and diff.max() <= 2.0 / 255.0 + 1e-9
 
 
-def test_the_overlay_keeps_its_peeled_hidden_layers_between_redraws(output_dir):
+def test_the_overlay_keeps_its_peeled_hidden_layers_between_redraws(output_dir, peel_level_4):
     """Under hidden lines the overlay keeps what it drew (the fill, the
     hidden lines, the peeled layers among them, and the wire) once a redraw
     repeats the key of the one before, and from then on only composites it:

@@ -16,10 +16,17 @@ import time
 import gpu
 import numpy as np
 
-from .edge_select import TEXELS_PER_REGION_LINE, region_listing, run_bounds
+from .edge_select import (
+    OWN_EDGES_MEASURED,
+    TEXELS_PER_REGION_LINE,
+    TEXELS_PER_SEGMENT,
+    region_listing,
+    run_bounds,
+)
 from .extract import (
     IN_REGION,
     IS_NGON,
+    NGON_SHIFT,
     NORMALS_BY_TRIANGLE,
     NORMALS_BY_VERTEX,
     REGION_LINES,
@@ -28,7 +35,7 @@ from .extract import (
     ngon_triangles_overlap,
     ngons_flat,
 )
-from .shaders import WALK_TABLE_SHIFT
+from .shaders import WALK_GROUP, WALK_TABLE_SHIFT
 
 TABLE_WIDTH = 4096  # texels per row; rows stay below the 16384 texture limit up to 67M entries
 
@@ -239,6 +246,7 @@ class GPUMesh:
         self._batch = None  # batch, made on first use
         self._corner_buffer = None  # its vertex buffer, shared with batch_of_triangles()
         self._walk_table = None  # (points batch, table texture): walk_table(), made on first use
+        self._walk_groups = None  # (points batch or None, box table): walk_groups(), made on first use
         self.gpu_bytes = sum(
             texture_bytes(table)
             for table in (self.positions, self.triangles, self.ngon_corners, self.corners, self.attribute_colors)
@@ -295,6 +303,42 @@ class GPUMesh:
             self._walk_table = (gpu.types.GPUBatch(type="POINTS", buf=vbo), table)
             self.gpu_bytes += 4 * self.triangle_count + texture_bytes(table)
         return self._walk_table
+
+    def walk_groups(self):
+        """(points batch, RGBA32F box table) of the walk-table groups
+        (core/draw.py _run_walk_table, shaders/walk_groups_vert.glsl): one
+        point per group of WALK_GROUP consecutive segments of each block
+        that a triangle walks, with the texel of its first segment and how
+        many it holds; the table is laid out as the outline table, a box at
+        each group's first texel. Made on first use, as walk_table()."""
+        if self._walk_groups is None:
+            flags = np.asarray(self.edge_flags_cpu, dtype=np.int64)
+            walks = (flags & IN_REGION) != 0
+            # A triangle that measures its own edges has its face's corners
+            # ahead of its block (solidwire_vert.glsl main()).
+            header = np.where((flags[walks] & OWN_EDGES_MEASURED) == OWN_EDGES_MEASURED, TEXELS_PER_SEGMENT, 0)
+            starts = self.triangles_cpu[walks, 3].astype(np.int64) + header
+            blocks = np.unique(np.stack([starts, flags[walks] >> NGON_SHIFT], axis=1), axis=0)
+            blocks = blocks[blocks[:, 1] > 0]
+            per_block = -(-blocks[:, 1] // WALK_GROUP)
+            block_of = np.repeat(np.arange(len(blocks)), per_block)
+            first_group = np.cumsum(per_block) - per_block
+            group = np.arange(len(block_of)) - first_group[block_of]
+            texels = blocks[block_of, 0] + TEXELS_PER_SEGMENT * WALK_GROUP * group
+            sizes = np.minimum(blocks[block_of, 1] - WALK_GROUP * group, WALK_GROUP)
+            batch = None  # (no block: nothing walks, nothing reads a box)
+            if len(texels):
+                fmt = gpu.types.GPUVertFormat()
+                fmt.attr_add(id="group_texel", comp_type="I32", len=1, fetch_mode="INT")
+                fmt.attr_add(id="group_size", comp_type="I32", len=1, fetch_mode="INT")
+                vbo = gpu.types.GPUVertBuf(fmt, len(texels))
+                vbo.attr_fill("group_texel", texels.astype(np.int32))
+                vbo.attr_fill("group_size", sizes.astype(np.int32))
+                batch = gpu.types.GPUBatch(type="POINTS", buf=vbo)
+            boxes = gpu.types.GPUTexture((self.ngon_corners.width, self.ngon_corners.height), format="RGBA32F")
+            self._walk_groups = (batch, boxes)
+            self.gpu_bytes += 8 * len(texels) + texture_bytes(boxes)
+        return self._walk_groups
 
     def triangles_with_lines(self, ranges=None) -> np.ndarray:
         """After the walk-table pre-pass: the triangles (ascending) that

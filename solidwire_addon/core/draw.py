@@ -1480,6 +1480,7 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
     redraw), None for all. Draws into the table's own framebuffer and puts
     back the bound one, its viewport and the blend and depth state."""
     batch, table = mesh.walk_table()
+    group_batch, group_boxes = mesh.walk_groups()
     # (Made for each run, as the pass targets' are: a framebuffer belongs to
     # the GL context that made it, and a mesh is drawn in two.)
     framebuffer = gpu.types.GPUFrameBuffer(color_slots=(table,))
@@ -1488,6 +1489,24 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
     saved_viewport = gpu.state.viewport_get()
     saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
     try:
+        if group_batch is not None:
+            # First the window box of each group of the blocks' segments,
+            # which the pass tests before setting any of them up.
+            with gpu.types.GPUFrameBuffer(color_slots=(group_boxes,)).bind():
+                gpu.state.viewport_set(0, 0, group_boxes.width, group_boxes.height)
+                gpu.state.blend_set("NONE")
+                gpu.state.depth_test_set("NONE")
+                gpu.state.depth_mask_set(False)
+                gpu.state.program_point_size_set(False)
+                gpu.state.point_size_set(1.0)
+                groups = shaders.get_walk_groups(variant.in_front)
+                groups.bind()
+                groups.uniform_block("params", block)
+                groups.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
+                groups.uniform_int("group_table_size", (group_boxes.width, group_boxes.height))
+                groups.uniform_sampler("vertex_positions", mesh.positions)
+                groups.uniform_sampler("ngon_corners", mesh.ngon_corners)
+                group_batch.draw(groups)
         with framebuffer.bind():
             gpu.state.viewport_set(0, 0, table.width, table.height)
             gpu.state.blend_set("NONE")
@@ -1506,6 +1525,7 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
             if shaders.uses_uniform(shader, "object_to_view_z"):
                 shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
             shader.uniform_int("walk_table_size", (table.width, table.height))
+            shader.uniform_sampler("walk_group_boxes", group_boxes)
             _bind_mesh(shader, pass_variant, mesh)
             if ranges is None:
                 batch.draw(shader)

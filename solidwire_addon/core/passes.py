@@ -1514,10 +1514,12 @@ def _peel_hidden_regions(
 # (edge_select.WALK_LIMIT) is walked face by face, where a line can stop
 # short: a mesh with one is always peeled. Otherwise a mesh is peeled where
 # its triangles' regions hold this many lines or more on average. Measured
-# (scripts/bench_regions.py --walks, 2-core VM, llvmpipe, 1280 x 720,
-# Suzanne with cage edges, F12 walked / peeled): level 3 (32 lines a
-# region) 322 / 394 ms, level 4 (64) 1,161 / 635 ms.
-PEEL_MIN_REGION_LINES = 48
+# (2-core VM, llvmpipe, 1280 x 720, Suzanne with cage edges, F12 walked /
+# peeled, medians of four alternating in one process), since the walk
+# tests groups of segments by their window boxes and its draw leaves out
+# the triangles with no line near (draw._run_walk_table): level 4 (64
+# lines a region) 469 / 589 ms, level 5 (128) 1,809 / 982 ms.
+PEEL_MIN_REGION_LINES = 96
 # Each peeled layer lies strictly behind the one before at every pixel, so
 # the peeling ends; this only guards against a driver that breaks that
 # (a NaN depth passes every test) turning the frame into an endless loop.

@@ -47,6 +47,10 @@ SETUP_MAX_TRIANGLES = SETUP_ROW_TRIANGLES * 16384
 # longer than that is walked whole).
 WALK_TABLE_SHIFT = 12
 WALK_PICK_BASE = 4096
+# Segments of a region block per group of the walk-table groups
+# (shaders/walk_groups_vert.glsl): the pre-pass tests a group's window box
+# before it sets up any of them. A cage edge at level 3 is a chain of 8.
+WALK_GROUP = 4
 SETUP_GROUP_SIZE = 64  # compute invocations per work group, one per triangle
 
 CLIP_PLANES = 6  # as many as Blender's clipping region (RegionView3D.clip_planes)
@@ -305,6 +309,7 @@ SAMPLERS = {
     "display_lut": (8, "FLOAT_3D"),
     "setup_table": (9, "FLOAT_2D"),
     "walk_table": (9, "FLOAT_2D"),  # (never beside the set-up table: a walked mesh has blocks)
+    "walk_group_boxes": (9, "FLOAT_2D"),  # (the walk-table pre-pass's: its draw reads the table there)
     "visibility": (10, "FLOAT_2D"),
     "triangle_flag_table": (11, "FLOAT_2D"),
     "region_line_image": (12, "DEPTH_2D"),
@@ -542,6 +547,8 @@ def _add_walk_table_sources(info, variant: ShaderVariant, iface: _Interface) -> 
     walk.flat("VEC4", "walk_pick")
     info.vertex_out(walk)
     info.push_constant("IVEC2", "walk_table_size")
+    add_sampler(info, "walk_group_boxes")
+    info.define("WALK_GROUP", str(WALK_GROUP))
     common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("quad_partner.glsl")
     styles = read_source("line_style.glsl") + edge_styles_source()
     head = read_source("item_table.glsl") if variant.per_item else ""
@@ -1021,6 +1028,34 @@ def get_setup(in_front: bool = False):
         info.compute_source(
             read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("setup_comp.glsl")
         )
+        shader = _keep(_cache, key, gpu.shader.create_from_info(info))
+    return shader
+
+
+def get_walk_groups(in_front: bool = False):
+    """The walk-table groups (shaders/walk_groups_vert.glsl): one point per
+    group of WALK_GROUP segments of a region block writes the window box
+    of their ends. ``in_front``: compiled without the near-plane test
+    (ALL_IN_FRONT, as ShaderVariant.in_front)."""
+    key = (_context, "walk groups", bool(in_front))
+    shader = _cache.get(key)
+    if shader is None:
+        info = pulling_info()
+        if in_front:
+            info.define("ALL_IN_FRONT", "1")
+        add_sampler(info, "ngon_corners")
+        info.vertex_in(0, "INT", "group_texel")
+        info.vertex_in(1, "INT", "group_size")
+        info.push_constant("IVEC2", "group_table_size")
+        iface = gpu.types.GPUStageInterfaceInfo("solidwire_walk_groups_iface")
+        iface.flat("VEC4", "group_box")
+        info.vertex_out(iface)
+        info.fragment_out(0, "VEC4", "frag_color")
+        info.define("WALK_GROUP", str(WALK_GROUP))
+        info.vertex_source(
+            read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("walk_groups_vert.glsl")
+        )
+        info.fragment_source(read_source("walk_groups_frag.glsl"))
         shader = _keep(_cache, key, gpu.shader.create_from_info(info))
     return shader
 
