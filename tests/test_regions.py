@@ -17,7 +17,7 @@ import pytest
 from mathutils import Matrix
 
 import solidwire_addon
-from solidwire_addon.core import draw, edge_select, exr, passes
+from solidwire_addon.core import draw, edge_select, exr, passes, shaders
 from tests.support import accuracy, reference, scenes
 from tests.test_render_reference import _Override
 
@@ -1115,6 +1115,31 @@ def _assert_kept_redraw(image, expected):
     three into the 8-bit buffer, in another order)."""
     diff = np.abs(image - expected)
     assert (diff > 1.5 / 255.0).mean() < 1e-3 and diff.max() <= 2.0 / 255.0 + 1e-9
+
+
+def test_level_4_walks_where_its_hidden_lines_are_drawn_once(output_dir):
+    """Regions of 64 lines (level 4) are walked where the hidden lines are
+    drawn once (a render, the overlay's direct redraw) and peeled where the
+    overlay draws them into its two kept images at once (the walk would
+    pick again for the second): passes.PEEL_MIN_REGION_LINES and
+    PEEL_MIN_REGION_LINES_TWICE. The kept images give the direct redraw's
+    image all the same, and the render is accurate either way."""
+    from solidwire_addon.core import targets
+
+    width, height = 200, 150
+    scene = scenes.empty_scene(width, height, use_cage_edges=True, thickness=1.5, use_hidden_lines=True)
+    _cubes_one_behind_another(scene, 4)
+    cubes = [bpy.data.objects["Cube"], bpy.data.objects["Far"]]
+    accuracy.assert_accurate(accuracy.measure(scene, "regions_level4_walked", output_dir))
+    assert solidwire_addon.stats().get("hidden_region_layers") is None
+    if shaders.software_rasteriser():  # (on by default there: DrawOptions.drop_lineless_triangles)
+        assert solidwire_addon.stats().get("lineless_triangles_left_out", 0) > 0
+    targets.release()  # nothing kept, no key drawn before: drawn directly
+    direct, stats = _overlay_redraw(scene, (width, height), cubes, alpha=True)
+    assert stats.get("hidden_region_layers") is None and not stats.get("frame_reused")
+    kept, stats = _overlay_redraw(scene, (width, height), cubes, alpha=True)  # the same key: the kept images
+    assert stats.get("hidden_region_layers") == 4
+    _assert_kept_redraw(kept, direct)
 
 
 def test_the_overlay_keeps_its_peeled_hidden_layers_between_redraws(output_dir, peel_level_4):
