@@ -1493,12 +1493,7 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
             # First the window box of each group of the blocks' segments,
             # which the pass tests before setting any of them up.
             with gpu.types.GPUFrameBuffer(color_slots=(group_boxes,)).bind():
-                gpu.state.viewport_set(0, 0, group_boxes.width, group_boxes.height)
-                gpu.state.blend_set("NONE")
-                gpu.state.depth_test_set("NONE")
-                gpu.state.depth_mask_set(False)
-                gpu.state.program_point_size_set(False)
-                gpu.state.point_size_set(1.0)
+                _point_texels_state(group_boxes)
                 groups = shaders.get_walk_groups(variant.in_front)
                 groups.bind()
                 groups.uniform_block("params", block)
@@ -1508,16 +1503,7 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
                 groups.uniform_sampler("ngon_corners", mesh.ngon_corners)
                 group_batch.draw(groups)
         with framebuffer.bind():
-            gpu.state.viewport_set(0, 0, table.width, table.height)
-            gpu.state.blend_set("NONE")
-            gpu.state.depth_test_set("NONE")
-            gpu.state.depth_mask_set(False)
-            # One texel a point: Blender's viewport leaves a point size of
-            # its own (programmable or fixed) behind, which widened the
-            # points over their neighbours' texels after a viewport draw.
-            # (Its draws set their own again: nothing to put back.)
-            gpu.state.program_point_size_set(False)
-            gpu.state.point_size_set(1.0)
+            _point_texels_state(table)
             shader.bind()
             shader.uniform_block("params", block)
             if shaders.uses_uniform(shader, "object_to_clip"):
@@ -1538,6 +1524,21 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
         gpu.state.depth_test_set(saved[1])
         gpu.state.depth_mask_set(saved[2])
     return table
+
+
+def _point_texels_state(table) -> None:
+    """GPU state for a pass of points that each write one texel of
+    ``table`` (the bound framebuffer's): its viewport, no blend and no
+    depth. One texel a point: Blender's viewport leaves a point size of
+    its own (programmable or fixed) behind, which widened the points over
+    their neighbours' texels after a viewport draw. (Its draws set their
+    own again: nothing to put back.)"""
+    gpu.state.viewport_set(0, 0, table.width, table.height)
+    gpu.state.blend_set("NONE")
+    gpu.state.depth_test_set("NONE")
+    gpu.state.depth_mask_set(False)
+    gpu.state.program_point_size_set(False)
+    gpu.state.point_size_set(1.0)
 
 
 def _material_table(mesh, materials, tables: dict):

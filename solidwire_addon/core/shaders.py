@@ -1008,6 +1008,16 @@ def disable_setup() -> None:
     _setup_support[:] = [False]
 
 
+def _pulling_info_in_front(in_front: bool):
+    """pulling_info() for a pass over a mesh's edges: without the clipping
+    code (ALL_IN_FRONT) where the draw lies wholly in front of the near
+    plane."""
+    info = pulling_info()
+    if in_front:
+        info.define("ALL_IN_FRONT", "1")
+    return info
+
+
 def get_setup(in_front: bool = False):
     """The set-up pre-pass (shaders/setup_comp.glsl): one invocation per
     triangle writes its SETUP_TEXELS texels of edge set-up. ``in_front``:
@@ -1016,9 +1026,7 @@ def get_setup(in_front: bool = False):
     key = (_context, "setup", bool(in_front))
     shader = _cache.get(key)
     if shader is None:
-        info = pulling_info()
-        if in_front:
-            info.define("ALL_IN_FRONT", "1")
+        info = _pulling_info_in_front(in_front)
         info.push_constant("INT", "triangle_count")
         add_sampler(info, "triangle_vertices")
         info.image(0, "RGBA32F", "FLOAT_2D", "setup_table", qualifiers={"WRITE"})
@@ -1040,9 +1048,7 @@ def get_walk_groups(in_front: bool = False):
     key = (_context, "walk groups", bool(in_front))
     shader = _cache.get(key)
     if shader is None:
-        info = pulling_info()
-        if in_front:
-            info.define("ALL_IN_FRONT", "1")
+        info = _pulling_info_in_front(in_front)
         add_sampler(info, "ngon_corners")
         info.vertex_in(0, "INT", "group_texel")
         info.vertex_in(1, "INT", "group_size")
