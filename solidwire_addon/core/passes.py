@@ -302,10 +302,9 @@ def _draw_hidden(
     drawn = [draw_mod.draw(walked, view, settings, target=replace(base.hidden(), depth_test=test), cull=cull)]
     peeled_target = replace(base.hidden(region_layers_peeled=True), depth_test=test)
     drawn.append(draw_mod.draw(rest, view, settings, target=peeled_target, cull=cull))
-    if stats is not None:
-        for counts in drawn:
-            left_out = {key: counts.extra[key] for key in (draw_mod.LINELESS_LEFT_OUT,) if key in counts.extra}
-            stats.add(DrawStats(extra=left_out))
+    for counts in drawn if stats is not None else ():
+        if draw_mod.LINELESS_LEFT_OUT in counts.extra:
+            stats.add(DrawStats(extra={draw_mod.LINELESS_LEFT_OUT: counts.extra[draw_mod.LINELESS_LEFT_OUT]}))
 
 
 def _overlay_kept_frame(frame: Frame, settings, hidden: bool) -> bool:
@@ -1535,6 +1534,7 @@ PEEL_MOST_LAYERS = 4096
 def _peeled_items(items, images: int = 1) -> list:
     """The items whose hidden region layers are peeled where the hidden
     lines go into ``images`` images (see PEEL_MIN_REGION_LINES)."""
+    # (Never above the one-image threshold, whatever that is set to.)
     least = PEEL_MIN_REGION_LINES if images == 1 else min(PEEL_MIN_REGION_LINES_TWICE, PEEL_MIN_REGION_LINES)
     peeled = []
     for item in items:
