@@ -639,6 +639,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
         "line_runs",
         "depth_only",  # the surface's own program with the colour masked: only its picks' pre-pass is left out
         "drop_lineless",  # which triangles a hidden-line draw leaves out (read back from its picks)
+        "walk_scope",  # which draws share a walk-table pre-pass's picks
     }
     names = {f.name for f in fields(draw.DrawTarget)}
     assert names == set(selects_code) | state_or_input, "classify every DrawTarget field here"
@@ -662,6 +663,7 @@ def test_a_draws_variant_follows_from_its_target_description_alone():
             "behind_tiles": object(),
             "depth_only": True,
             "drop_lineless": True,
+            "walk_scope": object(),
         }[name]
         assert draw.shader_variant(settings, replace(draw.DrawTarget(), **{name: value})) == plain, name
     # The visibility stage's numbering is compiled code of that stage only.

@@ -54,18 +54,23 @@ _SHIPPED_MIN_LINES = draw.WALK_TABLE_MIN_LINES
 
 def _counting(monkeypatch, table_on: bool, drop_lineless: bool = False) -> list:
     """Turn the pre-pass on (or off), and with it the hidden-line draw's
-    leaving out of the triangles it picked nothing for, and count its
-    runs."""
+    leaving out of the triangles it picked nothing for, and count the draws
+    that asked for it: each one's mesh, triangle ranges (None: every
+    triangle) and whether it kept the table walked before for the same key
+    (draw._walk_key) instead of walking."""
     runs = []
     real = draw._run_walk_table
+
+    def counted(*args, **kwargs):
+        mesh = args[0]
+        before = mesh.walk_key
+        table = real(*args, **kwargs)
+        runs.append((mesh, args[5] if len(args) > 5 else None, before is not None and mesh.walk_key is before))
+        return table
+
     monkeypatch.setattr(draw, "WALK_TABLE_MIN_LINES", _SHIPPED_MIN_LINES if table_on else 10**9)
     monkeypatch.setattr(runtime, "options", DrawOptions(drop_lineless_triangles=drop_lineless))
-    # Each run's mesh and triangle ranges (None: every triangle).
-    monkeypatch.setattr(
-        draw,
-        "_run_walk_table",
-        lambda *args: (runs.append((args[0], args[5] if len(args) > 5 else None)), real(*args))[1],
-    )
+    monkeypatch.setattr(draw, "_run_walk_table", counted)
     return runs
 
 
@@ -98,7 +103,7 @@ def test_walk_table_gives_the_same_render(look, output_dir, monkeypatch):
         from_table = scenes.render_multilayer_exr(scene, output_dir / f"walk_on_{look}_{drop_lineless}.exr")
         assert runs, "the pre-pass never ran: the walked mesh is not walked here any more"
         if look == "floor walked":
-            assert {mesh.triangle_count for mesh, _ranges in runs} >= {
+            assert {mesh.triangle_count for mesh, _ranges, _kept in runs} >= {
                 len(obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.loop_triangles)
                 for obj in (scene.objects["Floor"],)
             }
@@ -154,8 +159,15 @@ def test_walk_table_gives_the_same_overlay(monkeypatch):
         runs, from_table = overlay_images(True, drop_lineless)
         assert len(runs) >= 4
         # The edit's pre-pass drew the triangles the edit's draw drew alone.
-        mesh, edit_ranges = runs[-1]
+        mesh, edit_ranges, _kept = runs[-1]
         assert edit_ranges is not None and 0 < edit_ranges[1].sum() < mesh.triangle_count
+        # The kept images' two hidden-line draws (one into each image) walk
+        # once: the second keeps the first's table, inside the same ranges.
+        (first_ranges, first_kept), (_, second_kept) = [
+            (ranges, kept) for walked_mesh, ranges, kept in runs if walked_mesh is mesh
+        ][-2:]
+        assert not first_kept and second_kept
+        assert all(np.array_equal(a, b) for a, b in zip(first_ranges, edit_ranges))
         # Every redraw that draws (not the one that composites what the
         # first kept) left triangles out, the edit's inside its ranges too.
         assert all(left_out[k] > 0 for k in (0, 2, 3)) if drop_lineless else not any(left_out)

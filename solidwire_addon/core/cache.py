@@ -247,6 +247,12 @@ class GPUMesh:
         self._corner_buffer = None  # its vertex buffer, shared with batch_of_triangles()
         self._walk_table = None  # (points batch, table texture): walk_table(), made on first use
         self._walk_groups = None  # (points batch or None, box table): walk_groups(), made on first use
+        # What the walk table holds now (draw._walk_key; None: not known),
+        # and what was read back from it for that walk: (walk key, ranges'
+        # bytes, triangles_with_lines()) and (those triangles, their batch).
+        self.walk_key = None
+        self._walked_triangles = None
+        self._walked_batch = None
         self.gpu_bytes = sum(
             texture_bytes(table)
             for table in (self.positions, self.triangles, self.ngon_corners, self.corners, self.attribute_colors)
@@ -266,11 +272,18 @@ class GPUMesh:
         """:attr:`batch` for the triangles ``triangles`` (ascending numbers)
         alone: an index buffer over the same corners, so gl_VertexID is
         still 3 t + corner and the vertex stage pulls what it always does.
-        Made per draw (its index buffer is as long as the pick)."""
+        Made per pick (its index buffer is as long as the pick); the last
+        one is kept for the very array triangles_with_lines() keeps, so a
+        second draw over the same walk builds none."""
+        kept = self._walked_batch
+        if kept is not None and kept[0] is triangles:
+            return kept[1]
         corners = 3 * triangles.astype(np.int32)[:, None] + np.arange(3, dtype=np.int32)
-        return gpu.types.GPUBatch(
+        batch = gpu.types.GPUBatch(
             type="TRIS", buf=self._corners(), elem=gpu.types.GPUIndexBuf(type="TRIS", seq=corners)
         )
+        self._walked_batch = (triangles, batch)
+        return batch
 
     def _corners(self):
         """The direct draw's vertex buffer: three corners a triangle, in
@@ -349,7 +362,12 @@ class GPUMesh:
         texels the pre-pass wrote. A region's triangle with none shows
         nothing there: its own drawn edges are in its region's block, at
         distance 0, so they would have been kept. Reads the counts back
-        (one float a triangle)."""
+        (one float a triangle), once per walk (:attr:`walk_key`): a second
+        draw over the same walk gets the same array."""
+        ranges_bytes = None if ranges is None else (ranges[0].tobytes(), ranges[1].tobytes())
+        known = self._walked_triangles
+        if known is not None and self.walk_key is not None and known[:2] == (self.walk_key, ranges_bytes):
+            return known[2]
         _batch, table = self.walk_table()
         counts = np.asarray(table_channel(table), dtype=np.float32)[: self.triangle_count]
         keep = (counts != 0.0) | ((self.edge_flags_cpu & IN_REGION) == 0)
@@ -359,7 +377,9 @@ class GPUMesh:
             np.add.at(starts, first, 1)
             np.add.at(starts, first + count, -1)
             keep &= np.cumsum(starts[:-1]) > 0
-        return np.flatnonzero(keep)
+        triangles = np.flatnonzero(keep)
+        self._walked_triangles = (self.walk_key, ranges_bytes, triangles)
+        return triangles
 
     def flag_table(self):
         """The edge-flag word of every triangle, as an RG32F texture

@@ -116,7 +116,11 @@ class DrawTarget:
     triangles that lie wholly in front of it are left out of the draw.
     ``drop_lineless`` (a direct HIDDEN_LINES draw, options.DrawOptions):
     the region triangles that the walk-table pre-pass found no line near
-    are left out (they would draw nothing)."""
+    are left out (they would draw nothing). ``walk_scope`` (a direct draw
+    that walks its regions with the walk-table pre-pass): draws given the
+    same scope object keep one walk of a mesh while nothing the walk
+    depends on changes (_walk_key): the overlay's kept images draw the
+    hidden lines twice, once into each image. None: every draw walks."""
 
     depth_test: str = "LESS_EQUAL"
     depth_write: bool = True
@@ -142,6 +146,7 @@ class DrawTarget:
     line_runs: str = ALL_RUNS
     depth_only: bool = False
     drop_lineless: bool = False
+    walk_scope: object = None
     wire_layer: bool = False
 
     def hidden(self, region_layers_peeled: bool = False) -> DrawTarget:
@@ -565,14 +570,17 @@ def draw(
     if variant.item_colors:
         table, bases = colors.color_table(items, settings, lambda style: styled(settings, style, show_wire))
         extras["item_colors"] = table_texture(table)
-    blocks = {None: gpu.types.GPUUniformBuf(params_block(settings, view, target))}
+    # Each style's block, and its bytes (what a pre-pass's output depends on).
+    packed = {None: params_block(settings, view, target)}
+    blocks = {None: gpu.types.GPUUniformBuf(packed[None])}
 
     def ubo(style):
         block = blocks.get(style)
         if block is None:
-            block = blocks[style] = gpu.types.GPUUniformBuf(
-                params_block(styled(settings, style, show_wire), view, target, class_reference=settings.thickness)
+            packed[style] = params_block(
+                styled(settings, style, show_wire), view, target, class_reference=settings.thickness
             )
+            block = blocks[style] = gpu.types.GPUUniformBuf(packed[style])
         return block
 
     # A resolve writes no depth (the record did) unless it writes the
@@ -593,6 +601,7 @@ def draw(
     try:
         call = _DrawCall(
             ubo=ubo,
+            packed=packed,
             settings=settings,
             program=program,
             flip=flip,
@@ -609,6 +618,7 @@ def draw(
             and target.lines == HIDDEN_LINES
             and stage is None
             and not target.depth_write,
+            walk_scope=target.walk_scope,
             numbering=_DrawNumbers(
                 stage,
                 extras,
@@ -794,11 +804,12 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False, hi
 @dataclass
 class _DrawCall:
     """What every part of one draw() shares: ``ubo(style)`` the parameter
-    block of a style, the winding flip, the frame's extras (textures and
+    block of a style (``packed[style]`` its bytes, once ubo made it), the winding flip, the frame's extras (textures and
     blocks bound once) and colour-table bases, whether many instances of a
     mesh draw instanced, and the deferred stages' draw numbering."""
 
     ubo: object
+    packed: dict
     settings: object
     program: object
     flip: bool
@@ -809,6 +820,7 @@ class _DrawCall:
     numbering: _DrawNumbers
     depth_only: bool = False
     drop_lineless: bool = False  # DrawTarget.drop_lineless, where the draw shows lines alone
+    walk_scope: object = None  # DrawTarget.walk_scope
 
 
 def clip_space_planes(planes, view: View) -> list:
@@ -1347,7 +1359,17 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
                 # (Before each draw, as the set-up pre-pass: the picks are
                 # for this object's matrix.)
                 ranges = numbering.direct_ranges(mesh, object_to_clip)
-                walk_table = _run_walk_table(mesh, variant, object_to_clip, one.object_to_view, ubo(style), ranges)
+                block = ubo(style)
+                walk_table = _run_walk_table(
+                    mesh,
+                    variant,
+                    object_to_clip,
+                    one.object_to_view,
+                    block,
+                    ranges,
+                    call.walk_scope,
+                    call.packed[style],
+                )
                 shader.bind()
                 bound = _UNBOUND  # the pre-pass bound its own block
                 _bind_extras(shader, variant, extras)
@@ -1471,20 +1493,49 @@ def _run_setup(mesh, object_to_clip, block, in_front: bool = False, viewport=Non
     mesh.setup_key = key
 
 
-def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges=None):
+def _walk_key(scope, mesh, pass_variant, object_to_clip, object_to_view, packed: bytes, ranges) -> tuple:
+    """Everything the walk table of ``mesh`` depends on within ``scope``
+    (DrawTarget.walk_scope, held here: no other object takes its place):
+    its triangles and positions (serial and shape version,
+    cache.GPUMesh), the pre-pass's variant, the matrices and the parameter
+    block as it gets them (the reach, the viewport), the triangle ranges it
+    writes, and the GL context that wrote it (as _setup_key)."""
+    return (
+        scope,
+        mesh.serial,
+        mesh.version,
+        pass_variant,
+        np.asarray(object_to_clip, dtype=np.float32).tobytes(),
+        np.asarray(object_to_view[2], dtype=np.float32).tobytes(),
+        bytes(packed),
+        None if ranges is None else (ranges[0].tobytes(), ranges[1].tobytes()),
+        shaders.current_gl_context(),
+    )
+
+
+def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges=None, scope=None, packed=b""):
     """The walk-table pre-pass of one draw (shaders/walk_table_vert.glsl):
     one point per triangle of ``mesh`` writes which segments of its block
     lie within reach of it, into the mesh's table (cache.GPUMesh.walk_table),
     which it returns for the draw to read; ``ranges``: only the triangle
     ranges the draw draws (_DrawNumbers.direct_ranges: an edit's partial
     redraw), None for all. Draws into the table's own framebuffer and puts
-    back the bound one, its viewport and the blend and depth state."""
+    back the bound one, its viewport and the blend and depth state. With a
+    ``scope`` (DrawTarget.walk_scope; ``packed`` the bytes of ``block``) a
+    table already walked in that scope for the same key (_walk_key) is
+    kept instead."""
     batch, table = mesh.walk_table()
+    pass_variant = replace(variant, walk_table=False, walk_table_pass=True, clip_planes=False)
+    key = None
+    if scope is not None:
+        key = _walk_key(scope, mesh, pass_variant, object_to_clip, object_to_view, packed, ranges)
+    if key is not None and mesh.walk_key == key:
+        return table
+    mesh.walk_key = None
     group_batch, group_boxes = mesh.walk_groups()
     # (Made for each run, as the pass targets' are: a framebuffer belongs to
     # the GL context that made it, and a mesh is drawn in two.)
     framebuffer = gpu.types.GPUFrameBuffer(color_slots=(table,))
-    pass_variant = replace(variant, walk_table=False, walk_table_pass=True, clip_planes=False)
     shader = shaders.get(pass_variant)
     saved_viewport = gpu.state.viewport_get()
     saved = gpu.state.blend_get(), gpu.state.depth_test_get(), gpu.state.depth_mask_get()
@@ -1518,6 +1569,7 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
             else:  # (one point a triangle, in table order)
                 for start, count in zip(ranges[0].tolist(), ranges[1].tolist()):
                     batch.draw_range(shader, elem_start=start, elem_count=count)
+        mesh.walk_key = key
     finally:
         gpu.state.viewport_set(*saved_viewport)
         gpu.state.blend_set(saved[0])

@@ -443,6 +443,8 @@ def _draw_kept_frame(frame: Frame, settings, targets, visible, occluded, rect=No
         if settings.use_fill:
             draw_mod.draw(items, view, settings, target=_with_lines(lines_base, False), cull=cull)
     wire_only = replace(settings, use_fill=False)  # (as plan() gives the hidden-line and wire passes)
+    # The hidden lines go into both images: one walk of each mesh for both.
+    base = replace(base, walk_scope=object())
     behind = occluded.framebuffer(visible.depth)  # (never written: only the visible image's depth is)
     with behind.bind(), _scissored(rect):
         _clear(behind, width, height, depth=False)
