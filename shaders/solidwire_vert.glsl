@@ -116,7 +116,7 @@ int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
       return -1;
     }
 #  ifdef WALK_TABLE_PASS
-    walk_picks[kept] = k; /* the pre-pass keeps which (walk_table_vert.glsl) */
+    walk_picks[kept] = k; /* the pre-pass keeps which (walk_table_frag.glsl) */
 #  else
     float chain = span.y - span.x;
 #    ifdef USE_DENSITY_FADE
@@ -410,7 +410,7 @@ void solidwire_corner()
 void main()
 #endif
 {
-#ifdef REGION_LAYERS_PEELED
+#if defined(REGION_LAYERS_PEELED) && !defined(WALK_TABLE_PASS)
   /* A hidden-line pass whose multi-face regions' layers were drawn by depth
    * peeling (passes.py, docs/image_model.md §2.6): their triangles are
    * dropped before any set-up (outside the clip volume). */
@@ -479,7 +479,7 @@ void main()
 #ifdef USE_CLIP_PLANES
   clip_distances(position); /* (before the depth bias, which moves only z) */
 #endif
-#ifndef RESOLVE_PASS
+#if !defined(RESOLVE_PASS) && !defined(WALK_TABLE_PASS)
   gl_Position = biased(position);
 #endif
 }

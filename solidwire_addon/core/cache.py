@@ -245,7 +245,7 @@ class GPUMesh:
 
         self._batch = None  # batch, made on first use
         self._corner_buffer = None  # its vertex buffer, shared with batch_of_triangles()
-        self._walk_table = None  # (points batch, table texture): walk_table(), made on first use
+        self._walk_table = None  # walk_table(), made on first use
         self._walk_groups = None  # (points batch or None, box table): walk_groups(), made on first use
         # What the walk table holds now (draw._walk_key; None: not known),
         # and what was read back from it for that walk: (walk key, ranges'
@@ -298,23 +298,16 @@ class GPUMesh:
         return self._corner_buffer
 
     def walk_table(self):
-        """(points batch, RGBA32F table) of the walk-table pre-pass
-        (core/draw.py _run_walk_table, shaders/walk_table_vert.glsl): one
-        point per triangle with its edge-flag word, and a texel per
+        """The RGBA32F table of the walk-table pre-pass (core/draw.py
+        _run_walk_table, shaders/walk_table_frag.glsl): a texel per
         triangle, 2^WALK_TABLE_SHIFT a row. Made on first use: only meshes
         whose regions are walked in a direct draw need it. (No framebuffer
         is kept: one belongs to the GL context that made it, and a mesh is
         drawn by the viewport's and the render engine's.)"""
         if self._walk_table is None:
-            fmt = gpu.types.GPUVertFormat()
-            fmt.attr_add(id="edge_flags", comp_type="I32", len=1, fetch_mode="INT")
-            vbo = gpu.types.GPUVertBuf(fmt, self.triangle_count)
-            vbo.attr_fill("edge_flags", np.asarray(self.edge_flags_cpu, dtype=np.int32))
             width = 1 << WALK_TABLE_SHIFT
-            size = (width, max(1, -(-self.triangle_count // width)))
-            table = gpu.types.GPUTexture(size, format="RGBA32F")
-            self._walk_table = (gpu.types.GPUBatch(type="POINTS", buf=vbo), table)
-            self.gpu_bytes += 4 * self.triangle_count + texture_bytes(table)
+            self._walk_table = gpu.types.GPUTexture((width, max(1, -(-self.triangle_count // width))), format="RGBA32F")
+            self.gpu_bytes += texture_bytes(self._walk_table)
         return self._walk_table
 
     def walk_groups(self):
@@ -368,8 +361,7 @@ class GPUMesh:
         known = self._walked_triangles
         if known is not None and self.walk_key is not None and known[:2] == (self.walk_key, ranges_bytes):
             return known[2]
-        _batch, table = self.walk_table()
-        counts = np.asarray(table_channel(table), dtype=np.float32)[: self.triangle_count]
+        counts = np.asarray(table_channel(self.walk_table()), dtype=np.float32)[: self.triangle_count]
         keep = (counts != 0.0) | ((self.edge_flags_cpu & IN_REGION) == 0)
         if ranges is not None:
             first, count = ranges

@@ -1354,7 +1354,7 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
             if variant.walk_table and call.depth_only:
                 # (The same program, for the same depths; its picks are
                 # never read. Bound all the same: the program samples it.)
-                shader.uniform_sampler("walk_table", mesh.walk_table()[1])
+                shader.uniform_sampler("walk_table", mesh.walk_table())
             elif variant.walk_table:
                 # (Before each draw, as the set-up pre-pass: the picks are
                 # for this object's matrix.)
@@ -1514,17 +1514,17 @@ def _walk_key(scope, mesh, pass_variant, object_to_clip, object_to_view, packed:
 
 
 def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges=None, scope=None, packed=b""):
-    """The walk-table pre-pass of one draw (shaders/walk_table_vert.glsl):
-    one point per triangle of ``mesh`` writes which segments of its block
+    """The walk-table pre-pass of one draw (shaders/walk_table_frag.glsl):
+    a fragment per triangle of ``mesh`` writes which segments of its block
     lie within reach of it, into the mesh's table (cache.GPUMesh.walk_table),
     which it returns for the draw to read; ``ranges``: only the triangle
     ranges the draw draws (_DrawNumbers.direct_ranges: an edit's partial
-    redraw), None for all. Draws into the table's own framebuffer and puts
+    redraw; the table's rows that hold them), None for all. Draws into the table's own framebuffer and puts
     back the bound one, its viewport and the blend and depth state. With a
     ``scope`` (DrawTarget.walk_scope; ``packed`` the bytes of ``block``) a
     table already walked in that scope for the same key (_walk_key) is
     kept instead."""
-    batch, table = mesh.walk_table()
+    table = mesh.walk_table()
     pass_variant = replace(variant, walk_table=False, walk_table_pass=True, clip_planes=False)
     key = None
     if scope is not None:
@@ -1561,14 +1561,14 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
                 shader.uniform_float("object_to_clip", object_to_clip.T.astype(np.float32).ravel().tolist())
             if shaders.uses_uniform(shader, "object_to_view_z"):
                 shader.uniform_float("object_to_view_z", object_to_view[2].astype(np.float32).tolist())
-            shader.uniform_int("walk_table_size", (table.width, table.height))
+            shader.uniform_int("walk_triangle_count", mesh.triangle_count)
             shader.uniform_sampler("walk_group_boxes", group_boxes)
+            shader.uniform_sampler("triangle_flag_table", mesh.flag_table())
             _bind_mesh(shader, pass_variant, mesh)
-            if ranges is None:
-                batch.draw(shader)
-            else:  # (one point a triangle, in table order)
-                for start, count in zip(ranges[0].tolist(), ranges[1].tolist()):
-                    batch.draw_range(shader, elem_start=start, elem_count=count)
+            for first_row, end_row in _table_rows(mesh.triangle_count, ranges):
+                # (NDC rows of the table: a fragment per texel, one per triangle.)
+                low, high = (2.0 * first_row / table.height - 1.0, 2.0 * end_row / table.height - 1.0)
+                draw_rectangle(shader, (-1.0, low, 1.0, high))
         mesh.walk_key = key
     finally:
         gpu.state.viewport_set(*saved_viewport)
@@ -1576,6 +1576,24 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
         gpu.state.depth_test_set(saved[1])
         gpu.state.depth_mask_set(saved[2])
     return table
+
+
+def _table_rows(triangle_count: int, ranges=None) -> list:
+    """(first row, end row) of each run of the walk table's rows that
+    holds a triangle of ``ranges`` ((first triangle, count) arrays; None:
+    every triangle), in order: 2^WALK_TABLE_SHIFT triangles a row."""
+    shift = shaders.WALK_TABLE_SHIFT
+    if ranges is None:
+        return [(0, -(-triangle_count // (1 << shift)))] if triangle_count else []
+    first, count = np.asarray(ranges[0], np.int64), np.asarray(ranges[1], np.int64)
+    keep = count > 0
+    rows = []
+    for low, high in zip((first[keep] >> shift).tolist(), (((first + count - 1)[keep] >> shift) + 1).tolist()):
+        if rows and low <= rows[-1][1]:
+            rows[-1] = (rows[-1][0], max(rows[-1][1], high))
+        else:
+            rows.append((low, high))
+    return rows
 
 
 def _point_texels_state(table) -> None:

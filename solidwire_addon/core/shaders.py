@@ -42,7 +42,7 @@ SETUP_TEXELS = 7
 # (4095 texels wide, under the 16384 limit for 9.5M triangles).
 SETUP_ROW_TRIANGLES = 585
 SETUP_MAX_TRIANGLES = SETUP_ROW_TRIANGLES * 16384
-# The walk-table pre-pass's table (shaders/walk_table_vert.glsl): 2^SHIFT
+# The walk-table pre-pass's table (shaders/walk_table_frag.glsl): 2^SHIFT
 # triangles a row; two picks a channel, below WALK_PICK_BASE each (a block
 # longer than that is walked whole).
 WALK_TABLE_SHIFT = 12
@@ -187,7 +187,7 @@ class ShaderVariant:
     # Walked regions in a direct draw (a mesh of large regions that is not
     # peeled, docs/dev/how-it-works.md "Walked regions"): ``walk_table_pass``
     # is the pre-pass that picks, once per triangle, the segments of its
-    # block within reach (shaders/walk_table_vert.glsl); a draw with
+    # block within reach (shaders/walk_table_frag.glsl); a draw with
     # ``walk_table`` reads those picks (WALK_TABLE) instead of choosing them
     # at its provoking corner.
     walk_table: bool = False
@@ -449,6 +449,12 @@ def _create_info(variant: ShaderVariant):
             add_sampler(info, "record_depth")
             info.define("RECORD_DEPTH", "1")
             compat.depth_write(info, "ANY")
+    elif variant.walk_table_pass:
+        # One rectangle over the table's rows, a fragment per triangle
+        # (walk_table_frag.glsl): its edge flags from a table, as the resolve's.
+        info.vertex_in(0, "INT", "rect_corner")
+        info.push_constant("VEC4", "resolve_rect")
+        add_sampler(info, "triangle_flag_table")
     else:
         info.vertex_in(0, "INT", "edge_flags")
     if variant.region_lines:
@@ -537,32 +543,39 @@ def _create_info(variant: ShaderVariant):
     return info
 
 
+# The walk-table pre-pass's stand-ins for the vertex stage's inputs (set by
+# walk_table_frag.glsl before it runs the corner code).
+_WALK_TABLE_GLOBALS = """#define WALK_TABLE_PASS 1
+int edge_flags;
+int sw_vertex_id;
+#define SW_VERTEX_ID sw_vertex_id
+int walk_picks[SEGMENT_SLOTS];
+"""
+
+
 def _add_walk_table_sources(info, variant: ShaderVariant, iface: _Interface) -> None:
-    """The walk-table pre-pass (shaders/walk_table_vert.glsl): the draw's
-    own corner code with every varying a plain global, run once per
-    triangle as its provoking corner, handing on one texel of picks."""
+    """The walk-table pre-pass (shaders/walk_table_frag.glsl): the draw's
+    own corner code with every varying a plain global, run in a fragment
+    per triangle as its provoking corner, writing one texel of picks."""
     if variant.clip_planes:
-        raise ValueError("the walk-table pre-pass is not clipped (its points are table texels)")
-    walk = gpu.types.GPUStageInterfaceInfo("solidwire_walk_iface")
-    walk.flat("VEC4", "walk_pick")
-    info.vertex_out(walk)
-    info.push_constant("IVEC2", "walk_table_size")
+        raise ValueError("the walk-table pre-pass is not clipped (its fragments are table texels)")
+    info.push_constant("INT", "walk_triangle_count")
     add_sampler(info, "walk_group_boxes")
     info.define("WALK_GROUP", str(WALK_GROUP))
     common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("quad_partner.glsl")
     styles = read_source("line_style.glsl") + edge_styles_source()
     head = read_source("item_table.glsl") if variant.per_item else ""
-    info.vertex_source(
-        "#define SW_VERTEX_ID (3 * gl_VertexID + 2)\n#define WALK_TABLE_PASS 1\nint walk_picks[SEGMENT_SLOTS];\n"
+    info.vertex_source(read_source("resolve_vert.glsl"))
+    info.fragment_source(
+        _WALK_TABLE_GLOBALS
         + iface.globals_glsl()
         + head
         + common
         + styles
         + read_source("clip_region.glsl")
         + read_source("solidwire_vert.glsl")
-        + read_source("walk_table_vert.glsl")
+        + read_source("walk_table_frag.glsl")
     )
-    info.fragment_source(read_source("walk_table_frag.glsl"))
 
 
 def _define_partner_depth_hair(info, linear_depth: bool) -> None:
