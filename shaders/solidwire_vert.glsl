@@ -132,7 +132,7 @@ int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
 
 #  ifdef WALK_TABLE
 /* The segments the walk-table pre-pass picked for this triangle
- * (walk_table_vert.glsl: its count, then two block indices a channel),
+ * (walk_table_frag.glsl: its count, then two block indices a channel),
  * set up as select_segments() would have: the same segments, the same
  * code, at one corner per triangle instead of three SIMD lanes. */
 int read_walk_table(int triangle)

@@ -1,6 +1,6 @@
-"""The walk-table pre-pass (shaders/walk_table_vert.glsl): where a direct
+"""The walk-table pre-pass (shaders/walk_table_frag.glsl): where a direct
 draw walks its regions' lines (under hidden lines, meshes whose regions are
-not peeled), one point per triangle picks the segments of its block within
+not peeled), a fragment per triangle picks the segments of its block within
 reach, and the draw reads those picks instead of choosing them at its
 provoking corner. Same selection code, so the image is the same to the
 bit, in a render (every pass) and in the viewport overlay. The hidden-line
@@ -20,7 +20,7 @@ import pytest
 
 from solidwire_addon.blender import runtime
 from solidwire_addon.blender.views import camera_view
-from solidwire_addon.core import draw, targets
+from solidwire_addon.core import draw, shaders, targets
 from solidwire_addon.core.options import DrawOptions
 from tests.support import scenes
 from tests.test_overlay import FakeViewport
@@ -142,7 +142,7 @@ def test_walk_table_gives_the_same_overlay(monkeypatch):
                 walked.data.update()
             depsgraph = bpy.context.evaluated_depsgraph_get()
             # What Blender's own viewport leaves behind (its vertices' point
-            # size): the pre-pass's points must still be one texel each.
+            # size): the groups' points (walk_groups) must still be one texel each.
             gpu.state.program_point_size_set(False)
             gpu.state.point_size_set(4.0)
             viewport = FakeViewport(200, 150)
@@ -175,3 +175,16 @@ def test_walk_table_gives_the_same_overlay(monkeypatch):
             np.testing.assert_array_equal(table_image, corner_image)
             assert (table_image[..., 3] > 0).mean() > 0.05
         assert not np.array_equal(from_table[3], from_table[1])  # the edit shows
+
+
+def test_the_pre_pass_fills_the_rows_that_hold_the_draws_ranges():
+    """The pre-pass's rectangles (draw._table_rows): every row of the table
+    that holds a triangle of the ranges an edit draws, neighbours joined,
+    and no other; every row of the mesh's triangles for a whole draw."""
+    row = 1 << shaders.WALK_TABLE_SHIFT
+    assert draw._table_rows(0) == []
+    assert draw._table_rows(row) == [(0, 1)]
+    assert draw._table_rows(row + 1) == [(0, 2)]
+    first = np.array([5, row - 1, 3 * row, 5 * row + 7, 9 * row], dtype=np.int64)
+    count = np.array([10, 2, row, 0, 1], dtype=np.int64)
+    assert draw._table_rows(10 * row, (first, count)) == [(0, 2), (3, 4), (9, 10)]
