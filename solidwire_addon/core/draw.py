@@ -804,9 +804,10 @@ def _parts(groups, program, stage, view: View, diagonals_shown: bool = False, hi
 @dataclass
 class _DrawCall:
     """What every part of one draw() shares: ``ubo(style)`` the parameter
-    block of a style (``packed[style]`` its bytes, once ubo made it), the winding flip, the frame's extras (textures and
-    blocks bound once) and colour-table bases, whether many instances of a
-    mesh draw instanced, and the deferred stages' draw numbering."""
+    block of a style (``packed[style]`` its bytes, once ubo made it), the
+    winding flip, the frame's extras (textures and blocks bound once) and
+    colour-table bases, whether many instances of a mesh draw instanced,
+    and the deferred stages' draw numbering."""
 
     ubo: object
     packed: dict
@@ -1519,11 +1520,11 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
     lie within reach of it, into the mesh's table (cache.GPUMesh.walk_table),
     which it returns for the draw to read; ``ranges``: only the triangle
     ranges the draw draws (_DrawNumbers.direct_ranges: an edit's partial
-    redraw; the table's rows that hold them), None for all. Draws into the table's own framebuffer and puts
-    back the bound one, its viewport and the blend and depth state. With a
-    ``scope`` (DrawTarget.walk_scope; ``packed`` the bytes of ``block``) a
-    table already walked in that scope for the same key (_walk_key) is
-    kept instead."""
+    redraw; the table's rows that hold them), None for all. Draws into the
+    table's own framebuffer and puts back the bound one, its viewport and
+    the blend and depth state. With a ``scope`` (DrawTarget.walk_scope;
+    ``packed`` the bytes of ``block``) a table already walked in that scope
+    for the same key (_walk_key) is kept instead."""
     table = mesh.walk_table()
     pass_variant = replace(variant, walk_table=False, walk_table_pass=True, clip_planes=False)
     key = None
@@ -1597,12 +1598,12 @@ def _table_rows(triangle_count: int, ranges=None) -> list:
 
 
 def _point_texels_state(table) -> None:
-    """GPU state for a pass of points that each write one texel of
-    ``table`` (the bound framebuffer's): its viewport, no blend and no
-    depth. One texel a point: Blender's viewport leaves a point size of
-    its own (programmable or fixed) behind, which widened the points over
-    their neighbours' texels after a viewport draw. (Its draws set their
-    own again: nothing to put back.)"""
+    """GPU state for a pass that writes the texels of ``table`` (the bound
+    framebuffer's) one for one, by points or by a rectangle's fragments:
+    its viewport, no blend and no depth. One texel a point: Blender's
+    viewport leaves a point size of its own (programmable or fixed)
+    behind, which widened the points over their neighbours' texels after a
+    viewport draw. (Its draws set their own again: nothing to put back.)"""
     gpu.state.viewport_set(0, 0, table.width, table.height)
     gpu.state.blend_set("NONE")
     gpu.state.depth_test_set("NONE")
