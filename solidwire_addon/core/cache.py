@@ -248,8 +248,8 @@ class GPUMesh:
         self._walk_table = None  # walk_table(), made on first use
         self._walk_groups = None  # (points batch or None, box table): walk_groups(), made on first use
         # What the walk table holds now (draw._walk_key; None: not known),
-        # and what was read back from it for that walk: (walk key, ranges'
-        # bytes, triangles_with_lines()) and (those triangles, their batch).
+        # and what was read back from it for that walk: (walk key,
+        # triangles_with_lines()) and (those triangles, their batch).
         self.walk_key = None
         self._walked_triangles = None
         self._walked_batch = None
@@ -357,10 +357,9 @@ class GPUMesh:
         distance 0, so they would have been kept. Reads the counts back
         (one float a triangle), once per walk (:attr:`walk_key`): a second
         draw over the same walk gets the same array."""
-        ranges_bytes = None if ranges is None else (ranges[0].tobytes(), ranges[1].tobytes())
-        known = self._walked_triangles
-        if known is not None and self.walk_key is not None and known[:2] == (self.walk_key, ranges_bytes):
-            return known[2]
+        known = self._walked_triangles  # (the walk's key holds its ranges too)
+        if known is not None and self.walk_key is not None and known[0] == self.walk_key:
+            return known[1]
         counts = np.asarray(table_channel(self.walk_table()), dtype=np.float32)[: self.triangle_count]
         keep = (counts != 0.0) | ((self.edge_flags_cpu & IN_REGION) == 0)
         if ranges is not None:
@@ -370,7 +369,7 @@ class GPUMesh:
             np.add.at(starts, first + count, -1)
             keep &= np.cumsum(starts[:-1]) > 0
         triangles = np.flatnonzero(keep)
-        self._walked_triangles = (self.walk_key, ranges_bytes, triangles)
+        self._walked_triangles = (self.walk_key, triangles)
         return triangles
 
     def flag_table(self):
