@@ -407,7 +407,10 @@ void walk_ngon_outline(vec2 p, float half_thickness, int corners, inout NearLine
 /* Lines beyond the triangle's own edges: its region's or its n-gon's. */
 void walk_blocks(vec2 p, float half_thickness, bool listed, bool lines_from_image, inout NearLines found)
 {
-#ifdef USE_NGONS
+#ifdef WALK_PICKS_ONLY
+  /* Every triangle of the draw has its lines in its picks (walk_picks_only). */
+  walk_selected_segments(p, half_thickness, found);
+#elif defined(USE_NGONS)
   int block_size = triangle_flags >> NGON_SHIFT;
   if (listed && segment_count >= 0) {
     walk_selected_segments(p, half_thickness, found);
@@ -579,10 +582,11 @@ void main()
 #else
   const bool lines_from_image = false;
 #endif
-#ifdef NO_EDGE_SETUP
+#if defined(NO_EDGE_SETUP) || defined(WALK_PICKS_ONLY)
   /* No edge of the triangle's own was set up (every line is in the
-   * region-lines image, no diagonal drawn): measuring them would find
-   * nothing nearer than NO_EDGE. */
+   * region-lines image, no diagonal drawn; or in the walk's picks, the
+   * triangle a region's with no quad corner, whose own edges are in its
+   * block): measuring them would find nothing nearer than NO_EDGE. */
   NearLines found = no_lines();
 #else
   NearLines found = own_edge_lines(p, half_thickness, listed);

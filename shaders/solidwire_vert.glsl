@@ -284,14 +284,20 @@ bool set_up_edges(vec4 ids, bool is_quad, bool is_ngon, out vec4 c0, out vec4 c1
 #  endif
   vec2 w0, w1, w2;
   bool convex;
-#  ifdef NO_EDGE_SETUP
+#  if defined(NO_EDGE_SETUP) || defined(WALK_PICKS_ONLY)
   /* Every triangle of this draw takes its lines from the region-lines pass
-   * and draws no diagonal (ShaderVariant.no_edge_setup): no edge of its
-   * own is measured, so none is set up. */
+   * and draws no diagonal (ShaderVariant.no_edge_setup), or from the picks
+   * of the walk-table pre-pass alone (ShaderVariant.walk_picks_only, whose
+   * triangles are all in front: the pre-pass picks none for another): no
+   * edge of its own is measured, so none is set up. */
   edge_line0 = edge_line1 = edge_line2 = edge_line3 = edge_line4 = vec3(0.0, 0.0, NO_EDGE);
   edge_span0 = edge_span1 = edge_span2 = edge_span3 = edge_span4 = vec2(0.0);
   w0 = w1 = w2 = vec2(0.0);
+#    ifdef WALK_PICKS_ONLY
+  in_front = true;
+#    else
   in_front = false;
+#    endif
   convex = false;
 #  else
   triangle_edges(c0, c1, c2, c3, ids, is_quad, edge_line0, edge_span0, edge_line1, edge_span1, edge_line2,

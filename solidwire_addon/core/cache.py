@@ -24,6 +24,7 @@ from .edge_select import (
     run_bounds,
 )
 from .extract import (
+    HAS_QUAD_CORNER,
     IN_REGION,
     IS_NGON,
     NGON_SHIFT,
@@ -249,10 +250,10 @@ class GPUMesh:
         self._walk_groups = None  # (points batch or None, box table): walk_groups(), made on first use
         # What the walk table holds now (draw._walk_key; None: not known),
         # and what was read back from it for that walk: (walk key,
-        # triangles_with_lines()) and (those triangles, their batch).
+        # walked_triangles()) and {id(those triangles): (them, their batch)}.
         self.walk_key = None
         self._walked_triangles = None
-        self._walked_batch = None
+        self._walked_batches = {}
         self.gpu_bytes = sum(
             texture_bytes(table)
             for table in (self.positions, self.triangles, self.ngon_corners, self.corners, self.attribute_colors)
@@ -272,17 +273,19 @@ class GPUMesh:
         """:attr:`batch` for the triangles ``triangles`` (ascending numbers)
         alone: an index buffer over the same corners, so gl_VertexID is
         still 3 t + corner and the vertex stage pulls what it always does.
-        Made per pick (its index buffer is as long as the pick); the last
-        one is kept for the very array triangles_with_lines() keeps, so a
-        second draw over the same walk builds none."""
-        kept = self._walked_batch
+        Made per pick (its index buffer is as long as the pick); those of
+        the very arrays walked_triangles() keeps for the last walk are kept
+        with them, so a second draw over the same walk builds none."""
+        kept = self._walked_batches.get(id(triangles))
         if kept is not None and kept[0] is triangles:
             return kept[1]
         corners = 3 * triangles.astype(np.int32)[:, None] + np.arange(3, dtype=np.int32)
         batch = gpu.types.GPUBatch(
             type="TRIS", buf=self._corners(), elem=gpu.types.GPUIndexBuf(type="TRIS", seq=corners)
         )
-        self._walked_batch = (triangles, batch)
+        known = self._walked_triangles
+        if known is not None and any(triangles is part for part in known[1]):
+            self._walked_batches[id(triangles)] = (triangles, batch)
         return batch
 
     def _corners(self):
@@ -346,31 +349,41 @@ class GPUMesh:
             self.gpu_bytes += 8 * len(texels) + texture_bytes(boxes)
         return self._walk_groups
 
-    def triangles_with_lines(self, ranges=None) -> np.ndarray:
+    def walked_triangles(self, ranges=None) -> tuple[np.ndarray, np.ndarray]:
         """After the walk-table pre-pass: the triangles (ascending) that
-        can show a line in a hidden-line draw, every one outside a
-        multi-face region and those inside one for which the pre-pass kept
-        a segment or left the whole block to walk (a count other than 0);
-        ``ranges`` (first triangle, count): only inside those, the only
-        texels the pre-pass wrote. A region's triangle with none shows
-        nothing there: its own drawn edges are in its region's block, at
-        distance 0, so they would have been kept. Reads the counts back
+        can show a line in a hidden-line draw, in two parts: (every other,
+        picked). *Picked*: a region's triangle with no quad corner of its
+        own for which the pre-pass kept segments (a count above 0), which
+        hold every line within its reach (its own drawn edges are in its
+        region's block, at distance 0, so they were kept), and which it
+        therefore measures alone (shaders.ShaderVariant.walk_picks_only).
+        *Every other*: those outside a multi-face region, and the region's
+        triangles that walk their whole block (a count of -1) or have a
+        quad corner. A region's triangle with a count of 0 shows nothing
+        and is in neither. ``ranges`` (first triangle, count): only inside
+        those, the only texels the pre-pass wrote. Reads the counts back
         (one float a triangle), once per walk (:attr:`walk_key`): a second
-        draw over the same walk gets the same array."""
+        draw over the same walk gets the same arrays."""
         known = self._walked_triangles  # (the walk's key holds its ranges too)
         if known is not None and self.walk_key is not None and known[0] == self.walk_key:
             return known[1]
         counts = np.asarray(table_channel(self.walk_table()), dtype=np.float32)[: self.triangle_count]
-        keep = (counts != 0.0) | ((self.edge_flags_cpu & IN_REGION) == 0)
+        flags = self.edge_flags_cpu
+        listed = (flags & IN_REGION) != 0
+        picked = listed & ((flags & HAS_QUAD_CORNER) == 0) & (counts > 0.0)
+        other = (counts != 0.0) | ~listed
         if ranges is not None:
             first, count = ranges
             starts = np.zeros(self.triangle_count + 1, dtype=np.int32)
             np.add.at(starts, first, 1)
             np.add.at(starts, first + count, -1)
-            keep &= np.cumsum(starts[:-1]) > 0
-        triangles = np.flatnonzero(keep)
-        self._walked_triangles = (self.walk_key, triangles)
-        return triangles
+            inside = np.cumsum(starts[:-1]) > 0
+            picked &= inside
+            other &= inside
+        parts = (np.flatnonzero(other & ~picked), np.flatnonzero(picked))
+        self._walked_triangles = (self.walk_key, parts)
+        self._walked_batches = {}
+        return parts
 
     def flag_table(self):
         """The edge-flag word of every triangle, as an RG32F texture

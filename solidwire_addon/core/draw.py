@@ -120,7 +120,8 @@ class DrawTarget:
     that walks its regions with the walk-table pre-pass): draws given the
     same scope object keep one walk of a mesh while nothing the walk
     depends on changes (_walk_key): the overlay's kept images draw the
-    hidden lines twice, once into each image. None: every draw walks."""
+    hidden lines twice, once into each image. None: every draw() call walks
+    (its own two draws of a mesh, _splits_walked_triangles, share one walk)."""
 
     depth_test: str = "LESS_EQUAL"
     depth_write: bool = True
@@ -310,8 +311,11 @@ EXACT = ExactProgram()
 
 
 # The DrawStats count of the triangles a hidden-line draw left out for
-# showing no line there (DrawTarget.drop_lineless).
+# showing no line there (DrawTarget.drop_lineless), and of those it drew
+# with the variant that measures the walk's picks alone
+# (ShaderVariant.walk_picks_only).
 LINELESS_LEFT_OUT = "lineless_triangles_left_out"
+WALK_PICKS_DRAWN = "walk_picked_triangles"
 
 # A mesh drawn by at least this many visible instances is drawn with one
 # draw_instanced call (matrices from a float texture) instead of one draw per
@@ -618,7 +622,9 @@ def draw(
             and target.lines == HIDDEN_LINES
             and stage is None
             and not target.depth_write,
-            walk_scope=target.walk_scope,
+            # (A scope of this draw's own where none is given: its two draws
+            # of a walked mesh, _splits_walked_triangles, share one walk.)
+            walk_scope=object() if target.walk_scope is None else target.walk_scope,
             numbering=_DrawNumbers(
                 stage,
                 extras,
@@ -636,7 +642,12 @@ def draw(
         # One variant per part; parts in a fixed order (both deferred stages
         # must draw, and so number, alike).
         for part in sorted(parts):
-            _draw_groups(parts[part], part.variant(variant), call)
+            part_variant = part.variant(variant)
+            _draw_groups(parts[part], part_variant, call)
+            if _splits_walked_triangles(part_variant, call):
+                # Its picked triangles, with the variant made for them (the
+                # same walk: call.walk_scope).
+                _draw_groups(parts[part], replace(part_variant, walk_picks_only=True), call)
         if call.numbering.runs_left_out:
             stats.extra["region_runs_left_out"] = call.numbering.runs_left_out
         if call.numbering.triangles_left_out:
@@ -644,6 +655,15 @@ def draw(
     finally:
         gpu.state.face_culling_set("NONE")
     return stats
+
+
+def _splits_walked_triangles(variant, call: _DrawCall) -> bool:
+    """Whether a part's draw of ``variant`` reads back its walk's picks
+    (DrawTarget.drop_lineless), and so draws the triangles that the picks
+    give every line (cache.GPUMesh.walked_triangles) in a second draw with
+    the variant that measures them alone (ShaderVariant.walk_picks_only):
+    the same image."""
+    return variant.walk_table and call.drop_lineless and not call.depth_only and not variant.walk_picks_only
 
 
 def _available(variant, settings, items, extras: dict):
@@ -821,7 +841,7 @@ class _DrawCall:
     numbering: _DrawNumbers
     depth_only: bool = False
     drop_lineless: bool = False  # DrawTarget.drop_lineless, where the draw shows lines alone
-    walk_scope: object = None  # DrawTarget.walk_scope
+    walk_scope: object = None  # DrawTarget.walk_scope, or one of this draw() call's own
 
 
 def clip_space_planes(planes, view: View) -> list:
@@ -1352,6 +1372,7 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
                 bound = _UNBOUND  # the pre-pass bound its own block
                 shader.uniform_sampler("setup_table", mesh.setup_table)
             triangles = None  # every triangle (of the ranges the draw reaches)
+            picked = ()  # those a second draw measures the picks of alone (_splits_walked_triangles)
             if variant.walk_table and call.depth_only:
                 # (The same program, for the same depths; its picks are
                 # never read. Bound all the same: the program samples it.)
@@ -1377,7 +1398,8 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
                 numbering.bind(shader)
                 shader.uniform_sampler("walk_table", walk_table)
                 if call.drop_lineless:
-                    triangles = mesh.triangles_with_lines(ranges)
+                    others, picked = mesh.walked_triangles(ranges)
+                    triangles = picked if variant.walk_picks_only else others
             if style is not bound:
                 bound = style
                 shader.uniform_block("params", ubo(style))
@@ -1403,10 +1425,15 @@ def _draw_groups(groups, variant, call: _DrawCall) -> None:
                 )
             elif len(triangles):
                 mesh.batch_of_triangles(triangles).draw(shader)
+            if variant.walk_picks_only:
+                # (The object, and what it left out, counted by its other draw.)
+                stats.add(DrawStats(extra={WALK_PICKS_DRAWN: len(triangles)}))
+                continue
             stats.objects_drawn += 1
             stats.triangles_drawn += mesh.triangle_count
             if triangles is not None:
-                stats.add(DrawStats(extra={LINELESS_LEFT_OUT: mesh.triangle_count - len(triangles)}))
+                left_out = mesh.triangle_count - len(triangles) - len(picked)
+                stats.add(DrawStats(extra={LINELESS_LEFT_OUT: left_out}))
     if instanced:
         _draw_instanced(instanced, variant, call)
 
@@ -1526,7 +1553,7 @@ def _run_walk_table(mesh, variant, object_to_clip, object_to_view, block, ranges
     ``packed`` the bytes of ``block``) a table already walked in that scope
     for the same key (_walk_key) is kept instead."""
     table = mesh.walk_table()
-    pass_variant = replace(variant, walk_table=False, walk_table_pass=True, clip_planes=False)
+    pass_variant = replace(variant, walk_table=False, walk_picks_only=False, walk_table_pass=True, clip_planes=False)
     key = None
     if scope is not None:
         key = _walk_key(scope, mesh, pass_variant, object_to_clip, object_to_view, packed, ranges)

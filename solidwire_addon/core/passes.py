@@ -294,8 +294,9 @@ def _draw_hidden(
     _peel_hidden_regions drew (the region triangles of ``peeled``; a peeled
     mesh with no other triangle is not drawn at all); ``test``: its depth
     test (ALWAYS: every fragment, whatever lies in front). The triangles
-    it left out for showing no line (DrawTarget.drop_lineless) go into
-    ``stats``'s extra counts; what it drew is the surface pass's to count."""
+    it left out for showing no line (DrawTarget.drop_lineless), and those
+    it drew measuring their walk's picks alone, go into ``stats``'s extra
+    counts; what it drew is the surface pass's to count."""
     peeled_ids = {id(item) for item in peeled}
     walked = [item for item in items if id(item) not in peeled_ids]
     rest = [item for item in peeled if item.mesh.region_sizes()[2]]
@@ -303,8 +304,9 @@ def _draw_hidden(
     peeled_target = replace(base.hidden(region_layers_peeled=True), depth_test=test)
     drawn.append(draw_mod.draw(rest, view, settings, target=peeled_target, cull=cull))
     for counts in drawn if stats is not None else ():
-        if draw_mod.LINELESS_LEFT_OUT in counts.extra:
-            stats.add(DrawStats(extra={draw_mod.LINELESS_LEFT_OUT: counts.extra[draw_mod.LINELESS_LEFT_OUT]}))
+        for name in (draw_mod.LINELESS_LEFT_OUT, draw_mod.WALK_PICKS_DRAWN):
+            if name in counts.extra:
+                stats.add(DrawStats(extra={name: counts.extra[name]}))
 
 
 def _overlay_kept_frame(frame: Frame, settings, hidden: bool) -> bool:

@@ -192,6 +192,15 @@ class ShaderVariant:
     # at its provoking corner.
     walk_table: bool = False
     walk_table_pass: bool = False
+    # A hidden-line draw with ``walk_table`` of only the region triangles
+    # (no quad corner of their own) whose picks hold every line within their
+    # reach (WALK_PICKS_ONLY, core/cache.GPUMesh.walked_triangles): nothing
+    # else of theirs is a line, so no edge of their own is set up and the
+    # fragment stage measures the picks alone. A CPU rasteriser runs every
+    # loop and branch compiled in for every fragment, taken or not: the
+    # other triangles' block and outline walks and their own edges cost these
+    # ones as much as themselves.
+    walk_picks_only: bool = False
     # The surface pass of the render under hidden lines: the colour is the
     # fill alone and the visible wire goes to an output of its own
     # (WIRE_LAYER, frag_wire), drawn unblended like the colour, so that the
@@ -507,6 +516,10 @@ def _create_info(variant: ShaderVariant):
     if variant.walk_table:
         add_sampler(info, "walk_table")
         info.define("WALK_TABLE", "1")
+    if variant.walk_picks_only:
+        if not (variant.walk_table and variant.hidden_pass):
+            raise ValueError("only a hidden-line draw that reads a walk table draws its picked triangles alone")
+        info.define("WALK_PICKS_ONLY", "1")
     if variant.ngons:
         info.define("USE_NGONS", "1")
         info.define("SEGMENT_SLOTS", str(SEGMENT_SLOTS))
