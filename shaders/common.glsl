@@ -100,3 +100,15 @@ float view_depth_of_window_depth(float window_depth, vec4 rows)
   float ndc = 2.0 * window_depth - 1.0;
   return (rows.y - ndc * rows.w) / (rows.x - ndc * rows.z);
 }
+
+#ifdef WALK_PICK_BASE
+/* Pick `slot` (0 to 5) of a walk-table texel's last three channels
+ * (`pairs`; walk_table_frag.glsl): two a channel, the first plus
+ * WALK_PICK_BASE times the second. */
+int walk_table_pick(vec3 pairs, int slot)
+{
+  float pair = (slot < 2) ? pairs.x : ((slot < 4) ? pairs.y : pairs.z);
+  float high = floor(pair / float(WALK_PICK_BASE));
+  return int(((slot & 1) == 0) ? pair - high * float(WALK_PICK_BASE) : high);
+}
+#endif

@@ -345,30 +345,54 @@ void walk_selected_segments(vec2 p, float half_thickness, inout NearLines found)
   }
 }
 
+/* Segment `k` of the triangle's region block (`segment`, its first texel),
+ * set up here. */
+void walk_block_segment(vec2 p, float half_thickness, int k, vec4 segment, inout NearLines found)
+{
+  int texel = ngon_corner_start + SEGMENT_TEXELS * k;
+  vec3 line;
+  vec2 span;
+  /* Stored lower id first: patterns run from the lower-id end. */
+  edge_setup(vertex_clip(segment.x), vertex_clip(segment.y), line, span);
+  float d = edge_distance_sq(line, span, p);
+  int style = int(segment.z);
+#  ifdef USE_DENSITY_FADE
+  OFFER(style, d, line, span, chain_length(texel + 1, span));
+#  else
+  OFFER(style, d, line, span, 0.0);
+#  endif
+  keep_block_segment(style, d, line, span, found);
+}
+
 /* Every segment of the triangle's region block; with `lines_from_image`
  * only its diagonals (its lines are in the region-lines image). */
 void walk_region_block(vec2 p, float half_thickness, int block_size, bool lines_from_image, inout NearLines found)
 {
   for (int k = 0; k < block_size; k++) {
-    int texel = ngon_corner_start + SEGMENT_TEXELS * k;
-    vec4 segment = fetch_texel(ngon_corners, texel);
+    vec4 segment = fetch_texel(ngon_corners, ngon_corner_start + SEGMENT_TEXELS * k);
     if (lines_from_image && int(segment.z) != DIAGONAL_STYLE) {
       break; /* the block's diagonals come first; its lines are in the image */
     }
-    vec3 line;
-    vec2 span;
-    /* Stored lower id first: patterns run from the lower-id end. */
-    edge_setup(vertex_clip(segment.x), vertex_clip(segment.y), line, span);
-    float d = edge_distance_sq(line, span, p);
-    int style = int(segment.z);
-#  ifdef USE_DENSITY_FADE
-    OFFER(style, d, line, span, chain_length(texel + 1, span));
-#  else
-    OFFER(style, d, line, span, 0.0);
-#  endif
-    keep_block_segment(style, d, line, span, found);
+    walk_block_segment(p, half_thickness, k, segment, found);
   }
 }
+
+#  if defined(WALK_TABLE) && !defined(WALK_PICKS_ONLY)
+/* The `groups` groups of the block that the walk-table pre-pass found near
+ * (walk_near_groups: each one's first segment), in the block's order: its
+ * other groups hold no segment within reach of the triangle, so the
+ * nearest line within reach, and with it the image, is the whole block's. */
+void walk_near_block_groups(vec2 p, float half_thickness, int block_size, int groups, inout NearLines found)
+{
+  for (int slot = 0; slot < groups; slot++) {
+    int first = walk_table_pick(walk_near_groups, slot);
+    int end = min(first + WALK_GROUP, block_size);
+    for (int k = first; k < end; k++) {
+      walk_block_segment(p, half_thickness, k, fetch_texel(ngon_corners, ngon_corner_start + SEGMENT_TEXELS * k), found);
+    }
+  }
+}
+#  endif
 
 /* The whole outline of the triangle's n-gon and every one of its
  * diagonals, not only this triangle's own. */
@@ -415,6 +439,11 @@ void walk_blocks(vec2 p, float half_thickness, bool listed, bool lines_from_imag
   if (listed && segment_count >= 0) {
     walk_selected_segments(p, half_thickness, found);
   }
+#  if defined(WALK_TABLE)
+  else if (listed && segment_count < -1) {
+    walk_near_block_groups(p, half_thickness, block_size, -2 - segment_count, found);
+  }
+#  endif
   else if (listed) {
     walk_region_block(p, half_thickness, block_size, lines_from_image, found);
   }

@@ -76,7 +76,10 @@ float segment_triangle_distance(vec2 a, vec2 b, vec2 t0, vec2 t1, vec2 t2)
  * (docs/image_model.md §3.4: edges beyond h + 2s cannot change a pixel).
  * t0..t2: the triangle's window corners relative to the viewport centre.
  * Returns how many it kept, or -1 when more than SEGMENT_SLOTS are near
- * (the fragment stage then walks the whole block). */
+ * (the fragment stage then walks the whole block). The walk-table pre-pass
+ * returns -2 - n instead where those lie in n groups of the block, n up
+ * to SEGMENT_SLOTS, which it keeps in walk_group_picks (the fragment stage
+ * then walks those groups alone). */
 int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
 {
   int block = edge_flags >> NGON_SHIFT;
@@ -85,11 +88,21 @@ int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
   /* The pre-pass first tests each group of the block by its window box
    * (walk_groups_vert.glsl): a group whose box lies beyond reach of the
    * triangle's box holds no segment within reach, and its segments are not
-   * set up. The same segments are kept, in the same order. */
+   * set up. The same segments are kept, in the same order. Past
+   * SEGMENT_SLOTS segments it only counts the groups that pass. */
   vec2 near_low = min(min(t0, t1), t2) - reach, near_high = max(max(t0, t1), t2) + reach;
+  int near_groups = 0;
+  bool overflow = false;
   for (int group = 0; group < block; group += WALK_GROUP) {
     vec4 box = fetch_texel(walk_group_boxes, ngon_corner_start + SEGMENT_TEXELS * group);
     if (box.x > near_high.x || box.y > near_high.y || box.z < near_low.x || box.w < near_low.y) {
+      continue;
+    }
+    if (near_groups < SEGMENT_SLOTS) {
+      walk_group_picks[near_groups] = group;
+    }
+    near_groups++;
+    if (overflow) {
       continue;
     }
     int group_end = min(group + WALK_GROUP, block);
@@ -113,7 +126,12 @@ int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
       continue;
     }
     if (kept == SEGMENT_SLOTS) {
+#  ifdef WALK_TABLE_PASS
+      overflow = true;
+      break;
+#  else
       return -1;
+#  endif
     }
 #  ifdef WALK_TABLE_PASS
     walk_picks[kept] = k; /* the pre-pass keeps which (walk_table_frag.glsl) */
@@ -127,6 +145,11 @@ int select_segments(vec2 t0, vec2 t1, vec2 t2, float reach)
     kept++;
   }
   }
+#  ifdef WALK_TABLE_PASS
+  if (overflow) {
+    return (near_groups <= SEGMENT_SLOTS) ? -2 - near_groups : -1;
+  }
+#  endif
   return kept;
 }
 
@@ -140,10 +163,12 @@ int read_walk_table(int triangle)
   int row = triangle >> WALK_TABLE_SHIFT;
   vec4 picks = texelFetch(walk_table, ivec2(triangle - (row << WALK_TABLE_SHIFT), row), 0);
   int kept = int(picks.x);
+#    ifndef WALK_PICKS_ONLY
+  /* Groups to walk (a count below -1): the fragment stage reads them. */
+  walk_near_groups = (kept < -1) ? picks.yzw : vec3(0.0);
+#    endif
   for (int slot = 0; slot < kept; slot++) {
-    float pair = (slot < 2) ? picks.y : ((slot < 4) ? picks.z : picks.w);
-    float high = floor(pair / float(WALK_PICK_BASE));
-    int k = int(((slot & 1) == 0) ? pair - high * float(WALK_PICK_BASE) : high);
+    int k = walk_table_pick(picks.yzw, slot);
     int texel = ngon_corner_start + SEGMENT_TEXELS * k;
     vec4 segment = fetch_texel(ngon_corners, texel);
     vec3 line;

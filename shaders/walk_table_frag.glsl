@@ -15,8 +15,10 @@
  * one thread and set up a point per triangle.)
  *
  * x the count (-1: the fragment stage walks the whole block; 0 outside a
- * walked region), y, z, w two picks each, the first plus WALK_PICK_BASE
- * times the second (float32 holds them exactly). */
+ * walked region; -2 - n: it walks n groups of the block, those whose boxes
+ * pass, where more than SEGMENT_SLOTS segments are near), y, z, w two
+ * picks each (segments, or the groups' first segments), the first plus
+ * WALK_PICK_BASE times the second (float32 holds them exactly). */
 
 void main()
 {
@@ -35,13 +37,19 @@ void main()
 #endif
   for (int slot = 0; slot < SEGMENT_SLOTS; slot++) {
     walk_picks[slot] = 0;
+    walk_group_picks[slot] = 0;
   }
   sw_vertex_id = 3 * triangle + 2;
   solidwire_corner();
   int kept = segment_count;
   int block = edge_flags >> NGON_SHIFT;
   if (block > WALK_PICK_BASE) {
-    kept = min(kept, -1); /* (picks past the packing's range: walk the whole block) */
+    kept = -1; /* (picks past the packing's range: walk the whole block) */
+  }
+  if (kept < -1) {
+    for (int slot = 0; slot < SEGMENT_SLOTS; slot++) {
+      walk_picks[slot] = walk_group_picks[slot];
+    }
   }
   float base = float(WALK_PICK_BASE);
   frag_color = vec4(float(kept),

@@ -28,7 +28,8 @@ THICKNESS_PIXELS, THICKNESS_WORLD, THICKNESS_DEPTH = 0, 1, 2
 EDGE_COUNT = 5  # three triangle edges + two edges to a quad's 4th corner
 # Segments of a region block that the vertex stage hands to the fragment
 # stage (those within reach of the triangle); more than this and the
-# fragment stage walks the whole block (solidwire_vert.glsl).
+# fragment stage walks the whole block (solidwire_vert.glsl), or with the
+# walk-table pre-pass those of up to as many of its groups as hold them.
 SEGMENT_SLOTS = 6
 
 DIAGONALS_HIDDEN, DIAGONALS_SOLID, DIAGONALS_PATTERN = 0, 1, 2
@@ -415,6 +416,8 @@ def _create_info(variant: ShaderVariant):
         for i in range(SEGMENT_SLOTS):
             iface.flat("VEC4", f"segment_line{i}")  # line xyz, span.x
             iface.flat("VEC4", f"segment_rest{i}")  # span.y, style, chain length, -
+    if variant.walk_table and not variant.walk_picks_only:
+        iface.flat("VEC3", "walk_near_groups")  # the groups a count below -1 walks (walk_table_frag.glsl)
     iface.smooth("FLOAT", "view_depth")
     if variant.hidden_pass and not variant.resolve:
         # The other triangle of a quad's (solidwire_frag.glsl, leave_out_the_visible_face).
@@ -513,6 +516,7 @@ def _create_info(variant: ShaderVariant):
             raise ValueError("only a direct, non-instanced draw that walks blocks has a walk table")
         info.define("WALK_TABLE_SHIFT", str(WALK_TABLE_SHIFT))
         info.define("WALK_PICK_BASE", str(WALK_PICK_BASE))
+        info.define("WALK_GROUP", str(WALK_GROUP))
     if variant.walk_table:
         add_sampler(info, "walk_table")
         info.define("WALK_TABLE", "1")
@@ -563,6 +567,7 @@ int edge_flags;
 int sw_vertex_id;
 #define SW_VERTEX_ID sw_vertex_id
 int walk_picks[SEGMENT_SLOTS];
+int walk_group_picks[SEGMENT_SLOTS];
 """
 
 
@@ -574,7 +579,6 @@ def _add_walk_table_sources(info, variant: ShaderVariant, iface: _Interface) -> 
         raise ValueError("the walk-table pre-pass is not clipped (its fragments are table texels)")
     info.push_constant("INT", "walk_triangle_count")
     add_sampler(info, "walk_group_boxes")
-    info.define("WALK_GROUP", str(WALK_GROUP))
     common = read_source("common.glsl") + read_source("edge_geometry.glsl") + read_source("quad_partner.glsl")
     styles = read_source("line_style.glsl") + edge_styles_source()
     head = read_source("item_table.glsl") if variant.per_item else ""
