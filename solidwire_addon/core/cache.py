@@ -359,9 +359,10 @@ class GPUMesh:
         therefore measures alone (shaders.ShaderVariant.walk_picks_only).
         *Every other*: those outside a multi-face region, and the region's
         triangles that walk their whole block or the groups of it near
-        them (a count below 0) or have a quad corner. A region's triangle with a count of 0 shows nothing
-        and is in neither. ``ranges`` (first triangle, count): only inside
-        those, the only texels the pre-pass wrote. Reads the counts back
+        them (a count below 0) or have a quad corner. A region's triangle
+        with a count of 0 shows nothing and is in neither. ``ranges``
+        (first triangle, count): only inside those, the only texels the
+        pre-pass wrote. Reads the counts back
         (one float a triangle), once per walk (:attr:`walk_key`): a second
         draw over the same walk gets the same arrays."""
         known = self._walked_triangles  # (the walk's key holds its ranges too)
