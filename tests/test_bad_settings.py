@@ -337,9 +337,7 @@ def _run_bpy(script: str, tmp_path: Path) -> subprocess.CompletedProcess:
         cwd=str(tmp_path),
         check=False,
     )
-    assert robustness.exited_cleanly(result.returncode), (
-        f"exit {result.returncode}\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
-    )
+    assert result.returncode == 0, f"exit {result.returncode}\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
     return result
 
 

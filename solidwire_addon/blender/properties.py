@@ -8,6 +8,8 @@ changes.
 
 from __future__ import annotations
 
+import types
+
 import bpy
 from bpy.props import (
     BoolProperty,
@@ -55,6 +57,43 @@ def _passes_changed(self, _context) -> None:
                 pass  # the passes are asked for again at the next render anyway
 
 
+# Blender holds each property's update callback as a Python function. The
+# bpy 4.2 module never lets go of it, nor of a property group's methods,
+# not even when the class is unregistered; a function whose globals reach
+# the ``bpy`` module keeps that module alive past interpreter shutdown.
+# Blender's own shutdown then never runs, and the process crashes as it
+# exits (exit status 139, after any script or farm job that registered the
+# add-on; 4.5 and later free them). So Blender is handed stand-ins whose
+# only global is this table, filled while the add-on is registered and
+# emptied when it is not: what a stand-in keeps alive then is an empty dict.
+_CALLBACK_TABLE: dict = {}
+_CALLBACKS: dict = {}
+
+
+def _stand_in(function, method: bool = False):
+    """What Blender holds in place of ``function``: an update callback
+    ``(self, context)`` or, with ``method``, a method ``(self)``, calling
+    ``function`` through the table.
+    Blender checks an update callback's positional arguments, hence a
+    signature of its own and no ``*args``."""
+    name = f"{function.__module__}.{function.__qualname__}"
+    _CALLBACKS[name] = function
+    if method:
+
+        def call(self):
+            return _CALLBACK_TABLE[name](self)
+    else:
+
+        def call(self, context):
+            return _CALLBACK_TABLE[name](self, context)
+
+    return types.FunctionType(call.__code__, {"_CALLBACK_TABLE": _CALLBACK_TABLE}, name, None, call.__closure__)
+
+
+def _snapshot(props) -> DrawSettings:
+    return DrawSettings.from_properties(props)
+
+
 # Settings whose change does more than redraw.
 _UPDATES = {
     "diagonal_mode": _diagonal_mode_changed,
@@ -69,7 +108,7 @@ def make_property(setting: schema.Setting):
     common = dict(
         name=setting.label,
         description=setting.description,
-        update=_UPDATES.get(setting.name, redraw_viewports),
+        update=_stand_in(_UPDATES.get(setting.name, redraw_viewports)),
     )
     if setting.kind == schema.BOOL:
         return BoolProperty(default=setting.default, **common)
@@ -95,7 +134,7 @@ def make_group(scope: str):
     name = f"SolidWire{scope.title().replace('_', '')}Settings"
     namespace = {"__annotations__": annotations, "__module__": __name__}
     if scope == schema.SCENE:
-        namespace["snapshot"] = lambda self: DrawSettings.from_properties(self)
+        namespace["snapshot"] = _stand_in(_snapshot, method=True)
     return type(name, (bpy.types.PropertyGroup,), namespace)
 
 
@@ -120,7 +159,7 @@ class SolidWireViewportToggle(bpy.types.PropertyGroup):
         name="SolidWire Overlay",
         description="Draw the solid wireframe over meshes in this 3D View",
         default=False,
-        update=redraw_viewports,
+        update=_stand_in(redraw_viewports),
     )
 
 
@@ -129,6 +168,7 @@ VIEWPORTS_ATTRIBUTE = "solidwire_viewports"
 
 
 def register_properties() -> None:
+    _CALLBACK_TABLE.update(_CALLBACKS)
     for scope, group in GROUPS.items():
         setattr(getattr(bpy.types, _OWNERS[scope]), ATTRIBUTE, PointerProperty(type=group))
     setattr(bpy.types.Screen, VIEWPORTS_ATTRIBUTE, CollectionProperty(type=SolidWireViewportToggle))
@@ -137,7 +177,7 @@ def register_properties() -> None:
         name="Exclude from SolidWire Overlay",
         description="Do not draw the SolidWire overlay on this object in 3D viewports",
         default=False,
-        update=redraw_viewports,
+        update=_stand_in(redraw_viewports),
     )
 
 
@@ -150,3 +190,4 @@ def unregister_properties() -> None:
         delattr(bpy.types.Screen, VIEWPORTS_ATTRIBUTE)
     if hasattr(bpy.types.Object, "solidwire_exclude"):
         del bpy.types.Object.solidwire_exclude
+    _CALLBACK_TABLE.clear()

@@ -14,16 +14,6 @@ from solidwire_addon.blender import overlay
 from solidwire_addon.blender.views import camera_view
 from tests.support import scenes
 
-# The bpy 4.2 module crashes at interpreter exit (SIGSEGV) once any
-# PropertyGroup with an update= callback was registered, even after it was
-# unregistered: upstream, reproduced without SolidWire (bpy 4.5 and 5.0 exit
-# cleanly). Subprocess tests accept that one exit status there, nothing else.
-UPSTREAM_EXIT_CRASH = bpy.app.version < (4, 5, 0)
-
-
-def exited_cleanly(returncode: int) -> bool:
-    return returncode == 0 or (UPSTREAM_EXIT_CRASH and returncode in (-11, 139))
-
 
 def render_exr(scene, path: Path) -> np.ndarray:
     """Render ``scene`` through the SOLIDWIRE engine (``bpy.ops.render.render``
