@@ -337,7 +337,7 @@ SETUP_TABLE_MIN = 50_000
 # at one corner of three costs as much as choosing at all three (measured:
 # Suzanne with cage edges at level 3 under hidden lines, F12 1280 x 720 on
 # llvmpipe, the hidden-line pass 247 ms choosing at one corner, 245 at all
-# three, 197 with the pre-pass; docs/dev/benchmarks.md). Below eight lines
+# three, 197 with the pre-pass; docs/dev/regions-log.md). Below eight lines
 # a block is too short for the pre-pass's draw to pay.
 WALK_TABLE_MIN_LINES = 8
 
