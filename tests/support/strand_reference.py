@@ -156,17 +156,12 @@ def primitives(depsgraph, show="show_in_render"):
             kind = int(types[c]) if types is not None else 0
             left = _attribute(data, "handle_left", count, 3, "vector")
             right = _attribute(data, "handle_right", count, 3, "vector")
-            if kind == 0 and len(ctrl) >= 2:
-                ev = catmull_rom(ctrl, int(res[c]) if res is not None else 12, closed)
-                pairs = [(i, i + 1) for i in range(len(ev) - 1)]
-            elif kind == 2 and len(ctrl) >= 2 and left is not None and right is not None:
-                ev = bezier(
-                    ctrl,
-                    left[offsets[c] : offsets[c + 1]],
-                    right[offsets[c] : offsets[c + 1]],
-                    int(res[c]) if res is not None else 12,
-                    closed,
-                )
+            # Huge or non-finite control points (the fuzz draws them) give
+            # inf or NaN here; such points are not drawable and are dropped
+            # below, as the add-on drops them.
+            with np.errstate(invalid="ignore", over="ignore"):
+                ev = _evaluated(ctrl, kind, closed, res[c] if res is not None else 12, left, right, offsets[c : c + 2])
+            if ev is not None:
                 pairs = [(i, i + 1) for i in range(len(ev) - 1)]
             else:
                 ev = ctrl
@@ -180,6 +175,17 @@ def primitives(depsgraph, show="show_in_render"):
                         (ev[i, :3], ev[j, :3], max(ev[i, 3], 0.0), max(ev[j, 3], 0.0), matrix, obj.name, strand)
                     )
     return segments, points
+
+
+def _evaluated(ctrl, kind, closed, resolution, left, right, span):
+    """A curve's evaluated points (Catmull-Rom or Bezier), or None for a
+    poly curve or one too short to evaluate (drawn through its control
+    points)."""
+    if kind == 0 and len(ctrl) >= 2:
+        return catmull_rom(ctrl, int(resolution), closed)
+    if kind == 2 and len(ctrl) >= 2 and left is not None and right is not None:
+        return bezier(ctrl, left[span[0] : span[1]], right[span[0] : span[1]], int(resolution), closed)
+    return None
 
 
 def render_strand_reference(scene, depsgraph=None, settings=None, mesh=None) -> StrandReference:
